@@ -1,0 +1,28 @@
+//! The subcommands: validated flags in, files and terminal output out.
+
+pub mod render;
+
+use crate::cli::{Cli, Command};
+use crate::error::Result;
+
+/// What `tidepool` prints when run without a subcommand.
+pub const GETTING_STARTED: &str = "\
+tidepool: water you can play with in any terminal.
+
+  tidepool render pool                  render the ripple pool to pool.png
+  tidepool render pool --out - --size 120x60
+                                        draw it in this terminal as half-block text
+  tidepool render pool --help           every flag, with defaults and units
+  tidepool --help                       all commands";
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    crate::signals::install();
+    match cli.command {
+        Some(Command::Render(render)) => render::run(render),
+        None => {
+            println!("{GETTING_STARTED}");
+            Ok(())
+        }
+    }
+}

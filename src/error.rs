@@ -1,0 +1,69 @@
+//! One error type for the whole program.
+//!
+//! Every variant renders as a single line that names the problem and, where there is one, the
+//! fix. `main` prints it after `tidepool: ` and exits with status 2; a closed pipe on stdout
+//! is not an error (see [`Error::is_broken_pipe`]).
+
+use std::io;
+use std::path::PathBuf;
+
+/// Everything that can go wrong in tidepool, as one line of text for the user.
+#[derive(Debug, thiserror::Error)]
+pub enum Error {
+    /// A flag's value is out of range or malformed: names the flag and the fix.
+    #[error("{flag}: {message}")]
+    InvalidArgument {
+        /// The flag, e.g. `--size`.
+        flag: &'static str,
+        /// What is wrong and how to fix it.
+        message: String,
+    },
+    /// An input image could not be read or decoded.
+    #[error("{flag} {path}: {message}")]
+    Image {
+        /// The flag that named the file.
+        flag: &'static str,
+        /// The file.
+        path: PathBuf,
+        /// What went wrong, with the fix.
+        message: String,
+    },
+    /// Reading or writing a file failed.
+    #[error("{action} {path}: {source}")]
+    Io {
+        /// What tidepool was doing: "cannot write", "cannot read"...
+        action: &'static str,
+        /// The file involved.
+        path: PathBuf,
+        /// The operating system's error.
+        #[source]
+        source: io::Error,
+    },
+    /// Writing to standard output failed.
+    #[error("cannot write to standard output: {0}")]
+    Stdout(#[source] io::Error),
+    /// Something the user asked for cannot be done in this situation.
+    #[error("{0}")]
+    Usage(String),
+}
+
+impl Error {
+    /// Builds an [`Error::InvalidArgument`].
+    pub fn arg(flag: &'static str, message: impl Into<String>) -> Self {
+        Error::InvalidArgument { flag, message: message.into() }
+    }
+
+    /// Builds an [`Error::Io`] with what was being done to which file.
+    pub fn io(action: &'static str, path: impl Into<PathBuf>, source: io::Error) -> Self {
+        Error::Io { action, path: path.into(), source }
+    }
+
+    /// True when the error is a closed pipe on standard output (`tidepool ... | head`), which
+    /// is how a reader says it has seen enough, not a failure.
+    pub fn is_broken_pipe(&self) -> bool {
+        matches!(self, Error::Stdout(e) if e.kind() == io::ErrorKind::BrokenPipe)
+    }
+}
+
+/// The result type used throughout tidepool.
+pub type Result<T, E = Error> = std::result::Result<T, E>;

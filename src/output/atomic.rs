@@ -1,0 +1,108 @@
+//! Writing files so that a failure never leaves a partial or clobbered file: the bytes go to
+//! a temporary file in the same folder, which is renamed over the target only when complete.
+
+use std::fs::OpenOptions;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::error::{Error, Result};
+use crate::signals;
+
+/// Writes `bytes` to `path` atomically.
+///
+/// The temporary file (`.NAME.tidepool-PID.tmp` beside the target) is registered with
+/// [`signals`], so Ctrl-C or SIGTERM mid-write removes it. On any error the temporary file is
+/// removed and an existing file at `path` is left as it was.
+pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    let temp = temp_path(path)?;
+    signals::register_temp_file(&temp);
+    let result = write_then_rename(&temp, path, bytes);
+    if result.is_err() {
+        let _ = std::fs::remove_file(&temp);
+    }
+    signals::unregister_temp_file(&temp);
+    result
+}
+
+fn write_then_rename(temp: &Path, path: &Path, bytes: &[u8]) -> Result<()> {
+    let mut file =
+        OpenOptions::new().write(true).create_new(true).open(temp).map_err(|e| Error::io("cannot write", path, e))?;
+    file.write_all(bytes).map_err(|e| Error::io("cannot write", path, e))?;
+    // Flush to the device so a full disk reports here, not silently at close.
+    file.sync_all().map_err(|e| Error::io("cannot write", path, e))?;
+    drop(file);
+    if path.is_dir() {
+        return Err(Error::Usage(format!("cannot write {}: it is a directory; give a file name", path.display())));
+    }
+    std::fs::rename(temp, path).map_err(|e| Error::io("cannot write", path, e))
+}
+
+/// The temporary name beside `path`, after checking that the folder exists.
+fn temp_path(path: &Path) -> Result<PathBuf> {
+    let name =
+        path.file_name().ok_or_else(|| Error::Usage(format!("cannot write {}: not a file name", path.display())))?;
+    let dir = match path.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        let what = if dir.exists() { "is not a directory" } else { "does not exist" };
+        return Err(Error::Usage(format!(
+            "cannot write {}: the folder {} {what}; create it or choose another --out",
+            path.display(),
+            dir.display()
+        )));
+    }
+    let mut temp_name = std::ffi::OsString::from(".");
+    temp_name.push(name);
+    temp_name.push(format!(".tidepool-{}.tmp", std::process::id()));
+    Ok(dir.join(temp_name))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scratch(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("tidepool-atomic-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    #[test]
+    fn writes_and_replaces_without_leftovers() {
+        let dir = scratch("replace");
+        let target = dir.join("out.bin");
+        write_file(&target, b"first").unwrap();
+        write_file(&target, b"second").unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"second");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "no temporary file left");
+    }
+
+    #[test]
+    fn a_missing_folder_is_a_clear_error() {
+        let dir = scratch("missing");
+        let err = write_file(&dir.join("nope/out.png"), b"x").unwrap_err().to_string();
+        assert!(err.contains("does not exist") && err.contains("--out"), "{err}");
+    }
+
+    #[test]
+    fn a_directory_target_is_refused_and_kept() {
+        let dir = scratch("dir");
+        let target = dir.join("taken");
+        std::fs::create_dir(&target).unwrap();
+        let err = write_file(&target, b"x").unwrap_err().to_string();
+        assert!(err.contains("directory"), "{err}");
+        assert!(target.is_dir());
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "no temporary file left");
+    }
+
+    #[test]
+    fn a_full_disk_leaves_the_old_file() {
+        // /dev/full is a character device, so the temporary file cannot be created there; the
+        // important part is that the error is reported and nothing is clobbered.
+        let err = write_file(Path::new("/dev/full/x.png"), b"x");
+        assert!(err.is_err());
+    }
+}

@@ -1,0 +1,84 @@
+//! Heightmap export: NPY (float32, for numpy, Blender, game engines) and 16-bit grey PNG.
+
+use image::ImageEncoder;
+use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+
+/// A grid of heights, row-major, row 0 = the top of the picture (or the north edge).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Heightmap {
+    /// Columns.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+    /// `width * height` values in the scene's unit (pool: raw amplitude; ocean/lake: metres).
+    pub values: Vec<f32>,
+}
+
+/// Encodes NPY format 1.0: `{'descr': '<f4', 'fortran_order': False, 'shape': (H, W), }`,
+/// space-padded so the data starts at a multiple of 64 bytes, then little-endian float32s.
+pub fn encode_npy(map: &Heightmap) -> Vec<u8> {
+    let dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({}, {}), }}", map.height, map.width);
+    // magic (6) + version (2) + header length (2) + dict + padding + '\n' = multiple of 64.
+    let unpadded = 10 + dict.len() + 1;
+    let padding = unpadded.next_multiple_of(64) - unpadded;
+    let header_len = dict.len() + padding + 1;
+    let mut out = Vec::with_capacity(10 + header_len + map.values.len() * 4);
+    out.extend_from_slice(b"\x93NUMPY\x01\x00");
+    out.extend_from_slice(&(header_len as u16).to_le_bytes());
+    out.extend_from_slice(dict.as_bytes());
+    out.resize(out.len() + padding, b' ');
+    out.push(b'\n');
+    for v in &map.values {
+        out.extend_from_slice(&v.to_le_bytes());
+    }
+    out
+}
+
+/// Encodes a 16-bit greyscale PNG where a pixel is `round(value · scale) + 32768`, clamped to
+/// 0..=65535 (pool: scale 1, the raw amplitude; ocean and lake: scale 100, centimetres).
+pub fn encode_png16(map: &Heightmap, scale: f32) -> Vec<u8> {
+    let mut samples = Vec::with_capacity(map.values.len() * 2);
+    for &v in &map.values {
+        let level = ((v * scale).round() + 32768.0).clamp(0.0, 65535.0) as u16;
+        // `image` takes 16-bit samples in native byte order and writes PNG's big-endian.
+        samples.extend_from_slice(&level.to_ne_bytes());
+    }
+    let mut out = Vec::new();
+    PngEncoder::new_with_quality(&mut out, CompressionType::Default, FilterType::Adaptive)
+        .write_image(&samples, map.width as u32, map.height as u32, image::ExtendedColorType::L16)
+        .expect("encoding a PNG into memory cannot fail for a valid heightmap");
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sample() -> Heightmap {
+        Heightmap { width: 3, height: 2, values: vec![0.0, 1.5, -2.0, 100.0, -32768.0, 40000.0] }
+    }
+
+    #[test]
+    fn npy_header_is_aligned_and_exact() {
+        let bytes = encode_npy(&sample());
+        assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
+        let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        assert_eq!((10 + header_len) % 64, 0);
+        let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+        assert!(header.starts_with("{'descr': '<f4', 'fortran_order': False, 'shape': (2, 3), }"));
+        assert!(header.ends_with(" \n"));
+        let data = &bytes[10 + header_len..];
+        assert_eq!(data.len(), 6 * 4);
+        assert_eq!(f32::from_le_bytes(data[4..8].try_into().unwrap()), 1.5);
+    }
+
+    #[test]
+    fn png16_offsets_scales_and_clamps() {
+        let png = encode_png16(&sample(), 1.0);
+        let decoded = image::load_from_memory(&png).unwrap();
+        let grey = decoded.as_luma16().expect("16-bit grey").as_raw().clone();
+        assert_eq!(grey, vec![32768, 32770, 32766, 32868, 0, 65535]);
+        let cm = encode_png16(&Heightmap { width: 1, height: 1, values: vec![0.123] }, 100.0);
+        assert_eq!(image::load_from_memory(&cm).unwrap().as_luma16().unwrap().as_raw(), &vec![32780]);
+    }
+}

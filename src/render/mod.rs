@@ -1,0 +1,5 @@
+//! Renderers: simulation state in, `tiny_skia::Pixmap` out. Nothing here does I/O except
+//! decoding image files the user names.
+
+pub mod background;
+pub mod pool;

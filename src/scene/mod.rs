@@ -1,0 +1,4 @@
+//! Scenes: a simulation together with the renderer that draws it. The headless renderer and
+//! the terminal player drive the same scene values the same way.
+
+pub mod pool;

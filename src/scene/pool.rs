@@ -1,0 +1,166 @@
+//! The ripple pool scene: the simulation, its rain, and the floor it refracts.
+
+use tiny_skia::Pixmap;
+
+use crate::output::heightmap::Heightmap;
+use crate::render::background;
+use crate::render::pool::{PoolLook, PoolRenderer};
+use crate::sim::rain::Rain;
+use crate::sim::ripple::{Damping, RipplePool, Stone};
+
+/// Everything about a pool except its size and floor image.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PoolSettings {
+    /// Damping of the water.
+    pub damping: Damping,
+    /// Raindrops per step on average.
+    pub rain_rate: f64,
+    /// Seed of the rain.
+    pub seed: u64,
+    /// How the water is drawn.
+    pub look: PoolLook,
+}
+
+/// A ripple pool with its rain and floor, one simulation cell per pixel.
+#[derive(Clone, Debug)]
+pub struct PoolScene {
+    pool: RipplePool,
+    rain: Rain,
+    renderer: PoolRenderer,
+    floor: Pixmap,
+    drops: Vec<Stone>,
+}
+
+impl PoolScene {
+    /// A still pool of `width x height` pixels over `floor` (scaled to cover the picture).
+    ///
+    /// Returns `None` when the size is zero or too large for a pixmap.
+    pub fn new(width: u32, height: u32, floor: Pixmap, settings: PoolSettings) -> Option<PoolScene> {
+        let fitted = background::cover(&floor, width, height)?;
+        Some(PoolScene {
+            pool: RipplePool::new(width as usize, height as usize, settings.damping),
+            rain: Rain::new(settings.rain_rate, settings.seed),
+            renderer: PoolRenderer::new(fitted, settings.look),
+            floor,
+            drops: Vec::new(),
+        })
+    }
+
+    /// Width in pixels (= cells).
+    pub fn width(&self) -> u32 {
+        self.pool.width() as u32
+    }
+
+    /// Height in pixels (= cells).
+    pub fn height(&self) -> u32 {
+        self.pool.height() as u32
+    }
+
+    /// The water.
+    pub fn pool(&self) -> &RipplePool {
+        &self.pool
+    }
+
+    /// The water, for changes such as damping or clearing.
+    pub fn pool_mut(&mut self) -> &mut RipplePool {
+        &mut self.pool
+    }
+
+    /// The rain.
+    pub fn rain_mut(&mut self) -> &mut Rain {
+        &mut self.rain
+    }
+
+    /// Drops a stone now.
+    pub fn drop_stone(&mut self, stone: Stone) {
+        self.pool.drop_stone(stone);
+    }
+
+    /// One simulation step: this step's raindrops land, then the water moves.
+    pub fn step(&mut self) {
+        self.drops.clear();
+        self.rain.drops(self.pool.width(), self.pool.height(), &mut self.drops);
+        for &drop in &self.drops {
+            self.pool.drop_stone(drop);
+        }
+        self.pool.step();
+    }
+
+    /// Draws the current water into `out`, which must have the scene's size.
+    pub fn render(&self, out: &mut Pixmap) {
+        self.renderer.render(&self.pool, out);
+    }
+
+    /// A new pixmap of the scene's size holding the current picture.
+    pub fn snapshot(&self) -> Pixmap {
+        let mut out = Pixmap::new(self.width(), self.height()).expect("the scene's size is a valid pixmap size");
+        self.render(&mut out);
+        out
+    }
+
+    /// Starts over at a new size: still water, the floor refitted, the rain continuing.
+    ///
+    /// Returns `false` (and changes nothing) when the size is zero or too large.
+    pub fn resize(&mut self, width: u32, height: u32) -> bool {
+        let Some(fitted) = background::cover(&self.floor, width, height) else {
+            return false;
+        };
+        let damping = self.pool.damping();
+        self.pool = RipplePool::new(width as usize, height as usize, damping);
+        self.renderer = PoolRenderer::new(fitted, self.renderer.look());
+        true
+    }
+
+    /// The current amplitudes as a heightmap (raw amplitude units).
+    pub fn heightmap(&self) -> Heightmap {
+        Heightmap {
+            width: self.pool.width(),
+            height: self.pool.height(),
+            values: self.pool.heights().iter().map(|&v| f32::from(v)).collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn settings(rain_rate: f64) -> PoolSettings {
+        PoolSettings { damping: Damping::PAPERS, rain_rate, seed: 7, look: PoolLook::default() }
+    }
+
+    #[test]
+    fn rain_moves_the_water_deterministically() {
+        let run = || {
+            let mut scene = PoolScene::new(64, 48, background::pool_floor(), settings(0.5)).unwrap();
+            for _ in 0..40 {
+                scene.step();
+            }
+            scene.snapshot().data().to_vec()
+        };
+        let still = PoolScene::new(64, 48, background::pool_floor(), settings(0.0)).unwrap().snapshot();
+        assert_eq!(run(), run());
+        assert_ne!(run(), still.data());
+    }
+
+    #[test]
+    fn resize_reallocates() {
+        let mut scene = PoolScene::new(64, 48, background::pool_floor(), settings(0.0)).unwrap();
+        scene.drop_stone(Stone { x: 10, y: 10, radius: 4, weight: 64 });
+        assert!(scene.resize(30, 20));
+        assert_eq!((scene.width(), scene.height()), (30, 20));
+        assert!(scene.pool().heights().iter().all(|&v| v == 0));
+        assert_eq!(scene.snapshot().width(), 30);
+        assert!(!scene.resize(0, 10));
+        assert_eq!(scene.width(), 30);
+    }
+
+    #[test]
+    fn heightmap_mirrors_the_amplitudes() {
+        let mut scene = PoolScene::new(10, 8, background::pool_floor(), settings(0.0)).unwrap();
+        scene.drop_stone(Stone { x: 4, y: 3, radius: 1, weight: 99 });
+        let map = scene.heightmap();
+        assert_eq!((map.width, map.height), (10, 8));
+        assert_eq!(map.values[3 * 10 + 4], -99.0);
+    }
+}

@@ -1,0 +1,93 @@
+//! Seeded rain: raindrops at random spots, a given number per step on average.
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+use super::ripple::Stone;
+
+/// A deterministic source of raindrops (the papers' radius 2, weight 64).
+///
+/// Each step drops `floor(rate)` drops plus one more with probability `fract(rate)`, so the
+/// expected number per step is exactly `rate` and a rate of 0 never draws from the generator.
+/// The generator is ChaCha8, whose stream is fixed by its seed on every platform.
+#[derive(Clone, Debug)]
+pub struct Rain {
+    rate: f64,
+    rng: ChaCha8Rng,
+}
+
+impl Rain {
+    /// Rain with `rate` expected drops per step (negative or NaN rates count as 0).
+    pub fn new(rate: f64, seed: u64) -> Rain {
+        Rain { rate: sanitize(rate), rng: ChaCha8Rng::seed_from_u64(seed) }
+    }
+
+    /// Expected drops per step.
+    pub fn rate(&self) -> f64 {
+        self.rate
+    }
+
+    /// Changes the rate; the random stream continues where it was.
+    pub fn set_rate(&mut self, rate: f64) {
+        self.rate = sanitize(rate);
+    }
+
+    /// The drops that fall during one step on a `width x height` pool, appended to `drops`.
+    pub fn drops(&mut self, width: usize, height: usize, drops: &mut Vec<Stone>) {
+        if self.rate <= 0.0 || width < 3 || height < 3 {
+            return;
+        }
+        let whole = self.rate.floor();
+        let mut count = whole as u64;
+        if self.rng.random::<f64>() < self.rate - whole {
+            count += 1;
+        }
+        for _ in 0..count {
+            let x = self.rng.random_range(1..width - 1) as i32;
+            let y = self.rng.random_range(1..height - 1) as i32;
+            drops.push(Stone::raindrop(x, y));
+        }
+    }
+}
+
+fn sanitize(rate: f64) -> f64 {
+    if rate.is_finite() && rate > 0.0 { rate } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn count(rate: f64, steps: usize, seed: u64) -> (usize, Vec<Stone>) {
+        let mut rain = Rain::new(rate, seed);
+        let mut drops = Vec::new();
+        for _ in 0..steps {
+            rain.drops(50, 40, &mut drops);
+        }
+        (drops.len(), drops)
+    }
+
+    #[test]
+    fn expected_drops_per_step_is_the_rate() {
+        let (n, _) = count(0.3, 10_000, 1);
+        assert!((2800..3200).contains(&n), "{n}");
+        let (n, _) = count(2.5, 1000, 2);
+        assert!((2450..2550).contains(&n), "{n}");
+        assert_eq!(count(0.0, 1000, 3).0, 0);
+        assert_eq!(count(f64::NAN, 1000, 3).0, 0);
+    }
+
+    #[test]
+    fn same_seed_same_rain() {
+        assert_eq!(count(0.7, 500, 9).1, count(0.7, 500, 9).1);
+        assert_ne!(count(0.7, 500, 9).1, count(0.7, 500, 10).1);
+    }
+
+    #[test]
+    fn drops_land_inside_the_walls() {
+        for s in count(3.0, 300, 4).1 {
+            assert!((1..49).contains(&s.x) && (1..39).contains(&s.y), "{s:?}");
+            assert_eq!((s.radius, s.weight), (2, 64));
+        }
+    }
+}

@@ -1,0 +1,418 @@
+//! The integer ripple pool of the papers (digest: ALGORITHMS.md section 1).
+//!
+//! Two `i16` amplitude buffers; every step replaces the older one with
+//! `((N + S + E + W) >> 1) - previous`, then damps it by `v -= v >> shift`, and swaps them.
+//! This is the explicit finite-difference wave equation with (c·dt/dx)² = 1/2: waves travel
+//! about 0.7 cells per step, reflect at the walls and superpose, and the cost of a step does not
+//! depend on how much water is moving.
+//!
+//! # Integer decisions
+//! - The neighbour sum reaches ±131,068, so it is formed in `i32`; the new amplitude is clamped
+//!   to the `i16` range *before* damping and stored back. Clamping (rather than wrapping like the
+//!   papers' C, or wider storage) keeps the buffers at two bytes a cell, which is what makes the
+//!   step fast (it is memory-bound), never panics in a debug build, and never turns a deep pile
+//!   of stones into garbage: an over-deep spot simply saturates, and damping (which can only
+//!   move a value towards zero) cannot leave the range again.
+//! - `>>` on a negative number rounds towards minus infinity, so both the `>> 1` of the spread
+//!   and the damping are biased downwards. Damped, a disturbed pool still returns to all-zero;
+//!   **undamped (`Damping::Off`) the mean level drifts slowly negative** after a disturbance,
+//!   because every odd neighbour sum loses half a unit. That is the papers' arithmetic, kept on
+//!   purpose so that tidepool matches them bit for bit.
+//! - The outermost ring of cells is a fixed zero wall (the papers' 1-D loop reads across row
+//!   ends instead; that defect is not reproduced). Stones are clipped to the interior.
+
+/// How fast waves lose energy: `v -= v >> shift` after every step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Damping {
+    /// No damping: waves ring until the walls' rounding eats them.
+    Off,
+    /// Lose `1 / 2^shift` of the amplitude per step; `shift` is in `1..=15` (papers: 5).
+    Shift(u8),
+}
+
+impl Damping {
+    /// The papers' damping, 1/32 per step.
+    pub const PAPERS: Damping = Damping::Shift(5);
+    /// The largest shift; `v >> 16` would be 0 or -1 for every `i16`, i.e. no damping at all.
+    pub const MAX_SHIFT: u8 = 15;
+
+    /// A damping from a shift, or `None` when the shift is outside `1..=15` (0 would zero the
+    /// pool every step; use [`Damping::Off`] for no damping).
+    pub fn shift(shift: u8) -> Option<Damping> {
+        (1..=Self::MAX_SHIFT).contains(&shift).then_some(Damping::Shift(shift))
+    }
+
+    /// One step weaker (larger shift), saturating at `Off`.
+    pub fn weaker(self) -> Damping {
+        match self {
+            Damping::Shift(s) if s < Self::MAX_SHIFT => Damping::Shift(s + 1),
+            _ => Damping::Off,
+        }
+    }
+
+    /// One step stronger (smaller shift), saturating at shift 1.
+    pub fn stronger(self) -> Damping {
+        match self {
+            Damping::Off => Damping::Shift(Self::MAX_SHIFT),
+            Damping::Shift(s) => Damping::Shift(s.saturating_sub(1).max(1)),
+        }
+    }
+}
+
+impl std::fmt::Display for Damping {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Damping::Off => f.write_str("off"),
+            Damping::Shift(s) => write!(f, "{s}"),
+        }
+    }
+}
+
+/// A stone (or raindrop): every cell with `dx² + dy² < radius²` is set to `-weight`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Stone {
+    /// Centre column in cells; may lie outside the pool (the circle is clipped).
+    pub x: i32,
+    /// Centre row in cells, 0 at the top.
+    pub y: i32,
+    /// Radius in cells, at least 1.
+    pub radius: u32,
+    /// Depth of the dent, `1..=32767` (papers: 32..128 looks right).
+    pub weight: i16,
+}
+
+impl Stone {
+    /// The papers' raindrop: radius 2, weight 64.
+    pub fn raindrop(x: i32, y: i32) -> Stone {
+        Stone { x, y, radius: 2, weight: 64 }
+    }
+}
+
+/// The ripple pool's state: the current and previous amplitude of every cell.
+#[derive(Clone, Debug)]
+pub struct RipplePool {
+    width: usize,
+    height: usize,
+    current: Vec<i16>,
+    previous: Vec<i16>,
+    damping: Damping,
+    steps: u64,
+}
+
+impl RipplePool {
+    /// A still pool of `width x height` cells.
+    pub fn new(width: usize, height: usize, damping: Damping) -> RipplePool {
+        let cells = width * height;
+        RipplePool { width, height, current: vec![0; cells], previous: vec![0; cells], damping, steps: 0 }
+    }
+
+    /// Width in cells.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Height in cells.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The current amplitudes, row-major, row 0 at the top.
+    pub fn heights(&self) -> &[i16] {
+        &self.current
+    }
+
+    /// The amplitudes one step ago (the wave equation's second state).
+    pub fn previous_heights(&self) -> &[i16] {
+        &self.previous
+    }
+
+    /// How many steps have run since the pool was made.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// The damping in effect.
+    pub fn damping(&self) -> Damping {
+        self.damping
+    }
+
+    /// Changes the damping from the next step on.
+    pub fn set_damping(&mut self, damping: Damping) {
+        self.damping = damping;
+    }
+
+    /// Stills the water (the step counter keeps counting).
+    pub fn clear(&mut self) {
+        self.current.fill(0);
+        self.previous.fill(0);
+    }
+
+    /// Drops a stone into the current buffer, clipped to the interior (the wall stays zero).
+    pub fn drop_stone(&mut self, stone: Stone) {
+        if self.width < 3 || self.height < 3 {
+            return;
+        }
+        let r = i64::from(stone.radius);
+        let r2 = r * r;
+        let (cx, cy) = (i64::from(stone.x), i64::from(stone.y));
+        let y0 = (cy - r + 1).max(1);
+        let y1 = (cy + r - 1).min(self.height as i64 - 2);
+        for y in y0..=y1 {
+            let dy = y - cy;
+            // The widest dx with dx² + dy² < r², found without floating point.
+            let room = r2 - dy * dy;
+            let mut half = (room as f64).sqrt() as i64;
+            while half * half >= room {
+                half -= 1;
+            }
+            while (half + 1) * (half + 1) < room {
+                half += 1;
+            }
+            let x0 = (cx - half).max(1);
+            let x1 = (cx + half).min(self.width as i64 - 2);
+            if x0 > x1 {
+                continue;
+            }
+            let row = y as usize * self.width;
+            self.current[row + x0 as usize..=row + x1 as usize].fill(-stone.weight);
+        }
+    }
+
+    /// Advances the water by one step.
+    pub fn step(&mut self) {
+        step_buffers(&self.current, &mut self.previous, self.width, self.height, self.damping);
+        std::mem::swap(&mut self.current, &mut self.previous);
+        self.steps += 1;
+    }
+}
+
+/// One step: writes the next amplitudes over `previous` (each cell reads only its own old value
+/// there, so the update is safe in place). Rows are zipped slices so the compiler can vectorize.
+fn step_buffers(current: &[i16], previous: &mut [i16], width: usize, height: usize, damping: Damping) {
+    if width < 3 || height < 3 {
+        return;
+    }
+    for y in 1..height - 1 {
+        let up = &current[(y - 1) * width..y * width];
+        let mid = &current[y * width..(y + 1) * width];
+        let down = &current[(y + 1) * width..(y + 2) * width];
+        let out = &mut previous[y * width + 1..(y + 1) * width - 1];
+        match damping {
+            Damping::Off => step_row::<false>(up, mid, down, out, 0),
+            Damping::Shift(shift) => step_row::<true>(up, mid, down, out, u32::from(shift)),
+        }
+    }
+}
+
+#[inline(always)]
+fn step_row<const DAMPED: bool>(up: &[i16], mid: &[i16], down: &[i16], out: &mut [i16], shift: u32) {
+    let left = &mid[..out.len()];
+    let right = &mid[2..];
+    let up = &up[1..];
+    let down = &down[1..];
+    for ((((o, &l), &r), &u), &d) in out.iter_mut().zip(left).zip(right).zip(up).zip(down) {
+        let sum = i32::from(l) + i32::from(r) + i32::from(u) + i32::from(d);
+        let mut v = ((sum >> 1) - i32::from(*o)).clamp(i32::from(i16::MIN), i32::from(i16::MAX));
+        if DAMPED {
+            v -= v >> shift;
+        }
+        *o = v as i16;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn pool_with(width: usize, height: usize, current: &[i16], previous: &[i16], damping: Damping) -> RipplePool {
+        let mut pool = RipplePool::new(width, height, damping);
+        pool.current.copy_from_slice(current);
+        pool.previous.copy_from_slice(previous);
+        pool
+    }
+
+    #[test]
+    fn step_matches_hand_computed_grid() {
+        // 4x4 grid: interior cells (1,1) (2,1) (1,2) (2,2).
+        #[rustfmt::skip]
+        let cur = [
+            0, 0, 0, 0,
+            0, 10, 3, 0,
+            0, -7, 0, 0,
+            0, 0, 0, 0,
+        ];
+        #[rustfmt::skip]
+        let prev = [
+            0, 0, 0, 0,
+            0, 2, 0, 0,
+            0, 0, -5, 0,
+            0, 0, 0, 0,
+        ];
+        let mut pool = pool_with(4, 4, &cur, &prev, Damping::Off);
+        pool.step();
+        // (1,1): N0+S-7+W0+E3 = -4 >> 1 = -2; -2 - 2 = -4
+        // (2,1): N0+S0+W10+E0 = 10 >> 1 = 5; 5 - 0 = 5
+        // (1,2): N10+S0+W0+E0 = 10 >> 1 = 5; 5 - 0 = 5
+        // (2,2): N3+S0+W-7+E0 = -4 >> 1 = -2; -2 - (-5) = 3
+        #[rustfmt::skip]
+        let expected = [
+            0, 0, 0, 0,
+            0, -4, 5, 0,
+            0, 5, 3, 0,
+            0, 0, 0, 0,
+        ];
+        assert_eq!(pool.heights(), &expected);
+        assert_eq!(pool.previous_heights(), &cur);
+        assert_eq!(pool.steps(), 1);
+    }
+
+    #[test]
+    fn odd_sums_round_towards_minus_infinity() {
+        // A single interior cell with neighbour sum -3: (-3 >> 1) = -2, not -1.
+        #[rustfmt::skip]
+        let cur = [
+            0, 0, 0,
+            0, 0, 0,
+            0, 0, 0,
+        ];
+        let mut pool = pool_with(3, 3, &cur, &cur, Damping::Off);
+        pool.current[1] = -3; // the top wall cell is only a neighbour; it is never written
+        pool.step();
+        assert_eq!(pool.heights()[4], -2);
+    }
+
+    #[test]
+    fn damping_applies_after_the_spread() {
+        let mut cur = [0i16; 9];
+        cur[3] = 200; // west wall neighbour of the centre
+        cur[5] = 200; // east
+        let prev = [0i16; 9];
+        let mut pool = pool_with(3, 3, &cur, &prev, Damping::Shift(5));
+        pool.step();
+        // spread: 400 >> 1 = 200; damping: 200 - (200 >> 5) = 200 - 6 = 194
+        assert_eq!(pool.heights()[4], 194);
+        let mut negative = pool_with(3, 3, &cur.map(|v| -v), &prev, Damping::Shift(5));
+        negative.step();
+        // -200 - (-200 >> 5) = -200 - (-7) = -193: the papers' asymmetric rounding.
+        assert_eq!(negative.heights()[4], -193);
+    }
+
+    #[test]
+    fn damping_off_keeps_energy_in_a_closed_pool() {
+        let mut off = RipplePool::new(64, 64, Damping::Off);
+        let mut damped = RipplePool::new(64, 64, Damping::PAPERS);
+        for pool in [&mut off, &mut damped] {
+            pool.drop_stone(Stone { x: 32, y: 32, radius: 4, weight: 100 });
+            for _ in 0..400 {
+                pool.step();
+            }
+        }
+        let energy = |p: &RipplePool| p.heights().iter().map(|&v| i64::from(v).abs()).sum::<i64>();
+        assert!(energy(&off) > 10_000, "undamped water keeps moving: {}", energy(&off));
+        assert!(energy(&damped) < energy(&off) / 20, "damped water calms down");
+    }
+
+    #[test]
+    fn damped_pool_returns_to_rest() {
+        let mut pool = RipplePool::new(48, 32, Damping::PAPERS);
+        pool.drop_stone(Stone { x: 20, y: 10, radius: 5, weight: 128 });
+        for _ in 0..3000 {
+            pool.step();
+        }
+        assert!(pool.heights().iter().all(|&v| v == 0));
+    }
+
+    #[test]
+    fn stone_covers_exactly_the_open_disc() {
+        let mut pool = RipplePool::new(21, 21, Damping::PAPERS);
+        pool.drop_stone(Stone { x: 10, y: 10, radius: 3, weight: 50 });
+        for y in 0..21i32 {
+            for x in 0..21i32 {
+                let inside = (x - 10).pow(2) + (y - 10).pow(2) < 9;
+                let v = pool.heights()[(y * 21 + x) as usize];
+                assert_eq!(v, if inside { -50 } else { 0 }, "cell ({x}, {y})");
+            }
+        }
+        // Radius 3 covers the whole 5x5 square (its corners are at 2² + 2² = 8 < 9) and nothing
+        // at distance 3 (3² = 9 is not < 9).
+        assert_eq!(pool.heights().iter().filter(|&&v| v != 0).count(), 25);
+    }
+
+    #[test]
+    fn radius_one_is_a_single_cell() {
+        let mut pool = RipplePool::new(5, 5, Damping::PAPERS);
+        pool.drop_stone(Stone { x: 2, y: 2, radius: 1, weight: 7 });
+        assert_eq!(pool.heights().iter().filter(|&&v| v != 0).count(), 1);
+        assert_eq!(pool.heights()[12], -7);
+    }
+
+    #[test]
+    fn stones_crossing_the_border_are_clipped_not_rejected() {
+        let mut pool = RipplePool::new(16, 12, Damping::PAPERS);
+        pool.drop_stone(Stone { x: 0, y: 0, radius: 4, weight: 64 });
+        pool.drop_stone(Stone { x: 100, y: -100, radius: 3, weight: 64 }); // far outside: nothing
+        pool.drop_stone(Stone { x: 15, y: 11, radius: 1000, weight: 9 }); // covers everything
+        let (w, h) = (16, 12);
+        for y in 0..h {
+            for x in 0..w {
+                let v = pool.heights()[y * w + x];
+                let wall = x == 0 || y == 0 || x == w - 1 || y == h - 1;
+                assert_eq!(v, if wall { 0 } else { -9 }, "cell ({x}, {y})");
+            }
+        }
+    }
+
+    #[test]
+    fn walls_stay_zero() {
+        let mut pool = RipplePool::new(30, 20, Damping::Off);
+        pool.drop_stone(Stone { x: 1, y: 1, radius: 6, weight: 32767 });
+        for _ in 0..200 {
+            pool.step();
+            let (w, h) = (30, 20);
+            for x in 0..w {
+                assert_eq!(pool.heights()[x], 0);
+                assert_eq!(pool.heights()[(h - 1) * w + x], 0);
+            }
+            for y in 0..h {
+                assert_eq!(pool.heights()[y * w], 0);
+                assert_eq!(pool.heights()[y * w + w - 1], 0);
+            }
+        }
+    }
+
+    #[test]
+    fn piled_stones_saturate_instead_of_wrapping() {
+        // Runs in the dev profile with overflow checks: any wrap would panic here.
+        let mut pool = RipplePool::new(40, 40, Damping::Off);
+        for round in 0..50 {
+            pool.drop_stone(Stone { x: 20, y: 20, radius: 6, weight: 32767 });
+            pool.drop_stone(Stone { x: 20 + round % 3, y: 19, radius: 9, weight: 32767 });
+            for _ in 0..7 {
+                pool.step();
+            }
+        }
+        let hit_limit = pool.heights().iter().any(|&v| v == i16::MAX || v == i16::MIN)
+            || pool.previous_heights().iter().any(|&v| v == i16::MAX || v == i16::MIN);
+        assert!(hit_limit, "this pile is deep enough to reach the i16 limits");
+    }
+
+    #[test]
+    fn tiny_pools_do_nothing_and_do_not_panic() {
+        for (w, h) in [(0, 0), (1, 1), (2, 5), (5, 2), (3, 3)] {
+            let mut pool = RipplePool::new(w, h, Damping::PAPERS);
+            pool.drop_stone(Stone { x: 1, y: 1, radius: 5, weight: 100 });
+            pool.step();
+        }
+    }
+
+    #[test]
+    fn damping_steps_saturate() {
+        assert_eq!(Damping::Shift(1).stronger(), Damping::Shift(1));
+        assert_eq!(Damping::Shift(15).weaker(), Damping::Off);
+        assert_eq!(Damping::Off.weaker(), Damping::Off);
+        assert_eq!(Damping::Off.stronger(), Damping::Shift(15));
+        assert_eq!(Damping::shift(0), None);
+        assert_eq!(Damping::shift(16), None);
+        assert_eq!(Damping::shift(5), Some(Damping::PAPERS));
+    }
+}
