@@ -228,20 +228,20 @@ fn render_pool(args: RenderPool) -> Result<()> {
     let mut scene = PoolScene::new(width, height, floor, settings).ok_or_else(|| {
         Error::arg("--size", format!("cannot allocate a {width}x{height} picture; choose a smaller size"))
     })?;
-    let script = if args.stones.is_empty() {
+    let mut script = if args.stones.is_empty() {
         default_stones(plan.size)
     } else {
         args.stones.iter().map(|&stone| (0, stone)).collect()
     };
+    script.sort_by_key(|&(at, _)| at);
     let steps = args.steps.unwrap_or_else(|| default_pool_steps(plan.size));
-    for step in 0..=steps {
-        for &(_, stone) in script.iter().filter(|(at, _)| *at == step) {
-            scene.drop_stone(stone);
-        }
-        if step < steps {
-            scene.step();
-        }
+    let mut now = 0;
+    for &(at, stone) in script.iter().filter(|(at, _)| *at <= steps) {
+        scene.advance(at - now);
+        now = at;
+        scene.drop_stone(stone);
     }
+    scene.advance(steps - now);
     let heights = plan.heightmap.is_some().then(|| scene.heightmap());
     plan.write(&scene.snapshot(), heights.as_ref(), 1.0)
 }
