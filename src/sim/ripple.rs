@@ -97,13 +97,22 @@ pub struct RipplePool {
     previous: Vec<i16>,
     damping: Damping,
     steps: u64,
+    scratch: super::stepper::Scratch,
 }
 
 impl RipplePool {
     /// A still pool of `width x height` cells.
     pub fn new(width: usize, height: usize, damping: Damping) -> RipplePool {
         let cells = width * height;
-        RipplePool { width, height, current: vec![0; cells], previous: vec![0; cells], damping, steps: 0 }
+        RipplePool {
+            width,
+            height,
+            current: vec![0; cells],
+            previous: vec![0; cells],
+            damping,
+            steps: 0,
+            scratch: Default::default(),
+        }
     }
 
     /// Width in cells.
@@ -187,7 +196,15 @@ impl RipplePool {
     /// blocking and all cores; see [`super::stepper`]). The result is bit-identical to calling
     /// [`RipplePool::step`] `steps` times, on any number of threads.
     pub fn advance(&mut self, steps: u64) {
-        super::stepper::advance(&mut self.current, &mut self.previous, self.width, self.height, self.damping, steps);
+        super::stepper::advance(
+            &mut self.current,
+            &mut self.previous,
+            self.width,
+            self.height,
+            self.damping,
+            steps,
+            &mut self.scratch,
+        );
         self.steps += steps;
     }
 }

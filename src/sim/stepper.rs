@@ -31,8 +31,17 @@ pub const MAX_BLOCK_STEPS: usize = 16;
 /// Below this many cells a pool is stepped on one thread (threads cost more than they save).
 const PARALLEL_MIN_CELLS: usize = 1 << 17;
 
+/// Buffers reused from step to step, so stepping allocates nothing in the steady state.
+#[derive(Clone, Debug, Default)]
+pub struct Scratch {
+    zero_row: Vec<i16>,
+    /// Two rows per band: level 0 of the rows just above and just below it.
+    halos: Vec<i16>,
+}
+
 /// Advances the pool by `steps` steps. `current` holds the newest state and `previous` the
 /// one before; on return they still do (the buffers are swapped as needed).
+#[allow(clippy::too_many_arguments)] // the pool's fields, passed apart to borrow them apart
 pub fn advance(
     current: &mut Vec<i16>,
     previous: &mut Vec<i16>,
@@ -40,6 +49,7 @@ pub fn advance(
     height: usize,
     damping: Damping,
     steps: u64,
+    scratch: &mut Scratch,
 ) {
     if width < 3 || height < 3 {
         // No interior: both buffers stay all zero; only the parity of the swap matters.
@@ -48,14 +58,14 @@ pub fn advance(
         }
         return;
     }
+    let threads = if width * height >= PARALLEL_MIN_CELLS { rayon::current_num_threads() } else { 1 };
+    // Bands must be at least twice the block length for the trapezoids to fit.
+    let bands = threads.min((height - 2) / (2 * MAX_BLOCK_STEPS)).max(1);
     let mut remaining = steps;
     while remaining > 0 {
-        let threads = if width * height >= PARALLEL_MIN_CELLS { rayon::current_num_threads() } else { 1 };
-        let rows = height - 2;
-        // Bands must be at least twice the block length for the trapezoids to work.
-        let bands = threads.min(rows / (2 * MAX_BLOCK_STEPS)).max(1);
         let block = remaining.min(MAX_BLOCK_STEPS as u64) as usize;
-        advance_block(current, previous, width, height, damping, block, bands);
+        let plan = Plan { width, rows: height - 2, bands, block, damping, kernel: Kernel::detect() };
+        plan.run(current, previous, scratch);
         if block % 2 == 1 {
             std::mem::swap(current, previous);
         }
@@ -63,61 +73,92 @@ pub fn advance(
     }
 }
 
-/// Computes `block` steps: after it, the newest state is in `a` when `block` is even, in `b`
-/// when odd. `a` holds the state at level 0, `b` level -1.
-fn advance_block(
-    a: &mut [i16],
-    b: &mut [i16],
+/// One block of steps over the whole pool.
+#[derive(Clone, Copy)]
+struct Plan {
     width: usize,
-    height: usize,
-    damping: Damping,
-    block: usize,
+    /// Interior rows (the grid's rows minus the two walls).
+    rows: usize,
     bands: usize,
-) {
-    let rows = height - 2;
-    let kernel = Kernel::detect();
-    // Band boundaries in interior-row coordinates (interior row 0 = grid row 1).
-    let edges: Vec<usize> = (0..=bands).map(|i| i * rows / bands).collect();
-    // Each band reads one row of level 0 above and below it; copy those before splitting.
-    let halo = |r: usize| a[(r + 1) * width..(r + 2) * width].to_vec();
-    let halos: Vec<(Option<Vec<i16>>, Option<Vec<i16>>)> = (0..bands)
-        .map(|i| {
-            let above = (i > 0).then(|| halo(edges[i] - 1));
-            let below = (i + 1 < bands).then(|| halo(edges[i + 1]));
-            (above, below)
-        })
-        .collect();
-    let zero_row = vec![0i16; width];
-    {
-        let mut a_rest = &mut a[width..(height - 1) * width];
-        let mut b_rest = &mut b[width..(height - 1) * width];
-        let mut views = Vec::with_capacity(bands);
-        for (i, (above, below)) in halos.iter().enumerate() {
-            let n = edges[i + 1] - edges[i];
-            let (a_band, a_tail) = std::mem::take(&mut a_rest).split_at_mut(n * width);
-            let (b_band, b_tail) = std::mem::take(&mut b_rest).split_at_mut(n * width);
-            a_rest = a_tail;
-            b_rest = b_tail;
-            views.push(Band {
-                a: a_band,
-                b: b_band,
-                width,
-                rows: n,
-                above: above.as_deref(),
-                below: below.as_deref(),
-                zero: &zero_row,
-            });
+    block: usize,
+    damping: Damping,
+    kernel: Kernel,
+}
+
+impl Plan {
+    /// The first interior row of band `i` (interior row 0 = grid row 1); `edge(bands)` = rows.
+    fn edge(&self, i: usize) -> usize {
+        i * self.rows / self.bands
+    }
+
+    /// Computes `block` steps: after it, the newest state is in `a` when `block` is even, in
+    /// `b` when odd. `a` holds level 0, `b` level -1.
+    fn run(&self, a: &mut [i16], b: &mut [i16], scratch: &mut Scratch) {
+        let w = self.width;
+        scratch.zero_row.clear();
+        scratch.zero_row.resize(w, 0);
+        scratch.halos.resize(2 * self.bands * w, 0);
+        // Each band reads one row of level 0 above and below it, owned by its neighbours:
+        // copy those before the rows are handed out to the threads.
+        for i in 0..self.bands {
+            let grid_row = |interior: usize| &a[(interior + 1) * w..(interior + 2) * w];
+            if i > 0 {
+                scratch.halos[2 * i * w..(2 * i + 1) * w].copy_from_slice(grid_row(self.edge(i) - 1));
+            }
+            if i + 1 < self.bands {
+                scratch.halos[(2 * i + 1) * w..(2 * i + 2) * w].copy_from_slice(grid_row(self.edge(i + 1)));
+            }
         }
-        if views.len() == 1 {
-            kernel.sweep(&mut views[0], block, damping);
-        } else {
-            use rayon::prelude::*;
-            views.par_iter_mut().for_each(|band| kernel.sweep(band, block, damping));
+        let interior = w..(self.rows + 1) * w;
+        self.sweep_bands(&mut a[interior.clone()], &mut b[interior], 0..self.bands, scratch);
+        // Phase two: the inverted triangles around each internal band edge.
+        for i in 1..self.bands {
+            self.fill_between_bands(a, b, self.edge(i));
         }
     }
-    // Phase two: the inverted triangles around each internal band edge.
-    for &edge in &edges[1..bands] {
-        fill_between_bands(a, b, width, edge, block, damping, kernel);
+
+    /// Phase one for bands `range`, whose rows are `a` and `b`; halves run in parallel.
+    fn sweep_bands(&self, a: &mut [i16], b: &mut [i16], range: std::ops::Range<usize>, scratch: &Scratch) {
+        let w = self.width;
+        if range.len() == 1 {
+            let i = range.start;
+            let halo = |k: usize| &scratch.halos[k * w..(k + 1) * w];
+            let mut band = Band {
+                a,
+                b,
+                width: w,
+                rows: self.edge(i + 1) - self.edge(i),
+                above: (i > 0).then(|| halo(2 * i)),
+                below: (i + 1 < self.bands).then(|| halo(2 * i + 1)),
+                zero: &scratch.zero_row,
+            };
+            self.kernel.sweep(&mut band, self.block, self.damping);
+            return;
+        }
+        let middle = range.start + range.len() / 2;
+        let split = (self.edge(middle) - self.edge(range.start)) * w;
+        let (a_top, a_bottom) = a.split_at_mut(split);
+        let (b_top, b_bottom) = b.split_at_mut(split);
+        rayon::join(
+            || self.sweep_bands(a_top, b_top, range.start..middle, scratch),
+            || self.sweep_bands(a_bottom, b_bottom, middle..range.end, scratch),
+        );
+    }
+
+    /// Phase two at the internal edge `edge` (the first interior row of the lower band): rows
+    /// within `t - 1` of the edge are brought to level `t`, for t = 2..=block.
+    fn fill_between_bands(&self, a: &mut [i16], b: &mut [i16], edge: usize) {
+        let w = self.width;
+        for t in 2..=self.block {
+            for r in edge + 1 - t..edge + t - 1 {
+                let g = r + 1; // interior row r is grid row r + 1
+                let (src, dst) = if t % 2 == 1 { (&*a, &mut *b) } else { (&*b, &mut *a) };
+                let up = &src[(g - 1) * w..g * w];
+                let mid = &src[g * w..(g + 1) * w];
+                let down = &src[(g + 1) * w..(g + 2) * w];
+                self.kernel.row(up, mid, down, &mut dst[g * w + 1..(g + 1) * w - 1], self.damping);
+            }
+        }
     }
 }
 
@@ -174,31 +215,6 @@ impl Band<'_> {
         let r_i = r as isize;
         let out = &mut dst[r * w + 1..(r + 1) * w - 1];
         row_kernel(row(r_i - 1), row(r_i), row(r_i + 1), out, damping);
-    }
-}
-
-/// Phase two at the internal edge `edge` (the first interior row of the lower band): rows
-/// within `t - 1` of the edge are brought to level `t`, for t = 2..=block.
-#[inline(always)]
-fn fill_between_bands(
-    a: &mut [i16],
-    b: &mut [i16],
-    width: usize,
-    edge: usize,
-    block: usize,
-    damping: Damping,
-    kernel: Kernel,
-) {
-    for t in 2..=block {
-        for r in edge + 1 - t..edge + t - 1 {
-            // Interior row r is grid row r + 1.
-            let g = r + 1;
-            let (src, dst) = if t % 2 == 1 { (&*a, &mut *b) } else { (&*b, &mut *a) };
-            let up = &src[(g - 1) * width..g * width];
-            let mid = &src[g * width..(g + 1) * width];
-            let down = &src[(g + 1) * width..(g + 2) * width];
-            kernel.row(up, mid, down, &mut dst[g * width + 1..(g + 1) * width - 1], damping);
-        }
     }
 }
 
