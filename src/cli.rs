@@ -39,6 +39,20 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene headless to a PNG file or half-block text (no terminal needed).
     Render(RenderCommand),
+    /// Measure how fast this machine runs tidepool, stage by stage (a few seconds).
+    Bench(BenchArgs),
+}
+
+/// `tidepool bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Seconds to spend on each workload (the median of the runs is reported).
+    #[arg(long, value_name = "S", default_value_t = 0.4, value_parser = parse_seconds)]
+    pub seconds: f64,
+
+    /// The terminal picture to measure, in pixels (columns x 2 per row).
+    #[arg(long, value_name = "WxH", default_value = "160x94", value_parser = parse_size)]
+    pub terminal: Size,
 }
 
 /// `tidepool render <scene>`.
@@ -106,6 +120,11 @@ pub struct OutputArgs {
     /// value = height + 32768; pool heights are raw amplitudes). Row 0 is the top of the picture.
     #[arg(long, value_name = "FILE")]
     pub heightmap: Option<PathBuf>,
+
+    /// Print how long each stage took (simulation, picture, encoding, writing) to standard
+    /// error, with throughput.
+    #[arg(long)]
+    pub stats: bool,
 }
 
 /// Flags of the ripple pool, shared by `render pool` and the player.
@@ -240,6 +259,15 @@ pub fn parse_damping(text: &str) -> Result<Damping, String> {
         .ok()
         .and_then(Damping::shift)
         .ok_or_else(|| format!("the shift {shift} is outside 1..=15 (5 is the papers'); use 'off' for no damping"))
+}
+
+/// Parses a duration in seconds, 0.01..=60.
+pub fn parse_seconds(text: &str) -> Result<f64, String> {
+    let v: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of seconds; e.g. 0.5"))?;
+    if !v.is_finite() || !(0.01..=60.0).contains(&v) {
+        return Err(format!("'{text}' must be between 0.01 and 60 seconds"));
+    }
+    Ok(v)
 }
 
 /// Parses a finite number >= 0.

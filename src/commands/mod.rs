@@ -1,5 +1,6 @@
 //! The subcommands: validated flags in, files and terminal output out.
 
+pub mod bench;
 pub mod render;
 
 use crate::cli::{Cli, Command};
@@ -20,6 +21,7 @@ pub fn run(cli: Cli) -> Result<()> {
     crate::signals::install();
     match cli.command {
         Some(Command::Render(render)) => render::run(render),
+        Some(Command::Bench(args)) => bench::run(args),
         None => {
             println!("{GETTING_STARTED}");
             Ok(())
