@@ -146,14 +146,42 @@ pub struct PoolArgs {
     #[arg(long, value_name = "F|auto", default_value = "auto", value_parser = parse_refraction, allow_negative_numbers = true)]
     pub refraction: crate::render::pool::Refraction,
 
-    /// Do not light the slopes (by default slopes facing the upper left are brightened).
+    /// Do not light the surface (by default flanks facing the sun are brightened, the others
+    /// darkened, and crests tilted towards the sun glint).
     #[arg(long)]
     pub no_shading: bool,
+
+    /// Do not draw caustics (the moving lines of focused sunlight on the floor).
+    #[arg(long)]
+    pub no_caustics: bool,
+
+    /// Water depth in pixels: deeper water focuses the caustics into sharper, brighter lines
+    /// and moves them further from the ripples that cast them (0..=10000).
+    #[arg(long, value_name = "PIXELS", default_value_t = 24.0, value_parser = parse_depth)]
+    pub depth: f32,
+
+    /// Where the sun is: azimuth in degrees clockwise from north (the top of the picture) and
+    /// elevation in degrees above the horizon (0..=90).
+    #[arg(long, value_name = "AZ_DEG,EL_DEG", default_value = "315,60", value_parser = parse_sun, allow_hyphen_values = true)]
+    pub sun: crate::render::pool::Sun,
 
     /// The pool floor: a PNG or JPEG, scaled to cover the picture (aspect kept, centred).
     /// [default: the built-in tiled floor]
     #[arg(long, value_name = "FILE")]
     pub background: Option<PathBuf>,
+}
+
+impl PoolArgs {
+    /// The look these flags ask for.
+    pub fn look(&self) -> crate::render::pool::PoolLook {
+        use crate::render::caustics::CausticsLook;
+        crate::render::pool::PoolLook {
+            refraction: self.refraction,
+            shading: !self.no_shading,
+            caustics: (!self.no_caustics).then(|| CausticsLook { depth_px: self.depth, ..CausticsLook::default() }),
+            sun: self.sun,
+        }
+    }
 }
 
 /// A picture size in pixels.
@@ -261,6 +289,32 @@ pub fn parse_damping(text: &str) -> Result<Damping, String> {
         .ok_or_else(|| format!("the shift {shift} is outside 1..=15 (5 is the papers'); use 'off' for no damping"))
 }
 
+/// Parses a water depth in pixels, 0..=10000.
+pub fn parse_depth(text: &str) -> Result<f32, String> {
+    let v: f32 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of pixels; e.g. 48"))?;
+    if !v.is_finite() || !(0.0..=10_000.0).contains(&v) {
+        return Err(format!("'{text}' must be between 0 and 10000 pixels"));
+    }
+    Ok(v)
+}
+
+/// Parses `AZIMUTH,ELEVATION` in degrees: any finite azimuth (wrapped to 0..360), elevation
+/// 0..=90.
+pub fn parse_sun(text: &str) -> Result<crate::render::pool::Sun, String> {
+    let hint = "write it as AZIMUTH,ELEVATION in degrees, e.g. 315,60";
+    let (az, el) = text.split_once(',').ok_or_else(|| format!("expected two numbers; {hint}"))?;
+    let number = |s: &str, name: &str| -> Result<f32, String> {
+        let v: f32 = s.trim().parse().map_err(|_| format!("the {name} '{}' is not a number; {hint}", s.trim()))?;
+        if v.is_finite() { Ok(v) } else { Err(format!("the {name} must be finite; {hint}")) }
+    };
+    let azimuth = number(az, "azimuth")?.rem_euclid(360.0);
+    let elevation = number(el, "elevation")?;
+    if !(0.0..=90.0).contains(&elevation) {
+        return Err(format!("the elevation {elevation} is outside 0..=90 degrees; {hint}"));
+    }
+    Ok(crate::render::pool::Sun { azimuth_deg: azimuth, elevation_deg: elevation })
+}
+
 /// Parses a duration in seconds, 0.01..=60.
 pub fn parse_seconds(text: &str) -> Result<f64, String> {
     let v: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of seconds; e.g. 0.5"))?;
@@ -345,6 +399,11 @@ mod tests {
         for bad in ["-1", "NaN", "inf", "x", "1e9"] {
             assert!(parse_rate(bad).is_err(), "{bad}");
         }
+        assert_eq!(parse_sun("-45, 30").map(|s| (s.azimuth_deg, s.elevation_deg)), Ok((315.0, 30.0)));
+        for bad in ["45", "45,91", "45,-1", "x,30", "inf,30", "45,30,1"] {
+            assert!(parse_sun(bad).is_err(), "{bad}");
+        }
+        assert!(parse_depth("-1").is_err() && parse_depth("nan").is_err() && parse_depth("48").is_ok());
         assert!(parse_refraction("auto").is_ok());
         assert!(parse_refraction("0").is_ok());
         for bad in ["-0.5", "nan", "1e9", "fast"] {

@@ -107,12 +107,12 @@ impl PoolScene {
     }
 
     /// Draws the current water into `out`, which must have the scene's size.
-    pub fn render(&self, out: &mut Pixmap) {
+    pub fn render(&mut self, out: &mut Pixmap) {
         self.renderer.render(&self.pool, out);
     }
 
     /// A new pixmap of the scene's size holding the current picture.
-    pub fn snapshot(&self) -> Pixmap {
+    pub fn snapshot(&mut self) -> Pixmap {
         let mut out = Pixmap::new(self.width(), self.height()).expect("the scene's size is a valid pixmap size");
         self.render(&mut out);
         out
