@@ -18,5 +18,6 @@ pub mod render;
 pub mod scene;
 pub mod signals;
 pub mod sim;
+pub mod simd;
 
 pub use error::{Error, Result};
