@@ -10,7 +10,10 @@ use common::{run_in, scratch, stderr};
 
 /// Renders a tiny pool on `background` and returns (exit code, stderr).
 fn render_on(dir: &Path, background: &str) -> (Option<i32>, String) {
-    let out = run_in(dir, &["render", "pool", "--size", "32x24", "--steps", "5", "--background", background, "--out", "out.png"]);
+    let out = run_in(
+        dir,
+        &["render", "pool", "--size", "32x24", "--steps", "5", "--background", background, "--out", "out.png"],
+    );
     (out.status.code(), stderr(&out))
 }
 
@@ -70,7 +73,13 @@ fn unusual_but_valid_images_simply_work() {
     image::RgbImage::from_fn(16, 16, |x, y| image::Rgb([x as u8 * 16, y as u8 * 16, 90]))
         .write_to(&mut Cursor::new(&mut jpeg), image::ImageFormat::Jpeg)
         .unwrap();
-    for (name, bytes) in [("deep.png", &deep), ("grey.png", &grey), ("palette.png", &palette), ("animated.png", &animated), ("photo.jpg", &jpeg)] {
+    for (name, bytes) in [
+        ("deep.png", &deep),
+        ("grey.png", &grey),
+        ("palette.png", &palette),
+        ("animated.png", &animated),
+        ("photo.jpg", &jpeg),
+    ] {
         std::fs::write(dir.join(name), bytes).unwrap();
         let (code, err) = render_on(&dir, name);
         assert_eq!(code, Some(0), "{name}: {err}");
