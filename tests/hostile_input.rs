@@ -119,7 +119,7 @@ fn broken_and_hostile_images_are_refused_cleanly() {
     std::fs::write(dir.join("notes.png"), b"remember to buy milk\n").unwrap();
     std::fs::create_dir(dir.join("folder.png")).unwrap();
     let cases = [
-        ("huge.png", "larger than 16384x16384"),
+        ("huge.png", "too large to decode"),
         ("scrambled.jpg", "decode"),
         ("cut.jpg", "decode"),
         ("empty.png", "empty"),
