@@ -244,7 +244,10 @@ impl Screen {
             return;
         }
         let (cols, rows) = (self.cols.max(1), self.rows.max(1));
-        self.wrap_pending = false;
+        // SGR leaves a pending wrap alone (as xterm does); moves and erases cancel it.
+        if command != b'm' {
+            self.wrap_pending = false;
+        }
         match command {
             b'H' | b'f' => self.cursor = ((n(1) - 1).min(cols - 1), (n(0) - 1).min(rows - 1)),
             b'A' => self.cursor.1 = self.cursor.1.saturating_sub(n(0)),
@@ -384,6 +387,15 @@ mod tests {
         s.lf_returns = false;
         s.feed(b"\nh");
         assert_eq!(s.row_text(1), " h ");
+    }
+
+    #[test]
+    fn colour_changes_keep_a_pending_wrap() {
+        let mut s = Screen::new(3, 2);
+        s.feed(b"abc\x1b[31md");
+        assert_eq!(s.row_text(1), "d  ", "SGR does not cancel the wrap");
+        s.feed(b"\x1b[1;1Habc\x1b[Cx");
+        assert_eq!(s.row_text(0), "abx", "a cursor move does");
     }
 
     #[test]
