@@ -6,6 +6,7 @@
 //! - [`output`]: pixels -> PNG, half-block text, heightmaps; atomic file writes.
 //! - [`scene`]: a simulation together with its renderer, driven alike by the headless
 //!   renderer and the terminal player.
+//! - [`term`]: the interactive terminal player; [`replay`]: recorded sessions.
 //! - [`cli`] and [`commands`]: the command line.
 #![warn(missing_docs)]
 
@@ -14,8 +15,10 @@ pub mod commands;
 pub mod error;
 pub mod output;
 pub mod render;
+pub mod replay;
 pub mod scene;
 pub mod signals;
 pub mod sim;
+pub mod term;
 
 pub use error::{Error, Result};

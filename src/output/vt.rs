@@ -5,6 +5,7 @@
 //! an implied CR, like a tty's `onlcr`), backspace, CSI cursor movement (`H f A B C D E F G d`),
 //! erase (`J K`), SGR (`0`, `39`, `49`, `38/48;2;r;g;b`, `38/48;5;n`, 30-37/40-47/90-97/100-107)
 //! and DEC private modes (`?1049`, `?25`, `?2026`, mouse modes), whose state is recorded.
+//! CAN/SUB abort a sequence, ESC inside a CSI restarts it.
 //! Anything else is ignored.
 
 use crate::output::halfblock::Rgb;
@@ -141,6 +142,15 @@ impl Screen {
     }
 
     fn byte(&mut self, b: u8) {
+        // CAN and SUB abort any sequence; ESC starts a new one (as in xterm).
+        if self.state != Parse::Ground && matches!(b, 0x18 | 0x1a) {
+            self.state = Parse::Ground;
+            return;
+        }
+        if matches!(self.state, Parse::Csi(_)) && b == 0x1b {
+            self.state = Parse::Escape;
+            return;
+        }
         match std::mem::replace(&mut self.state, Parse::Ground) {
             Parse::Ground => self.ground(b),
             Parse::Escape => match b {
