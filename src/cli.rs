@@ -55,8 +55,12 @@ Examples:
   tidepool play --record s.jsonl                # then: tidepool render pool --replay s.jsonl";
 
 /// `tidepool play [scene]`.
+///
+/// The player damps more than `render` (shift 4, not 5): a terminal pool is a few hundred
+/// pixels at most, and at the papers' damping a ring crosses it twice before it fades, so the
+/// water never settles, looks busy and costs every cell's bytes on every frame.
 #[derive(Args, Debug, Clone)]
-#[command(after_help = PLAY_KEYS)]
+#[command(after_help = PLAY_KEYS, mut_arg("damping", |a| a.default_value(PLAYER_DAMPING)))]
 pub struct PlayCommand {
     /// The scene to start with (`tab` switches while playing).
     #[arg(value_enum, default_value = "pool")]
@@ -98,6 +102,9 @@ pub struct PlayCommand {
     #[arg(long, value_name = "FILE")]
     pub record: Option<PathBuf>,
 }
+
+/// The player's default `--damping`.
+pub const PLAYER_DAMPING: &str = "4";
 
 /// The scenes `play` knows; `tab` cycles through them in this order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -441,6 +448,10 @@ mod tests {
         let cli = Cli::try_parse_from(["tidepool", "play"]).unwrap();
         let Some(Command::Play(play)) = cli.command else { panic!("not play") };
         assert_eq!((play.scene, play.fps, play.color, play.pool.rain), (PlayScene::Pool, 30, ColorChoice::Auto, None));
+        assert_eq!(play.pool.damping, Damping::Shift(4), "the player damps more than render");
+        let cli = Cli::try_parse_from(["tidepool", "render", "pool"]).unwrap();
+        let Some(Command::Render(RenderCommand { scene: RenderScene::Pool(pool) })) = cli.command else { panic!() };
+        assert_eq!(pool.pool.damping, Damping::PAPERS);
         assert!(Cli::try_parse_from(["tidepool", "play", "--fps", "0"]).is_err());
         assert!(Cli::try_parse_from(["tidepool", "play", "--color", "256"]).is_ok());
     }

@@ -37,12 +37,15 @@ pub struct PoolScene {
 
 /// The rain rate the player's `r` key switches on when the pool started without rain.
 pub const DEFAULT_TOGGLE_RAIN: f64 = 0.02;
-/// The weight of a stone dropped by the player (as deep as the default picture's stones).
-pub const PLAYER_STONE_WEIGHT: i16 = 160;
-/// A right click drops a stone this many times wider, and as deep as the weight allows.
+/// The weight of a stone dropped by the player: the papers' raindrop weight, which reads
+/// clearly at terminal size without setting the whole pool in motion.
+pub const PLAYER_STONE_WEIGHT: i16 = 64;
+/// A right click drops a stone this many times wider and twice as heavy.
 pub const BIG_STONE_FACTOR: u32 = 2;
 /// Stirring drops small light stones this many pixels apart along the drag.
 const STIR_SPACING: f32 = 2.0;
+/// The weight of the small stones of a stir.
+const STIR_WEIGHT: i16 = 32;
 
 impl PoolScene {
     /// A still pool of `width x height` pixels over `floor` (scaled to cover the picture).
@@ -175,7 +178,7 @@ impl Playable for PoolScene {
                         let t = i as f32 / n as f32;
                         let x = from.0 + (dx * t).round() as i32;
                         let y = from.1 + (dy * t).round() as i32;
-                        Event::Stone(Stone { x, y, radius: 2, weight: 48 })
+                        Event::Stone(Stone { x, y, radius: 2, weight: STIR_WEIGHT })
                     })
                     .collect()
             }
@@ -258,12 +261,12 @@ mod tests {
     fn actions_resolve_to_events_that_apply() {
         let mut scene = PoolScene::new(40, 30, background::pool_floor(), settings(0.0)).unwrap();
         let events = scene.resolve(Action::Stone { x: 10, y: 12, radius: 3, big: true });
-        assert_eq!(events, vec![Event::Stone(Stone { x: 10, y: 12, radius: 6, weight: 320 })]);
+        assert_eq!(events, vec![Event::Stone(Stone { x: 10, y: 12, radius: 6, weight: 128 })]);
         scene.apply(&events[0]);
         assert!(scene.pool().heights()[12 * 40 + 10] < 0);
         let stir = scene.resolve(Action::Stir { from: (5, 5), to: (15, 5) });
         assert_eq!(stir.len(), 5);
-        assert_eq!(stir[4], Event::Stone(Stone { x: 15, y: 5, radius: 2, weight: 48 }));
+        assert_eq!(stir[4], Event::Stone(Stone { x: 15, y: 5, radius: 2, weight: STIR_WEIGHT }));
         let rain = scene.resolve(Action::ToggleRain);
         assert_eq!(rain, vec![Event::Rain(DEFAULT_TOGGLE_RAIN)]);
         scene.apply(&rain[0]);

@@ -30,8 +30,8 @@ use crate::term::writer::FrameWriter;
 
 /// Stone radii `+` and `-` step through, in pixels.
 pub const STONE_RADII: [u32; 10] = [1, 2, 3, 4, 6, 8, 12, 16, 24, 32];
-/// The stone radius the player starts with, in pixels.
-pub const DEFAULT_STONE_RADIUS: u32 = 4;
+/// The stone radius the player starts with, in pixels (a terminal pool is ~100 pixels tall).
+pub const DEFAULT_STONE_RADIUS: u32 = 3;
 /// How long the aim marker stays after the last aim key.
 const AIM_VISIBLE: Duration = Duration::from_secs(4);
 /// How long a status message (screenshot saved) stays.

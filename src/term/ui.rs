@@ -54,7 +54,7 @@ pub fn status_line(frame: &mut Frame, row: usize, status: &Status, mode: ColorMo
     frame.clear_row(row, bg);
     let paused = if status.paused { " \u{b7} PAUSED" } else { "" };
     let left = format!(
-        " {} \u{b7} {} fps \u{b7} {} \u{b7} {} \u{b7} stone {}{paused} ",
+        " {}{paused} \u{b7} {} fps \u{b7} {} \u{b7} {} \u{b7} stone {} ",
         status.scene, status.fps, status.rate, status.detail, status.stone
     );
     let cols = frame.cols();
@@ -68,7 +68,12 @@ pub fn status_line(frame: &mut Frame, row: usize, status: &Status, mode: ColorMo
         }
     };
     let right_len = right.chars().count();
-    let x = cols.saturating_sub(right_len).max(left_len.min(cols));
+    // A message wins over the left part when the line is short; hints only take free room.
+    let x = if status.message.is_some() {
+        cols.saturating_sub(right_len)
+    } else {
+        cols.saturating_sub(right_len).max(left_len.min(cols))
+    };
     let key = if status.message.is_some() { solid(mode, HELP_KEY) } else { fg };
     frame.text(x, row, &right, key, bg);
 }
@@ -194,6 +199,9 @@ mod tests {
         let s = Status { message: Some("saved x.png".into()), paused: true, ..status() };
         status_line(&mut f, 0, &s, ColorMode::Palette16);
         assert!(row(&f, 0).trim_end().ends_with("saved x.png") && row(&f, 0).contains("PAUSED"));
+        let mut narrow = Frame::new(30, 1);
+        status_line(&mut narrow, 0, &s, ColorMode::TrueColor);
+        assert!(row(&narrow, 0).starts_with(" pool \u{b7} PAUSED") && row(&narrow, 0).ends_with("saved x.png "));
     }
 
     #[test]
