@@ -19,8 +19,6 @@
 //! - The whole frame is wrapped in synchronized output (`ESC[?2026h` ... `ESC[?2026l`) unless
 //!   switched off; a frame with no change is no bytes at all.
 
-use std::io::Write;
-
 use crate::output::color::Color;
 use crate::output::cursor::{self, Cursor};
 use crate::output::frame::{Cell, Frame};
@@ -91,15 +89,39 @@ fn color_params_len(c: Color, background: bool) -> usize {
     }
 }
 
+/// Appends `v` in decimal (`write!` is several times slower, and this runs per colour code).
+#[inline]
+fn push_u8(out: &mut Vec<u8>, v: u8) {
+    if v >= 100 {
+        out.push(b'0' + v / 100);
+    }
+    if v >= 10 {
+        out.push(b'0' + v / 10 % 10);
+    }
+    out.push(b'0' + v % 10);
+}
+
 fn push_color_params(out: &mut Vec<u8>, c: Color, background: bool) {
     let base = if background { 40 } else { 30 };
-    let _ = match c {
-        Color::Default => write!(out, "{}", base + 9),
-        Color::Index(i) if i < 8 => write!(out, "{}", base + i as u32),
-        Color::Index(i) if i < 16 => write!(out, "{}", base + 60 + (i as u32 - 8)),
-        Color::Index(i) => write!(out, "{};5;{i}", base + 8),
-        Color::Rgb([r, g, b]) => write!(out, "{};2;{r};{g};{b}", base + 8),
-    };
+    match c {
+        Color::Default => push_u8(out, base + 9),
+        Color::Index(i) if i < 8 => push_u8(out, base + i),
+        Color::Index(i) if i < 16 => push_u8(out, base + 60 + (i - 8)),
+        Color::Index(i) => {
+            push_u8(out, base + 8);
+            out.extend_from_slice(b";5;");
+            push_u8(out, i);
+        }
+        Color::Rgb([r, g, b]) => {
+            push_u8(out, base + 8);
+            out.extend_from_slice(b";2;");
+            push_u8(out, r);
+            out.push(b';');
+            push_u8(out, g);
+            out.push(b';');
+            push_u8(out, b);
+        }
+    }
 }
 
 /// A glyph with the colours it needs (`None`: this colour does not matter).
