@@ -6,7 +6,9 @@
 //!
 //!     cargo bench --bench encoder
 
-use criterion::{BatchSize, Criterion, black_box, criterion_group, criterion_main};
+use std::hint::black_box;
+
+use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use tidepool::output::color::{Color, ColorMode};
 use tidepool::output::diff::{EncodeOptions, Shown, encode_into};
 use tidepool::output::frame::Frame;
