@@ -8,9 +8,12 @@
 //! - The 256-colour palette is matched against the real xterm levels (0, 95, 135, 175, 215, 255
 //!   for the cube; 8..=238 step 10 for the grey ramp), with the midpoints as thresholds, not the
 //!   divide-by-43 shortcut, which picks the wrong level for a third of the values.
-//! - Below 24-bit colour an ordered (Bayer 4x4) dither hides the banding. It depends only on the
-//!   pixel's colour and position, so still water dithers the same way every frame and the
-//!   frame-to-frame diff stays empty (error diffusion would shimmer and defeat the diff).
+//! - 256 colours are not dithered: looked at in tmux, a Bayer dither turned the pool's flat
+//!   tiles into checkerboards and hid the ripples, while the plain nearest colour keeps tiles
+//!   flat and ripples readable. 16 colours are too few for that, so there an ordered (Bayer
+//!   4x4) dither mixes neighbouring colours. It depends only on the pixel's colour and position,
+//!   so still water dithers the same way every frame and the frame-to-frame diff stays empty
+//!   (error diffusion would shimmer and defeat the diff).
 
 use crate::output::halfblock::Rgb;
 use crate::output::vt::xterm_256;
@@ -75,7 +78,7 @@ impl ColorMode {
     pub fn quantize(self, rgb: Rgb, x: u32, y: u32) -> Color {
         match self {
             ColorMode::TrueColor => Color::Rgb(rgb),
-            ColorMode::Palette256 => Color::Index(nearest_256(dither(rgb, x, y, 24))),
+            ColorMode::Palette256 => Color::Index(nearest_256(rgb)),
             ColorMode::Palette16 => Color::Index(nearest_16(dither(rgb, x, y, 64))),
         }
     }
