@@ -33,7 +33,7 @@ fn scene() -> PoolScene {
     scene
 }
 
-fn frame(scene: &PoolScene, pixmap: &mut Pixmap) -> Frame {
+fn frame(scene: &mut PoolScene, pixmap: &mut Pixmap) -> Frame {
     scene.render(pixmap);
     let mut f = Frame::new(COLS, ROWS);
     f.draw_pixels(pixmap, ColorMode::TrueColor);
@@ -44,10 +44,10 @@ fn frame(scene: &PoolScene, pixmap: &mut Pixmap) -> Frame {
 fn encoder(c: &mut Criterion) {
     let mut scene = scene();
     let mut pixmap = Pixmap::new(scene.width(), scene.height()).unwrap();
-    let a = frame(&scene, &mut pixmap);
+    let a = frame(&mut scene, &mut pixmap);
     scene.step();
     scene.step();
-    let b = frame(&scene, &mut pixmap);
+    let b = frame(&mut scene, &mut pixmap);
     let options = EncodeOptions::default();
     let mut shown_a = Shown::UNKNOWN;
     let mut out = Vec::with_capacity(1 << 20);
@@ -81,12 +81,12 @@ fn encoder(c: &mut Criterion) {
     group.bench_function("render_encode_160x48", |bench| {
         bench.iter(|| {
             n += 1;
-            if n % 30 == 0 {
+            if n.is_multiple_of(30) {
                 scene.drop_stone(Stone { x: (n * 37 % 160) as i32, y: (n * 17 % 94) as i32, radius: 3, weight: 64 });
             }
             scene.step();
             scene.step();
-            let f = frame(&scene, &mut pixmap);
+            let f = frame(&mut scene, &mut pixmap);
             out.clear();
             encode_into(&mut shown, &f, options, &mut out);
             out.len()

@@ -41,6 +41,20 @@ pub enum Command {
     Render(RenderCommand),
     /// Play with the water full-screen in this terminal: keys and the mouse drop stones.
     Play(PlayCommand),
+    /// Measure how fast this machine runs tidepool, stage by stage (a few seconds).
+    Bench(BenchArgs),
+}
+
+/// `tidepool bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Seconds to spend on each workload (the median of the runs is reported).
+    #[arg(long, value_name = "S", default_value_t = 0.4, value_parser = parse_seconds)]
+    pub seconds: f64,
+
+    /// The terminal picture to measure, in pixels (columns x 2 per row).
+    #[arg(long, value_name = "WxH", default_value = "160x94", value_parser = parse_size)]
+    pub terminal: Size,
 }
 
 const PLAY_KEYS: &str = "\
@@ -169,13 +183,13 @@ pub enum RenderScene {
 pub struct RenderPool {
     /// Simulation steps before the picture is taken; waves travel about 0.7 px per step.
     /// [default: 90; fewer (at least 30) when the smaller side is under 360 pixels]
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub steps: Option<u64>,
 
     /// Drop a stone at step 0: centre X,Y in pixels (outside the picture is clipped), radius R
     /// in pixels (1..=1000, default 8) and weight W (1..=32767, default 64). Repeat the flag for
     /// more stones; any explicit stone replaces the default ones.
-    #[arg(long = "stone", value_name = "X,Y[,R[,W]]", value_parser = parse_stone)]
+    #[arg(long = "stone", value_name = "X,Y[,R[,W]]", value_parser = parse_stone, allow_hyphen_values = true)]
     pub stones: Vec<Stone>,
 
     /// The water.
@@ -189,7 +203,7 @@ pub struct RenderPool {
     /// Re-simulate a session recorded with `tidepool play --record FILE` and render its last
     /// step (or --steps N): identical to a screenshot taken at that step. The replay fixes the
     /// size, seed, stones and water flags.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "refraction", "no_shading", "background"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
     pub replay: Option<PathBuf>,
 }
 
@@ -202,7 +216,7 @@ pub struct OutputArgs {
     pub size: Option<Size>,
 
     /// Seed for everything random (rain, phases); the same seed and flags give the same bytes.
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    #[arg(long, value_name = "N", default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
 
     /// Output file, or - for standard output. The format follows the extension: .png, or
@@ -218,6 +232,11 @@ pub struct OutputArgs {
     /// value = height + 32768; pool heights are raw amplitudes). Row 0 is the top of the picture.
     #[arg(long, value_name = "FILE")]
     pub heightmap: Option<PathBuf>,
+
+    /// Print how long each stage took (simulation, picture, encoding, writing) to standard
+    /// error, with throughput.
+    #[arg(long)]
+    pub stats: bool,
 }
 
 /// Flags of the ripple pool, shared by `render pool` and the player.
@@ -225,28 +244,56 @@ pub struct OutputArgs {
 pub struct PoolArgs {
     /// Raindrops per simulation step on average (radius 2, weight 64), a number >= 0.
     /// [default: 0 for render]
-    #[arg(long, value_name = "RATE", value_parser = parse_rate)]
+    #[arg(long, value_name = "RATE", value_parser = parse_rate, allow_negative_numbers = true)]
     pub rain: Option<f64>,
 
     /// Damping: each step the water loses 1/2^SHIFT of its amplitude (SHIFT 1..=15; higher
     /// calms more slowly), or `off` for none.
-    #[arg(long, value_name = "SHIFT|off", default_value = "5", value_parser = parse_damping)]
+    #[arg(long, value_name = "SHIFT|off", default_value = "5", value_parser = parse_damping, allow_negative_numbers = true)]
     pub damping: Damping,
 
     /// How far the surface slope displaces the floor: 1.0 is the papers' factor, 0 shows the
     /// floor undistorted, `auto` scales with the picture (its smaller side / 720, between 0.15
     /// and 1) so ripples read as ripples at every size.
-    #[arg(long, value_name = "F|auto", default_value = "auto", value_parser = parse_refraction)]
+    #[arg(long, value_name = "F|auto", default_value = "auto", value_parser = parse_refraction, allow_negative_numbers = true)]
     pub refraction: crate::render::pool::Refraction,
 
-    /// Do not light the slopes (by default slopes facing the upper left are brightened).
+    /// Do not light the surface (by default flanks facing the sun are brightened, the others
+    /// darkened, and crests tilted towards the sun glint).
     #[arg(long)]
     pub no_shading: bool,
+
+    /// Do not draw caustics (the moving lines of focused sunlight on the floor).
+    #[arg(long)]
+    pub no_caustics: bool,
+
+    /// Water depth in pixels: deeper water focuses the caustics into sharper, brighter lines
+    /// and moves them further from the ripples that cast them (0..=10000).
+    #[arg(long, value_name = "PIXELS", default_value_t = 24.0, value_parser = parse_depth)]
+    pub depth: f32,
+
+    /// Where the sun is: azimuth in degrees clockwise from north (the top of the picture) and
+    /// elevation in degrees above the horizon (0..=90).
+    #[arg(long, value_name = "AZ_DEG,EL_DEG", default_value = "315,60", value_parser = parse_sun, allow_hyphen_values = true)]
+    pub sun: crate::render::pool::Sun,
 
     /// The pool floor: a PNG or JPEG, scaled to cover the picture (aspect kept, centred).
     /// [default: the built-in tiled floor]
     #[arg(long, value_name = "FILE")]
     pub background: Option<PathBuf>,
+}
+
+impl PoolArgs {
+    /// The look these flags ask for.
+    pub fn look(&self) -> crate::render::pool::PoolLook {
+        use crate::render::caustics::CausticsLook;
+        crate::render::pool::PoolLook {
+            refraction: self.refraction,
+            shading: !self.no_shading,
+            caustics: (!self.no_caustics).then(|| CausticsLook { depth_px: self.depth, ..CausticsLook::default() }),
+            sun: self.sun,
+        }
+    }
 }
 
 /// A picture size in pixels.
@@ -352,6 +399,41 @@ pub fn parse_damping(text: &str) -> Result<Damping, String> {
         .ok()
         .and_then(Damping::shift)
         .ok_or_else(|| format!("the shift {shift} is outside 1..=15 (5 is the papers'); use 'off' for no damping"))
+}
+
+/// Parses a water depth in pixels, 0..=10000.
+pub fn parse_depth(text: &str) -> Result<f32, String> {
+    let v: f32 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of pixels; e.g. 48"))?;
+    if !v.is_finite() || !(0.0..=10_000.0).contains(&v) {
+        return Err(format!("'{text}' must be between 0 and 10000 pixels"));
+    }
+    Ok(v)
+}
+
+/// Parses `AZIMUTH,ELEVATION` in degrees: any finite azimuth (wrapped to 0..360), elevation
+/// 0..=90.
+pub fn parse_sun(text: &str) -> Result<crate::render::pool::Sun, String> {
+    let hint = "write it as AZIMUTH,ELEVATION in degrees, e.g. 315,60";
+    let (az, el) = text.split_once(',').ok_or_else(|| format!("expected two numbers; {hint}"))?;
+    let number = |s: &str, name: &str| -> Result<f32, String> {
+        let v: f32 = s.trim().parse().map_err(|_| format!("the {name} '{}' is not a number; {hint}", s.trim()))?;
+        if v.is_finite() { Ok(v) } else { Err(format!("the {name} must be finite; {hint}")) }
+    };
+    let azimuth = number(az, "azimuth")?.rem_euclid(360.0);
+    let elevation = number(el, "elevation")?;
+    if !(0.0..=90.0).contains(&elevation) {
+        return Err(format!("the elevation {elevation} is outside 0..=90 degrees; {hint}"));
+    }
+    Ok(crate::render::pool::Sun { azimuth_deg: azimuth, elevation_deg: elevation })
+}
+
+/// Parses a duration in seconds, 0.01..=60.
+pub fn parse_seconds(text: &str) -> Result<f64, String> {
+    let v: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of seconds; e.g. 0.5"))?;
+    if !v.is_finite() || !(0.01..=60.0).contains(&v) {
+        return Err(format!("'{text}' must be between 0.01 and 60 seconds"));
+    }
+    Ok(v)
 }
 
 /// Parses a finite number >= 0.
@@ -462,6 +544,11 @@ mod tests {
         for bad in ["-1", "NaN", "inf", "x", "1e9"] {
             assert!(parse_rate(bad).is_err(), "{bad}");
         }
+        assert_eq!(parse_sun("-45, 30").map(|s| (s.azimuth_deg, s.elevation_deg)), Ok((315.0, 30.0)));
+        for bad in ["45", "45,91", "45,-1", "x,30", "inf,30", "45,30,1"] {
+            assert!(parse_sun(bad).is_err(), "{bad}");
+        }
+        assert!(parse_depth("-1").is_err() && parse_depth("nan").is_err() && parse_depth("48").is_ok());
         assert!(parse_refraction("auto").is_ok());
         assert!(parse_refraction("0").is_ok());
         for bad in ["-0.5", "nan", "1e9", "fast"] {

@@ -14,6 +14,7 @@ pub mod cli;
 pub mod commands;
 pub mod error;
 pub mod output;
+pub mod progress;
 pub mod render;
 pub mod replay;
 pub mod scene;

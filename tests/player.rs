@@ -164,7 +164,7 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     assert!(replay.entries.iter().any(|e| e.event == Event::Resize([30, 18])));
 
     // The picture on screen before the resize is the replay at the screenshot.
-    let scene = tidepool::commands::replay::simulate(&path, &replay, Some(step)).unwrap();
+    let mut scene = tidepool::commands::replay::simulate(&path, &replay, Some(step)).unwrap();
     let expected = scene.snapshot();
     let mut compared = 0;
     for y in 0..22 {

@@ -1,5 +1,6 @@
 //! The subcommands: validated flags in, files and terminal output out.
 
+pub mod bench;
 pub mod play;
 pub mod render;
 pub mod replay;
@@ -23,6 +24,7 @@ pub fn run(cli: Cli) -> Result<()> {
     crate::signals::install();
     match cli.command {
         Some(Command::Render(render)) => render::run(render),
+        Some(Command::Bench(args)) => bench::run(args),
         Some(Command::Play(play)) => play::run(play),
         None => match <Cli as clap::Parser>::try_parse_from(["tidepool", "play"]) {
             Ok(Cli { command: Some(Command::Play(play)) }) => play::run(play),

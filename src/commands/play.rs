@@ -10,7 +10,6 @@ use crate::error::{Error, Result};
 use crate::output::color::ColorMode;
 use crate::output::diff::EncodeOptions;
 use crate::render::background;
-use crate::render::pool::PoolLook;
 use crate::scene::playable::Playable;
 use crate::scene::pool::{PoolScene, PoolSettings};
 use crate::term::app::{self, PlayerConfig, SceneFactory};
@@ -42,12 +41,8 @@ pub fn run(command: PlayCommand) -> Result<()> {
         None => background::pool_floor(),
     };
     let rain = command.pool.rain.unwrap_or(DEFAULT_PLAYER_RAIN);
-    let settings = PoolSettings {
-        damping: command.pool.damping,
-        rain_rate: rain,
-        seed: command.seed,
-        look: PoolLook { refraction: command.pool.refraction, shading: !command.pool.no_shading },
-    };
+    let settings =
+        PoolSettings { damping: command.pool.damping, rain_rate: rain, seed: command.seed, look: command.pool.look() };
     let make: SceneFactory = Box::new(move |kind, width, height| match kind {
         PlayScene::Pool => PoolScene::new(width, height, floor.clone(), settings)
             .map(|scene| Box::new(scene) as Box<dyn Playable>)

@@ -112,7 +112,7 @@ impl Screen {
             return None;
         }
         let cell = self.cell(x, y / 2);
-        let upper = y % 2 == 0;
+        let upper = y.is_multiple_of(2);
         match cell.ch {
             '\u{2580}' => {
                 if upper {

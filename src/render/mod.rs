@@ -2,4 +2,5 @@
 //! decoding image files the user names.
 
 pub mod background;
+pub mod caustics;
 pub mod pool;

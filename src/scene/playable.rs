@@ -58,7 +58,7 @@ pub trait Playable {
     fn step(&mut self);
 
     /// Draws the current state into `out`, which has the scene's size.
-    fn render(&self, out: &mut Pixmap);
+    fn render(&mut self, out: &mut Pixmap);
 
     /// The events an action causes now (empty when it means nothing to this scene).
     fn resolve(&self, action: Action) -> Vec<Event>;

@@ -2,3 +2,4 @@
 
 pub mod rain;
 pub mod ripple;
+pub mod stepper;
