@@ -25,7 +25,11 @@ fn count(haystack: &[u8], needle: &[u8]) -> usize {
 #[ignore = "a 12-second measurement; run it with --ignored --nocapture in --release"]
 fn bytes_per_frame_against_the_naive_redraw() {
     let dir = temp_dir("bytes-per-frame");
-    let mut p = Player::spawn(&dir, COLS, ROWS, &["play"], &[]);
+    // MEASURE_ARGS="--damping 5" compares other settings against the defaults;
+    // MEASURE_DUMP=FILE keeps the measured bytes for a closer look.
+    let extra = std::env::var("MEASURE_ARGS").unwrap_or_default();
+    let args: Vec<&str> = std::iter::once("play").chain(extra.split_whitespace()).collect();
+    let mut p = Player::spawn(&dir, COLS, ROWS, &args, &[]);
     p.wait_for(SYNC_END, 0, Duration::from_secs(20));
     let start = Instant::now();
     let (mut from, mut to) = (0, 0);
@@ -44,11 +48,14 @@ fn bytes_per_frame_against_the_naive_redraw() {
     assert_eq!(p.wait_exit(Duration::from_secs(20)).exit_code(), 0);
     let out = p.output();
     let window = &out[from..to];
+    if let Some(path) = std::env::var_os("MEASURE_DUMP") {
+        std::fs::write(path, window).unwrap();
+    }
     let frames = count(window, SYNC_BEGIN);
     let per_frame = window.len() / frames.max(1);
     let percent = 100.0 * per_frame as f64 / NAIVE_BYTES_PER_FRAME as f64;
     println!(
-        "160x48, 8 s after a 4 s warm-up: {} bytes in {frames} frames ({:.1} frames/s sent), {per_frame} bytes/frame = {percent:.1}% of the naive {NAIVE_BYTES_PER_FRAME}, {:.0} kB/s",
+        "{args:?} 160x48, 8 s after a 4 s warm-up: {} bytes in {frames} frames ({:.1} frames/s sent), {per_frame} bytes/frame = {percent:.1}% of the naive {NAIVE_BYTES_PER_FRAME}, {:.0} kB/s",
         window.len(),
         frames as f64 / 8.0,
         window.len() as f64 / 8.0 / 1000.0

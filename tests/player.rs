@@ -151,9 +151,9 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     let stones: Vec<Stone> =
         replay.entries.iter().filter_map(|e| if let Event::Stone(s) = e.event { Some(s) } else { None }).collect();
     assert_eq!(stones.len(), 4, "{:?}", replay.entries);
-    assert_eq!(stones[1], Stone { x: 9, y: 4, radius: 3, weight: 64 }, "left click: the cell's upper pixel");
-    assert_eq!(stones[2], Stone { x: 29, y: 14, radius: 6, weight: 128 }, "right click: a big stone");
-    assert_eq!(stones[3], Stone { x: 26, y: 8, radius: 3, weight: 64 }, "aim: centre (20, 10) + 3 columns, 1 row up");
+    assert_eq!(stones[1], Stone { x: 9, y: 4, radius: 3, weight: 48 }, "left click: the cell's upper pixel");
+    assert_eq!(stones[2], Stone { x: 29, y: 14, radius: 6, weight: 96 }, "right click: a big stone");
+    assert_eq!(stones[3], Stone { x: 26, y: 8, radius: 3, weight: 48 }, "aim: centre (20, 10) + 3 columns, 1 row up");
     let step = replay.entries[0].step;
     assert!(replay.entries.iter().all(|e| e.step == step), "paused: every event at one step");
     let shot = replay

@@ -37,9 +37,11 @@ pub struct PoolScene {
 
 /// The rain rate the player's `r` key switches on when the pool started without rain.
 pub const DEFAULT_TOGGLE_RAIN: f64 = 0.02;
-/// The weight of a stone dropped by the player: the papers' raindrop weight, which reads
-/// clearly at terminal size without setting the whole pool in motion.
-pub const PLAYER_STONE_WEIGHT: i16 = 64;
+/// The weight of a stone dropped by the player. At terminal size a ring of weight 48 still
+/// reads clearly, and every changed cell costs ~36 bytes in exact truecolor, so a heavier
+/// default stone would set the whole pool in motion and cost every frame (measured: the
+/// README's bytes-per-frame figure).
+pub const PLAYER_STONE_WEIGHT: i16 = 48;
 /// A right click drops a stone this many times wider and twice as heavy.
 pub const BIG_STONE_FACTOR: u32 = 2;
 /// Stirring drops small light stones this many pixels apart along the drag.
@@ -294,7 +296,7 @@ mod tests {
     fn actions_resolve_to_events_that_apply() {
         let mut scene = PoolScene::new(40, 30, background::pool_floor(), settings(0.0)).unwrap();
         let events = scene.resolve(Action::Stone { x: 10, y: 12, radius: 3, big: true });
-        assert_eq!(events, vec![Event::Stone(Stone { x: 10, y: 12, radius: 6, weight: 128 })]);
+        assert_eq!(events, vec![Event::Stone(Stone { x: 10, y: 12, radius: 6, weight: 96 })]);
         scene.apply(&events[0]);
         assert!(scene.pool().heights()[12 * 40 + 10] < 0);
         let stir = scene.resolve(Action::Stir { from: (5, 5), to: (15, 5) });
