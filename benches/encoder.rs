@@ -5,6 +5,10 @@
 //!   render, cells, diff encode (the issue asks for >= 120 of these a second on one core).
 //!
 //!     cargo bench --bench encoder
+//!
+//! Medians on the 2-core development machine, pinned to one core
+//! (`RAYON_NUM_THREADS=1 taskset -c 0 cargo bench --bench encoder`): full frame 335 µs,
+//! diff frame 42 µs, render + encode 462 µs (about 2,160 frames a second).
 
 use std::hint::black_box;
 

@@ -243,7 +243,7 @@ pub struct OutputArgs {
 #[derive(Args, Debug, Clone)]
 pub struct PoolArgs {
     /// Raindrops per simulation step on average (radius 2, weight 64), a number >= 0.
-    /// [default: 0 for render]
+    /// [default: 0 for render, 0.02 for play]
     #[arg(long, value_name = "RATE", value_parser = parse_rate, allow_negative_numbers = true)]
     pub rain: Option<f64>,
 

@@ -20,6 +20,11 @@ pub const DEFAULT_PLAYER_RAIN: f64 = 0.02;
 /// saves the bytes of colours that only flicker by a step or two.
 pub const SSH_COLOR_THRESHOLD: u8 = 3;
 
+/// `--color-threshold` when not given: 0 (exact) locally, [`SSH_COLOR_THRESHOLD`] over SSH.
+pub fn default_threshold(ssh_connection: Option<&str>) -> u8 {
+    if ssh_connection.is_some_and(|v| !v.trim().is_empty()) { SSH_COLOR_THRESHOLD } else { 0 }
+}
+
 /// Runs the player.
 pub fn run(command: PlayCommand) -> Result<()> {
     if !std::io::stdout().is_terminal() {
@@ -34,8 +39,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
         ColorChoice::Palette256 => ColorMode::Palette256,
         ColorChoice::Palette16 => ColorMode::Palette16,
     };
-    let over_ssh = env("SSH_CONNECTION").is_some_and(|v| !v.is_empty());
-    let threshold = command.color_threshold.unwrap_or(if over_ssh { SSH_COLOR_THRESHOLD } else { 0 });
+    let threshold = command.color_threshold.unwrap_or(default_threshold(env("SSH_CONNECTION").as_deref()));
     let floor = match &command.pool.background {
         Some(path) => background::load("--background", path)?,
         None => background::pool_floor(),
@@ -57,4 +61,16 @@ pub fn run(command: PlayCommand) -> Result<()> {
         record: command.record.clone().map(|path| (path, super::replay::pool_options(&command.pool, rain))),
     };
     app::run(command.scene, make, config)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn threshold_is_exact_locally_and_3_over_ssh() {
+        assert_eq!(default_threshold(None), 0);
+        assert_eq!(default_threshold(Some("")), 0);
+        assert_eq!(default_threshold(Some("10.0.0.1 52000 10.0.0.2 22")), 3);
+    }
 }

@@ -5,6 +5,11 @@
 //! motion, so a moving mouse sends nothing; a drag still produces an event per cell crossed,
 //! which [`coalesce`] reduces to the latest position per batch (the stir interpolates the
 //! path), as it does for bursts of resize events.
+//!
+//! A click means the upper pixel of the clicked cell. SGR-pixels reporting (mode 1016) is not
+//! turned on: crossterm reports its pixel coordinates as if they were cells, nothing tells the
+//! two apart without a mode query crossterm cannot parse, and tmux does not pass it through; a
+//! half-cell of precision is not worth a click landing in the wrong place.
 
 use crossterm::event::{Event, KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
 
