@@ -207,3 +207,18 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     }
     assert!(resized.row_text(9).contains("pool"), "the status line moved to the new last row");
 }
+
+/// `--max-bps` lowers the frame rate so the output fits the budget, however busy the water.
+#[test]
+fn max_bps_caps_the_output_rate() {
+    let mut p = started("max-bps", &["--rain", "2", "--max-bps", "20k"], &[]);
+    std::thread::sleep(Duration::from_millis(1000));
+    let from = p.len();
+    std::thread::sleep(Duration::from_millis(3000));
+    let window = p.len() - from;
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+    // 3 s at 20 kB/s, plus at most one frame of slack (a 40x12 frame is under 20 kB).
+    assert!(window <= 3 * 20_000 + 20_000, "{window} bytes in 3 s");
+    assert!(window >= 3 * 20_000 / 4, "busy water still uses the budget: {window} bytes in 3 s");
+}
