@@ -555,4 +555,47 @@ mod tests {
             assert!(parse_refraction(bad).is_err(), "{bad}");
         }
     }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            /// No text makes a parser panic; every answer is a value or a message.
+            #[test]
+            fn parsers_never_panic(text in "\\PC{0,40}") {
+                let _ = parse_size(&text);
+                let _ = parse_stone(&text);
+                let _ = parse_damping(&text);
+                let _ = parse_rate(&text);
+                let _ = parse_refraction(&text);
+                let _ = parse_sun(&text);
+                let _ = parse_depth(&text);
+                let _ = parse_seconds(&text);
+            }
+
+            /// Sizes within the limits round-trip; anything past a limit is refused.
+            #[test]
+            fn sizes_round_trip_within_the_limits(w in 1u32..=20_000, h in 1u32..=20_000) {
+                let parsed = parse_size(&format!("{w}x{h}"));
+                let fits = w <= MAX_SIDE && h <= MAX_SIDE && u64::from(w) * u64::from(h) <= MAX_PIXELS;
+                prop_assert_eq!(parsed.is_ok(), fits);
+                if let Ok(size) = parsed {
+                    prop_assert_eq!((size.width, size.height), (w, h));
+                }
+            }
+
+            /// Stones round-trip, with the documented defaults and ranges.
+            #[test]
+            fn stones_round_trip(x in any::<i32>(), y in any::<i32>(), r in -5i64..1100, wt in -5i64..33_000) {
+                let parsed = parse_stone(&format!("{x},{y},{r},{wt}"));
+                let valid = (1..=1000).contains(&r) && (1..=32767).contains(&wt);
+                prop_assert_eq!(parsed.is_ok(), valid);
+                if let Ok(stone) = parsed {
+                    prop_assert_eq!(stone, Stone { x, y, radius: r as u32, weight: wt as i16 });
+                }
+                prop_assert_eq!(parse_stone(&format!("{x},{y}")), Ok(Stone { x, y, radius: 8, weight: 64 }));
+            }
+        }
+    }
 }

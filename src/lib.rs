@@ -20,6 +20,7 @@ pub mod replay;
 pub mod scene;
 pub mod signals;
 pub mod sim;
+pub mod simd;
 pub mod term;
 
 pub use error::{Error, Result};

@@ -61,7 +61,7 @@ pub fn decode(bytes: &[u8]) -> Result<Pixmap, String> {
         image::ImageError::Limits(_) => {
             format!("the image is larger than {MAX_IMAGE_SIDE}x{MAX_IMAGE_SIDE} pixels; scale it down")
         }
-        other => format!("cannot decode the image ({other})"),
+        other => format!("cannot decode the image ({})", one_line(&other.to_string())),
     })?;
     let rgba = image.to_rgba8();
     let (width, height) = rgba.dimensions();
@@ -74,6 +74,11 @@ pub fn decode(bytes: &[u8]) -> Result<Pixmap, String> {
             .expect("opaque pixels are always valid");
     }
     Ok(pixmap)
+}
+
+/// The decoder's message on one line (some carry newlines), trimmed.
+fn one_line(message: &str) -> String {
+    message.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
 /// Scales `source` to cover a `width x height` pixmap (keeping its aspect ratio, centred, the

@@ -15,6 +15,8 @@
 //! stencils cancel it exactly (the papers' refraction offsets have the same property). The
 //! result is a multiplier per cell (1 = flat water) in 8.8 fixed point.
 
+use crate::simd::Simd;
+
 /// Amplitude units per pixel of surface height: a weight-64 stone makes a dent one pixel deep.
 pub const AMPLITUDE_PER_PIXEL: f32 = 64.0;
 /// Water's refractive index.
@@ -99,11 +101,16 @@ impl LightMap {
         let rows_per_task = if parallel { ((1 << 15) / width / step).max(16) } else { rows };
         let tasks = rows.div_ceil(rows_per_task);
         self.windows.resize_with(tasks, Window::default);
+        let simd = Simd::detect();
         let run = |(task, (chunk, window)): (usize, (&mut [u8], &mut Window))| {
-            window.reset(cols);
-            for (i, out) in chunk.chunks_exact_mut(cols).enumerate() {
-                let [up, mid, down] = window.rows_around(&field, task * rows_per_task + i);
-                light_row(up, mid, down, k, look.strength, out);
+            let task = Task { field: &field, first_row: task * rows_per_task, k, strength: look.strength };
+            match simd {
+                // SAFETY: the variants are only returned after run-time detection of the feature.
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx512 => unsafe { task.run_avx512(window, chunk) },
+                #[cfg(target_arch = "x86_64")]
+                Simd::Avx2 => unsafe { task.run_avx2(window, chunk) },
+                _ => task.run(window, chunk),
             }
         };
         if parallel {
@@ -126,6 +133,38 @@ struct Field<'a> {
     step: usize,
 }
 
+/// One parallel task: a run of light-map rows.
+struct Task<'a> {
+    field: &'a Field<'a>,
+    first_row: usize,
+    k: f32,
+    strength: f32,
+}
+
+impl Task<'_> {
+    #[inline(always)]
+    fn run(&self, window: &mut Window, chunk: &mut [u8]) {
+        let cols = self.field.width.div_ceil(self.field.step);
+        window.reset(cols);
+        for (i, out) in chunk.chunks_exact_mut(cols).enumerate() {
+            let [up, mid, down] = window.rows_around(self.field, self.first_row + i);
+            light_row(up, mid, down, self.k, self.strength, out);
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn run_avx2(&self, window: &mut Window, chunk: &mut [u8]) {
+        self.run(window, chunk)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx512f,avx512bw")]
+    fn run_avx512(&self, window: &mut Window, chunk: &mut [u8]) {
+        self.run(window, chunk)
+    }
+}
+
 /// Slots in the ring of heights smoothed along rows (five are read at once, plus reuse).
 const ACROSS_SLOTS: usize = 8;
 /// Slots in the ring of fully smoothed rows (three are read at once).
@@ -138,10 +177,13 @@ struct Window {
     across_keys: [Option<usize>; ACROSS_SLOTS],
     smooth: Vec<i32>,
     smooth_keys: [Option<usize>; SMOOTH_SLOTS],
+    /// One pool row smoothed along itself at full resolution, before decimation.
+    full_row: Vec<i32>,
     cols: usize,
 }
 
 impl Window {
+    #[inline(always)]
     fn reset(&mut self, cols: usize) {
         self.cols = cols;
         self.across.resize(ACROSS_SLOTS * cols, 0);
@@ -151,6 +193,7 @@ impl Window {
     }
 
     /// The smoothed light-map rows j-1, j and j+1 (edges repeated).
+    #[inline(always)]
     fn rows_around(&mut self, field: &Field<'_>, j: usize) -> [&[i32]; 3] {
         let wanted = [j.saturating_sub(1), j, (j + 1).min(field.rows - 1)];
         for r in wanted {
@@ -164,6 +207,7 @@ impl Window {
     }
 
     /// Makes light-map row `r` ([1 4 6 4 1] down the columns at pool row r·step) present.
+    #[inline(always)]
     fn ensure_smooth(&mut self, field: &Field<'_>, r: usize) {
         let slot = r % SMOOTH_SLOTS;
         if self.smooth_keys[slot] == Some(r) {
@@ -187,6 +231,7 @@ impl Window {
     }
 
     /// Makes pool row `y`, smoothed along the row at every `step`-th column, present.
+    #[inline(always)]
     fn ensure_across(&mut self, field: &Field<'_>, y: usize) {
         let slot = y % ACROSS_SLOTS;
         if self.across_keys[slot] == Some(y) {
@@ -194,11 +239,24 @@ impl Window {
         }
         let w = field.width;
         let row = &field.heights[y * w..(y + 1) * w];
+        // The whole row first, in a loop the compiler vectorizes, then every `step`-th value.
+        self.full_row.resize(w, 0);
+        let full = &mut self.full_row;
         let at = |x: isize| i32::from(row[x.clamp(0, w as isize - 1) as usize]);
+        for x in (0..w.min(2)).chain(w.saturating_sub(2).max(2)..w) {
+            let x = x as isize;
+            full[x as usize] = at(x - 2) + 4 * at(x - 1) + 6 * at(x) + 4 * at(x + 1) + at(x + 2);
+        }
+        if w > 4 {
+            let taps = |d: usize| row[d..d + w - 4].iter().map(|&v| i32::from(v));
+            let inner = full[2..w - 2].iter_mut().zip(taps(0).zip(taps(1)).zip(taps(2)).zip(taps(3)).zip(taps(4)));
+            for (v, ((((a, b), c), d), e)) in inner {
+                *v = a + 4 * b + 6 * c + 4 * d + e;
+            }
+        }
         let out = &mut self.across[slot * self.cols..(slot + 1) * self.cols];
-        for (i, v) in out.iter_mut().enumerate() {
-            let x = (i * field.step) as isize;
-            *v = at(x - 2) + 4 * at(x - 1) + 6 * at(x) + 4 * at(x + 1) + at(x + 2);
+        for (v, &f) in out.iter_mut().zip(full.iter().step_by(field.step)) {
+            *v = f;
         }
         self.across_keys[slot] = Some(y);
     }
@@ -208,19 +266,32 @@ impl Window {
 #[inline(always)]
 fn light_row(up: &[i32], mid: &[i32], down: &[i32], k: f32, strength: f32, out: &mut [u8]) {
     let w = out.len();
-    for (x, light) in out.iter_mut().enumerate() {
-        let (l, r) = (x.saturating_sub(1), (x + 1).min(w - 1));
-        let centre = 2 * mid[x];
-        let hxx = mid[l] + mid[r] - centre;
-        let hyy = up[x] + down[x] - centre;
-        let hxy = (down[r] - down[l] - up[r] + up[l]) / 4;
-        let (a, b, c) = (k * hxx as f32, k * hyy as f32, k * hxy as f32);
-        let det = (1.0 + a) * (1.0 + b) - c * c;
-        // Where det crosses zero the rays cross: the caustic line itself. Soften the pole.
-        let focus = 1.0 / det.abs().max(1.0 / MAX_GAIN);
-        let gain = (1.0 + strength * (focus - 1.0)).clamp(MIN_GAIN, MAX_GAIN);
-        *light = (gain * f32::from(UNIT_GAIN)).round() as u8;
+    let rows = [up, mid, down];
+    for x in (0..w.min(1)).chain(w.saturating_sub(1).max(1)..w) {
+        out[x] = light_at(rows, x.saturating_sub(1), x, (x + 1).min(w - 1), k, strength);
     }
+    // The interior without clamping, so the compiler can vectorize it (an index loop: the
+    // iterator form of the same loop measured 25 % more instructions per frame).
+    #[allow(clippy::needless_range_loop)]
+    for x in 1..w.saturating_sub(1) {
+        out[x] = light_at(rows, x - 1, x, x + 1, k, strength);
+    }
+}
+
+/// The light at column `x` with neighbours `l` and `r`: `1 / |det J|`, softened and mixed
+/// with the ambient light.
+#[inline(always)]
+fn light_at([up, mid, down]: [&[i32]; 3], l: usize, x: usize, r: usize, k: f32, strength: f32) -> u8 {
+    let centre = 2 * mid[x];
+    let hxx = mid[l] + mid[r] - centre;
+    let hyy = up[x] + down[x] - centre;
+    let hxy = (down[r] - down[l] - up[r] + up[l]) / 4;
+    let (a, b, c) = (k * hxx as f32, k * hyy as f32, k * hxy as f32);
+    let det = (1.0 + a) * (1.0 + b) - c * c;
+    // Where det crosses zero the rays cross: the caustic line itself. Soften the pole.
+    let focus = 1.0 / det.abs().max(1.0 / MAX_GAIN);
+    let gain = (1.0 + strength * (focus - 1.0)).clamp(MIN_GAIN, MAX_GAIN);
+    (gain * f32::from(UNIT_GAIN) + 0.5) as u8
 }
 
 #[cfg(test)]
