@@ -29,7 +29,7 @@ Examples:
 #[derive(Parser, Debug)]
 #[command(name = "tidepool", version, about = ABOUT, after_help = EXAMPLES)]
 pub struct Cli {
-    /// What to do; without one, tidepool shows how to get started.
+    /// What to do; without one, tidepool plays the pool in this terminal (`tidepool play`).
     #[command(subcommand)]
     pub command: Option<Command>,
 }
@@ -39,6 +39,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene headless to a PNG file or half-block text (no terminal needed).
     Render(RenderCommand),
+    /// Play with the water full-screen in this terminal: keys and the mouse drop stones.
+    Play(PlayCommand),
     /// Measure how fast this machine runs tidepool, stage by stage (a few seconds).
     Bench(BenchArgs),
 }
@@ -53,6 +55,110 @@ pub struct BenchArgs {
     /// The terminal picture to measure, in pixels (columns x 2 per row).
     #[arg(long, value_name = "WxH", default_value = "160x94", value_parser = parse_size)]
     pub terminal: Size,
+}
+
+const PLAY_KEYS: &str = "\
+Keys: space stone at random · arrows/hjkl aim, enter drop · r rain · c clear · +/- stone size ·
+[/] damping · p pause · s screenshot (PNG) · tab next scene · ? help · q, Esc, Ctrl-C quit.
+Mouse: left click drops a stone, drag stirs the water, right click drops a big stone.
+
+Examples:
+  tidepool                                      # the pool, full screen
+  tidepool play pool --rain 0.1 --damping 6     # more rain, longer ripples
+  tidepool play --max-bps 200k                  # a slow SSH link: cap the output rate
+  tidepool play --record s.jsonl                # then: tidepool render pool --replay s.jsonl";
+
+/// `tidepool play [scene]`.
+///
+/// The player damps more than `render` (shift 4, not 5): a terminal pool is a few hundred
+/// pixels at most, and at the papers' damping a ring crosses it twice before it fades, so the
+/// water never settles, looks busy and costs every cell's bytes on every frame.
+#[derive(Args, Debug, Clone)]
+#[command(after_help = PLAY_KEYS, mut_arg("damping", |a| a.default_value(PLAYER_DAMPING)))]
+pub struct PlayCommand {
+    /// The scene to start with (`tab` switches while playing).
+    #[arg(value_enum, default_value = "pool")]
+    pub scene: PlayScene,
+
+    /// The water of the pool. [--rain default: 0.02 drops per step]
+    #[command(flatten)]
+    pub pool: PoolArgs,
+
+    /// Seed for everything random (rain, random stones); the same seed and the same inputs
+    /// give the same water.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub seed: u64,
+
+    /// Display frames per second (1..=240); the simulation runs at its own fixed rate.
+    #[arg(long, value_name = "N", default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=240))]
+    pub fps: u32,
+
+    /// Colours: truecolor (24-bit), 256 (xterm palette), 16, or auto (from COLORTERM and
+    /// TERM; SSH and tmux may hide truecolor support, see the README).
+    #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
+    pub color: ColorChoice,
+
+    /// Treat a colour change of at most N (0..=255, per channel) as no change, to save bytes.
+    /// Screenshots always use exact pixels. [default: 0, or 3 when SSH_CONNECTION is set]
+    #[arg(long, value_name = "N")]
+    pub color_threshold: Option<u8>,
+
+    /// Do not wrap frames in synchronized output (ESC[?2026h/l), for terminals that mishandle it.
+    #[arg(long)]
+    pub no_sync: bool,
+
+    /// Cap the output at N bytes per second (suffixes k and M: 200k, 1.5M) by lowering the
+    /// frame rate, for slow links.
+    #[arg(long, value_name = "N", value_parser = parse_bps)]
+    pub max_bps: Option<u64>,
+
+    /// Record the session as JSON lines, for `tidepool render pool --replay FILE`.
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
+}
+
+/// The player's default `--damping`.
+pub const PLAYER_DAMPING: &str = "4";
+
+/// The scenes `play` knows; `tab` cycles through them in this order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PlayScene {
+    /// The ripple pool.
+    Pool,
+}
+
+/// `--color`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ColorChoice {
+    /// Guess from COLORTERM and TERM.
+    Auto,
+    /// 24-bit colour.
+    Truecolor,
+    /// The xterm 256-colour palette.
+    #[value(name = "256")]
+    Palette256,
+    /// The 16 basic colours.
+    #[value(name = "16")]
+    Palette16,
+}
+
+/// Parses a byte rate: a whole number with an optional `k` (1000) or `M` (1,000,000) suffix.
+pub fn parse_bps(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let (number, unit) = match t.char_indices().last() {
+        Some((i, 'k' | 'K')) => (&t[..i], 1e3),
+        Some((i, 'm' | 'M')) => (&t[..i], 1e6),
+        _ => (t, 1.0),
+    };
+    let v: f64 = number.trim().parse().map_err(|_| format!("'{text}' is not a byte rate; e.g. 200k or 1.5M"))?;
+    let bytes = v * unit;
+    if !bytes.is_finite() || bytes < 1000.0 {
+        return Err(format!("'{text}' is below 1k bytes per second, too little to draw a frame; e.g. 200k"));
+    }
+    if bytes > 1e12 {
+        return Err(format!("'{text}' is beyond any link; leave --max-bps out for no cap"));
+    }
+    Ok(bytes as u64)
 }
 
 /// `tidepool render <scene>`.
@@ -93,6 +199,12 @@ pub struct RenderPool {
     /// The picture and where it goes.
     #[command(flatten)]
     pub output: OutputArgs,
+
+    /// Re-simulate a session recorded with `tidepool play --record FILE` and render its last
+    /// step (or --steps N): identical to a screenshot taken at that step. The replay fixes the
+    /// size, seed, stones and water flags.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
+    pub replay: Option<PathBuf>,
 }
 
 /// Flags every rendered scene takes.
@@ -131,7 +243,7 @@ pub struct OutputArgs {
 #[derive(Args, Debug, Clone)]
 pub struct PoolArgs {
     /// Raindrops per simulation step on average (radius 2, weight 64), a number >= 0.
-    /// [default: 0 for render]
+    /// [default: 0 for render, 0.02 for play]
     #[arg(long, value_name = "RATE", value_parser = parse_rate, allow_negative_numbers = true)]
     pub rain: Option<f64>,
 
@@ -391,6 +503,39 @@ mod tests {
         assert!(parse_damping("0").unwrap_err().contains("use 'off'"));
         assert!(parse_damping("16").is_err());
         assert!(parse_damping("-1").is_err());
+    }
+
+    #[test]
+    fn byte_rates() {
+        assert_eq!(parse_bps("200k"), Ok(200_000));
+        assert_eq!(parse_bps("1.5M"), Ok(1_500_000));
+        assert_eq!(parse_bps("5000"), Ok(5000));
+        for bad in ["", "k", "-5k", "10", "fast", "1e20"] {
+            assert!(parse_bps(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn replay_conflicts_with_what_it_fixes() {
+        let parse = |args: &[&str]| Cli::try_parse_from(["tidepool", "render", "pool"].iter().chain(args));
+        assert!(parse(&["--replay", "r.jsonl", "--out", "x.png", "--steps", "5"]).is_ok());
+        for flag in [&["--size", "10x10"][..], &["--seed", "3"], &["--stone", "1,2"], &["--damping", "4"]] {
+            let err = parse(&[&["--replay", "r.jsonl"][..], flag].concat()).unwrap_err();
+            assert_eq!(err.kind(), clap::error::ErrorKind::ArgumentConflict, "{flag:?}");
+        }
+    }
+
+    #[test]
+    fn play_is_the_default_scene_pool() {
+        let cli = Cli::try_parse_from(["tidepool", "play"]).unwrap();
+        let Some(Command::Play(play)) = cli.command else { panic!("not play") };
+        assert_eq!((play.scene, play.fps, play.color, play.pool.rain), (PlayScene::Pool, 30, ColorChoice::Auto, None));
+        assert_eq!(play.pool.damping, Damping::Shift(4), "the player damps more than render");
+        let cli = Cli::try_parse_from(["tidepool", "render", "pool"]).unwrap();
+        let Some(Command::Render(RenderCommand { scene: RenderScene::Pool(pool) })) = cli.command else { panic!() };
+        assert_eq!(pool.pool.damping, Damping::PAPERS);
+        assert!(Cli::try_parse_from(["tidepool", "play", "--fps", "0"]).is_err());
+        assert!(Cli::try_parse_from(["tidepool", "play", "--color", "256"]).is_ok());
     }
 
     #[test]

@@ -271,6 +271,9 @@ fn default_steps_scale(scale: f32) -> f32 {
 }
 
 fn render_pool(args: RenderPool) -> Result<()> {
+    if let Some(path) = &args.replay {
+        return super::replay::render(&args, path);
+    }
     let plan = OutputPlan::new(&args.output, "pool", std::io::stdout().is_terminal(), terminal_pixels())?;
     let floor = match &args.pool.background {
         Some(path) => background::load("--background", path)?,
