@@ -35,7 +35,57 @@ unsafe impl GlobalAlloc for Counting {
 static ALLOCATOR: Counting = Counting;
 
 #[test]
-fn pool_frames_allocate_nothing_after_warm_up() {
+fn frames_allocate_nothing_after_warm_up() {
+    pool_frames();
+    player_frames();
+}
+
+/// The player's frame path: step, picture, cells with status line and overlays, diff encoding.
+fn player_frames() {
+    use tidepool::output::color::ColorMode;
+    use tidepool::output::diff::{EncodeOptions, Shown, encode_into};
+    use tidepool::scene::playable::Playable;
+    use tidepool::term::screen::{FrameBuilder, Overlay};
+
+    let (cols, rows) = (160u16, 48u16);
+    let (w, h) = tidepool::term::app::picture_size(cols, rows);
+    let settings = PoolSettings { damping: Damping::PAPERS, rain_rate: 0.3, seed: 5, look: PoolLook::default() };
+    let mut scene = PoolScene::new(w, h, background::pool_floor(), settings).unwrap();
+    let mut pixmap = tiny_skia::Pixmap::new(w, h).unwrap();
+    let mut builder = FrameBuilder::default();
+    let mut shown = Shown::UNKNOWN;
+    let mut bytes = Vec::new();
+    let help = tidepool::term::ui::help_lines(&scene.help());
+    let message = String::from("saved tidepool-pool-000123.png");
+    let options = EncodeOptions { threshold: 0, sync: true };
+    let mut run_frames = |frames: u32| {
+        for k in 0..frames {
+            Playable::step(&mut scene);
+            Playable::step(&mut scene);
+            let overlay = Overlay {
+                aim: Some((k % w, 10)),
+                help: (k % 3 == 0).then_some(help.as_slice()),
+                message: (k % 2 == 0).then_some(message.as_str()),
+                fps: 30,
+                bytes_per_second: 1_000_000 + u64::from(k),
+                stone: 3,
+                paused: false,
+            };
+            let frame = builder.build((cols, rows), &mut scene, &mut pixmap, ColorMode::TrueColor, &overlay);
+            bytes.clear();
+            encode_into(&mut shown, frame, options, &mut bytes);
+        }
+    };
+    rayon::scope(|_| {
+        run_frames(10);
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        run_frames(60);
+        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert_eq!(during, 0, "player frames at {cols}x{rows}: {during} allocations in 60 steady-state frames");
+    });
+}
+
+fn pool_frames() {
     // Start every rayon worker first: threads starting up allocate, concurrently with
     // whatever is being measured.
     rayon::broadcast(|_| ());

@@ -64,6 +64,13 @@ impl Frame {
         Frame { cols, rows, cells: vec![Cell::BLANK; cols * rows] }
     }
 
+    /// Makes this a blank `cols x rows` frame, reusing the allocation.
+    pub fn reset(&mut self, cols: usize, rows: usize) {
+        (self.cols, self.rows) = (cols, rows);
+        self.cells.clear();
+        self.cells.resize(cols * rows, Cell::BLANK);
+    }
+
     /// Columns.
     pub fn cols(&self) -> usize {
         self.cols
@@ -95,6 +102,13 @@ impl Frame {
     /// column: only use characters that are one column wide.
     pub fn text(&mut self, x: usize, y: usize, text: &str, fg: Color, bg: Color) {
         for (i, ch) in text.chars().enumerate() {
+            self.set(x + i, y, Cell::Text { ch, fg, bg });
+        }
+    }
+
+    /// Like [`Frame::text`], but at most `max` columns of `text`.
+    pub fn text_clipped(&mut self, x: usize, y: usize, text: &str, max: usize, fg: Color, bg: Color) {
+        for (i, ch) in text.chars().take(max).enumerate() {
             self.set(x + i, y, Cell::Text { ch, fg, bg });
         }
     }

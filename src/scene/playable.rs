@@ -44,7 +44,7 @@ pub enum Action {
 }
 
 /// A scene the terminal player can drive.
-pub trait Playable {
+pub trait Playable: Send {
     /// The scene's name, as `tidepool play NAME` spells it.
     fn name(&self) -> &'static str;
 
@@ -67,7 +67,7 @@ pub trait Playable {
     fn apply(&mut self, event: &Event);
 
     /// A short state summary for the status line, e.g. `rain 0.02 · damping 5`.
-    fn status(&self) -> String;
+    fn status(&self, out: &mut String);
 
     /// The scene's own keys for the help overlay, as (keys, what they do).
     fn help(&self) -> Vec<(&'static str, &'static str)>;

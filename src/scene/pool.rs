@@ -235,9 +235,14 @@ impl Playable for PoolScene {
         }
     }
 
-    fn status(&self) -> String {
-        let rain = if self.rain.rate() > 0.0 { format!("rain {}", self.rain.rate()) } else { "rain off".into() };
-        format!("{rain} \u{b7} damping {}", self.pool.damping())
+    fn status(&self, out: &mut String) {
+        use std::fmt::Write;
+        out.clear();
+        let _ = match self.rain.rate() {
+            rate if rate > 0.0 => write!(out, "rain {rate}"),
+            _ => write!(out, "rain off"),
+        };
+        let _ = write!(out, " \u{b7} damping {}", self.pool.damping());
     }
 
     fn help(&self) -> Vec<(&'static str, &'static str)> {
@@ -313,7 +318,9 @@ mod tests {
         scene.apply(&Event::Resize([20, 10]));
         assert_eq!(Playable::size(&scene), (20, 10));
         assert!(scene.resolve(Action::Key('w')).is_empty());
-        assert!(scene.status().contains("rain 0.02"));
+        let mut status = String::new();
+        scene.status(&mut status);
+        assert!(status.contains("rain 0.02"));
     }
 
     #[test]

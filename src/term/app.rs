@@ -24,8 +24,9 @@ use crate::replay::{Event, Recorder};
 use crate::scene::playable::{Action, Playable};
 use crate::term::guard::{self, TerminalGuard};
 use crate::term::input::{Input, coalesce, map_event};
-use crate::term::pacing::{FramePacer, Meter, SimClock, human_rate};
-use crate::term::ui::{self, MIN_SIZE, Status};
+use crate::term::pacing::{FramePacer, Meter, SimClock};
+use crate::term::screen::{FrameBuilder, Overlay, big_enough};
+use crate::term::ui;
 use crate::term::writer::FrameWriter;
 
 /// Stone radii `+` and `-` step through, in pixels.
@@ -44,7 +45,7 @@ const STONE_SEED_MIX: u64 = 0x5354_4f4e_4553_0001;
 pub const TEST_PANIC_VAR: &str = "TIDEPOOL_TEST_PANIC";
 
 /// Makes a scene of a kind at a size in pixels (used at start, on `tab`).
-pub type SceneFactory = Box<dyn FnMut(PlayScene, u32, u32) -> Result<Box<dyn Playable>>>;
+pub type SceneFactory = Box<dyn FnMut(PlayScene, u32, u32) -> Result<Box<dyn Playable>> + Send>;
 
 /// How the player runs.
 #[derive(Clone, Debug)]
@@ -68,10 +69,6 @@ pub fn picture_size(cols: u16, rows: u16) -> (u32, u32) {
     (u32::from(cols).max(3), (2 * u32::from(rows).saturating_sub(1)).max(3))
 }
 
-fn big_enough((cols, rows): (u16, u16)) -> bool {
-    cols >= MIN_SIZE.0 && rows >= MIN_SIZE.1
-}
-
 enum Flow {
     Continue,
     Quit,
@@ -87,7 +84,8 @@ struct Player {
     step: u64,
     term: (u16, u16),
     sim: SimClock,
-    help: bool,
+    /// The help overlay's lines while it is open (built when opened, not every frame).
+    help: Option<Vec<(&'static str, &'static str)>>,
     aim: (i32, i32),
     aim_until: Option<Instant>,
     message: Option<(String, Instant)>,
@@ -135,7 +133,7 @@ pub fn run(first: PlayScene, mut make: SceneFactory, config: PlayerConfig) -> Re
         recorder,
         step: 0,
         term,
-        help: false,
+        help: None,
         aim: ((w / 2) as i32, ((h / 2) & !1) as i32),
         aim_until: None,
         message: None,
@@ -144,7 +142,10 @@ pub fn run(first: PlayScene, mut make: SceneFactory, config: PlayerConfig) -> Re
     };
     let result = {
         let guard = TerminalGuard::enter().map_err(|e| Error::Usage(format!("cannot set up the terminal: {e}")))?;
-        let result = player.run_loop();
+        // The loop runs on a rayon worker: the parallel parts of a frame (simulation bands,
+        // picture rows) then go to the worker's own queue instead of rayon's global injector,
+        // which allocates a block every 63 jobs. Steady-state frames allocate nothing.
+        let result = rayon::scope(|_| player.run_loop());
         drop(guard);
         result
     };
@@ -169,6 +170,7 @@ impl Player {
         let mut pixmap = Pixmap::new(w, h).expect("the scene's size is a valid pixmap size");
         let test_panic = std::env::var_os(TEST_PANIC_VAR).is_some();
         let mut inputs = Vec::new();
+        let mut builder = FrameBuilder::default();
         loop {
             let now = Instant::now();
             let deadline = self.sim.next_due().map_or(pacer.next_due(), |s| s.min(pacer.next_due()));
@@ -217,9 +219,9 @@ impl Player {
             if (pixmap.width(), pixmap.height()) != size {
                 pixmap = Pixmap::new(size.0, size.1).expect("the scene's size is a valid pixmap size");
             }
-            let frame = self.frame(&mut pixmap, &meter, now);
+            let frame = self.frame(&mut builder, &mut pixmap, &meter, now);
             let mut bytes = writer.buffer();
-            encode_into(&mut shown, &frame, self.config.encode, &mut bytes);
+            encode_into(&mut shown, frame, self.config.encode, &mut bytes);
             let len = bytes.len();
             if len > 0 {
                 writer.send(bytes);
@@ -232,34 +234,24 @@ impl Player {
         }
     }
 
-    /// The frame to show now.
-    fn frame(&mut self, pixmap: &mut Pixmap, meter: &Meter, now: Instant) -> Frame {
-        let (cols, rows) = (usize::from(self.term.0), usize::from(self.term.1));
-        let mut frame = Frame::new(cols, rows);
-        if !big_enough(self.term) {
-            ui::too_small(&mut frame);
-            return frame;
-        }
-        self.scene.render(pixmap);
-        frame.draw_pixels(pixmap, self.config.color);
-        if self.aim_until.is_some_and(|t| now < t) {
-            ui::aim_marker(&mut frame, self.aim.0 as u32, self.aim.1 as u32);
-        }
-        if self.help {
-            ui::help_overlay(&mut frame, &ui::help_lines(&self.scene.help()), self.config.color);
-        }
-        let message = self.message.as_ref().filter(|(_, until)| now < *until).map(|(m, _)| m.clone());
-        let status = Status {
-            scene: self.scene.name(),
+    /// The frame to show now, built by `builder` (which keeps its buffers between frames).
+    fn frame<'b>(
+        &mut self,
+        builder: &'b mut FrameBuilder,
+        pixmap: &mut Pixmap,
+        meter: &Meter,
+        now: Instant,
+    ) -> &'b Frame {
+        let overlay = Overlay {
+            aim: self.aim_until.is_some_and(|t| now < t).then_some((self.aim.0 as u32, self.aim.1 as u32)),
+            help: self.help.as_deref(),
+            message: self.message.as_ref().filter(|(_, until)| now < *until).map(|(m, _)| m.as_str()),
             fps: meter.fps,
-            rate: human_rate(meter.bytes_per_second),
-            detail: self.scene.status(),
+            bytes_per_second: meter.bytes_per_second,
             stone: self.radius,
             paused: self.sim.paused(),
-            message,
         };
-        ui::status_line(&mut frame, rows - 1, &status, self.config.color);
-        frame
+        builder.build(self.term, self.scene.as_mut(), pixmap, self.config.color, &overlay)
     }
 
     /// Resolves an action with the scene, applies and records its events.
@@ -292,9 +284,14 @@ impl Player {
         let now = Instant::now();
         match input {
             Input::Quit => return Ok(Flow::Quit),
-            Input::Escape if self.help => self.help = false,
+            Input::Escape if self.help.is_some() => self.help = None,
             Input::Escape => return Ok(Flow::Quit),
-            Input::Help => self.help = !self.help,
+            Input::Help => {
+                self.help = match self.help {
+                    Some(_) => None,
+                    None => Some(ui::help_lines(&self.scene.help())),
+                }
+            }
             Input::RandomStone => {
                 let (x, y) = (self.rng.random_range(0..w) as i32, self.rng.random_range(0..h) as i32);
                 self.act(Action::Stone { x, y, radius: self.radius, big: false });
@@ -384,6 +381,9 @@ impl Player {
         let (w, h) = self.scene.size();
         self.scene = (self.make)(next, w, h)?;
         self.kind = next;
+        if self.help.is_some() {
+            self.help = Some(ui::help_lines(&self.scene.help()));
+        }
         self.sim = SimClock::new(self.scene.steps_per_second(), Instant::now());
         Ok(())
     }

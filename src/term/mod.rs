@@ -7,5 +7,6 @@ pub mod app;
 pub mod guard;
 pub mod input;
 pub mod pacing;
+pub mod screen;
 pub mod ui;
 pub mod writer;

@@ -138,14 +138,23 @@ impl Meter {
 
 /// A byte rate for people: `850 B/s`, `12.3 kB/s`, `1.20 MB/s`.
 pub fn human_rate(bytes_per_second: u64) -> String {
+    let mut text = String::new();
+    write_human_rate(&mut text, bytes_per_second);
+    text
+}
+
+/// [`human_rate`] into a reused buffer (cleared first).
+pub fn write_human_rate(out: &mut String, bytes_per_second: u64) {
+    use std::fmt::Write;
+    out.clear();
     let b = bytes_per_second as f64;
-    if b < 1000.0 {
-        format!("{bytes_per_second} B/s")
+    let _ = if b < 1000.0 {
+        write!(out, "{bytes_per_second} B/s")
     } else if b < 1e6 {
-        format!("{:.1} kB/s", b / 1e3)
+        write!(out, "{:.1} kB/s", b / 1e3)
     } else {
-        format!("{:.2} MB/s", b / 1e6)
-    }
+        write!(out, "{:.2} MB/s", b / 1e6)
+    };
 }
 
 #[cfg(test)]

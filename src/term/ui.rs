@@ -24,21 +24,21 @@ fn solid(mode: ColorMode, rgb: [u8; 3]) -> Color {
 
 /// What the status line says.
 #[derive(Clone, Debug, Default)]
-pub struct Status {
+pub struct Status<'a> {
     /// The scene's name.
     pub scene: &'static str,
     /// Frames drawn per second.
     pub fps: u32,
     /// Bytes per second, formatted.
-    pub rate: String,
+    pub rate: &'a str,
     /// The scene's own summary.
-    pub detail: String,
+    pub detail: &'a str,
     /// The stone radius in pixels.
     pub stone: u32,
     /// Paused.
     pub paused: bool,
     /// A passing message (screenshot saved...), shown instead of the key hints.
-    pub message: Option<String>,
+    pub message: Option<&'a str>,
 }
 
 /// The key hints, longest first: the first that fits is shown.
@@ -48,26 +48,35 @@ const HINTS: [&str; 3] = [
     "? help \u{b7} q quit",
 ];
 
-/// Draws the status line into row `row`.
-pub fn status_line(frame: &mut Frame, row: usize, status: &Status, mode: ColorMode) {
+/// Draws the status line into row `row`; `scratch` is a reusable buffer (no allocation once it
+/// has grown to a line's length).
+pub fn status_line(frame: &mut Frame, row: usize, status: &Status<'_>, mode: ColorMode, scratch: &mut String) {
+    use std::fmt::Write;
     let (fg, bg) = (solid(mode, STATUS_FG), solid(mode, STATUS_BG));
     frame.clear_row(row, bg);
     let paused = if status.paused { " \u{b7} PAUSED" } else { "" };
-    let left = format!(
+    scratch.clear();
+    let _ = write!(
+        scratch,
         " {}{paused} \u{b7} {} fps \u{b7} {} \u{b7} {} \u{b7} stone {} ",
         status.scene, status.fps, status.rate, status.detail, status.stone
     );
     let cols = frame.cols();
-    let left_len = left.chars().count();
-    frame.text(0, row, &left, fg, bg);
-    let right = match &status.message {
-        Some(m) => format!(" {m} "),
+    let left_len = scratch.chars().count();
+    frame.text(0, row, scratch, fg, bg);
+    scratch.clear();
+    match status.message {
+        Some(m) => {
+            let _ = write!(scratch, " {m} ");
+        }
         None => {
             let room = cols.saturating_sub(left_len + 1);
-            HINTS.iter().find(|h| h.chars().count() <= room).map(|h| format!("{h} ")).unwrap_or_default()
+            if let Some(h) = HINTS.iter().find(|h| h.chars().count() <= room) {
+                let _ = write!(scratch, "{h} ");
+            }
         }
-    };
-    let right_len = right.chars().count();
+    }
+    let right_len = scratch.chars().count();
     // A message wins over the left part when the line is short; hints only take free room.
     let x = if status.message.is_some() {
         cols.saturating_sub(right_len)
@@ -75,7 +84,7 @@ pub fn status_line(frame: &mut Frame, row: usize, status: &Status, mode: ColorMo
         cols.saturating_sub(right_len).max(left_len.min(cols))
     };
     let key = if status.message.is_some() { solid(mode, HELP_KEY) } else { fg };
-    frame.text(x, row, &right, key, bg);
+    frame.text(x, row, scratch, key, bg);
 }
 
 /// Marks the aim at pixel `(x, y)`: a `+` in the cell, over the cell's own colour.
@@ -140,19 +149,22 @@ pub fn help_overlay(frame: &mut Frame, lines: &[(&str, &str)], mode: ColorMode) 
         if y >= y0 + height {
             break;
         }
-        let clip = |s: &str, from: usize| s.chars().take((x0 + width).saturating_sub(from + 1)).collect::<String>();
-        frame.text(x0 + 2, y, &clip(k, x0 + 2), key, bg);
-        frame.text(x0 + 4 + key_width, y, &clip(t, x0 + 4 + key_width), fg, bg);
+        let room = |from: usize| (x0 + width).saturating_sub(from + 1);
+        frame.text_clipped(x0 + 2, y, k, room(x0 + 2), key, bg);
+        frame.text_clipped(x0 + 4 + key_width, y, t, room(x0 + 4 + key_width), fg, bg);
     }
 }
+
+/// The second line of the "terminal too small" notice (kept in step with [`MIN_SIZE`] by a
+/// test; a constant, so drawing the notice allocates nothing).
+const MIN_SIZE_NOTE: &str = "need 10x5";
 
 /// Fills the frame with the "terminal too small" notice.
 pub fn too_small(frame: &mut Frame) {
     for y in 0..frame.rows() {
         frame.clear_row(y, Color::Default);
     }
-    let (min_cols, min_rows) = MIN_SIZE;
-    let lines = ["terminal too small".to_string(), format!("need {min_cols}x{min_rows}")];
+    let lines = ["terminal too small", MIN_SIZE_NOTE];
     let top = frame.rows().saturating_sub(lines.len()) / 2;
     for (i, line) in lines.iter().enumerate() {
         let x = frame.cols().saturating_sub(line.len()) / 2;
@@ -173,12 +185,17 @@ mod tests {
             .collect()
     }
 
-    fn status() -> Status {
+    #[test]
+    fn too_small_names_the_minimum() {
+        assert_eq!(MIN_SIZE_NOTE, format!("need {}x{}", MIN_SIZE.0, MIN_SIZE.1));
+    }
+
+    fn status() -> Status<'static> {
         Status {
             scene: "pool",
             fps: 30,
-            rate: "1.2 kB/s".into(),
-            detail: "rain 0.02 \u{b7} damping 5".into(),
+            rate: "1.2 kB/s",
+            detail: "rain 0.02 \u{b7} damping 5",
             stone: 4,
             ..Status::default()
         }
@@ -188,7 +205,7 @@ mod tests {
     fn status_line_fits_any_width() {
         for cols in [10, 40, 80, 160, 300] {
             let mut f = Frame::new(cols, 3);
-            status_line(&mut f, 2, &status(), ColorMode::TrueColor);
+            status_line(&mut f, 2, &status(), ColorMode::TrueColor, &mut String::new());
             let text = row(&f, 2);
             assert!(text.starts_with(" pool"), "{text}");
             if cols >= 160 {
@@ -196,11 +213,11 @@ mod tests {
             }
         }
         let mut f = Frame::new(120, 1);
-        let s = Status { message: Some("saved x.png".into()), paused: true, ..status() };
-        status_line(&mut f, 0, &s, ColorMode::Palette16);
+        let s = Status { message: Some("saved x.png"), paused: true, ..status() };
+        status_line(&mut f, 0, &s, ColorMode::Palette16, &mut String::new());
         assert!(row(&f, 0).trim_end().ends_with("saved x.png") && row(&f, 0).contains("PAUSED"));
         let mut narrow = Frame::new(30, 1);
-        status_line(&mut narrow, 0, &s, ColorMode::TrueColor);
+        status_line(&mut narrow, 0, &s, ColorMode::TrueColor, &mut String::new());
         assert!(row(&narrow, 0).starts_with(" pool \u{b7} PAUSED") && row(&narrow, 0).ends_with("saved x.png "));
     }
 

@@ -25,14 +25,16 @@ impl FrameWriter {
     pub fn spawn(write: impl Fn(&[u8]) -> io::Result<()> + Send + 'static) -> io::Result<FrameWriter> {
         let (frames, inbox) = mpsc::sync_channel::<Vec<u8>>(1);
         let (error_tx, errors) = mpsc::channel();
-        let (spare_tx, spare) = mpsc::channel();
+        // Bounded, so handing buffers back never allocates (an unbounded channel allocates a
+        // block every few dozen messages); at most two frames are ever in flight.
+        let (spare_tx, spare) = mpsc::sync_channel(2);
         let busy = Arc::new(AtomicBool::new(false));
         let flag = Arc::clone(&busy);
         std::thread::Builder::new().name("tidepool-writer".into()).spawn(move || {
             for mut frame in inbox {
                 let result = write(&frame);
                 frame.clear();
-                let _ = spare_tx.send(frame);
+                let _ = spare_tx.try_send(frame);
                 flag.store(false, Ordering::SeqCst);
                 if let Err(e) = result {
                     let _ = error_tx.send(e);
