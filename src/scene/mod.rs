@@ -1,4 +1,5 @@
 //! Scenes: a simulation together with the renderer that draws it. The headless renderer and
 //! the terminal player drive the same scene values the same way.
 
+pub mod ocean;
 pub mod pool;
