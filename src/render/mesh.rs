@@ -41,7 +41,7 @@ use crate::sim::surface::{Footprint, Surface, SurfaceSample};
 /// How far the lattice overhangs the picture left and right, as a fraction of its width.
 pub const SIDE_MARGIN: f32 = 0.12;
 /// How far the lattice overhangs the picture below, as a fraction of its height.
-pub const BOTTOM_MARGIN: f32 = 0.3;
+pub const BOTTOM_MARGIN: f32 = 0.2;
 
 /// The sample points and triangles for one camera.
 #[derive(Clone, Debug)]
@@ -278,7 +278,7 @@ fn sample_all<S: Surface + ?Sized>(
             *o = surface.sample(g[0], g[1], f);
         }
     };
-    if threads < 2 || ground.len() < 4096 {
+    if threads < 2 || ground.len() < 1024 {
         one(ground, footprints, out);
         return;
     }

@@ -180,7 +180,7 @@ pub fn spectrum_plot(sea: &PiersonMoskowitz) -> Pixmap {
     };
     left.draw(&mut out, "E(f)", "frequency f, Hz", "m^2/Hz", &energy);
     let right = Panel {
-        rect: Rect::from_ltrb(620.0, 110.0, 970.0, 360.0).unwrap(),
+        rect: Rect::from_ltrb(590.0, 110.0, 940.0, 360.0).unwrap(),
         x: (-180.0, 180.0),
         y: (0.0, d_max * 1.1),
         x_ticks: Some(vec![-180.0, -90.0, 0.0, 90.0, 180.0]),

@@ -7,7 +7,7 @@
 //! otherwise) and hand that to the same [`crate::render::mesh::MeshRenderer`].
 //!
 //! Drawing the sky per pixel would cost more than the sea at 4K, so [`Sky::draw`] evaluates it
-//! on a grid every [`SKY_GRID_PX`] pixels, interpolates bilinearly and tone-maps through a
+//! on a grid every [`sky_grid_px`] pixels, interpolates bilinearly and tone-maps through a
 //! table; only the sun's disc and its tight glow are evaluated per pixel.
 
 use tiny_skia::{Pixmap, PremultipliedColorU8};
@@ -16,8 +16,11 @@ use super::camera::Camera;
 use super::shade::{Light, Rgb, mix, to_srgb8};
 use super::vec3::{Vec3, dot};
 
-/// Spacing of the sky's evaluation grid, px.
-pub const SKY_GRID_PX: usize = 4;
+/// Spacing of the sky's evaluation grid, px: a 135th of the picture height, within 4..=16
+/// (16 px at 4K, where the sky's smallest feature, the sun's wide glow, spans hundreds).
+pub fn sky_grid_px(height: u32) -> usize {
+    (height as usize / 135).clamp(4, 16)
+}
 /// The sun's apparent radius as drawn, degrees (about twice the real one, so it shows at
 /// terminal sizes).
 pub const SUN_RADIUS_DEG: f32 = 0.5;
@@ -97,13 +100,13 @@ impl Sky {
         let (w, h) = (out.width() as usize, out.height() as usize);
         let sky_rows = (camera.horizon_y().floor() + 1.0).clamp(0.0, h as f32) as usize;
         let below_px = pixel(to_srgb8(below));
-        let lut = ToneTable::new();
+        let lut = ToneTable::shared();
         let pixels = out.pixels_mut();
         pixels[sky_rows * w..].fill(below_px);
         if sky_rows == 0 {
             return;
         }
-        let g = SKY_GRID_PX;
+        let g = sky_grid_px(h as u32);
         let (gw, gh) = (w.div_ceil(g) + 1, sky_rows.div_ceil(g) + 1);
         let mut grid = Vec::with_capacity(gw * gh);
         for gy in 0..gh {
@@ -112,16 +115,25 @@ impl Sky {
                 grid.push(self.smooth(d));
             }
         }
+        // Per row: the grid colours at this height, tone-mapped, then integer interpolation
+        // along the row (the sky changes slowly; this keeps a 4K sky to a few milliseconds).
         let inv = 1.0 / g as f32;
+        let mut row_levels = vec![[0u32; 3]; gw];
         for y in 0..sky_rows {
             let (gy, ty) = (y / g, (y % g) as f32 * inv);
+            for (gx, level) in row_levels.iter_mut().enumerate() {
+                let c = mix(grid[gy * gw + gx], grid[(gy + 1) * gw + gx], ty);
+                *level = [0, 1, 2].map(|i| u32::from(lut.level(c[i])));
+            }
             let row = &mut pixels[y * w..(y + 1) * w];
-            for (x, p) in row.iter_mut().enumerate() {
-                let (gx, tx) = (x / g, (x % g) as f32 * inv);
-                let at = |i: usize, j: usize| grid[(gy + j) * gw + gx + i];
-                let top = mix(at(0, 0), at(1, 0), tx);
-                let bottom = mix(at(0, 1), at(1, 1), tx);
-                *p = lut.pixel(mix(top, bottom, ty));
+            for (block, pair) in row.chunks_mut(g).zip(row_levels.windows(2)) {
+                let (a, b) = (pair[0], pair[1]);
+                for (t, p) in block.iter_mut().enumerate() {
+                    // 16.16 fixed point: weight of b is t/g.
+                    let wb = ((t as u32) << 16) / g as u32;
+                    let lerp = |i: usize| ((a[i] * (65536 - wb) + b[i] * wb + 32768) >> 16) as u8;
+                    *p = pixel([lerp(0), lerp(1), lerp(2)]);
+                }
             }
         }
         // The sun, exactly, where its disc and tight glow matter (within about 4°).
@@ -170,6 +182,11 @@ impl ToneTable {
     const STEPS: f32 = 1024.0;
     const MAX: f32 = 4.0;
 
+    fn shared() -> &'static ToneTable {
+        static TABLE: std::sync::OnceLock<ToneTable> = std::sync::OnceLock::new();
+        TABLE.get_or_init(ToneTable::new)
+    }
+
     fn new() -> ToneTable {
         let n = (Self::STEPS * Self::MAX) as usize + 1;
         ToneTable { levels: (0..n).map(|i| to_srgb8([i as f32 / Self::STEPS, 0.0, 0.0])[0]).collect() }
@@ -179,11 +196,6 @@ impl ToneTable {
     fn level(&self, v: f32) -> u8 {
         let i = (v.clamp(0.0, Self::MAX) * Self::STEPS + 0.5) as usize;
         self.levels[i.min(self.levels.len() - 1)]
-    }
-
-    #[inline(always)]
-    fn pixel(&self, c: Rgb) -> PremultipliedColorU8 {
-        pixel([self.level(c[0]), self.level(c[1]), self.level(c[2])])
     }
 }
 

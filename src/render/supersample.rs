@@ -47,26 +47,35 @@ pub fn downsample(src: &Pixmap, factor: u32, filter: Downsample, dst: &mut Pixma
 }
 
 fn box_filter(src: &Pixmap, f: usize, dst: &mut Pixmap) {
+    match f {
+        2 => box_n::<2>(src, dst),
+        3 => box_n::<3>(src, dst),
+        4 => box_n::<4>(src, dst),
+        _ => unreachable!("supersampling factors are 1..=4"),
+    }
+}
+
+/// The block mean for a factor known at compile time: rows are summed in u16 (at most
+/// 16 x 255), a block of F pixels at a time, so the loops unroll and vectorise.
+fn box_n<const F: usize>(src: &Pixmap, dst: &mut Pixmap) {
     let (dw, sw) = (dst.width() as usize, src.width() as usize);
     let data = src.data();
-    let n = (f * f) as u32;
-    let out = dst.data_mut();
-    let mut sums = vec![0u32; dw * 4];
-    for (dy, out_row) in out.chunks_exact_mut(dw * 4).enumerate() {
+    let n = (F * F) as u32;
+    let mut sums = vec![0u16; dw * 4];
+    for (dy, out_row) in dst.data_mut().chunks_exact_mut(dw * 4).enumerate() {
         sums.fill(0);
-        for sy in dy * f..(dy + 1) * f {
+        for sy in dy * F..(dy + 1) * F {
             let row = &data[sy * sw * 4..(sy + 1) * sw * 4];
-            for (dx, sum) in sums.chunks_exact_mut(4).enumerate() {
-                for px in row[dx * f * 4..(dx + 1) * f * 4].chunks_exact(4) {
-                    sum[0] += u32::from(px[0]);
-                    sum[1] += u32::from(px[1]);
-                    sum[2] += u32::from(px[2]);
-                    sum[3] += u32::from(px[3]);
+            for (sum, block) in sums.chunks_exact_mut(4).zip(row.chunks_exact(4 * F)) {
+                for px in block.chunks_exact(4) {
+                    for c in 0..4 {
+                        sum[c] += u16::from(px[c]);
+                    }
                 }
             }
         }
-        for (o, s) in out_row.iter_mut().zip(&sums) {
-            *o = ((s + n / 2) / n) as u8;
+        for (o, &s) in out_row.iter_mut().zip(&sums) {
+            *o = ((u32::from(s) + n / 2) / n) as u8;
         }
     }
 }
