@@ -43,6 +43,20 @@ pub enum Command {
     Render(RenderCommand),
     /// Print the Pierson–Moskowitz sea state of a wind (peak, Hs, Beaufort, WMO code), or plot it.
     Spectrum(ocean::SpectrumCommand),
+    /// Measure how fast this machine runs tidepool, stage by stage (a few seconds).
+    Bench(BenchArgs),
+}
+
+/// `tidepool bench`.
+#[derive(Args, Debug)]
+pub struct BenchArgs {
+    /// Seconds to spend on each workload (the median of the runs is reported).
+    #[arg(long, value_name = "S", default_value_t = 0.4, value_parser = parse_seconds)]
+    pub seconds: f64,
+
+    /// The terminal picture to measure, in pixels (columns x 2 per row).
+    #[arg(long, value_name = "WxH", default_value = "160x94", value_parser = parse_size)]
+    pub terminal: Size,
 }
 
 /// `tidepool render <scene>`.
@@ -69,13 +83,13 @@ pub enum RenderScene {
 pub struct RenderPool {
     /// Simulation steps before the picture is taken; waves travel about 0.7 px per step.
     /// [default: 90; fewer (at least 30) when the smaller side is under 360 pixels]
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", allow_negative_numbers = true)]
     pub steps: Option<u64>,
 
     /// Drop a stone at step 0: centre X,Y in pixels (outside the picture is clipped), radius R
     /// in pixels (1..=1000, default 8) and weight W (1..=32767, default 64). Repeat the flag for
     /// more stones; any explicit stone replaces the default ones.
-    #[arg(long = "stone", value_name = "X,Y[,R[,W]]", value_parser = parse_stone)]
+    #[arg(long = "stone", value_name = "X,Y[,R[,W]]", value_parser = parse_stone, allow_hyphen_values = true)]
     pub stones: Vec<Stone>,
 
     /// The water.
@@ -96,7 +110,7 @@ pub struct OutputArgs {
     pub size: Option<Size>,
 
     /// Seed for everything random (rain, phases); the same seed and flags give the same bytes.
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    #[arg(long, value_name = "N", default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
 
     /// Output file, or - for standard output. The format follows the extension: .png, or
@@ -112,6 +126,11 @@ pub struct OutputArgs {
     /// value = height + 32768; pool heights are raw amplitudes). Row 0 is the top of the picture.
     #[arg(long, value_name = "FILE")]
     pub heightmap: Option<PathBuf>,
+
+    /// Print how long each stage took (simulation, picture, encoding, writing) to standard
+    /// error, with throughput.
+    #[arg(long)]
+    pub stats: bool,
 }
 
 /// Flags of the ripple pool, shared by `render pool` and the player.
@@ -119,18 +138,18 @@ pub struct OutputArgs {
 pub struct PoolArgs {
     /// Raindrops per simulation step on average (radius 2, weight 64), a number >= 0.
     /// [default: 0 for render]
-    #[arg(long, value_name = "RATE", value_parser = parse_rate)]
+    #[arg(long, value_name = "RATE", value_parser = parse_rate, allow_negative_numbers = true)]
     pub rain: Option<f64>,
 
     /// Damping: each step the water loses 1/2^SHIFT of its amplitude (SHIFT 1..=15; higher
     /// calms more slowly), or `off` for none.
-    #[arg(long, value_name = "SHIFT|off", default_value = "5", value_parser = parse_damping)]
+    #[arg(long, value_name = "SHIFT|off", default_value = "5", value_parser = parse_damping, allow_negative_numbers = true)]
     pub damping: Damping,
 
     /// How far the surface slope displaces the floor: 1.0 is the papers' factor, 0 shows the
     /// floor undistorted, `auto` scales with the picture (its smaller side / 720, between 0.15
     /// and 1) so ripples read as ripples at every size.
-    #[arg(long, value_name = "F|auto", default_value = "auto", value_parser = parse_refraction)]
+    #[arg(long, value_name = "F|auto", default_value = "auto", value_parser = parse_refraction, allow_negative_numbers = true)]
     pub refraction: crate::render::pool::Refraction,
 
     /// Do not light the slopes (by default slopes facing the upper left are brightened).
@@ -246,6 +265,15 @@ pub fn parse_damping(text: &str) -> Result<Damping, String> {
         .ok()
         .and_then(Damping::shift)
         .ok_or_else(|| format!("the shift {shift} is outside 1..=15 (5 is the papers'); use 'off' for no damping"))
+}
+
+/// Parses a duration in seconds, 0.01..=60.
+pub fn parse_seconds(text: &str) -> Result<f64, String> {
+    let v: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of seconds; e.g. 0.5"))?;
+    if !v.is_finite() || !(0.01..=60.0).contains(&v) {
+        return Err(format!("'{text}' must be between 0.01 and 60 seconds"));
+    }
+    Ok(v)
 }
 
 /// Parses a finite number >= 0.

@@ -13,6 +13,7 @@ pub mod cli;
 pub mod commands;
 pub mod error;
 pub mod output;
+pub mod progress;
 pub mod render;
 pub mod scene;
 pub mod signals;

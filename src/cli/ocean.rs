@@ -109,6 +109,11 @@ pub struct RenderOcean {
     /// north edge.
     #[arg(long, value_name = "FILE")]
     pub heightmap: Option<PathBuf>,
+
+    /// Print how long each stage took (mesh, picture, heightmap, encoding, writing) and the
+    /// triangle count to standard error.
+    #[arg(long)]
+    pub stats: bool,
 }
 
 impl RenderOcean {
@@ -120,6 +125,7 @@ impl RenderOcean {
             out: self.out.clone(),
             format: self.format,
             heightmap: self.heightmap.clone(),
+            stats: self.stats,
         }
     }
 }

@@ -1,5 +1,6 @@
 //! The subcommands: validated flags in, files and terminal output out.
 
+pub mod bench;
 pub mod ocean;
 pub mod render;
 pub mod spectrum;
@@ -25,6 +26,7 @@ pub fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Some(Command::Render(render)) => render::run(render),
         Some(Command::Spectrum(args)) => spectrum::run(args),
+        Some(Command::Bench(args)) => bench::run(args),
         None => {
             println!("{GETTING_STARTED}");
             Ok(())

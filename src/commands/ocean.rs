@@ -1,10 +1,11 @@
 //! `tidepool render ocean`: a wind-driven sea to a PNG, half-block text and a heightmap.
 
 use std::io::IsTerminal;
+use std::time::Instant;
 
 use crate::cli::ocean::RenderOcean;
 use crate::cli::{Format, check_pixels};
-use crate::commands::render::{OutputPlan, terminal_pixels};
+use crate::commands::render::{OutputPlan, Stats, terminal_pixels};
 use crate::error::{Error, Result};
 use crate::render::background;
 use crate::render::camera::CameraPose;
@@ -56,12 +57,25 @@ pub fn render_ocean(args: RenderOcean) -> Result<()> {
         Error::arg("--size", format!("cannot allocate a {width}x{height} picture; choose a smaller size or --ssaa"))
     })?;
     scene.set_time(args.time);
+    let mut stats = Stats::default();
+    let started = Instant::now();
     let picture = scene.snapshot();
+    let ssaa = scene.renderer().view().ssaa;
+    let triangles = scene.renderer().triangle_count();
+    stats.record("render", started, format!("{width}x{height}, ssaa {ssaa}, {triangles} triangles"));
+    let started = Instant::now();
     let heights = plan.heightmap.is_some().then(|| {
         let extent = args.extent.unwrap_or_else(|| default_extent_m(scene.sea()));
         scene.heightmap(extent, width as usize, height as usize)
     });
+    if heights.is_some() {
+        stats.record("sample", started, format!("heightmap {width}x{height}"));
+    }
     // The supersampled buffer is the largest allocation; free it before encoding.
     drop(scene);
-    plan.write(&picture, heights.as_ref(), HEIGHTMAP_PNG_SCALE)
+    plan.write_timed(&picture, heights.as_ref(), HEIGHTMAP_PNG_SCALE, &mut stats)?;
+    if args.stats {
+        eprint!("{}", stats.report());
+    }
+    Ok(())
 }

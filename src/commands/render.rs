@@ -2,6 +2,7 @@
 
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
 
 use tiny_skia::Pixmap;
 
@@ -9,6 +10,7 @@ use crate::cli::{Format, OutputArgs, RenderCommand, RenderPool, RenderScene, Siz
 use crate::error::{Error, Result};
 use crate::output::heightmap::{self, Heightmap};
 use crate::output::{atomic, halfblock, png};
+use crate::progress::Progress;
 use crate::render::background;
 use crate::render::pool::PoolLook;
 use crate::scene::pool::{PoolScene, PoolSettings};
@@ -126,22 +128,79 @@ impl OutputPlan {
     /// Encodes and writes the picture, then the heightmap (heights in the scene's unit;
     /// `png_scale` converts them to PNG levels).
     pub fn write(&self, picture: &Pixmap, heights: Option<&Heightmap>, png_scale: f32) -> Result<()> {
+        self.write_timed(picture, heights, png_scale, &mut Stats::default())
+    }
+
+    /// [`OutputPlan::write`], recording how long encoding and writing took.
+    pub fn write_timed(
+        &self,
+        picture: &Pixmap,
+        heights: Option<&Heightmap>,
+        png_scale: f32,
+        stats: &mut Stats,
+    ) -> Result<()> {
+        let started = Instant::now();
         let bytes = match self.format {
             Format::Png => png::encode(picture),
             Format::Ansi => halfblock::encode(picture),
         };
-        match &self.target {
-            Target::Stdout => write_stdout(&bytes)?,
-            Target::File(path) => atomic::write_file(path, &bytes)?,
-        }
+        let format = if self.format == Format::Png { "png" } else { "half-block text" };
+        stats.record("encode", started, format!("{format}, {}", human_bytes(bytes.len())));
+        let started = Instant::now();
+        let target = match &self.target {
+            Target::Stdout => {
+                write_stdout(&bytes)?;
+                "standard output".to_string()
+            }
+            Target::File(path) => {
+                atomic::write_file(path, &bytes)?;
+                path.display().to_string()
+            }
+        };
+        stats.record("write", started, target);
         if let (Some((path, kind)), Some(map)) = (&self.heightmap, heights) {
+            let started = Instant::now();
             let bytes = match kind {
                 HeightmapKind::Npy => heightmap::encode_npy(map),
                 HeightmapKind::Png16 => heightmap::encode_png16(map, png_scale),
             };
             atomic::write_file(path, &bytes)?;
+            stats.record("heightmap", started, format!("{}, {}", path.display(), human_bytes(bytes.len())));
         }
         Ok(())
+    }
+}
+
+/// Per-stage timings of one render, printed to standard error by `--stats`.
+#[derive(Debug, Default)]
+pub struct Stats {
+    stages: Vec<(&'static str, Duration, String)>,
+}
+
+impl Stats {
+    /// Records that `stage` ran from `started` until now; `detail` says what it did.
+    pub fn record(&mut self, stage: &'static str, started: Instant, detail: String) {
+        self.stages.push((stage, started.elapsed(), detail));
+    }
+
+    /// The stages as aligned lines: name, milliseconds, detail.
+    pub fn report(&self) -> String {
+        let mut text = String::new();
+        for (stage, took, detail) in &self.stages {
+            text.push_str(&format!("{stage:<10} {:>9.2} ms   {detail}\n", took.as_secs_f64() * 1e3));
+        }
+        let total: Duration = self.stages.iter().map(|(_, took, _)| *took).sum();
+        text.push_str(&format!("{:<10} {:>9.2} ms\n", "total", total.as_secs_f64() * 1e3));
+        text
+    }
+}
+
+/// `1234567` -> `1.2 MB`.
+pub fn human_bytes(bytes: usize) -> String {
+    match bytes {
+        b if b >= 1 << 20 => format!("{:.1} MB", b as f64 / 1048576.0),
+        b if b >= 1 << 10 => format!("{:.1} KB", b as f64 / 1024.0),
+        b => format!("{b} B"),
     }
 }
 
@@ -229,22 +288,46 @@ fn render_pool(args: RenderPool) -> Result<()> {
     let mut scene = PoolScene::new(width, height, floor, settings).ok_or_else(|| {
         Error::arg("--size", format!("cannot allocate a {width}x{height} picture; choose a smaller size"))
     })?;
-    let script = if args.stones.is_empty() {
+    let mut script = if args.stones.is_empty() {
         default_stones(plan.size)
     } else {
         args.stones.iter().map(|&stone| (0, stone)).collect()
     };
+    script.sort_by_key(|&(at, _)| at);
     let steps = args.steps.unwrap_or_else(|| default_pool_steps(plan.size));
-    for step in 0..=steps {
-        for &(_, stone) in script.iter().filter(|(at, _)| *at == step) {
-            scene.drop_stone(stone);
+    let mut stats = Stats::default();
+    let started = Instant::now();
+    let mut progress = Progress::new("steps", steps);
+    let mut advance = |scene: &mut PoolScene, steps: u64| {
+        // In slices, so a long run can show progress; slices of whole blocks cost nothing.
+        let mut left = steps;
+        while left > 0 {
+            let slice = left.min(1024);
+            scene.advance(slice);
+            progress.advance(slice);
+            left -= slice;
         }
-        if step < steps {
-            scene.step();
-        }
+    };
+    let mut now = 0;
+    for &(at, stone) in script.iter().filter(|(at, _)| *at <= steps) {
+        advance(&mut scene, at - now);
+        now = at;
+        scene.drop_stone(stone);
     }
+    advance(&mut scene, steps - now);
+    drop(progress);
+    let cells = f64::from(width) * f64::from(height) * steps as f64;
+    let rate = cells / started.elapsed().as_secs_f64().max(1e-9) / 1e9;
+    stats.record("sim", started, format!("{steps} steps, {rate:.2} G cell-updates/s"));
+    let started = Instant::now();
+    let picture = scene.snapshot();
+    stats.record("render", started, format!("{width}x{height}"));
     let heights = plan.heightmap.is_some().then(|| scene.heightmap());
-    plan.write(&scene.snapshot(), heights.as_ref(), 1.0)
+    plan.write_timed(&picture, heights.as_ref(), 1.0, &mut stats)?;
+    if args.output.stats {
+        eprint!("{}", stats.report());
+    }
+    Ok(())
 }
 
 #[cfg(test)]
@@ -252,7 +335,7 @@ mod tests {
     use super::*;
 
     fn args(out: Option<&str>, format: Option<Format>, size: Option<Size>) -> OutputArgs {
-        OutputArgs { size, seed: 1, out: out.map(PathBuf::from), format, heightmap: None }
+        OutputArgs { size, seed: 1, out: out.map(PathBuf::from), format, heightmap: None, stats: false }
     }
 
     #[test]

@@ -10,7 +10,7 @@
 //! Everything is integer arithmetic in 8.8 fixed point, so the picture is the same on every
 //! machine and the loop is cheap.
 
-use tiny_skia::{Pixmap, PremultipliedColorU8};
+use tiny_skia::Pixmap;
 
 use crate::sim::ripple::RipplePool;
 
@@ -60,9 +60,16 @@ const SHADE_LIMIT: i32 = 90;
 #[derive(Clone, Debug)]
 pub struct PoolRenderer {
     background: Pixmap,
+    /// The background's pixels as packed RGBA words, for two-channels-at-a-time filtering.
+    texels: Vec<u32>,
     look: PoolLook,
     refraction_q8: i32,
 }
+
+/// Pictures smaller than this are drawn on one thread.
+const PARALLEL_MIN_PIXELS: usize = 1 << 16;
+/// Pixels per parallel task: big enough to amortise scheduling, small enough to balance.
+const PIXELS_PER_TASK: usize = 1 << 15;
 
 impl PoolRenderer {
     /// A renderer for pools the size of `background` (already fitted, e.g. with
@@ -70,7 +77,8 @@ impl PoolRenderer {
     pub fn new(background: Pixmap, look: PoolLook) -> PoolRenderer {
         let factor = look.refraction.factor(background.width(), background.height());
         let refraction_q8 = (factor * 256.0).round().clamp(0.0, 1e6) as i32;
-        PoolRenderer { background, look, refraction_q8 }
+        let texels = background.data().chunks_exact(4).map(|p| u32::from_ne_bytes([p[0], p[1], p[2], p[3]])).collect();
+        PoolRenderer { background, texels, look, refraction_q8 }
     }
 
     /// The look this renderer was made with.
@@ -83,7 +91,8 @@ impl PoolRenderer {
         &self.background
     }
 
-    /// Draws `pool` into `out`. Both must have the background's size.
+    /// Draws `pool` into `out`. Both must have the background's size. Large pictures are drawn
+    /// in row bands on all cores; every pixel is computed the same way whatever the split.
     ///
     /// # Panics
     /// When the sizes differ (a programming error, not a user error).
@@ -92,93 +101,91 @@ impl PoolRenderer {
         assert_eq!((pool.width(), pool.height()), (w, h), "pool and background sizes differ");
         assert_eq!((out.width() as usize, out.height() as usize), (w, h), "output size differs");
         let heights = pool.heights();
-        let dst = out.pixels_mut();
-        for y in 0..h {
-            for x in 0..w {
-                let (xoff, yoff) = slope(heights, w, h, x, y);
-                // Displaced position in 8.8 fixed point; fractional positions are filtered.
-                let sx = ((x as i32) << 8) + xoff * self.refraction_q8;
-                let sy = ((y as i32) << 8) + yoff * self.refraction_q8;
-                let mut pixel = self.sample(sx, sy);
+        let bytes = out.data_mut();
+        if w * h < PARALLEL_MIN_PIXELS {
+            self.render_rows(heights, 0, bytes);
+        } else {
+            use rayon::prelude::*;
+            let rows_per_task = (PIXELS_PER_TASK / w).max(1);
+            bytes
+                .par_chunks_mut(rows_per_task * w * 4)
+                .enumerate()
+                .for_each(|(task, rows)| self.render_rows(heights, task * rows_per_task, rows));
+        }
+    }
+
+    /// Draws the rows starting at `first_row` into `out` (whole rows of RGBA bytes).
+    fn render_rows(&self, heights: &[i16], first_row: usize, out: &mut [u8]) {
+        let (w, h) = (self.background.width() as usize, self.background.height() as usize);
+        let q = self.refraction_q8;
+        for (i, out_row) in out.chunks_exact_mut(w * 4).enumerate() {
+            let y = first_row + i;
+            // Rows y-2..=y+2, the picture's edge rows repeated beyond it.
+            let row = |dy: isize| {
+                let r = (y as isize + dy).clamp(0, h as isize - 1) as usize;
+                &heights[r * w..(r + 1) * w]
+            };
+            let (up2, up, mid, down, down2) = (row(-2), row(-1), row(0), row(1), row(2));
+            for (x, pixel) in out_row.chunks_exact_mut(4).enumerate() {
+                let (l1, r1) = (x.saturating_sub(1), (x + 1).min(w - 1));
+                // The papers' offsets: left minus right, up minus down.
+                let xoff = i32::from(mid[l1]) - i32::from(mid[r1]);
+                let yoff = i32::from(up[x]) - i32::from(down[x]);
+                let mut colour = self.sample(((x as i32) << 8) + xoff * q, ((y as i32) << 8) + yoff * q);
                 if self.look.shading {
-                    pixel = shade(pixel, light_slope(heights, w, h, x, y));
+                    let (l2, r2) = (x.saturating_sub(2), (x + 2).min(w - 1));
+                    let across = i32::from(mid[l2]) + i32::from(mid[l1]) - i32::from(mid[r1]) - i32::from(mid[r2]);
+                    let along = i32::from(up2[x]) + i32::from(up[x]) - i32::from(down[x]) - i32::from(down2[x]);
+                    colour = shade(colour, across + along);
                 }
-                dst[y * w + x] = pixel;
+                pixel.copy_from_slice(&colour.to_ne_bytes());
             }
         }
     }
 
     /// The background at an 8.8 fixed-point position, bilinearly filtered, clamped to the edges.
     #[inline(always)]
-    fn sample(&self, sx: i32, sy: i32) -> PremultipliedColorU8 {
+    fn sample(&self, sx: i32, sy: i32) -> u32 {
         let (w, h) = (self.background.width() as i32, self.background.height() as i32);
-        let bg = self.background.pixels();
         let sx = sx.clamp(0, (w - 1) << 8);
         let sy = sy.clamp(0, (h - 1) << 8);
         let (x0, y0) = ((sx >> 8) as usize, (sy >> 8) as usize);
         let (fx, fy) = ((sx & 255) as u32, (sy & 255) as u32);
-        let at = |x: usize, y: usize| bg[y * w as usize + x];
+        let w = w as usize;
+        let at = |x: usize, y: usize| self.texels[y * w + x];
         if fx == 0 && fy == 0 {
             return at(x0, y0);
         }
-        let x1 = (x0 + 1).min(w as usize - 1);
+        let x1 = (x0 + 1).min(w - 1);
         let y1 = (y0 + 1).min(h as usize - 1);
-        let (p00, p01, p10, p11) = (at(x0, y0), at(x1, y0), at(x0, y1), at(x1, y1));
-        let mix = |a: u8, b: u8, c: u8, d: u8| {
-            let top = u32::from(a) * (256 - fx) + u32::from(b) * fx;
-            let bottom = u32::from(c) * (256 - fx) + u32::from(d) * fx;
-            ((top * (256 - fy) + bottom * fy + (1 << 15)) >> 16) as u8
-        };
-        PremultipliedColorU8::from_rgba(
-            mix(p00.red(), p01.red(), p10.red(), p11.red()),
-            mix(p00.green(), p01.green(), p10.green(), p11.green()),
-            mix(p00.blue(), p01.blue(), p10.blue(), p11.blue()),
-            255,
-        )
-        .expect("opaque pixels are always valid")
+        let top = lerp_packed(at(x0, y0), at(x1, y0), fx);
+        let bottom = lerp_packed(at(x0, y1), at(x1, y1), fx);
+        lerp_packed(top, bottom, fy)
     }
 }
 
-/// The height at (x, y), with the picture's edge cells repeated outside it.
+/// Linear interpolation of two packed RGBA words, two channels per multiply: `f` in 0..=256
+/// is the weight of `b`. Each channel is `(a·(256-f) + b·f) >> 8`, which keeps 255 at 255.
 #[inline(always)]
-fn height_at(heights: &[i16], w: usize, h: usize, x: isize, y: isize) -> i32 {
-    let x = x.clamp(0, w as isize - 1) as usize;
-    let y = y.clamp(0, h as isize - 1) as usize;
-    i32::from(heights[y * w + x])
+fn lerp_packed(a: u32, b: u32, f: u32) -> u32 {
+    const MASK: u32 = 0x00FF_00FF;
+    let g = 256 - f;
+    let even = (((a & MASK) * g + (b & MASK) * f) >> 8) & MASK;
+    let odd = ((((a >> 8) & MASK) * g + ((b >> 8) & MASK) * f) >> 8) & MASK;
+    even | (odd << 8)
 }
 
-/// The papers' offsets at (x, y): left minus right, up minus down.
+/// Brightens a packed opaque pixel whose surface faces the light (upper left) and darkens the
+/// others, by an amount proportional to `slope_sum` (the slope away from the light).
 #[inline(always)]
-fn slope(heights: &[i16], w: usize, h: usize, x: usize, y: usize) -> (i32, i32) {
-    let (x, y) = (x as isize, y as isize);
-    let at = |dx: isize, dy: isize| height_at(heights, w, h, x + dx, y + dy);
-    (at(-1, 0) - at(1, 0), at(0, -1) - at(0, 1))
-}
-
-/// The slope towards the light (upper left), measured over two cells each side.
-///
-/// The integer scheme carries a faint grid-scale texture (the two sub-lattices drift apart);
-/// the papers' one-cell slope turns it into speckle. The wider stencil [1, 1, 0, -1, -1]
-/// cancels the finest modes and keeps the ring fronts, so the light follows the waves.
-#[inline(always)]
-fn light_slope(heights: &[i16], w: usize, h: usize, x: usize, y: usize) -> i32 {
-    let (x, y) = (x as isize, y as isize);
-    let at = |dx: isize, dy: isize| height_at(heights, w, h, x + dx, y + dy);
-    let sx = at(-2, 0) + at(-1, 0) - at(1, 0) - at(2, 0);
-    let sy = at(0, -2) + at(0, -1) - at(0, 1) - at(0, 2);
-    sx + sy
-}
-
-/// Brightens a pixel whose surface faces the light (upper left) and darkens the others.
-///
-/// The surface normal is proportional to (xoff, yoff, 2), so its dot product with a light from
-/// the upper left falls as the slope sum rises.
-#[inline(always)]
-fn shade(pixel: PremultipliedColorU8, slope_sum: i32) -> PremultipliedColorU8 {
+fn shade(pixel: u32, slope_sum: i32) -> u32 {
     let delta = ((-slope_sum * SHADE_PER_SLOPE_Q8) >> 8).clamp(-SHADE_LIMIT, SHADE_LIMIT);
+    if delta == 0 {
+        return pixel;
+    }
+    let [r, g, b, a] = pixel.to_ne_bytes();
     let adjust = |c: u8| (i32::from(c) + delta).clamp(0, 255) as u8;
-    PremultipliedColorU8::from_rgba(adjust(pixel.red()), adjust(pixel.green()), adjust(pixel.blue()), 255)
-        .expect("opaque pixels are always valid")
+    u32::from_ne_bytes([adjust(r), adjust(g), adjust(b), a])
 }
 
 #[cfg(test)]
@@ -190,7 +197,7 @@ mod tests {
         let mut bg = Pixmap::new(w, h).unwrap();
         for (i, p) in bg.pixels_mut().iter_mut().enumerate() {
             let (x, y) = ((i as u32 % w) as u8, (i as u32 / w) as u8);
-            *p = PremultipliedColorU8::from_rgba(x, y, 7, 255).unwrap();
+            *p = tiny_skia::PremultipliedColorU8::from_rgba(x, y, 7, 255).unwrap();
         }
         bg
     }
@@ -247,11 +254,38 @@ mod tests {
 
     #[test]
     fn shading_lights_slopes_facing_the_upper_left() {
-        let grey = PremultipliedColorU8::from_rgba(100, 100, 100, 255).unwrap();
-        assert!(shade(grey, -10).red() > 100);
-        assert!(shade(grey, 10).red() < 100);
+        let grey = u32::from_ne_bytes([100, 100, 100, 255]);
+        let red = |p: u32| p.to_ne_bytes()[0];
+        assert!(red(shade(grey, -10)) > 100);
+        assert!(red(shade(grey, 10)) < 100);
         assert_eq!(shade(grey, 0), grey);
-        assert_eq!(shade(grey, -100_000).red(), 100 + SHADE_LIMIT as u8);
+        assert_eq!(red(shade(grey, -100_000)), 100 + SHADE_LIMIT as u8);
+        assert_eq!(shade(grey, -100_000).to_ne_bytes()[3], 255, "alpha untouched");
+    }
+
+    #[test]
+    fn packed_lerp_is_exact_per_channel() {
+        let a = u32::from_ne_bytes([0, 255, 10, 255]);
+        let b = u32::from_ne_bytes([255, 0, 30, 255]);
+        assert_eq!(lerp_packed(a, b, 0), a);
+        assert_eq!(lerp_packed(a, b, 256), b);
+        assert_eq!(lerp_packed(a, b, 128).to_ne_bytes(), [127, 127, 20, 255]);
+    }
+
+    #[test]
+    fn parallel_rows_equal_single_thread_rows() {
+        let (w, h) = (400u32, 300u32);
+        let renderer = PoolRenderer::new(striped_background(w, h), PoolLook::default());
+        let mut pool = RipplePool::new(w as usize, h as usize, Damping::PAPERS);
+        for k in 0..9 {
+            pool.drop_stone(Stone { x: 40 * k, y: 30 * k, radius: 7, weight: 300 });
+        }
+        pool.advance(25);
+        let mut parallel = Pixmap::new(w, h).unwrap();
+        renderer.render(&pool, &mut parallel);
+        let mut single = Pixmap::new(w, h).unwrap();
+        renderer.render_rows(pool.heights(), 0, single.data_mut());
+        assert_eq!(parallel.data(), single.data());
     }
 
     #[test]

@@ -97,13 +97,22 @@ pub struct RipplePool {
     previous: Vec<i16>,
     damping: Damping,
     steps: u64,
+    scratch: super::stepper::Scratch,
 }
 
 impl RipplePool {
     /// A still pool of `width x height` cells.
     pub fn new(width: usize, height: usize, damping: Damping) -> RipplePool {
         let cells = width * height;
-        RipplePool { width, height, current: vec![0; cells], previous: vec![0; cells], damping, steps: 0 }
+        RipplePool {
+            width,
+            height,
+            current: vec![0; cells],
+            previous: vec![0; cells],
+            damping,
+            steps: 0,
+            scratch: Default::default(),
+        }
     }
 
     /// Width in cells.
@@ -180,49 +189,107 @@ impl RipplePool {
 
     /// Advances the water by one step.
     pub fn step(&mut self) {
-        step_buffers(&self.current, &mut self.previous, self.width, self.height, self.damping);
-        std::mem::swap(&mut self.current, &mut self.previous);
-        self.steps += 1;
+        self.advance(1);
     }
-}
 
-/// One step: writes the next amplitudes over `previous` (each cell reads only its own old value
-/// there, so the update is safe in place). Rows are zipped slices so the compiler can vectorize.
-fn step_buffers(current: &[i16], previous: &mut [i16], width: usize, height: usize, damping: Damping) {
-    if width < 3 || height < 3 {
-        return;
-    }
-    for y in 1..height - 1 {
-        let up = &current[(y - 1) * width..y * width];
-        let mid = &current[y * width..(y + 1) * width];
-        let down = &current[(y + 1) * width..(y + 2) * width];
-        let out = &mut previous[y * width + 1..(y + 1) * width - 1];
-        match damping {
-            Damping::Off => step_row::<false>(up, mid, down, out, 0),
-            Damping::Shift(shift) => step_row::<true>(up, mid, down, out, u32::from(shift)),
-        }
-    }
-}
-
-#[inline(always)]
-fn step_row<const DAMPED: bool>(up: &[i16], mid: &[i16], down: &[i16], out: &mut [i16], shift: u32) {
-    let left = &mid[..out.len()];
-    let right = &mid[2..];
-    let up = &up[1..];
-    let down = &down[1..];
-    for ((((o, &l), &r), &u), &d) in out.iter_mut().zip(left).zip(right).zip(up).zip(down) {
-        let sum = i32::from(l) + i32::from(r) + i32::from(u) + i32::from(d);
-        let mut v = ((sum >> 1) - i32::from(*o)).clamp(i32::from(i16::MIN), i32::from(i16::MAX));
-        if DAMPED {
-            v -= v >> shift;
-        }
-        *o = v as i16;
+    /// Advances the water by `steps` steps, as fast as this machine allows (SIMD, temporal
+    /// blocking and all cores; see [`super::stepper`]). The result is bit-identical to calling
+    /// [`RipplePool::step`] `steps` times, on any number of threads.
+    pub fn advance(&mut self, steps: u64) {
+        super::stepper::advance(
+            &mut self.current,
+            &mut self.previous,
+            self.width,
+            self.height,
+            self.damping,
+            steps,
+            &mut self.scratch,
+        );
+        self.steps += steps;
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The rule written as plainly as possible, to check the fast paths against.
+    pub(crate) fn reference_step(pool: &mut RipplePool) {
+        let (w, h) = (pool.width, pool.height);
+        if w >= 3 && h >= 3 {
+            for y in 1..h - 1 {
+                for x in 1..w - 1 {
+                    let i = y * w + x;
+                    let c = &pool.current;
+                    let sum = i32::from(c[i - 1]) + i32::from(c[i + 1]) + i32::from(c[i - w]) + i32::from(c[i + w]);
+                    let mut v = ((sum >> 1) - i32::from(pool.previous[i])).clamp(-32768, 32767);
+                    if let Damping::Shift(s) = pool.damping {
+                        v -= v >> s;
+                    }
+                    pool.previous[i] = v as i16;
+                }
+            }
+        }
+        std::mem::swap(&mut pool.current, &mut pool.previous);
+        pool.steps += 1;
+    }
+
+    /// A pool with deterministic pseudo-random water (including saturated cells).
+    fn rough_pool(width: usize, height: usize, damping: Damping, seed: u64) -> RipplePool {
+        let mut pool = RipplePool::new(width, height, damping);
+        let mut state = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        for k in 0..(width * height / 40).max(3) {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            let x = (state >> 33) as i32 % width.max(1) as i32;
+            let y = (state >> 13) as i32 % height.max(1) as i32;
+            let weight = if k % 7 == 0 { 32767 } else { ((state >> 50) % 3000) as i16 + 1 };
+            pool.drop_stone(Stone { x, y, radius: 1 + (k % 5) as u32, weight });
+        }
+        pool
+    }
+
+    #[test]
+    fn fast_paths_match_the_plain_rule_bit_for_bit() {
+        for (w, h) in [(3, 3), (4, 7), (17, 5), (33, 40), (64, 64), (130, 97), (300, 520)] {
+            for damping in [Damping::Off, Damping::Shift(1), Damping::PAPERS, Damping::Shift(15)] {
+                let mut fast = rough_pool(w, h, damping, (w * h) as u64);
+                let mut slow = fast.clone();
+                for steps in [1u64, 2, 3, 16, 17, 40] {
+                    fast.advance(steps);
+                    for _ in 0..steps {
+                        reference_step(&mut slow);
+                    }
+                    assert_eq!(fast.heights(), slow.heights(), "{w}x{h} {damping:?} after {steps}");
+                    assert_eq!(fast.previous_heights(), slow.previous_heights(), "{w}x{h} {damping:?}");
+                    assert_eq!(fast.steps(), slow.steps());
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn thread_count_does_not_change_a_bit() {
+        // Large enough for several bands (the parallel path starts at 2^17 cells).
+        let (w, h) = (300, 600);
+        let start = rough_pool(w, h, Damping::PAPERS, 99);
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            let mut water = start.clone();
+            pool.install(|| water.advance(53));
+            water
+        };
+        let one = run(1);
+        let mut reference = start.clone();
+        for _ in 0..53 {
+            reference_step(&mut reference);
+        }
+        assert_eq!(one.heights(), reference.heights());
+        for threads in [2, 3, 5] {
+            let many = run(threads);
+            assert_eq!(many.heights(), one.heights(), "{threads} threads");
+            assert_eq!(many.previous_heights(), one.previous_heights(), "{threads} threads");
+        }
+    }
 
     fn pool_with(width: usize, height: usize, current: &[i16], previous: &[i16], damping: Damping) -> RipplePool {
         let mut pool = RipplePool::new(width, height, damping);
@@ -268,33 +335,29 @@ mod tests {
 
     #[test]
     fn odd_sums_round_towards_minus_infinity() {
-        // A single interior cell with neighbour sum -3: (-3 >> 1) = -2, not -1.
-        #[rustfmt::skip]
-        let cur = [
-            0, 0, 0,
-            0, 0, 0,
-            0, 0, 0,
-        ];
-        let mut pool = pool_with(3, 3, &cur, &cur, Damping::Off);
-        pool.current[1] = -3; // the top wall cell is only a neighbour; it is never written
+        // Centre (2, 2) of a 5x5 pool whose only disturbance is its northern neighbour:
+        // (-3 >> 1) = -2, not -1.
+        let mut pool = RipplePool::new(5, 5, Damping::Off);
+        pool.current[5 + 2] = -3;
         pool.step();
-        assert_eq!(pool.heights()[4], -2);
+        assert_eq!(pool.heights()[2 * 5 + 2], -2);
     }
 
     #[test]
     fn damping_applies_after_the_spread() {
-        let mut cur = [0i16; 9];
-        cur[3] = 200; // west wall neighbour of the centre
-        cur[5] = 200; // east
-        let prev = [0i16; 9];
-        let mut pool = pool_with(3, 3, &cur, &prev, Damping::Shift(5));
+        // Centre (2, 2) of a 5x5 pool with its west and east neighbours at 200.
+        let mut cur = [0i16; 25];
+        cur[2 * 5 + 1] = 200;
+        cur[2 * 5 + 3] = 200;
+        let prev = [0i16; 25];
+        let mut pool = pool_with(5, 5, &cur, &prev, Damping::Shift(5));
         pool.step();
         // spread: 400 >> 1 = 200; damping: 200 - (200 >> 5) = 200 - 6 = 194
-        assert_eq!(pool.heights()[4], 194);
-        let mut negative = pool_with(3, 3, &cur.map(|v| -v), &prev, Damping::Shift(5));
+        assert_eq!(pool.heights()[12], 194);
+        let mut negative = pool_with(5, 5, &cur.map(|v| -v), &prev, Damping::Shift(5));
         negative.step();
         // -200 - (-200 >> 5) = -200 - (-7) = -193: the papers' asymmetric rounding.
-        assert_eq!(negative.heights()[4], -193);
+        assert_eq!(negative.heights()[12], -193);
     }
 
     #[test]

@@ -1,0 +1,164 @@
+//! Benchmarks of the ripple pool: `sim/ripple_step`, `render/pool`, `output/png`.
+//!
+//! `sim/ripple_step` runs a plain transliteration of the papers' scalar loop next to tidepool's
+//! step in the same run, and prints the speed-ups at the end, so every run shows how much
+//! faster the real step is on this machine.
+//!
+//! Run: `cargo bench --bench pool` (add `-- sim/` to run one group).
+
+use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
+use tidepool::render::background;
+use tidepool::render::pool::{PoolLook, PoolRenderer};
+use tidepool::sim::ripple::{Damping, RipplePool, Stone};
+use tiny_skia::Pixmap;
+
+/// The papers' loop, transliterated: index arithmetic, an i32 sum, shifts, store, swap.
+struct PapersPool {
+    buf1: Vec<i16>,
+    buf2: Vec<i16>,
+    width: usize,
+    height: usize,
+}
+
+impl PapersPool {
+    fn step(&mut self) {
+        let w = self.width;
+        for y in 1..self.height - 1 {
+            for x in 1..w - 1 {
+                let i = y * w + x;
+                let sum = self.buf1[i - 1] as i32
+                    + self.buf1[i + 1] as i32
+                    + self.buf1[i - w] as i32
+                    + self.buf1[i + w] as i32;
+                let mut v = (sum >> 1) - self.buf2[i] as i32;
+                v -= v >> 5;
+                self.buf2[i] = v as i16;
+            }
+        }
+        std::mem::swap(&mut self.buf1, &mut self.buf2);
+    }
+}
+
+fn rough_pool(side: usize) -> RipplePool {
+    let mut pool = RipplePool::new(side, side, Damping::PAPERS);
+    for k in 0..64 {
+        let x = (k * 7919 % side) as i32;
+        let y = (k * 104729 % side) as i32;
+        pool.drop_stone(Stone { x, y, radius: 6, weight: 200 });
+    }
+    pool.advance(20);
+    pool
+}
+
+fn thread_pool(threads: usize) -> rayon::ThreadPool {
+    rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap()
+}
+
+fn ripple_step(c: &mut Criterion) {
+    let mut group = c.benchmark_group("sim/ripple_step");
+    group.sample_size(20);
+    let one = thread_pool(1);
+    let two = thread_pool(2);
+    for side in [256usize, 1024, 2048] {
+        let pool = rough_pool(side);
+        group.throughput(Throughput::Elements((side * side) as u64));
+        let mut papers = PapersPool {
+            buf1: pool.heights().to_vec(),
+            buf2: pool.previous_heights().to_vec(),
+            width: side,
+            height: side,
+        };
+        group.bench_function(BenchmarkId::new("papers_scalar", side), |b| b.iter(|| papers.step()));
+        let mut single = pool.clone();
+        group.bench_function(BenchmarkId::new("step_1thread", side), |b| one.install(|| b.iter(|| single.step())));
+        // Blocked runs: one iteration is 16 steps, so report 16 steps' worth of cells.
+        group.throughput(Throughput::Elements((side * side * 16) as u64));
+        let mut blocked = pool.clone();
+        group.bench_function(BenchmarkId::new("advance16_1thread", side), |b| {
+            one.install(|| b.iter(|| blocked.advance(16)))
+        });
+        let mut parallel = pool.clone();
+        group.bench_function(BenchmarkId::new("advance16_2threads", side), |b| {
+            two.install(|| b.iter(|| parallel.advance(16)))
+        });
+    }
+    group.finish();
+}
+
+fn render_pool(c: &mut Criterion) {
+    let mut group = c.benchmark_group("render/pool");
+    group.sample_size(20);
+    let floor = background::pool_floor();
+    for (w, h) in [(160u32, 96u32), (1920, 1080)] {
+        let mut pool = RipplePool::new(w as usize, h as usize, Damping::PAPERS);
+        for k in 0..12 {
+            pool.drop_stone(Stone { x: (k * 37 % w) as i32, y: (k * 53 % h) as i32, radius: 5, weight: 160 });
+        }
+        pool.advance(40);
+        let renderer = PoolRenderer::new(background::cover(&floor, w, h).unwrap(), PoolLook::default());
+        let mut out = Pixmap::new(w, h).unwrap();
+        group.throughput(Throughput::Elements(u64::from(w * h)));
+        group.bench_function(BenchmarkId::new("refract_shade", format!("{w}x{h}")), |b| {
+            b.iter(|| renderer.render(&pool, &mut out))
+        });
+        // A frame of the interactive loop: a raindrop, a step, the picture. The drops keep
+        // the water moving so the filtered (fractional-offset) path is what gets measured.
+        let mut k = 0u32;
+        group.bench_function(BenchmarkId::new("step_and_render", format!("{w}x{h}")), |b| {
+            b.iter(|| {
+                k = k.wrapping_add(1);
+                pool.drop_stone(Stone { x: (k * 7919 % w) as i32, y: (k * 104729 % h) as i32, radius: 3, weight: 128 });
+                pool.step();
+                renderer.render(&pool, &mut out)
+            })
+        });
+    }
+    group.finish();
+}
+
+fn output_png(c: &mut Criterion) {
+    let mut group = c.benchmark_group("output/png");
+    group.sample_size(10);
+    let floor = background::cover(&background::pool_floor(), 1920, 1080).unwrap();
+    group.bench_function("encode_1920x1080", |b| b.iter(|| tidepool::output::png::encode(&floor)));
+    group.finish();
+}
+
+/// Reads criterion's median estimate (ns) of one benchmark from `target/criterion`.
+fn median_ns(group: &str, bench: &str) -> Option<f64> {
+    let dir = std::env::var_os("CARGO_TARGET_DIR").map(std::path::PathBuf::from).unwrap_or_else(|| "target".into());
+    let path = dir.join("criterion").join(group.replace('/', "_")).join(bench).join("new/estimates.json");
+    let text = std::fs::read_to_string(path).ok()?;
+    let json: serde_json::Value = serde_json::from_str(&text).ok()?;
+    json["median"]["point_estimate"].as_f64()
+}
+
+fn print_speedups() {
+    println!("\nsim/ripple_step, medians of this run (cell updates per second, speed-up over the papers' loop):");
+    for side in [256, 1024, 2048] {
+        let cells = (side * side) as f64;
+        let Some(base) = median_ns("sim/ripple_step", &format!("papers_scalar/{side}")) else { continue };
+        let rate = |ns: f64, steps: f64| cells * steps / ns; // Gcells/s
+        print!("  {side}x{side}: papers {:.2} G/s", rate(base, 1.0));
+        for (name, steps) in [("step_1thread", 1.0), ("advance16_1thread", 16.0), ("advance16_2threads", 16.0)] {
+            if let Some(ns) = median_ns("sim/ripple_step", &format!("{name}/{side}")) {
+                print!(", {name} {:.2} G/s ({:.1}x)", rate(ns, steps), base * steps / ns);
+            }
+        }
+        if let (Some(a), Some(b)) = (
+            median_ns("sim/ripple_step", &format!("advance16_1thread/{side}")),
+            median_ns("sim/ripple_step", &format!("advance16_2threads/{side}")),
+        ) {
+            print!(", 2 threads / 1 thread {:.2}x", a / b);
+        }
+        println!();
+    }
+}
+
+criterion_group!(benches, ripple_step, render_pool, output_png);
+
+fn main() {
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+    print_speedups();
+}

@@ -1,0 +1,207 @@
+//! The command line as a user meets it: exit statuses, messages, files written or left alone.
+
+mod common;
+
+use common::{run, run_in, scratch, stderr, tidepool};
+
+#[test]
+fn help_and_version_exit_zero_and_explain_the_flags() {
+    let help = run(&["render", "pool", "--help"]);
+    assert!(help.status.success());
+    let text = String::from_utf8_lossy(&help.stdout);
+    for flag in [
+        "--size",
+        "--seed",
+        "--steps",
+        "--stone",
+        "--rain",
+        "--damping",
+        "--refraction",
+        "--no-shading",
+        "--background",
+        "--heightmap",
+        "--out",
+        "--format",
+    ] {
+        assert!(text.contains(flag), "render pool --help mentions {flag}");
+    }
+    assert!(text.contains("default"), "defaults are shown");
+    let version = run(&["--version"]);
+    assert!(version.status.success());
+    assert!(String::from_utf8_lossy(&version.stdout).starts_with("tidepool "));
+}
+
+#[test]
+fn bad_values_name_the_flag_and_exit_two() {
+    let cases: &[(&[&str], &str)] = &[
+        (&["--size", "0x0"], "--size"),
+        (&["--size", "100000x100000"], "--size"),
+        (&["--size", "abc"], "--size"),
+        (&["--stone", "10,10,-3"], "--stone"),
+        (&["--stone", "10"], "--stone"),
+        (&["--stone", "-5,-5,0"], "--stone"),
+        (&["--steps", "-3"], "--steps"),
+        (&["--seed", "-1"], "--seed"),
+        (&["--damping", "0"], "use 'off'"),
+        (&["--rain", "-1"], "--rain"),
+        (&["--rain", "NaN"], "--rain"),
+        (&["--refraction", "inf"], "--refraction"),
+        (&["--out", "picture.jpg"], "--out"),
+        (&["--heightmap", "h.exr"], "--heightmap"),
+        (&["--background", "/nonexistent/floor.png"], "--background"),
+        (&["--frobnicate"], "--frobnicate"),
+    ];
+    let dir = scratch("bad_values");
+    for (args, needle) in cases {
+        let out = run_in(&dir, &[&["render", "pool"], *args].concat());
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = stderr(&out);
+        assert!(err.contains(needle), "{args:?}: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing was written");
+}
+
+#[test]
+fn corrupt_backgrounds_are_refused_cleanly() {
+    let dir = scratch("corrupt_backgrounds");
+    std::fs::write(dir.join("empty.png"), b"").unwrap();
+    std::fs::write(dir.join("text.png"), b"this is not a picture").unwrap();
+    let mut png = Vec::new();
+    image::RgbImage::new(64, 64).write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
+    std::fs::write(dir.join("truncated.png"), &png[..png.len() / 2]).unwrap();
+    std::fs::create_dir(dir.join("folder.png")).unwrap();
+    for (file, needle) in
+        [("empty.png", "empty"), ("text.png", "format"), ("truncated.png", "decode"), ("folder.png", "directory")]
+    {
+        let out = run_in(&dir, &["render", "pool", "--background", file, "--out", "x.png"]);
+        assert_eq!(out.status.code(), Some(2), "{file}");
+        let err = stderr(&out);
+        assert!(err.starts_with("tidepool: --background") && err.contains(needle), "{file}: {err}");
+        assert_eq!(err.lines().count(), 1, "one line: {err}");
+    }
+    assert!(!dir.join("x.png").exists());
+}
+
+#[test]
+fn same_arguments_give_identical_bytes() {
+    let dir = scratch("deterministic");
+    for name in ["a", "b"] {
+        for ext in ["png", "ans"] {
+            let out = run_in(
+                &dir,
+                &[
+                    "render",
+                    "pool",
+                    "--size",
+                    "120x80",
+                    "--rain",
+                    "0.5",
+                    "--seed",
+                    "42",
+                    "--steps",
+                    "60",
+                    "--out",
+                    &format!("{name}.{ext}"),
+                    "--heightmap",
+                    &format!("{name}-{ext}.npy"),
+                ],
+            );
+            assert!(out.status.success(), "{}", stderr(&out));
+        }
+    }
+    for file in ["{}.png", "{}.ans", "{}-png.npy"] {
+        let a = std::fs::read(dir.join(file.replace("{}", "a"))).unwrap();
+        let b = std::fs::read(dir.join(file.replace("{}", "b"))).unwrap();
+        assert!(a == b, "{file} differs between identical runs");
+    }
+    let other_seed = run_in(
+        &dir,
+        &["render", "pool", "--size", "120x80", "--rain", "0.5", "--seed", "43", "--steps", "60", "--out", "c.png"],
+    );
+    assert!(other_seed.status.success());
+    assert_ne!(std::fs::read(dir.join("a.png")).unwrap(), std::fs::read(dir.join("c.png")).unwrap());
+}
+
+#[test]
+fn heightmaps_hold_the_raw_amplitudes() {
+    let dir = scratch("heightmaps");
+    let args = ["render", "pool", "--size", "40x30", "--stone", "20,15,3,77", "--steps", "0", "--out", "p.png"];
+    assert!(run_in(&dir, &[&args[..], &["--heightmap", "h.npy"]].concat()).status.success());
+    assert!(run_in(&dir, &[&args[..], &["--heightmap", "h.png"]].concat()).status.success());
+    let npy = std::fs::read(dir.join("h.npy")).unwrap();
+    let header_len = u16::from_le_bytes([npy[8], npy[9]]) as usize;
+    assert!(String::from_utf8_lossy(&npy[10..10 + header_len]).contains("'shape': (30, 40)"));
+    let values: Vec<f32> =
+        npy[10 + header_len..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    assert_eq!(values.len(), 1200);
+    assert_eq!(values[15 * 40 + 20], -77.0, "the stone's centre, row 0 at the top");
+    assert_eq!(values[0], 0.0);
+    let png = image::open(dir.join("h.png")).unwrap();
+    let grey = png.as_luma16().expect("16-bit grey");
+    assert_eq!(grey.get_pixel(20, 15).0[0], 32768 - 77);
+    assert_eq!(grey.get_pixel(0, 0).0[0], 32768);
+}
+
+#[test]
+fn stdout_gets_half_block_text_and_a_closed_pipe_is_quiet() {
+    let out = run(&["render", "pool", "--out", "-", "--size", "30x20"]);
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert_eq!(text.lines().count(), 10);
+    assert!(text.lines().all(|l| l.ends_with("\x1b[0m") && l.contains('\u{2580}')));
+
+    let mut child = tidepool()
+        .args(["render", "pool", "--out", "-", "--size", "400x400"])
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut first = [0u8; 100];
+    std::io::Read::read_exact(child.stdout.as_mut().unwrap(), &mut first).unwrap();
+    drop(child.stdout.take()); // like `| head -c 100`
+    let out = child.wait_with_output().unwrap();
+    assert!(out.status.success(), "broken pipe is not an error: {:?} {}", out.status, stderr(&out));
+    assert!(stderr(&out).is_empty());
+}
+
+#[test]
+fn failed_writes_keep_the_existing_file() {
+    let dir = scratch("failed_writes");
+    std::fs::write(dir.join("keep.png"), b"precious").unwrap();
+    // The picture is written first, then the heightmap into a missing folder fails: the error
+    // names the folder, and nothing half-written is left behind.
+    let out = run_in(&dir, &["render", "pool", "--size", "20x20", "--out", "new.png", "--heightmap", "missing/h.npy"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("missing"), "{}", stderr(&out));
+    let out = run_in(&dir, &["render", "pool", "--size", "20x20", "--out", "nowhere/keep.png"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("does not exist"), "{}", stderr(&out));
+    assert_eq!(std::fs::read(dir.join("keep.png")).unwrap(), b"precious");
+    let leftovers: Vec<_> = std::fs::read_dir(&dir).unwrap().filter_map(|e| e.ok()).map(|e| e.file_name()).collect();
+    assert!(leftovers.iter().all(|n| !n.to_string_lossy().ends_with(".tmp")), "{leftovers:?}");
+}
+
+#[test]
+fn ctrl_c_exits_130_and_leaves_no_file() {
+    let dir = scratch("ctrl_c");
+    let mut child = tidepool()
+        .current_dir(&dir)
+        .args(["render", "pool", "--size", "512x512", "--steps", "100000000", "--out", "never.png"])
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(300));
+    // SAFETY-free: send SIGINT through the kill command, as a terminal's Ctrl-C would.
+    let killed = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    assert!(killed.success());
+    let status = child.wait().unwrap();
+    assert_eq!(status.code(), Some(130));
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "no file, no temporary file");
+}
+
+#[test]
+fn no_subcommand_shows_how_to_start() {
+    let out = run(&[]);
+    assert!(out.status.success());
+    assert!(String::from_utf8_lossy(&out.stdout).contains("tidepool render pool"));
+}

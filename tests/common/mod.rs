@@ -1,0 +1,51 @@
+//! Helpers shared by the integration tests: running the binary and the golden-image harness.
+#![allow(dead_code)] // each test binary uses its own subset
+
+pub mod golden;
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The `tidepool` binary under test.
+pub fn tidepool() -> Command {
+    let mut command = Command::new(env!("CARGO_BIN_EXE_tidepool"));
+    // Tests must not depend on the developer's terminal or SSH session.
+    command.env_remove("SSH_CONNECTION").env_remove("COLORTERM").env("TERM", "xterm-256color");
+    command
+}
+
+/// Runs `tidepool` with `args` and returns its output.
+pub fn run(args: &[&str]) -> Output {
+    tidepool().args(args).output().expect("the tidepool binary runs")
+}
+
+/// Runs `tidepool` with `args` in `dir`.
+pub fn run_in(dir: &Path, args: &[&str]) -> Output {
+    tidepool().current_dir(dir).args(args).output().expect("the tidepool binary runs")
+}
+
+/// Standard error as text.
+pub fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+/// A fresh, empty scratch folder under `target/` for one test.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = target_dir().join("test-scratch").join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Cargo's target folder (where failure strips and scratch files go).
+pub fn target_dir() -> PathBuf {
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(dir) => PathBuf::from(dir),
+        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("target"),
+    }
+}
+
+/// Decodes a PNG file into straight RGBA.
+pub fn read_png(path: &Path) -> image::RgbaImage {
+    image::open(path).unwrap_or_else(|e| panic!("{} is not a readable image: {e}", path.display())).to_rgba8()
+}

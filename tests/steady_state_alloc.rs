@@ -1,0 +1,65 @@
+//! The interactive loop's steady state must not allocate: a frame (stones, steps, picture)
+//! reuses every buffer. A counting allocator checks it, including rayon's worker threads.
+//! This binary holds a single test so no other test's allocations are counted.
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+use tidepool::render::background;
+use tidepool::render::pool::PoolLook;
+use tidepool::scene::pool::{PoolScene, PoolSettings};
+use tidepool::sim::ripple::{Damping, Stone};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::Relaxed);
+        // SAFETY: forwarded unchanged to the system allocator.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+#[test]
+fn pool_frames_allocate_nothing_after_warm_up() {
+    // Start every rayon worker first: threads starting up allocate, concurrently with
+    // whatever is being measured.
+    rayon::broadcast(|_| ());
+    // A terminal-sized pool (one thread) and a full-HD one (row bands on rayon).
+    for (w, h) in [(160u32, 94u32), (1920, 1080)] {
+        let settings = PoolSettings { damping: Damping::PAPERS, rain_rate: 0.5, seed: 3, look: PoolLook::default() };
+        let mut scene = PoolScene::new(w, h, background::pool_floor(), settings).unwrap();
+        let mut frame = tiny_skia::Pixmap::new(w, h).unwrap();
+        let mut run_frames = |scene: &mut PoolScene, frames: u32| {
+            for k in 0..frames {
+                scene.drop_stone(Stone { x: (k * 37 % w) as i32, y: (k * 23 % h) as i32, radius: 4, weight: 100 });
+                scene.advance(2);
+                scene.render(&mut frame);
+            }
+        };
+        // The loop runs on a rayon worker, as the player's does: jobs then go to the worker's
+        // own deque. (Jobs injected from outside the pool land in rayon's global injector,
+        // which allocates a block every 63 jobs.)
+        let during = rayon::scope(|_| {
+            run_frames(&mut scene, 5); // warm-up: scratch buffers, deques
+            let before = ALLOCATIONS.load(Ordering::Relaxed);
+            run_frames(&mut scene, 60);
+            ALLOCATIONS.load(Ordering::Relaxed) - before
+        });
+        assert_eq!(during, 0, "{w}x{h}: {during} allocations in 60 steady-state frames");
+    }
+}
