@@ -38,7 +38,7 @@ fn tileable(rng: &mut ChaCha8Rng, lo: f64, hi: f64, count: usize) -> Vec<f64> {
 }
 
 fn main() {
-    let mut rng = ChaCha8Rng::seed_from_u64(2026_11_22);
+    let mut rng = ChaCha8Rng::seed_from_u64(20261122);
     let patches = tileable(&mut rng, 1.0, 4.0, 24);
     let medium = tileable(&mut rng, 4.0, 12.0, 60);
     let ridges = tileable(&mut rng, 10.0, 28.0, 90);

@@ -48,7 +48,7 @@ pub fn text_width(text: &str) -> i32 {
 
 /// About five round tick values covering `lo..=hi`.
 pub fn ticks(lo: f64, hi: f64) -> Vec<f64> {
-    if !(hi > lo) {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
         return vec![lo];
     }
     let raw = (hi - lo) / 5.0;

@@ -86,9 +86,9 @@ impl Default for WaterLook {
         WaterLook {
             ambient: 1.0,
             diffuse: 0.6,
-            sun_irradiance: 1.5,
+            sun_irradiance: 0.9,
             base_slope_variance: 0.0008,
-            foam: [0.80, 0.84, 0.86],
+            foam: [0.74, 0.79, 0.82],
             haze_m: 20_000.0,
         }
     }
@@ -158,7 +158,8 @@ pub fn shade_facet<E: Environment + ?Sized>(look: &WaterLook, light: &Light, env
     }
     if f.foam > 0.0 {
         let foam = [0, 1, 2].map(|i| look.foam[i] * (look.ambient * light.sky[i] + light.sun[i] * n_dot_l));
-        colour = mix(colour, foam, f.foam.min(1.0));
+        // Foam is a froth of bubbles over water, never a solid sheet: at most 85 % cover.
+        colour = mix(colour, foam, 0.85 * f.foam.min(1.0));
     }
     let haze = 1.0 - (-f.distance_m / look.haze_m).exp();
     let away = normalize([-v[0], -v[1], 0.0]);

@@ -54,8 +54,8 @@ impl Sky {
         Sky {
             sun_dir,
             sun: mix([1.0, 0.94, 0.84], [1.0, 0.66, 0.40], low * low),
-            zenith: [0.09, 0.24, 0.58],
-            horizon: [0.56, 0.68, 0.82],
+            zenith: [0.05, 0.17, 0.48],
+            horizon: [0.50, 0.63, 0.80],
             warm: [0.95, 0.66, 0.45],
             warmth: low,
             cos_disc: SUN_RADIUS_DEG.to_radians().cos(),

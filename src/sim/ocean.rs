@@ -12,7 +12,7 @@
 //! e^-20 of m0.
 //!
 //! # The tail
-//! Above the cut-off fc = 3·fm (wavelength λc = λp/9, 1.5 % of m0) a wrapping diamond-square
+//! Above the cut-off fc = 5·fm (wavelength λc = λp/25, 0.2 % of m0) a wrapping diamond-square
 //! fBm with H = 1 carries the variance: its corner lattice has the spacing λc (the paper's
 //! "corners from PM", drawn with the tail's standard deviation), 8 corners a side (so the
 //! period is 8·λc and the tiling does not show), and it refines down to about 0.2 m (at most
@@ -36,8 +36,10 @@
 //! indicator `q = 0.6·h/σ + 0.8·p` exceeds the Gaussian quantile z with P(N > z) = W, through
 //! a soft ramp centred on z (which keeps the mean coverage). `h/σ` puts the foam on the
 //! crests of wave groups, where breaking happens; `p` is a unit-variance patch pattern (the
-//! tail's fBm read with its corners [`FOAM_PATCH_M`] apart, so patches are metres wide at any
-//! wind) that breaks the foam into patches and streaks instead of painting whole crests white.
+//! tail's fBm read with its corners [`FOAM_PATCH_M`] apart across the wind and
+//! [`FOAM_STREAK`] times that along it, so patches are metres wide at any wind and lie in
+//! streaks along the wind, as the Beaufort descriptions have them) that breaks the foam up
+//! instead of painting whole crests white.
 //! The two are independent, so q has unit variance.
 
 use std::f64::consts::PI;
@@ -51,8 +53,10 @@ use super::surface::{Footprint, Surface, SurfaceSample};
 
 /// Lowest frequency of the sines, as a multiple of fm.
 pub const BAND_LOW: f64 = 0.5;
-/// The cut-off between the sines and the fBm tail, as a multiple of fm.
-pub const CUTOFF: f64 = 3.0;
+/// The cut-off between the sines and the fBm tail, as a multiple of fm. At 3·fm the sea
+/// looked smooth near the camera: the steeper short waves that show crests were left to the
+/// isotropic fBm; at 5·fm they are directional sines.
+pub const CUTOFF: f64 = 5.0;
 /// Frequency bins of the sines.
 pub const FREQUENCY_BINS: usize = 24;
 /// Direction bins of the sines over the full circle.
@@ -68,8 +72,11 @@ pub const TAIL_CORNERS: usize = 8;
 pub const FOAM_LONG: f32 = 0.6;
 /// Weight of the patch pattern in the whitecap indicator (0.6² + 0.8² = 1).
 pub const FOAM_SHORT: f32 = 0.8;
-/// The size of whitecap patches, m: the spacing of the patch pattern's corner lattice.
-pub const FOAM_PATCH_M: f32 = 12.0;
+/// The width of whitecap patches across the wind, m: the spacing of the patch pattern's
+/// corner lattice.
+pub const FOAM_PATCH_M: f32 = 6.0;
+/// How much longer foam patches are along the wind than across it.
+pub const FOAM_STREAK: f32 = 4.0;
 /// The finest cell of the tail the refinement aims at, metres.
 pub const TAIL_FINEST_M: f64 = 0.2;
 /// The most octaves the tail is refined below its corner lattice.
@@ -155,6 +162,8 @@ pub struct Sea {
     tail: Option<Tail>,
     foam_z: f32,
     slope_total: f32,
+    /// Unit vector (east, north) the wind blows towards.
+    downwind: [f32; 2],
 }
 
 impl Sea {
@@ -210,7 +219,9 @@ impl Sea {
         let wavelength = components.iter().map(|c| (2.0 * PI / c.wavenumber) as f32).collect();
         let foam_z = upper_normal_quantile(whitecap_fraction(spectrum.wind_m_s())) as f32;
         let slope_total = cox_munk_slope_variance(spectrum.wind_m_s()) as f32;
-        Sea { params, spectrum, components, kx, ky, amp, wavelength, tail, foam_z, slope_total }
+        let to = (params.wind_from_deg + 180.0).to_radians();
+        let downwind = [to.sin() as f32, to.cos() as f32];
+        Sea { params, spectrum, components, kx, ky, amp, wavelength, tail, foam_z, slope_total, downwind }
     }
 
     fn tail(spectrum: &PiersonMoskowitz, cutoff_hz: f64, downwind: f64, seed: u64) -> Tail {
@@ -389,7 +400,7 @@ impl SeaFrame<'_> {
                 Some(patch) => FOAM_LONG * h / resolved_var.sqrt() + FOAM_SHORT * patch,
                 None => h / resolved_var.sqrt(),
             };
-            smoothstep(sea.foam_z - 0.25, sea.foam_z + 0.25, q)
+            smoothstep(sea.foam_z - 0.4, sea.foam_z + 0.4, q)
         } else {
             0.0
         };
@@ -409,9 +420,12 @@ impl SeaFrame<'_> {
         if octave >= tail.field.levels() {
             return None;
         }
-        let gx = (x - self.tail_offset[0]) / cell;
-        let gy = (y - self.tail_offset[1]) / cell;
-        Some(tail.field.sample(gx, gy, octave) / tail.octave_variance[octave as usize].sqrt())
+        // In the wind's frame, stretched along it: foam lies in streaks along the wind.
+        let (px, py) = (x - self.tail_offset[0], y - self.tail_offset[1]);
+        let [dx, dy] = self.sea.downwind;
+        let along = (px * dx + py * dy) / FOAM_STREAK;
+        let across = -px * dy + py * dx;
+        Some(tail.field.sample(along / cell, across / cell, octave) / tail.octave_variance[octave as usize].sqrt())
     }
 
     /// The full surface height at (east, north) metres.
