@@ -27,8 +27,9 @@
 //! surface and a [`Shading`]: an [`Environment`] (the sky, or a sky with a shore), a [`WaterLook`], the [`Light`] and a
 //! [`SeaTexture`] (any image). Keep the `MeshRenderer` between frames.
 
+use rayon::prelude::*;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
-use tiny_skia::{BlendMode, Paint, Pixmap};
+use tiny_skia::{BlendMode, Paint, Pixmap, PixmapMut};
 
 use super::camera::Camera;
 use super::raster::TriangleFiller;
@@ -39,7 +40,7 @@ use super::vec3::{Vec3, cross, length, normalize, scale, sub};
 use crate::sim::surface::{Footprint, Surface, SurfaceSample};
 
 /// How far the lattice overhangs the picture left and right, as a fraction of its width.
-pub const SIDE_MARGIN: f32 = 0.12;
+pub const SIDE_MARGIN: f32 = 0.05;
 /// How far the lattice overhangs the picture below, as a fraction of its height.
 pub const BOTTOM_MARGIN: f32 = 0.2;
 
@@ -152,6 +153,7 @@ pub struct MeshRenderer {
     samples: Vec<SurfaceSample>,
     projected: Vec<Option<(f32, f32)>>,
     world: Vec<Vec3>,
+    faces: Vec<Option<Face>>,
 }
 
 /// Everything about the water's appearance the mesh renderer needs besides the surface.
@@ -218,74 +220,97 @@ impl MeshRenderer {
         }
         let (w, h) = (out.width() as f32, out.height() as f32);
         let eye = camera.eye();
-        let mut paint = Paint { anti_alias: false, blend_mode: BlendMode::Source, ..Paint::default() };
-        let mut filler = TriangleFiller::new();
-        for t in &topo.triangles {
-            let [a, b, c] = t.map(|i| i as usize);
-            let (Some(pa), Some(pb), Some(pc)) = (self.projected[a], self.projected[b], self.projected[c]) else {
-                continue;
-            };
-            let (min_x, max_x) = (pa.0.min(pb.0).min(pc.0), pa.0.max(pb.0).max(pc.0));
-            let (min_y, max_y) = (pa.1.min(pb.1).min(pc.1), pa.1.max(pb.1).max(pc.1));
-            if max_x < 0.0 || max_y < 0.0 || min_x > w || min_y > h {
-                continue;
+        let (world, projected, samples) = (&self.world, &self.projected, &self.samples);
+        // Shade every visible triangle (in parallel, order kept), then fill bands of rows in
+        // parallel, each band drawing the faces that reach it in painter's order.
+        topo.triangles
+            .par_iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| i as usize);
+                let (pa, pb, pc) = (projected[a]?, projected[b]?, projected[c]?);
+                let (min_x, max_x) = (pa.0.min(pb.0).min(pc.0), pa.0.max(pb.0).max(pc.0));
+                let (min_y, max_y) = (pa.1.min(pb.1).min(pc.1), pa.1.max(pb.1).max(pc.1));
+                if max_x < 0.0 || max_y < 0.0 || min_x > w || min_y > h {
+                    return None;
+                }
+                // spade's faces are counter-clockwise; a displaced triangle that turned over on
+                // the screen shows its underside (the far slope of a crest, folded over by a
+                // tall wave far away). A nearer front face covers that spot, so skip it.
+                if (pb.0 - pa.0) * (pc.1 - pa.1) - (pb.1 - pa.1) * (pc.0 - pa.0) <= 0.0 {
+                    return None;
+                }
+                let (wa, wb, wc) = (world[a], world[b], world[c]);
+                let mut normal = normalize(cross(sub(wb, wa), sub(wc, wa)));
+                if normal[2] < 0.0 {
+                    normal = scale(normal, -1.0);
+                }
+                let centroid = scale([wa[0] + wb[0] + wc[0], wa[1] + wb[1] + wc[1], wa[2] + wb[2] + wc[2]], 1.0 / 3.0);
+                let to_eye = sub(eye, centroid);
+                let distance_m = length(to_eye);
+                let (sa, sb, sc) = (&samples[a], &samples[b], &samples[c]);
+                let size_m =
+                    (topo.footprints[a].mean_m() + topo.footprints[b].mean_m() + topo.footprints[c].mean_m()) / 3.0;
+                let facet = Facet {
+                    normal,
+                    to_eye: scale(to_eye, 1.0 / distance_m.max(1e-6)),
+                    distance_m,
+                    albedo: shading.texture.sample(centroid[0], centroid[1], size_m),
+                    foam: (sa.foam + sb.foam + sc.foam) / 3.0,
+                    slope_variance: (sa.unresolved_slope_variance
+                        + sb.unresolved_slope_variance
+                        + sc.unresolved_slope_variance)
+                        / 3.0,
+                };
+                let colour = to_srgb8(shade_facet(&shading.look, &shading.light, shading.environment, &facet));
+                Some(Face { points: [pa, pb, pc], min_y, max_y, colour })
+            })
+            .collect_into_vec(&mut self.faces);
+        let faces = &self.faces;
+        let width = out.width();
+        let rows = out.height() as usize;
+        out.data_mut().par_chunks_mut(BAND_ROWS * width as usize * 4).enumerate().for_each(|(band, bytes)| {
+            let y0 = (band * BAND_ROWS) as f32;
+            let band_rows = (rows - band * BAND_ROWS).min(BAND_ROWS);
+            let y1 = y0 + band_rows as f32;
+            let Some(mut pixmap) = PixmapMut::from_bytes(bytes, width, band_rows as u32) else { return };
+            let mut paint = Paint { anti_alias: false, blend_mode: BlendMode::Source, ..Paint::default() };
+            let mut filler = TriangleFiller::new();
+            for face in faces.iter().flatten().filter(|f| f.max_y >= y0 && f.min_y <= y1) {
+                let [r, g, b] = face.colour;
+                paint.set_color_rgba8(r, g, b, 255);
+                filler.fill(&mut pixmap, &paint, face.points.map(|(x, y)| (x, y - y0)));
             }
-            // spade's faces are counter-clockwise; a displaced triangle that turned over on
-            // the screen shows its underside (the far slope of a crest, folded over by a tall
-            // wave far away). A nearer front face covers that spot, so skip it.
-            if (pb.0 - pa.0) * (pc.1 - pa.1) - (pb.1 - pa.1) * (pc.0 - pa.0) <= 0.0 {
-                continue;
-            }
-            let (wa, wb, wc) = (self.world[a], self.world[b], self.world[c]);
-            let mut normal = normalize(cross(sub(wb, wa), sub(wc, wa)));
-            if normal[2] < 0.0 {
-                normal = scale(normal, -1.0);
-            }
-            let centroid = scale([wa[0] + wb[0] + wc[0], wa[1] + wb[1] + wc[1], wa[2] + wb[2] + wc[2]], 1.0 / 3.0);
-            let to_eye = sub(eye, centroid);
-            let distance_m = length(to_eye);
-            let (sa, sb, sc) = (&self.samples[a], &self.samples[b], &self.samples[c]);
-            let size_m =
-                (topo.footprints[a].mean_m() + topo.footprints[b].mean_m() + topo.footprints[c].mean_m()) / 3.0;
-            let facet = Facet {
-                normal,
-                to_eye: scale(to_eye, 1.0 / distance_m.max(1e-6)),
-                distance_m,
-                albedo: shading.texture.sample(centroid[0], centroid[1], size_m),
-                foam: (sa.foam + sb.foam + sc.foam) / 3.0,
-                slope_variance: (sa.unresolved_slope_variance
-                    + sb.unresolved_slope_variance
-                    + sc.unresolved_slope_variance)
-                    / 3.0,
-            };
-            let [r, g, bl] = to_srgb8(shade_facet(&shading.look, &shading.light, shading.environment, &facet));
-            paint.set_color_rgba8(r, g, bl, 255);
-            filler.fill(out, &paint, [pa, pb, pc]);
-        }
+        });
     }
 }
 
-/// Samples the surface at every point, split across the available cores for large meshes.
+/// Rows per band of the parallel fill. Fixed, so the picture does not depend on the number of
+/// cores (a face is translated by the band's origin before filling).
+pub const BAND_ROWS: usize = 128;
+
+/// A shaded triangle ready to fill: screen points, vertical extent, colour.
+#[derive(Clone, Copy, Debug)]
+struct Face {
+    points: [(f32, f32); 3],
+    min_y: f32,
+    max_y: f32,
+    colour: [u8; 3],
+}
+
+/// Samples the surface at every point, in parallel chunks (the result does not depend on how
+/// the chunks are spread over cores: each point is sampled alone).
 fn sample_all<S: Surface + ?Sized>(
     surface: &S,
     ground: &[[f32; 2]],
     footprints: &[Footprint],
     out: &mut [SurfaceSample],
 ) {
-    let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(8);
-    let one = |ground: &[[f32; 2]], footprints: &[Footprint], out: &mut [SurfaceSample]| {
-        for ((g, f), o) in ground.iter().zip(footprints).zip(out.iter_mut()) {
+    const CHUNK: usize = 512;
+    out.par_chunks_mut(CHUNK).enumerate().for_each(|(i, chunk)| {
+        let start = i * CHUNK;
+        for (k, o) in chunk.iter_mut().enumerate() {
+            let (g, f) = (ground[start + k], &footprints[start + k]);
             *o = surface.sample(g[0], g[1], f);
-        }
-    };
-    if threads < 2 || ground.len() < 1024 {
-        one(ground, footprints, out);
-        return;
-    }
-    let chunk = ground.len().div_ceil(threads);
-    std::thread::scope(|scope| {
-        for ((g, f), o) in ground.chunks(chunk).zip(footprints.chunks(chunk)).zip(out.chunks_mut(chunk)) {
-            scope.spawn(move || one(g, f, o));
         }
     });
 }

@@ -1,6 +1,6 @@
 //! The ocean renderer: sky, then the sea mesh, at `ssaa` times the size, filtered down.
 //!
-//! The mesh density is tied to the output resolution ([`mesh_spacing_px`]): about 2.5 output
+//! The mesh density is tied to the output resolution ([`mesh_spacing_px`]): about 3 output
 //! pixels between samples for a terminal frame (so its few pixels still show facets), growing
 //! to about 8 at 1920x1080 so the triangle count (and time) stays bounded while each facet
 //! stays small on screen. Everything else is in metres, so from the same camera a storm looks
@@ -46,9 +46,9 @@ impl Default for OceanView {
 }
 
 /// Output pixels between mesh samples for a `width x height` picture: √(W·H)/180, within
-/// 2.5..=8.
+/// 3.2..=8 (a terminal frame gets a triangle per 5 or so pixels, 1080p one per 30).
 pub fn mesh_spacing_px(width: u32, height: u32) -> f32 {
-    ((f64::from(width) * f64::from(height)).sqrt() / 180.0).clamp(2.5, 8.0) as f32
+    ((f64::from(width) * f64::from(height)).sqrt() / 180.0).clamp(3.2, 8.0) as f32
 }
 
 /// Draws a sea into pictures of one size, keeping its mesh and buffers between frames.
@@ -171,7 +171,7 @@ mod tests {
 
     #[test]
     fn spacing_follows_the_resolution() {
-        assert_eq!(mesh_spacing_px(160, 96), 2.5);
+        assert_eq!(mesh_spacing_px(160, 96), 3.2);
         assert_eq!(mesh_spacing_px(1920, 1080), 8.0);
         let mid = mesh_spacing_px(1280, 720);
         assert!(mid > 5.0 && mid < 5.5);

@@ -10,7 +10,7 @@
 //! every intersection computed from the edge's end points in a fixed order, so shared edges
 //! clip identically and tiny-skia never has to clip.
 
-use tiny_skia::{FillRule, Paint, PathBuilder, Pixmap, Transform};
+use tiny_skia::{FillRule, Paint, PathBuilder, PixmapMut, Transform};
 
 /// Up to 3 + 4 vertices: a triangle clipped by four sides.
 const MAX: usize = 8;
@@ -36,7 +36,7 @@ impl TriangleFiller {
     }
 
     /// Fills the triangle `points` (pixel coordinates, any orientation) with `paint`.
-    pub fn fill(&mut self, out: &mut Pixmap, paint: &Paint, points: [(f32, f32); 3]) {
+    pub fn fill(&mut self, out: &mut PixmapMut<'_>, paint: &Paint, points: [(f32, f32); 3]) {
         let (w, h) = (out.width() as f32, out.height() as f32);
         let mut poly: Polygon = ([(0.0, 0.0); MAX], 3);
         poly.0[..3].copy_from_slice(&points);
@@ -114,7 +114,7 @@ fn clip(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use tiny_skia::{BlendMode, Color};
+    use tiny_skia::{BlendMode, Color, Pixmap};
 
     #[test]
     fn shared_edges_across_the_border_leave_no_gap() {
@@ -129,7 +129,7 @@ mod tests {
         paint.set_color_rgba8(0, 100, 0, 255);
         let mut filler = TriangleFiller::new();
         for t in tris {
-            filler.fill(&mut out, &paint, t);
+            filler.fill(&mut out.as_mut(), &paint, t);
         }
         // Pixel (1, 95) lies 0.02 px inside the shared edge; unclipped by us, neither got it.
         for x in 1..4 {
@@ -142,10 +142,10 @@ mod tests {
         let mut out = Pixmap::new(10, 10).unwrap();
         let mut paint = Paint { anti_alias: false, ..Paint::default() };
         paint.set_color_rgba8(10, 20, 30, 255);
-        TriangleFiller::new().fill(&mut out, &paint, [(-100.0, -100.0), (300.0, -100.0), (-100.0, 300.0)]);
+        TriangleFiller::new().fill(&mut out.as_mut(), &paint, [(-100.0, -100.0), (300.0, -100.0), (-100.0, 300.0)]);
         assert!(out.pixels().iter().all(|p| p.alpha() == 255), "a huge triangle covers everything");
         let mut empty = Pixmap::new(10, 10).unwrap();
-        TriangleFiller::new().fill(&mut empty, &paint, [(20.0, 20.0), (30.0, 20.0), (20.0, 30.0)]);
+        TriangleFiller::new().fill(&mut empty.as_mut(), &paint, [(20.0, 20.0), (30.0, 20.0), (20.0, 30.0)]);
         assert!(empty.pixels().iter().all(|p| p.alpha() == 0));
     }
 }

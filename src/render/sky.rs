@@ -119,6 +119,8 @@ impl Sky {
         // along the row (the sky changes slowly; this keeps a 4K sky to a few milliseconds).
         let inv = 1.0 / g as f32;
         let mut row_levels = vec![[0u32; 3]; gw];
+        // 16.16 fixed-point weight of the right-hand grid point at each offset in a cell.
+        let weights: Vec<u32> = (0..g as u32).map(|t| (t << 16) / g as u32).collect();
         for y in 0..sky_rows {
             let (gy, ty) = (y / g, (y % g) as f32 * inv);
             for (gx, level) in row_levels.iter_mut().enumerate() {
@@ -128,9 +130,7 @@ impl Sky {
             let row = &mut pixels[y * w..(y + 1) * w];
             for (block, pair) in row.chunks_mut(g).zip(row_levels.windows(2)) {
                 let (a, b) = (pair[0], pair[1]);
-                for (t, p) in block.iter_mut().enumerate() {
-                    // 16.16 fixed point: weight of b is t/g.
-                    let wb = ((t as u32) << 16) / g as u32;
+                for (p, &wb) in block.iter_mut().zip(&weights) {
                     let lerp = |i: usize| ((a[i] * (65536 - wb) + b[i] * wb + 32768) >> 16) as u8;
                     *p = pixel([lerp(0), lerp(1), lerp(2)]);
                 }
