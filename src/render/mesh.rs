@@ -22,10 +22,29 @@
 //!    half-transparent seams along shared edges, non-AA fills of a mesh are watertight. Smooth
 //!    edges come from supersampling ([`crate::render::supersample`]).
 //!
-//! To reuse it (the lake): build a [`Camera`], draw the background (the
-//! [`crate::render::sky::Sky`] or your own), call [`MeshRenderer::prepare`] and [`MeshRenderer::draw`] with your
-//! surface and a [`Shading`]: an [`Environment`] (the sky, or a sky with a shore), a [`WaterLook`], the [`Light`] and a
-//! [`SeaTexture`] (any image). Keep the `MeshRenderer` between frames.
+//! # Reusing it (the lake)
+//!
+//! ```text
+//! impl Surface for LakeFrame { fn sample(&self, x, y, footprint) -> SurfaceSample { .. } }
+//! struct SkyAndShore { sky: Sky, .. }   impl Environment for SkyAndShore { fn radiance(..) }
+//!
+//! let camera = Camera::new(pose, width * ssaa, height * ssaa);     // once per view
+//! let mut mesh = MeshRenderer::new();                               // keep between frames
+//! // each frame:
+//! sky.draw(&camera, far_water_colour, &mut big);                    // or your own background
+//! mesh.prepare(&camera, spacing_px * ssaa as f32);                  // no-op if nothing moved
+//! mesh.draw(&lake_frame, &Shading { environment: &sky_and_shore, light: sky.light(),
+//!                                   look: WaterLook { .. }, texture: &texture }, &mut big);
+//! supersample::downsample(&big, ssaa, Downsample::Box, &mut out);
+//! ```
+//!
+//! - [`Surface`] returns heights in metres plus foam cover and the slope variance the mesh
+//!   cannot show (0 for a smooth lake); its [`Footprint`] says what the mesh can carry.
+//! - [`Environment`] is what the water reflects: [`crate::render::sky::Sky`] alone for the
+//!   ocean; the lake answers with its shore for directions that hit the shore.
+//! - [`WaterLook`] holds the colours and strengths (body light, glint, foam, haze distance);
+//!   [`SeaTexture`] is any image tiled over the water in metres (`SeaTexture::from_pixmap`).
+//! - [`crate::render::ocean::OceanRenderer`] is the ocean's use of all this, in 60 lines.
 
 use rayon::prelude::*;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
