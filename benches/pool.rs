@@ -9,6 +9,7 @@
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use tidepool::render::background;
 use tidepool::render::pool::{PoolLook, PoolRenderer};
+use tidepool::sim::rain::Rain;
 use tidepool::sim::ripple::{Damping, RipplePool, Stone};
 use tiny_skia::Pixmap;
 
@@ -90,16 +91,35 @@ fn render_pool(c: &mut Criterion) {
     group.sample_size(20);
     let floor = background::pool_floor();
     for (w, h) in [(160u32, 96u32), (1920, 1080)] {
+        // Lively water: heavy rain (one papers' raindrop per 100,000 pixels per step) for 200
+        // steps leaves rings over the whole picture, the busy case for refraction and light.
+        let mut rain = Rain::new(f64::from(w * h) / 100_000.0, 7);
         let mut pool = RipplePool::new(w as usize, h as usize, Damping::PAPERS);
-        for k in 0..12 {
-            pool.drop_stone(Stone { x: (k * 37 % w) as i32, y: (k * 53 % h) as i32, radius: 5, weight: 160 });
+        let mut drops = Vec::new();
+        for _ in 0..200 {
+            drops.clear();
+            rain.drops(w as usize, h as usize, &mut drops);
+            for &drop in &drops {
+                pool.drop_stone(drop);
+            }
+            pool.step();
         }
-        pool.advance(40);
-        let renderer = PoolRenderer::new(background::cover(&floor, w, h).unwrap(), PoolLook::default());
+        let mut renderer = PoolRenderer::new(background::cover(&floor, w, h).unwrap(), PoolLook::default());
         let mut out = Pixmap::new(w, h).unwrap();
         group.throughput(Throughput::Elements(u64::from(w * h)));
         group.bench_function(BenchmarkId::new("refract_shade", format!("{w}x{h}")), |b| {
             b.iter(|| renderer.render(&pool, &mut out))
+        });
+        // The same without caustics and without light, to see what each costs.
+        let bare = PoolLook { caustics: None, ..PoolLook::default() };
+        let mut no_caustics = PoolRenderer::new(background::cover(&floor, w, h).unwrap(), bare);
+        group.bench_function(BenchmarkId::new("refract_shade_no_caustics", format!("{w}x{h}")), |b| {
+            b.iter(|| no_caustics.render(&pool, &mut out))
+        });
+        let mut refract_only =
+            PoolRenderer::new(background::cover(&floor, w, h).unwrap(), PoolLook { shading: false, ..bare });
+        group.bench_function(BenchmarkId::new("refract_only", format!("{w}x{h}")), |b| {
+            b.iter(|| refract_only.render(&pool, &mut out))
         });
         // A frame of the interactive loop: a raindrop, a step, the picture. The drops keep
         // the water moving so the filtered (fractional-offset) path is what gets measured.

@@ -31,7 +31,7 @@ Examples:
 #[derive(Parser, Debug)]
 #[command(name = "tidepool", version, about = ABOUT, after_help = EXAMPLES)]
 pub struct Cli {
-    /// What to do; without one, tidepool shows how to get started.
+    /// What to do; without one, tidepool plays the pool in this terminal (`tidepool play`).
     #[command(subcommand)]
     pub command: Option<Command>,
 }
@@ -43,6 +43,8 @@ pub enum Command {
     Render(RenderCommand),
     /// Print the Pierson–Moskowitz sea state of a wind (peak, Hs, Beaufort, WMO code), or plot it.
     Spectrum(ocean::SpectrumCommand),
+    /// Play with the water full-screen in this terminal: keys and the mouse drop stones.
+    Play(PlayCommand),
     /// Measure how fast this machine runs tidepool, stage by stage (a few seconds).
     Bench(BenchArgs),
 }
@@ -57,6 +59,110 @@ pub struct BenchArgs {
     /// The terminal picture to measure, in pixels (columns x 2 per row).
     #[arg(long, value_name = "WxH", default_value = "160x94", value_parser = parse_size)]
     pub terminal: Size,
+}
+
+const PLAY_KEYS: &str = "\
+Keys: space stone at random · arrows/hjkl aim, enter drop · r rain · c clear · +/- stone size ·
+[/] damping · p pause · s screenshot (PNG) · tab next scene · ? help · q, Esc, Ctrl-C quit.
+Mouse: left click drops a stone, drag stirs the water, right click drops a big stone.
+
+Examples:
+  tidepool                                      # the pool, full screen
+  tidepool play pool --rain 0.1 --damping 6     # more rain, longer ripples
+  tidepool play --max-bps 200k                  # a slow SSH link: cap the output rate
+  tidepool play --record s.jsonl                # then: tidepool render pool --replay s.jsonl";
+
+/// `tidepool play [scene]`.
+///
+/// The player damps more than `render` (shift 4, not 5): a terminal pool is a few hundred
+/// pixels at most, and at the papers' damping a ring crosses it twice before it fades, so the
+/// water never settles, looks busy and costs every cell's bytes on every frame.
+#[derive(Args, Debug, Clone)]
+#[command(after_help = PLAY_KEYS, mut_arg("damping", |a| a.default_value(PLAYER_DAMPING)))]
+pub struct PlayCommand {
+    /// The scene to start with (`tab` switches while playing).
+    #[arg(value_enum, default_value = "pool")]
+    pub scene: PlayScene,
+
+    /// The water of the pool. [--rain default: 0.02 drops per step]
+    #[command(flatten)]
+    pub pool: PoolArgs,
+
+    /// Seed for everything random (rain, random stones); the same seed and the same inputs
+    /// give the same water.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub seed: u64,
+
+    /// Display frames per second (1..=240); the simulation runs at its own fixed rate.
+    #[arg(long, value_name = "N", default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=240))]
+    pub fps: u32,
+
+    /// Colours: truecolor (24-bit), 256 (xterm palette), 16, or auto (from COLORTERM and
+    /// TERM; SSH and tmux may hide truecolor support, see the README).
+    #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
+    pub color: ColorChoice,
+
+    /// Treat a colour change of at most N (0..=255, per channel) as no change, to save bytes.
+    /// Screenshots always use exact pixels. [default: 0, or 3 when SSH_CONNECTION is set]
+    #[arg(long, value_name = "N")]
+    pub color_threshold: Option<u8>,
+
+    /// Do not wrap frames in synchronized output (ESC[?2026h/l), for terminals that mishandle it.
+    #[arg(long)]
+    pub no_sync: bool,
+
+    /// Cap the output at N bytes per second (suffixes k and M: 200k, 1.5M) by lowering the
+    /// frame rate, for slow links.
+    #[arg(long, value_name = "N", value_parser = parse_bps)]
+    pub max_bps: Option<u64>,
+
+    /// Record the session as JSON lines, for `tidepool render pool --replay FILE`.
+    #[arg(long, value_name = "FILE")]
+    pub record: Option<PathBuf>,
+}
+
+/// The player's default `--damping`.
+pub const PLAYER_DAMPING: &str = "4";
+
+/// The scenes `play` knows; `tab` cycles through them in this order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum PlayScene {
+    /// The ripple pool.
+    Pool,
+}
+
+/// `--color`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum ColorChoice {
+    /// Guess from COLORTERM and TERM.
+    Auto,
+    /// 24-bit colour.
+    Truecolor,
+    /// The xterm 256-colour palette.
+    #[value(name = "256")]
+    Palette256,
+    /// The 16 basic colours.
+    #[value(name = "16")]
+    Palette16,
+}
+
+/// Parses a byte rate: a whole number with an optional `k` (1000) or `M` (1,000,000) suffix.
+pub fn parse_bps(text: &str) -> Result<u64, String> {
+    let t = text.trim();
+    let (number, unit) = match t.char_indices().last() {
+        Some((i, 'k' | 'K')) => (&t[..i], 1e3),
+        Some((i, 'm' | 'M')) => (&t[..i], 1e6),
+        _ => (t, 1.0),
+    };
+    let v: f64 = number.trim().parse().map_err(|_| format!("'{text}' is not a byte rate; e.g. 200k or 1.5M"))?;
+    let bytes = v * unit;
+    if !bytes.is_finite() || bytes < 1000.0 {
+        return Err(format!("'{text}' is below 1k bytes per second, too little to draw a frame; e.g. 200k"));
+    }
+    if bytes > 1e12 {
+        return Err(format!("'{text}' is beyond any link; leave --max-bps out for no cap"));
+    }
+    Ok(bytes as u64)
 }
 
 /// `tidepool render <scene>`.
@@ -99,6 +205,12 @@ pub struct RenderPool {
     /// The picture and where it goes.
     #[command(flatten)]
     pub output: OutputArgs,
+
+    /// Re-simulate a session recorded with `tidepool play --record FILE` and render its last
+    /// step (or --steps N): identical to a screenshot taken at that step. The replay fixes the
+    /// size, seed, stones and water flags.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
+    pub replay: Option<PathBuf>,
 }
 
 /// Flags every rendered scene takes.
@@ -137,7 +249,7 @@ pub struct OutputArgs {
 #[derive(Args, Debug, Clone)]
 pub struct PoolArgs {
     /// Raindrops per simulation step on average (radius 2, weight 64), a number >= 0.
-    /// [default: 0 for render]
+    /// [default: 0 for render, 0.02 for play]
     #[arg(long, value_name = "RATE", value_parser = parse_rate, allow_negative_numbers = true)]
     pub rain: Option<f64>,
 
@@ -152,14 +264,42 @@ pub struct PoolArgs {
     #[arg(long, value_name = "F|auto", default_value = "auto", value_parser = parse_refraction, allow_negative_numbers = true)]
     pub refraction: crate::render::pool::Refraction,
 
-    /// Do not light the slopes (by default slopes facing the upper left are brightened).
+    /// Do not light the surface (by default flanks facing the sun are brightened, the others
+    /// darkened, and crests tilted towards the sun glint).
     #[arg(long)]
     pub no_shading: bool,
+
+    /// Do not draw caustics (the moving lines of focused sunlight on the floor).
+    #[arg(long)]
+    pub no_caustics: bool,
+
+    /// Water depth in pixels: deeper water focuses the caustics into sharper, brighter lines
+    /// and moves them further from the ripples that cast them (0..=10000).
+    #[arg(long, value_name = "PIXELS", default_value_t = 24.0, value_parser = parse_depth)]
+    pub depth: f32,
+
+    /// Where the sun is: azimuth in degrees clockwise from north (the top of the picture) and
+    /// elevation in degrees above the horizon (0..=90).
+    #[arg(long, value_name = "AZ_DEG,EL_DEG", default_value = "315,60", value_parser = parse_sun, allow_hyphen_values = true)]
+    pub sun: crate::render::pool::Sun,
 
     /// The pool floor: a PNG or JPEG, scaled to cover the picture (aspect kept, centred).
     /// [default: the built-in tiled floor]
     #[arg(long, value_name = "FILE")]
     pub background: Option<PathBuf>,
+}
+
+impl PoolArgs {
+    /// The look these flags ask for.
+    pub fn look(&self) -> crate::render::pool::PoolLook {
+        use crate::render::caustics::CausticsLook;
+        crate::render::pool::PoolLook {
+            refraction: self.refraction,
+            shading: !self.no_shading,
+            caustics: (!self.no_caustics).then(|| CausticsLook { depth_px: self.depth, ..CausticsLook::default() }),
+            sun: self.sun,
+        }
+    }
 }
 
 /// A picture size in pixels.
@@ -267,6 +407,32 @@ pub fn parse_damping(text: &str) -> Result<Damping, String> {
         .ok_or_else(|| format!("the shift {shift} is outside 1..=15 (5 is the papers'); use 'off' for no damping"))
 }
 
+/// Parses a water depth in pixels, 0..=10000.
+pub fn parse_depth(text: &str) -> Result<f32, String> {
+    let v: f32 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of pixels; e.g. 48"))?;
+    if !v.is_finite() || !(0.0..=10_000.0).contains(&v) {
+        return Err(format!("'{text}' must be between 0 and 10000 pixels"));
+    }
+    Ok(v)
+}
+
+/// Parses `AZIMUTH,ELEVATION` in degrees: any finite azimuth (wrapped to 0..360), elevation
+/// 0..=90.
+pub fn parse_sun(text: &str) -> Result<crate::render::pool::Sun, String> {
+    let hint = "write it as AZIMUTH,ELEVATION in degrees, e.g. 315,60";
+    let (az, el) = text.split_once(',').ok_or_else(|| format!("expected two numbers; {hint}"))?;
+    let number = |s: &str, name: &str| -> Result<f32, String> {
+        let v: f32 = s.trim().parse().map_err(|_| format!("the {name} '{}' is not a number; {hint}", s.trim()))?;
+        if v.is_finite() { Ok(v) } else { Err(format!("the {name} must be finite; {hint}")) }
+    };
+    let azimuth = number(az, "azimuth")?.rem_euclid(360.0);
+    let elevation = number(el, "elevation")?;
+    if !(0.0..=90.0).contains(&elevation) {
+        return Err(format!("the elevation {elevation} is outside 0..=90 degrees; {hint}"));
+    }
+    Ok(crate::render::pool::Sun { azimuth_deg: azimuth, elevation_deg: elevation })
+}
+
 /// Parses a duration in seconds, 0.01..=60.
 pub fn parse_seconds(text: &str) -> Result<f64, String> {
     let v: f64 = text.trim().parse().map_err(|_| format!("'{text}' is not a number of seconds; e.g. 0.5"))?;
@@ -346,15 +512,96 @@ mod tests {
     }
 
     #[test]
+    fn byte_rates() {
+        assert_eq!(parse_bps("200k"), Ok(200_000));
+        assert_eq!(parse_bps("1.5M"), Ok(1_500_000));
+        assert_eq!(parse_bps("5000"), Ok(5000));
+        for bad in ["", "k", "-5k", "10", "fast", "1e20"] {
+            assert!(parse_bps(bad).is_err(), "{bad}");
+        }
+    }
+
+    #[test]
+    fn replay_conflicts_with_what_it_fixes() {
+        let parse = |args: &[&str]| Cli::try_parse_from(["tidepool", "render", "pool"].iter().chain(args));
+        assert!(parse(&["--replay", "r.jsonl", "--out", "x.png", "--steps", "5"]).is_ok());
+        for flag in [&["--size", "10x10"][..], &["--seed", "3"], &["--stone", "1,2"], &["--damping", "4"]] {
+            let err = parse(&[&["--replay", "r.jsonl"][..], flag].concat()).unwrap_err();
+            assert_eq!(err.kind(), clap::error::ErrorKind::ArgumentConflict, "{flag:?}");
+        }
+    }
+
+    #[test]
+    fn play_is_the_default_scene_pool() {
+        let cli = Cli::try_parse_from(["tidepool", "play"]).unwrap();
+        let Some(Command::Play(play)) = cli.command else { panic!("not play") };
+        assert_eq!((play.scene, play.fps, play.color, play.pool.rain), (PlayScene::Pool, 30, ColorChoice::Auto, None));
+        assert_eq!(play.pool.damping, Damping::Shift(4), "the player damps more than render");
+        let cli = Cli::try_parse_from(["tidepool", "render", "pool"]).unwrap();
+        let Some(Command::Render(RenderCommand { scene: RenderScene::Pool(pool) })) = cli.command else { panic!() };
+        assert_eq!(pool.pool.damping, Damping::PAPERS);
+        assert!(Cli::try_parse_from(["tidepool", "play", "--fps", "0"]).is_err());
+        assert!(Cli::try_parse_from(["tidepool", "play", "--color", "256"]).is_ok());
+    }
+
+    #[test]
     fn rates_and_factors() {
         assert_eq!(parse_rate("0.02"), Ok(0.02));
         for bad in ["-1", "NaN", "inf", "x", "1e9"] {
             assert!(parse_rate(bad).is_err(), "{bad}");
         }
+        assert_eq!(parse_sun("-45, 30").map(|s| (s.azimuth_deg, s.elevation_deg)), Ok((315.0, 30.0)));
+        for bad in ["45", "45,91", "45,-1", "x,30", "inf,30", "45,30,1"] {
+            assert!(parse_sun(bad).is_err(), "{bad}");
+        }
+        assert!(parse_depth("-1").is_err() && parse_depth("nan").is_err() && parse_depth("48").is_ok());
         assert!(parse_refraction("auto").is_ok());
         assert!(parse_refraction("0").is_ok());
         for bad in ["-0.5", "nan", "1e9", "fast"] {
             assert!(parse_refraction(bad).is_err(), "{bad}");
+        }
+    }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            /// No text makes a parser panic; every answer is a value or a message.
+            #[test]
+            fn parsers_never_panic(text in "\\PC{0,40}") {
+                let _ = parse_size(&text);
+                let _ = parse_stone(&text);
+                let _ = parse_damping(&text);
+                let _ = parse_rate(&text);
+                let _ = parse_refraction(&text);
+                let _ = parse_sun(&text);
+                let _ = parse_depth(&text);
+                let _ = parse_seconds(&text);
+            }
+
+            /// Sizes within the limits round-trip; anything past a limit is refused.
+            #[test]
+            fn sizes_round_trip_within_the_limits(w in 1u32..=20_000, h in 1u32..=20_000) {
+                let parsed = parse_size(&format!("{w}x{h}"));
+                let fits = w <= MAX_SIDE && h <= MAX_SIDE && u64::from(w) * u64::from(h) <= MAX_PIXELS;
+                prop_assert_eq!(parsed.is_ok(), fits);
+                if let Ok(size) = parsed {
+                    prop_assert_eq!((size.width, size.height), (w, h));
+                }
+            }
+
+            /// Stones round-trip, with the documented defaults and ranges.
+            #[test]
+            fn stones_round_trip(x in any::<i32>(), y in any::<i32>(), r in -5i64..1100, wt in -5i64..33_000) {
+                let parsed = parse_stone(&format!("{x},{y},{r},{wt}"));
+                let valid = (1..=1000).contains(&r) && (1..=32767).contains(&wt);
+                prop_assert_eq!(parsed.is_ok(), valid);
+                if let Ok(stone) = parsed {
+                    prop_assert_eq!(stone, Stone { x, y, radius: r as u32, weight: wt as i16 });
+                }
+                prop_assert_eq!(parse_stone(&format!("{x},{y}")), Ok(Stone { x, y, radius: 8, weight: 64 }));
+            }
         }
     }
 }

@@ -42,6 +42,16 @@ pub enum Error {
     /// Writing to standard output failed.
     #[error("cannot write to standard output: {0}")]
     Stdout(#[source] io::Error),
+    /// A replay file (`--replay`) is malformed, truncated or of another version.
+    #[error("{path}, line {line}: {message}")]
+    Replay {
+        /// The replay file.
+        path: PathBuf,
+        /// The line at fault, from 1.
+        line: usize,
+        /// What is wrong, with the fix.
+        message: String,
+    },
     /// Something the user asked for cannot be done in this situation.
     #[error("{0}")]
     Usage(String),

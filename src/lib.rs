@@ -6,6 +6,7 @@
 //! - [`output`]: pixels -> PNG, half-block text, heightmaps; atomic file writes.
 //! - [`scene`]: a simulation together with its renderer, driven alike by the headless
 //!   renderer and the terminal player.
+//! - [`term`]: the interactive terminal player; [`replay`]: recorded sessions.
 //! - [`cli`] and [`commands`]: the command line.
 #![warn(missing_docs)]
 
@@ -15,8 +16,11 @@ pub mod error;
 pub mod output;
 pub mod progress;
 pub mod render;
+pub mod replay;
 pub mod scene;
 pub mod signals;
 pub mod sim;
+pub mod simd;
+pub mod term;
 
 pub use error::{Error, Result};

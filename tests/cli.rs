@@ -199,9 +199,12 @@ fn ctrl_c_exits_130_and_leaves_no_file() {
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "no file, no temporary file");
 }
 
+/// `tidepool` alone plays the pool full-screen (issue 3); without a terminal it says so in one
+/// line, points to `tidepool render`, and exits 2.
 #[test]
-fn no_subcommand_shows_how_to_start() {
+fn no_subcommand_without_a_terminal_points_to_render() {
     let out = run(&[]);
-    assert!(out.status.success());
-    assert!(String::from_utf8_lossy(&out.stdout).contains("tidepool render pool"));
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("not a terminal") && err.contains("tidepool render pool"), "{err}");
 }

@@ -2,16 +2,19 @@
 
 pub mod bench;
 pub mod ocean;
+pub mod play;
 pub mod render;
+pub mod replay;
 pub mod spectrum;
 
 use crate::cli::{Cli, Command};
 use crate::error::Result;
 
-/// What `tidepool` prints when run without a subcommand.
+/// A summary of the commands (`tidepool` alone plays the pool).
 pub const GETTING_STARTED: &str = "\
 tidepool: water you can play with in any terminal.
 
+  tidepool                              play with the pool full-screen (keys: ? in the player)
   tidepool render pool                  render the ripple pool to pool.png
   tidepool render pool --out - --size 120x60
                                         draw it in this terminal as half-block text
@@ -27,9 +30,10 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Render(render)) => render::run(render),
         Some(Command::Spectrum(args)) => spectrum::run(args),
         Some(Command::Bench(args)) => bench::run(args),
-        None => {
-            println!("{GETTING_STARTED}");
-            Ok(())
-        }
+        Some(Command::Play(play)) => play::run(play),
+        None => match <Cli as clap::Parser>::try_parse_from(["tidepool", "play"]) {
+            Ok(Cli { command: Some(Command::Play(play)) }) => play::run(play),
+            _ => unreachable!("`tidepool play` with no flags always parses"),
+        },
     }
 }

@@ -12,7 +12,6 @@ use crate::output::heightmap::{self, Heightmap};
 use crate::output::{atomic, halfblock, png};
 use crate::progress::Progress;
 use crate::render::background;
-use crate::render::pool::PoolLook;
 use crate::scene::pool::{PoolScene, PoolSettings};
 use crate::sim::ripple::Stone;
 
@@ -273,6 +272,9 @@ fn default_steps_scale(scale: f32) -> f32 {
 }
 
 fn render_pool(args: RenderPool) -> Result<()> {
+    if let Some(path) = &args.replay {
+        return super::replay::render(&args, path);
+    }
     let plan = OutputPlan::new(&args.output, "pool", std::io::stdout().is_terminal(), terminal_pixels())?;
     let floor = match &args.pool.background {
         Some(path) => background::load("--background", path)?,
@@ -282,7 +284,7 @@ fn render_pool(args: RenderPool) -> Result<()> {
         damping: args.pool.damping,
         rain_rate: args.pool.rain.unwrap_or(0.0),
         seed: args.output.seed,
-        look: PoolLook { refraction: args.pool.refraction, shading: !args.pool.no_shading },
+        look: args.pool.look(),
     };
     let Size { width, height } = plan.size;
     let mut scene = PoolScene::new(width, height, floor, settings).ok_or_else(|| {

@@ -14,6 +14,15 @@ use crate::signals;
 /// [`signals`], so Ctrl-C or SIGTERM mid-write removes it. On any error the temporary file is
 /// removed and an existing file at `path` is left as it was.
 pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
+    // A device, FIFO or socket (`/dev/null`, `/dev/stdout`, a named pipe) is written as it is:
+    // renaming a file over it would replace the device node itself.
+    if let Ok(meta) = std::fs::metadata(path)
+        && !meta.is_file()
+        && !meta.is_dir()
+    {
+        let mut file = OpenOptions::new().write(true).open(path).map_err(|e| Error::io("cannot write", path, e))?;
+        return file.write_all(bytes).and_then(|()| file.flush()).map_err(|e| Error::io("cannot write", path, e));
+    }
     let temp = temp_path(path)?;
     signals::register_temp_file(&temp);
     let result = write_then_rename(&temp, path, bytes);
@@ -96,6 +105,15 @@ mod tests {
         assert!(err.contains("directory"), "{err}");
         assert!(target.is_dir());
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "no temporary file left");
+    }
+
+    #[test]
+    fn devices_are_written_in_place_never_replaced() {
+        write_file(Path::new("/dev/null"), b"into the void").unwrap();
+        let meta = std::fs::metadata("/dev/null").unwrap();
+        assert!(!meta.is_file(), "/dev/null is still a device");
+        let err = write_file(Path::new("/dev/full"), b"no room").unwrap_err().to_string();
+        assert!(err.contains("No space left"), "{err}");
     }
 
     #[test]

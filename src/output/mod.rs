@@ -1,6 +1,10 @@
 //! Outputs: pixels (and heights) in, bytes out. Nothing here knows what it draws.
 
 pub mod atomic;
+pub mod color;
+pub mod cursor;
+pub mod diff;
+pub mod frame;
 pub mod halfblock;
 pub mod heightmap;
 pub mod png;

@@ -5,6 +5,7 @@
 //! an implied CR, like a tty's `onlcr`), backspace, CSI cursor movement (`H f A B C D E F G d`),
 //! erase (`J K`), SGR (`0`, `39`, `49`, `38/48;2;r;g;b`, `38/48;5;n`, 30-37/40-47/90-97/100-107)
 //! and DEC private modes (`?1049`, `?25`, `?2026`, mouse modes), whose state is recorded.
+//! CAN/SUB abort a sequence, ESC inside a CSI restarts it.
 //! Anything else is ignored.
 
 use crate::output::halfblock::Rgb;
@@ -111,7 +112,7 @@ impl Screen {
             return None;
         }
         let cell = self.cell(x, y / 2);
-        let upper = y % 2 == 0;
+        let upper = y.is_multiple_of(2);
         match cell.ch {
             '\u{2580}' => {
                 if upper {
@@ -141,6 +142,15 @@ impl Screen {
     }
 
     fn byte(&mut self, b: u8) {
+        // CAN and SUB abort any sequence; ESC starts a new one (as in xterm).
+        if self.state != Parse::Ground && matches!(b, 0x18 | 0x1a) {
+            self.state = Parse::Ground;
+            return;
+        }
+        if matches!(self.state, Parse::Csi(_)) && b == 0x1b {
+            self.state = Parse::Escape;
+            return;
+        }
         match std::mem::replace(&mut self.state, Parse::Ground) {
             Parse::Ground => self.ground(b),
             Parse::Escape => match b {
@@ -244,7 +254,10 @@ impl Screen {
             return;
         }
         let (cols, rows) = (self.cols.max(1), self.rows.max(1));
-        self.wrap_pending = false;
+        // SGR leaves a pending wrap alone (as xterm does); moves and erases cancel it.
+        if command != b'm' {
+            self.wrap_pending = false;
+        }
         match command {
             b'H' | b'f' => self.cursor = ((n(1) - 1).min(cols - 1), (n(0) - 1).min(rows - 1)),
             b'A' => self.cursor.1 = self.cursor.1.saturating_sub(n(0)),
@@ -384,6 +397,15 @@ mod tests {
         s.lf_returns = false;
         s.feed(b"\nh");
         assert_eq!(s.row_text(1), " h ");
+    }
+
+    #[test]
+    fn colour_changes_keep_a_pending_wrap() {
+        let mut s = Screen::new(3, 2);
+        s.feed(b"abc\x1b[31md");
+        assert_eq!(s.row_text(1), "d  ", "SGR does not cancel the wrap");
+        s.feed(b"\x1b[1;1Habc\x1b[Cx");
+        assert_eq!(s.row_text(0), "abx", "a cursor move does");
     }
 
     #[test]

@@ -7,6 +7,7 @@
 
 pub mod background;
 pub mod camera;
+pub mod caustics;
 pub mod mesh;
 pub mod ocean;
 pub mod plot;

@@ -114,7 +114,7 @@ mod tests {
     fn checker(w: u32, h: u32) -> Pixmap {
         let mut p = Pixmap::new(w, h).unwrap();
         for (i, px) in p.pixels_mut().iter_mut().enumerate() {
-            let v = if (i as u32 % w + i as u32 / w) % 2 == 0 { 200 } else { 100 };
+            let v = if (i as u32 % w + i as u32 / w).is_multiple_of(2) { 200 } else { 100 };
             *px = PremultipliedColorU8::from_rgba(v, v / 2, 10, 255).unwrap();
         }
         p

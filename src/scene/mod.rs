@@ -2,4 +2,5 @@
 //! the terminal player drive the same scene values the same way.
 
 pub mod ocean;
+pub mod playable;
 pub mod pool;

@@ -5,6 +5,8 @@ use tiny_skia::Pixmap;
 use crate::output::heightmap::Heightmap;
 use crate::render::background;
 use crate::render::pool::{PoolLook, PoolRenderer};
+use crate::replay::Event;
+use crate::scene::playable::{Action, Playable};
 use crate::sim::rain::Rain;
 use crate::sim::ripple::{Damping, RipplePool, Stone};
 
@@ -29,7 +31,23 @@ pub struct PoolScene {
     renderer: PoolRenderer,
     floor: Pixmap,
     drops: Vec<Stone>,
+    /// The rate `r` switches the rain back on to.
+    rain_when_on: f64,
 }
+
+/// The rain rate the player's `r` key switches on when the pool started without rain.
+pub const DEFAULT_TOGGLE_RAIN: f64 = 0.02;
+/// The weight of a stone dropped by the player. At terminal size a ring of weight 48 still
+/// reads clearly, and every changed cell costs ~36 bytes in exact truecolor, so a heavier
+/// default stone would set the whole pool in motion and cost every frame (measured: the
+/// README's bytes-per-frame figure).
+pub const PLAYER_STONE_WEIGHT: i16 = 48;
+/// A right click drops a stone this many times wider and twice as heavy.
+pub const BIG_STONE_FACTOR: u32 = 2;
+/// Stirring drops small light stones this many pixels apart along the drag.
+const STIR_SPACING: f32 = 2.0;
+/// The weight of the small stones of a stir.
+const STIR_WEIGHT: i16 = 32;
 
 impl PoolScene {
     /// A still pool of `width x height` pixels over `floor` (scaled to cover the picture).
@@ -43,6 +61,7 @@ impl PoolScene {
             renderer: PoolRenderer::new(fitted, settings.look),
             floor,
             drops: Vec::new(),
+            rain_when_on: if settings.rain_rate > 0.0 { settings.rain_rate } else { DEFAULT_TOGGLE_RAIN },
         })
     }
 
@@ -107,12 +126,12 @@ impl PoolScene {
     }
 
     /// Draws the current water into `out`, which must have the scene's size.
-    pub fn render(&self, out: &mut Pixmap) {
+    pub fn render(&mut self, out: &mut Pixmap) {
         self.renderer.render(&self.pool, out);
     }
 
     /// A new pixmap of the scene's size holding the current picture.
-    pub fn snapshot(&self) -> Pixmap {
+    pub fn snapshot(&mut self) -> Pixmap {
         let mut out = Pixmap::new(self.width(), self.height()).expect("the scene's size is a valid pixmap size");
         self.render(&mut out);
         out
@@ -138,6 +157,91 @@ impl PoolScene {
             height: self.pool.height(),
             values: self.pool.heights().iter().map(|&v| f32::from(v)).collect(),
         }
+    }
+}
+
+impl Playable for PoolScene {
+    fn name(&self) -> &'static str {
+        "pool"
+    }
+
+    /// The papers' pool runs at 60 steps a second: waves cross a 160-pixel terminal in ~4 s.
+    fn steps_per_second(&self) -> f64 {
+        60.0
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (self.width(), self.height())
+    }
+
+    fn step(&mut self) {
+        PoolScene::step(self);
+    }
+
+    fn render(&mut self, out: &mut Pixmap) {
+        PoolScene::render(self, out);
+    }
+
+    fn resolve(&self, action: Action) -> Vec<Event> {
+        match action {
+            Action::Stone { x, y, radius, big } => {
+                let (radius, weight) = if big {
+                    (radius * BIG_STONE_FACTOR, PLAYER_STONE_WEIGHT.saturating_mul(2))
+                } else {
+                    (radius, PLAYER_STONE_WEIGHT)
+                };
+                vec![Event::Stone(Stone { x, y, radius: radius.max(1), weight })]
+            }
+            Action::Stir { from, to } => {
+                let (dx, dy) = ((to.0 - from.0) as f32, (to.1 - from.1) as f32);
+                let n = ((dx.hypot(dy) / STIR_SPACING).ceil() as i32).clamp(1, 512);
+                (1..=n)
+                    .map(|i| {
+                        let t = i as f32 / n as f32;
+                        let x = from.0 + (dx * t).round() as i32;
+                        let y = from.1 + (dy * t).round() as i32;
+                        Event::Stone(Stone { x, y, radius: 2, weight: STIR_WEIGHT })
+                    })
+                    .collect()
+            }
+            Action::ToggleRain => {
+                let rate = if self.rain.rate() > 0.0 { 0.0 } else { self.rain_when_on };
+                vec![Event::Rain(rate)]
+            }
+            Action::Clear => vec![Event::Clear],
+            Action::Damping(stronger) => {
+                let d = self.pool.damping();
+                vec![Event::Damping(if stronger { d.stronger() } else { d.weaker() })]
+            }
+            Action::Key(_) => Vec::new(),
+        }
+    }
+
+    fn apply(&mut self, event: &Event) {
+        match *event {
+            Event::Stone(stone) => self.drop_stone(stone),
+            Event::Rain(rate) => {
+                if rate > 0.0 {
+                    self.rain_when_on = rate;
+                }
+                self.rain.set_rate(rate);
+            }
+            Event::Damping(d) => self.pool.set_damping(d),
+            Event::Clear => self.pool.clear(),
+            Event::Resize([w, h]) => {
+                self.resize(w, h);
+            }
+            Event::Screenshot(_) | Event::End => {}
+        }
+    }
+
+    fn status(&self) -> String {
+        let rain = if self.rain.rate() > 0.0 { format!("rain {}", self.rain.rate()) } else { "rain off".into() };
+        format!("{rain} \u{b7} damping {}", self.pool.damping())
+    }
+
+    fn help(&self) -> Vec<(&'static str, &'static str)> {
+        vec![("r", "rain on/off"), ("c", "clear the water"), ("[ ]", "damp more / less")]
     }
 }
 
@@ -186,6 +290,30 @@ mod tests {
         assert_eq!(scene.snapshot().width(), 30);
         assert!(!scene.resize(0, 10));
         assert_eq!(scene.width(), 30);
+    }
+
+    #[test]
+    fn actions_resolve_to_events_that_apply() {
+        let mut scene = PoolScene::new(40, 30, background::pool_floor(), settings(0.0)).unwrap();
+        let events = scene.resolve(Action::Stone { x: 10, y: 12, radius: 3, big: true });
+        assert_eq!(events, vec![Event::Stone(Stone { x: 10, y: 12, radius: 6, weight: 96 })]);
+        scene.apply(&events[0]);
+        assert!(scene.pool().heights()[12 * 40 + 10] < 0);
+        let stir = scene.resolve(Action::Stir { from: (5, 5), to: (15, 5) });
+        assert_eq!(stir.len(), 5);
+        assert_eq!(stir[4], Event::Stone(Stone { x: 15, y: 5, radius: 2, weight: STIR_WEIGHT }));
+        let rain = scene.resolve(Action::ToggleRain);
+        assert_eq!(rain, vec![Event::Rain(DEFAULT_TOGGLE_RAIN)]);
+        scene.apply(&rain[0]);
+        assert_eq!(scene.resolve(Action::ToggleRain), vec![Event::Rain(0.0)]);
+        let damping = scene.resolve(Action::Damping(true));
+        assert_eq!(damping, vec![Event::Damping(Damping::Shift(4))]);
+        scene.apply(&Event::Clear);
+        assert!(scene.pool().heights().iter().all(|&v| v == 0));
+        scene.apply(&Event::Resize([20, 10]));
+        assert_eq!(Playable::size(&scene), (20, 10));
+        assert!(scene.resolve(Action::Key('w')).is_empty());
+        assert!(scene.status().contains("rain 0.02"));
     }
 
     #[test]

@@ -85,7 +85,7 @@ impl Fbm {
             d *= shrink;
             // Square: edge midpoints from their four neighbours (two corners, two centres).
             for y in (0..size).step_by(half) {
-                let first = if (y / half) % 2 == 0 { half } else { 0 };
+                let first = if (y / half).is_multiple_of(2) { half } else { 0 };
                 for x in (first..size).step_by(step) {
                     let sum = values[wrap(y, -h) * size + x]
                         + values[wrap(y, h) * size + x]

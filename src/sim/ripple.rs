@@ -478,4 +478,79 @@ mod tests {
         assert_eq!(Damping::shift(16), None);
         assert_eq!(Damping::shift(5), Some(Damping::PAPERS));
     }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        fn damping() -> impl Strategy<Value = Damping> {
+            prop_oneof![Just(Damping::Off), (1u8..=15).prop_map(Damping::Shift)]
+        }
+
+        fn stone(w: usize, h: usize) -> impl Strategy<Value = Stone> {
+            (-20i32..w as i32 + 20, -20i32..h as i32 + 20, 1u32..40, 1i16..=i16::MAX)
+                .prop_map(|(x, y, radius, weight)| Stone { x, y, radius, weight })
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(64))]
+
+            /// Any stones, any damping, any number of steps: the fast paths compute exactly
+            /// the plain rule (which clamps to i16, so nothing ever wraps), and the walls stay
+            /// zero. Runs with overflow checks in the dev profile.
+            #[test]
+            fn any_stones_match_the_plain_rule(
+                (w, h, stones) in (3usize..70, 3usize..70).prop_flat_map(|(w, h)| {
+                    (Just(w), Just(h), proptest::collection::vec((stone(w, h), 0u64..40), 1..12))
+                }),
+                damping in damping(),
+            ) {
+                let mut fast = RipplePool::new(w, h, damping);
+                let mut slow = fast.clone();
+                for (stone, steps) in stones {
+                    fast.drop_stone(stone);
+                    slow.drop_stone(stone);
+                    fast.advance(steps);
+                    for _ in 0..steps {
+                        reference_step(&mut slow);
+                    }
+                    prop_assert_eq!(fast.heights(), slow.heights());
+                }
+                for x in 0..w {
+                    prop_assert_eq!(fast.heights()[x], 0);
+                    prop_assert_eq!(fast.heights()[(h - 1) * w + x], 0);
+                }
+                for y in 0..h {
+                    prop_assert_eq!(fast.heights()[y * w], 0);
+                    prop_assert_eq!(fast.heights()[y * w + w - 1], 0);
+                }
+            }
+
+            /// A stone in the centre of a square pool keeps the pool's 8-fold symmetry
+            /// exactly, damped or not: the rule, its rounding and the walls are all symmetric.
+            #[test]
+            fn a_centred_stone_keeps_eight_fold_symmetry(
+                half in 2usize..30,
+                radius in 1u32..20,
+                weight in 1i16..=i16::MAX,
+                steps in 0u64..120,
+                damping in damping(),
+            ) {
+                let n = 2 * half + 1;
+                let mut pool = RipplePool::new(n, n, damping);
+                pool.drop_stone(Stone { x: half as i32, y: half as i32, radius, weight });
+                pool.advance(steps);
+                let at = |x: usize, y: usize| pool.heights()[y * n + x];
+                for y in 0..n {
+                    for x in 0..n {
+                        let v = at(x, y);
+                        let (mx, my) = (n - 1 - x, n - 1 - y);
+                        prop_assert_eq!(v, at(mx, y));
+                        prop_assert_eq!(v, at(x, my));
+                        prop_assert_eq!(v, at(y, x), "diagonal mirror at ({}, {})", x, y);
+                    }
+                }
+            }
+        }
+    }
 }

@@ -23,6 +23,7 @@
 //! which are guarded by run-time feature detection.
 
 use super::ripple::Damping;
+use crate::simd::Simd;
 
 /// The most steps computed in one wavefront sweep. With `k` steps about `k + 2` rows of each
 /// buffer are live per band, e.g. 144 KB for a 2048-wide pool at k = 16: it fits in L2.
@@ -245,52 +246,16 @@ fn row_kernel_with<const DAMPED: bool>(up: &[i16], mid: &[i16], down: &[i16], ou
     }
 }
 
-/// The instruction set the kernels run with, detected once per block.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kernel {
-    /// The baseline x86-64 (SSE2) or non-x86 build.
-    Portable,
-    /// SSE4.1 (128-bit vectors with sign extension and 32-bit min/max, which the clamp needs;
-    /// plain SSE2 has to emulate them and is slower than scalar code).
-    #[cfg(target_arch = "x86_64")]
-    Sse41,
-    /// AVX2 (256-bit vectors).
-    #[cfg(target_arch = "x86_64")]
-    Avx2,
-    /// AVX-512BW (512-bit vectors).
-    #[cfg(target_arch = "x86_64")]
-    Avx512,
+/// The kernels, compiled once per instruction set (see [`crate::simd`]).
+pub type Kernel = Simd;
+
+/// Dispatch of the sweep and row kernels to their compiled variants.
+trait Kernels {
+    fn sweep(self, band: &mut Band<'_>, block: usize, damping: Damping);
+    fn row(self, up: &[i16], mid: &[i16], down: &[i16], out: &mut [i16], damping: Damping);
 }
 
-impl Kernel {
-    /// The widest kernel this CPU runs. `TIDEPOOL_SIMD=portable|sse4.1|avx2` caps it (for
-    /// benchmarks and for comparing the paths).
-    pub fn detect() -> Kernel {
-        #[cfg(target_arch = "x86_64")]
-        {
-            static DETECTED: std::sync::OnceLock<Kernel> = std::sync::OnceLock::new();
-            *DETECTED.get_or_init(|| {
-                let cap = std::env::var("TIDEPOOL_SIMD").unwrap_or_default();
-                let allowed = |level: &str| {
-                    let order = ["portable", "sse4.1", "avx2", "avx512"];
-                    let cap = order.iter().position(|l| *l == cap).unwrap_or(order.len());
-                    order.iter().position(|l| *l == level).is_some_and(|i| i <= cap)
-                };
-                if allowed("avx512") && std::is_x86_feature_detected!("avx512bw") {
-                    Kernel::Avx512
-                } else if allowed("avx2") && std::is_x86_feature_detected!("avx2") {
-                    Kernel::Avx2
-                } else if allowed("sse4.1") && std::is_x86_feature_detected!("sse4.1") {
-                    Kernel::Sse41
-                } else {
-                    Kernel::Portable
-                }
-            })
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        Kernel::Portable
-    }
-
+impl Kernels for Simd {
     fn sweep(self, band: &mut Band<'_>, block: usize, damping: Damping) {
         match self {
             Kernel::Portable => band.sweep(block, damping),

@@ -1,0 +1,390 @@
+//! The player's loop: read input, step the simulation at its fixed rate, draw a frame when one
+//! is due and the writer is free.
+//!
+//! One thread does input, simulation, rendering and encoding; a second only writes (see
+//! [`crate::term::writer`]). Input is polled with a timeout that ends at the next due step or
+//! frame, so a key press is handled at once, not at the next frame.
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use clap::ValueEnum;
+use crossterm::event;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use tiny_skia::Pixmap;
+
+use crate::cli::PlayScene;
+use crate::error::{Error, Result};
+use crate::output::color::ColorMode;
+use crate::output::diff::{EncodeOptions, Shown, encode_into};
+use crate::output::frame::Frame;
+use crate::replay::{Event, Recorder};
+use crate::scene::playable::{Action, Playable};
+use crate::term::guard::{self, TerminalGuard};
+use crate::term::input::{Input, coalesce, map_event};
+use crate::term::pacing::{FramePacer, Meter, SimClock, human_rate};
+use crate::term::ui::{self, MIN_SIZE, Status};
+use crate::term::writer::FrameWriter;
+
+/// Stone radii `+` and `-` step through, in pixels.
+pub const STONE_RADII: [u32; 10] = [1, 2, 3, 4, 6, 8, 12, 16, 24, 32];
+/// The stone radius the player starts with, in pixels (a terminal pool is ~100 pixels tall).
+pub const DEFAULT_STONE_RADIUS: u32 = 3;
+/// How long the aim marker stays after the last aim key.
+const AIM_VISIBLE: Duration = Duration::from_secs(4);
+/// How long a status message (screenshot saved) stays.
+const MESSAGE_VISIBLE: Duration = Duration::from_secs(4);
+/// Random stones use their own generator, seeded from `--seed` xor this, so that pressing
+/// `space` does not change the rain.
+const STONE_SEED_MIX: u64 = 0x5354_4f4e_4553_0001;
+/// Setting this variable makes the player panic after its first frame: the pty tests use it to
+/// check that a panic restores the terminal. Not a user feature.
+pub const TEST_PANIC_VAR: &str = "TIDEPOOL_TEST_PANIC";
+
+/// Makes a scene of a kind at a size in pixels (used at start, on `tab`).
+pub type SceneFactory = Box<dyn FnMut(PlayScene, u32, u32) -> Result<Box<dyn Playable>>>;
+
+/// How the player runs.
+#[derive(Clone, Debug)]
+pub struct PlayerConfig {
+    /// Display frames per second.
+    pub fps: u32,
+    /// Output byte rate cap.
+    pub max_bps: Option<u64>,
+    /// Terminal colours.
+    pub color: ColorMode,
+    /// Encoder options.
+    pub encode: EncodeOptions,
+    /// Seed of the random stones.
+    pub seed: u64,
+    /// Where to record the session, with the scene's pixel-changing options.
+    pub record: Option<(PathBuf, serde_json::Map<String, serde_json::Value>)>,
+}
+
+/// The picture size in pixels for a terminal of `cols x rows` (one row for the status line).
+pub fn picture_size(cols: u16, rows: u16) -> (u32, u32) {
+    (u32::from(cols).max(3), (2 * u32::from(rows).saturating_sub(1)).max(3))
+}
+
+fn big_enough((cols, rows): (u16, u16)) -> bool {
+    cols >= MIN_SIZE.0 && rows >= MIN_SIZE.1
+}
+
+enum Flow {
+    Continue,
+    Quit,
+}
+
+/// Everything the loop keeps besides the scene.
+struct Player {
+    kind: PlayScene,
+    scene: Box<dyn Playable>,
+    make: SceneFactory,
+    config: PlayerConfig,
+    recorder: Option<Arc<Mutex<Recorder>>>,
+    step: u64,
+    term: (u16, u16),
+    sim: SimClock,
+    help: bool,
+    aim: (i32, i32),
+    aim_until: Option<Instant>,
+    message: Option<(String, Instant)>,
+    drag: Option<(i32, i32)>,
+    radius: u32,
+    rng: ChaCha8Rng,
+}
+
+/// Runs the player until the user quits. `make` builds scenes; the terminal is restored on
+/// every way out.
+pub fn run(first: PlayScene, mut make: SceneFactory, config: PlayerConfig) -> Result<()> {
+    let term = crossterm::terminal::size().map_err(|e| Error::Usage(format!("cannot read the terminal size: {e}")))?;
+    let (w, h) = picture_size(term.0, term.1);
+    let scene = make(first, w, h)?;
+    let recorder = match &config.record {
+        None => None,
+        Some((path, options)) => {
+            let header = crate::replay::Header {
+                version: env!("CARGO_PKG_VERSION").into(),
+                scene: scene.name().into(),
+                seed: config.seed,
+                size: [w, h],
+                options: options.clone(),
+            };
+            Some(Arc::new(Mutex::new(Recorder::new(path, &header)?)))
+        }
+    };
+    let signal_hook = recorder.as_ref().map(|r| {
+        let r = Arc::clone(r);
+        crate::signals::add_hook(move || {
+            if let Ok(mut r) = r.lock() {
+                let step = r.step();
+                let _ = r.finish(step);
+            }
+        })
+    });
+    let now = Instant::now();
+    let mut player = Player {
+        kind: first,
+        sim: SimClock::new(scene.steps_per_second(), now),
+        scene,
+        make,
+        rng: ChaCha8Rng::seed_from_u64(config.seed ^ STONE_SEED_MIX),
+        config,
+        recorder,
+        step: 0,
+        term,
+        help: false,
+        aim: ((w / 2) as i32, ((h / 2) & !1) as i32),
+        aim_until: None,
+        message: None,
+        drag: None,
+        radius: DEFAULT_STONE_RADIUS,
+    };
+    let result = {
+        let guard = TerminalGuard::enter().map_err(|e| Error::Usage(format!("cannot set up the terminal: {e}")))?;
+        let result = player.run_loop();
+        drop(guard);
+        result
+    };
+    if let Some(key) = signal_hook {
+        crate::signals::remove_hook(key);
+    }
+    let finished = match &player.recorder {
+        Some(r) => r.lock().map_or(Ok(()), |mut r| r.finish(player.step)),
+        None => Ok(()),
+    };
+    result.and(finished)
+}
+
+impl Player {
+    fn run_loop(&mut self) -> Result<()> {
+        let writer = FrameWriter::spawn(guard::write_frame).map_err(Error::Stdout)?;
+        let start = Instant::now();
+        let mut pacer = FramePacer::new(self.config.fps, self.config.max_bps, start);
+        let mut meter = Meter::new(start);
+        let mut shown = Shown::UNKNOWN;
+        let (w, h) = self.scene.size();
+        let mut pixmap = Pixmap::new(w, h).expect("the scene's size is a valid pixmap size");
+        let test_panic = std::env::var_os(TEST_PANIC_VAR).is_some();
+        let mut inputs = Vec::new();
+        loop {
+            let now = Instant::now();
+            let deadline = self.sim.next_due().map_or(pacer.next_due(), |s| s.min(pacer.next_due()));
+            let timeout = deadline.saturating_duration_since(now).min(Duration::from_millis(50));
+            inputs.clear();
+            let read_error = |e: std::io::Error| Error::Usage(format!("cannot read the terminal: {e}"));
+            if event::poll(timeout).map_err(read_error)? {
+                loop {
+                    inputs.extend(map_event(event::read().map_err(read_error)?));
+                    if inputs.len() >= 1024 || !event::poll(Duration::ZERO).map_err(read_error)? {
+                        break;
+                    }
+                }
+            }
+            for input in coalesce(inputs.drain(..)) {
+                if let Input::Resize(..) = input {
+                    shown = Shown::UNKNOWN;
+                }
+                if let Flow::Quit = self.handle(input)? {
+                    return Ok(());
+                }
+            }
+            let now = Instant::now();
+            for _ in 0..self.sim.due(now) {
+                self.scene.step();
+                self.step += 1;
+            }
+            if let Some(r) = &self.recorder
+                && let Ok(mut r) = r.lock()
+            {
+                r.advance(self.step);
+            }
+            if let Some(e) = writer.error() {
+                return Err(Error::Stdout(e));
+            }
+            meter.tick(now);
+            if !pacer.ready(now) {
+                continue;
+            }
+            if !writer.idle() {
+                // The terminal is still busy with the last frame: drop this one.
+                pacer.sent(now, 0);
+                continue;
+            }
+            let size = self.scene.size();
+            if (pixmap.width(), pixmap.height()) != size {
+                pixmap = Pixmap::new(size.0, size.1).expect("the scene's size is a valid pixmap size");
+            }
+            let frame = self.frame(&mut pixmap, &meter, now);
+            let mut bytes = writer.buffer();
+            encode_into(&mut shown, &frame, self.config.encode, &mut bytes);
+            let len = bytes.len();
+            if len > 0 {
+                writer.send(bytes);
+            }
+            meter.frame(now, len);
+            pacer.sent(now, len);
+            if test_panic && len > 0 {
+                panic!("{TEST_PANIC_VAR} is set: panicking on purpose to test the terminal restore");
+            }
+        }
+    }
+
+    /// The frame to show now.
+    fn frame(&mut self, pixmap: &mut Pixmap, meter: &Meter, now: Instant) -> Frame {
+        let (cols, rows) = (usize::from(self.term.0), usize::from(self.term.1));
+        let mut frame = Frame::new(cols, rows);
+        if !big_enough(self.term) {
+            ui::too_small(&mut frame);
+            return frame;
+        }
+        self.scene.render(pixmap);
+        frame.draw_pixels(pixmap, self.config.color);
+        if self.aim_until.is_some_and(|t| now < t) {
+            ui::aim_marker(&mut frame, self.aim.0 as u32, self.aim.1 as u32);
+        }
+        if self.help {
+            ui::help_overlay(&mut frame, &ui::help_lines(&self.scene.help()), self.config.color);
+        }
+        let message = self.message.as_ref().filter(|(_, until)| now < *until).map(|(m, _)| m.clone());
+        let status = Status {
+            scene: self.scene.name(),
+            fps: meter.fps,
+            rate: human_rate(meter.bytes_per_second),
+            detail: self.scene.status(),
+            stone: self.radius,
+            paused: self.sim.paused(),
+            message,
+        };
+        ui::status_line(&mut frame, rows - 1, &status, self.config.color);
+        frame
+    }
+
+    /// Resolves an action with the scene, applies and records its events.
+    fn act(&mut self, action: Action) {
+        for event in self.scene.resolve(action) {
+            self.apply(event);
+        }
+    }
+
+    fn apply(&mut self, event: Event) {
+        self.scene.apply(&event);
+        if let Some(r) = &self.recorder
+            && let Ok(mut r) = r.lock()
+        {
+            r.record(self.step, event);
+        }
+    }
+
+    fn say(&mut self, message: String) {
+        self.message = Some((message, Instant::now() + MESSAGE_VISIBLE));
+    }
+
+    /// The picture pixel under terminal cell (col, row): its upper half.
+    fn pixel_at(&self, col: u16, row: u16) -> Option<(i32, i32)> {
+        (big_enough(self.term) && row + 1 < self.term.1).then_some((i32::from(col), 2 * i32::from(row)))
+    }
+
+    fn handle(&mut self, input: Input) -> Result<Flow> {
+        let (w, h) = self.scene.size();
+        let now = Instant::now();
+        match input {
+            Input::Quit => return Ok(Flow::Quit),
+            Input::Escape if self.help => self.help = false,
+            Input::Escape => return Ok(Flow::Quit),
+            Input::Help => self.help = !self.help,
+            Input::RandomStone => {
+                let (x, y) = (self.rng.random_range(0..w) as i32, self.rng.random_range(0..h) as i32);
+                self.act(Action::Stone { x, y, radius: self.radius, big: false });
+            }
+            Input::Aim(dx, dy) => {
+                self.aim.0 = (self.aim.0 + 2 * dx).clamp(0, w as i32 - 1);
+                self.aim.1 = (self.aim.1 + 2 * dy).clamp(0, (h as i32 - 1) & !1);
+                self.aim_until = Some(now + AIM_VISIBLE);
+            }
+            Input::DropAtAim => {
+                let (x, y) = self.aim;
+                self.aim_until = Some(now + AIM_VISIBLE);
+                self.act(Action::Stone { x, y, radius: self.radius, big: false });
+            }
+            Input::ToggleRain => self.act(Action::ToggleRain),
+            Input::Clear => self.act(Action::Clear),
+            Input::Damping(stronger) => self.act(Action::Damping(stronger)),
+            Input::StoneSize(bigger) => {
+                let i = STONE_RADII.iter().position(|&r| r >= self.radius).unwrap_or(0);
+                let i = if bigger { (i + 1).min(STONE_RADII.len() - 1) } else { i.saturating_sub(1) };
+                self.radius = STONE_RADII[i];
+            }
+            Input::Pause => self.sim.set_paused(!self.sim.paused(), now),
+            Input::Screenshot => self.screenshot(),
+            Input::NextScene => self.next_scene()?,
+            Input::Other(c) => self.act(Action::Key(c)),
+            Input::Press { col, row, big } => {
+                if let Some((x, y)) = self.pixel_at(col, row) {
+                    self.act(Action::Stone { x, y, radius: self.radius, big });
+                    self.drag = (!big).then_some((x, y));
+                }
+            }
+            Input::Drag { col, row } => {
+                if let (Some(from), Some(to)) = (self.drag, self.pixel_at(col, row))
+                    && from != to
+                {
+                    self.act(Action::Stir { from, to });
+                    self.drag = Some(to);
+                }
+            }
+            Input::Release => self.drag = None,
+            Input::Resize(cols, rows) => {
+                self.term = (cols, rows);
+                let size = picture_size(cols, rows);
+                if big_enough(self.term) && size != self.scene.size() {
+                    self.apply(Event::Resize([size.0, size.1]));
+                    self.aim = (self.aim.0.min(size.0 as i32 - 1), self.aim.1.min((size.1 as i32 - 1) & !1));
+                }
+            }
+        }
+        Ok(Flow::Continue)
+    }
+
+    /// Saves the current picture (exact pixels, no overlays) as a PNG in the current folder.
+    fn screenshot(&mut self) {
+        let (w, h) = self.scene.size();
+        let Some(mut shot) = Pixmap::new(w, h) else { return };
+        self.scene.render(&mut shot);
+        let base = format!("tidepool-{}-{:06}", self.scene.name(), self.step);
+        let name = (1..1000)
+            .map(|i| if i == 1 { format!("{base}.png") } else { format!("{base}-{i}.png") })
+            .find(|n| !std::path::Path::new(n).exists())
+            .unwrap_or_else(|| format!("{base}.png"));
+        match crate::output::atomic::write_file(name.as_ref(), &crate::output::png::encode(&shot)) {
+            Ok(()) => {
+                self.say(format!("saved {name}"));
+                self.apply(Event::Screenshot(name));
+            }
+            Err(e) => self.say(format!("screenshot failed: {e}")),
+        }
+    }
+
+    /// `tab`: the next scene that exists, at the same size.
+    fn next_scene(&mut self) -> Result<()> {
+        let kinds = PlayScene::value_variants();
+        let i = kinds.iter().position(|k| *k == self.kind).unwrap_or(0);
+        let next = kinds[(i + 1) % kinds.len()];
+        if next == self.kind {
+            self.say(format!("the {} is the only scene so far", self.scene.name()));
+            return Ok(());
+        }
+        if self.recorder.is_some() {
+            // A replay holds one scene; switching would make it lie.
+            self.say("tab is off while recording (a replay holds one scene)".into());
+            return Ok(());
+        }
+        let (w, h) = self.scene.size();
+        self.scene = (self.make)(next, w, h)?;
+        self.kind = next;
+        self.sim = SimClock::new(self.scene.steps_per_second(), Instant::now());
+        Ok(())
+    }
+}

@@ -1,0 +1,224 @@
+//! The terminal player in a real pseudo-terminal: every way out restores the terminal, keys and
+//! clicks drop stones where expected (decoded from the half-block output with the terminal
+//! model), still water sends only the status line, and a recorded session replays exactly.
+
+mod pty_support;
+
+use std::time::Duration;
+
+use pty_support::{Player, cooked, find, rfind, temp_dir};
+use tidepool::output::diff::{SYNC_BEGIN, SYNC_END};
+use tidepool::term::guard::{ENTER, RESTORE};
+
+const WAIT: Duration = Duration::from_secs(20);
+const ARGS: &[&str] = &["play", "--color", "truecolor", "--color-threshold", "0"];
+
+/// Starts a player and waits for its first whole frame; checks the terminal is in raw mode.
+fn started(name: &str, extra: &[&str], env: &[(&str, &str)]) -> Player {
+    let dir = temp_dir(name);
+    let args: Vec<&str> = ARGS.iter().chain(extra).copied().collect();
+    let p = Player::spawn(&dir, 40, 12, &args, env);
+    p.wait_for(SYNC_END, 0, WAIT);
+    assert!(find(&p.output(), ENTER).is_some(), "the alternate screen, hidden cursor and mouse were set up");
+    assert!(!cooked(&p.stty()), "raw mode while playing: {}", p.stty());
+    p
+}
+
+/// The terminal was handed back: the restore sequence after the last frame, cooked mode.
+fn assert_restored(p: &Player) {
+    let out = p.output();
+    let restore = rfind(&out, RESTORE).expect("the restore sequence was written");
+    let last_frame = rfind(&out, SYNC_BEGIN).unwrap();
+    assert!(restore > last_frame, "restored after the last frame");
+    assert!(cooked(&p.stty()), "cooked mode (icanon, echo) again: {}", p.stty());
+}
+
+#[test]
+fn q_esc_and_ctrl_c_quit_and_restore() {
+    for (name, key) in [("q", &b"q"[..]), ("esc", b"\x1b"), ("ctrl-c", b"\x03")] {
+        let mut p = started(&format!("quit-{name}"), &[], &[]);
+        p.send(key);
+        let status = p.wait_exit(WAIT);
+        assert_eq!(status.exit_code(), 0, "{name}");
+        assert_restored(&p);
+        assert!(p.output().ends_with(RESTORE), "{name}: nothing after the restore");
+    }
+}
+
+#[test]
+fn sigterm_and_sighup_restore() {
+    for (signal, code) in [("TERM", 143), ("HUP", 129), ("INT", 130)] {
+        let mut p = started(&format!("signal-{signal}"), &[], &[]);
+        p.signal(signal);
+        let status = p.wait_exit(WAIT);
+        assert_eq!(status.exit_code(), code, "SIG{signal}");
+        assert_restored(&p);
+    }
+}
+
+#[test]
+fn a_panic_restores_before_its_message() {
+    let dir = temp_dir("panic");
+    let mut p = Player::spawn(&dir, 40, 12, ARGS, &[(tidepool::term::app::TEST_PANIC_VAR, "1")]);
+    let status = p.wait_exit(WAIT);
+    assert_eq!(status.exit_code(), 101);
+    let out = p.output();
+    let restore = find(&out, RESTORE).expect("restored");
+    let message = find(&out, b"panicking on purpose").expect("the panic message is printed");
+    assert!(restore < message, "the terminal is restored first, so the message is readable");
+    assert!(cooked(&p.stty()));
+}
+
+#[test]
+fn not_a_terminal_is_one_line_and_status_2() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_tidepool")).output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.lines().count(), 1, "{err}");
+    assert!(err.contains("not a terminal") && err.contains("tidepool render"), "{err}");
+    assert!(out.stdout.is_empty());
+}
+
+#[test]
+fn a_tiny_terminal_says_it_is_too_small() {
+    let dir = temp_dir("tiny");
+    let mut p = Player::spawn(&dir, 20, 4, ARGS, &[]);
+    p.wait_for(SYNC_END, 0, WAIT);
+    let s = p.screen();
+    assert!((0..4).any(|y| s.row_text(y).contains("terminal too small")));
+    p.master.resize(portable_pty::PtySize { rows: 8, cols: 20, pixel_width: 0, pixel_height: 0 }).unwrap();
+    p.rows = 8;
+    std::thread::sleep(Duration::from_millis(500));
+    let s = p.screen();
+    assert!(s.pixel(3, 3).is_some(), "the pool is drawn once there is room");
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+}
+
+#[test]
+fn still_water_sends_only_the_status_line() {
+    let p = started("still", &["--rain", "0"], &[]);
+    std::thread::sleep(Duration::from_millis(1500));
+    let before = p.screen();
+    let from = p.len();
+    std::thread::sleep(Duration::from_millis(2500));
+    let out = p.output();
+    let window = &out[from..];
+    let mut after = before.clone();
+    after.feed(window);
+    for y in 0..before.rows() - 1 {
+        for x in 0..before.cols() {
+            assert_eq!(before.cell(x, y), after.cell(x, y), "picture cell ({x}, {y}) was redrawn");
+        }
+    }
+    let frames = window.windows(SYNC_BEGIN.len()).filter(|w| *w == SYNC_BEGIN).count();
+    // 2.5 s at 30 fps would be 75 frames; only the once-a-second status figures are sent.
+    assert!(frames <= 4, "{frames} frames in 2.5 s of still water");
+    assert!(window.len() < 4 * 40 * 40, "{} bytes in 2.5 s of still water", window.len());
+}
+
+/// Keys and clicks drop stones where expected; what the terminal shows (decoded with the
+/// terminal model) is the replay of the recorded session; the screenshot is bit-identical to
+/// `render pool --replay` at its step; a resize redraws the whole window at the new size.
+#[test]
+fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
+    use tidepool::replay::Event;
+    use tidepool::sim::ripple::Stone;
+
+    let mut p = started("drive", &["--rain", "0", "--record", "session.jsonl"], &[]);
+    p.send(b"p");
+    p.wait_for_status("PAUSED", WAIT);
+    // A random stone, a left click at cell (10, 3) and a right click at (30, 8), 1-based.
+    p.send(b" ");
+    p.send(b"\x1b[<0;10;3M\x1b[<0;10;3m");
+    p.send(b"\x1b[<2;30;8M\x1b[<2;30;8m");
+    // Aim three columns right and one row up from the centre, then drop.
+    p.send(b"lllk\r");
+    p.send(b"s");
+    p.wait_for_status("saved tidepool-pool-", WAIT);
+    std::thread::sleep(Duration::from_millis(300));
+    let shown = p.screen();
+    let before_resize = p.len();
+    p.master.resize(portable_pty::PtySize { rows: 10, cols: 30, pixel_width: 0, pixel_height: 0 }).unwrap();
+    std::thread::sleep(Duration::from_millis(800));
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+    assert_restored(&p);
+
+    let path = p.dir.join("session.jsonl");
+    let replay = tidepool::replay::read(&path).unwrap();
+    assert_eq!(replay.header.size, [40, 22]);
+    let stones: Vec<Stone> =
+        replay.entries.iter().filter_map(|e| if let Event::Stone(s) = e.event { Some(s) } else { None }).collect();
+    assert_eq!(stones.len(), 4, "{:?}", replay.entries);
+    assert_eq!(stones[1], Stone { x: 9, y: 4, radius: 3, weight: 48 }, "left click: the cell's upper pixel");
+    assert_eq!(stones[2], Stone { x: 29, y: 14, radius: 6, weight: 96 }, "right click: a big stone");
+    assert_eq!(stones[3], Stone { x: 26, y: 8, radius: 3, weight: 48 }, "aim: centre (20, 10) + 3 columns, 1 row up");
+    let step = replay.entries[0].step;
+    assert!(replay.entries.iter().all(|e| e.step == step), "paused: every event at one step");
+    let shot = replay
+        .entries
+        .iter()
+        .find_map(|e| if let Event::Screenshot(f) = &e.event { Some(f.clone()) } else { None })
+        .unwrap();
+    assert!(replay.entries.iter().any(|e| e.event == Event::Resize([30, 18])));
+
+    // The picture on screen before the resize is the replay at the screenshot.
+    let mut scene = tidepool::commands::replay::simulate(&path, &replay, Some(step)).unwrap();
+    let expected = scene.snapshot();
+    let mut compared = 0;
+    for y in 0..22 {
+        for x in 0..40 {
+            if let Some(rgb) = shown.pixel(x, y) {
+                assert_eq!(rgb, tidepool::output::halfblock::pixel_rgb(&expected, x as u32, y as u32), "({x}, {y})");
+                compared += 1;
+            }
+        }
+    }
+    assert!(compared >= 40 * 22 - 2, "only the aim marker's cell is not a picture: {compared}");
+
+    // The screenshot file equals `render pool --replay --steps S`.
+    let rendered = p.dir.join("replayed.png");
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_tidepool"))
+        .args(["render", "pool", "--replay"])
+        .arg(&path)
+        .args(["--steps", &step.to_string(), "--out"])
+        .arg(&rendered)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    assert_eq!(std::fs::read(p.dir.join(&shot)).unwrap(), std::fs::read(&rendered).unwrap(), "bit-identical");
+
+    // After the resize the window shows the 30x18 pool of the replay's end.
+    let mut resized = tidepool::output::vt::Screen::new(30, 10);
+    resized.lf_returns = false;
+    resized.feed(&p.output()[before_resize..rfind(&p.output(), RESTORE).unwrap()]);
+    let end = tidepool::commands::replay::simulate(&path, &replay, None).unwrap().snapshot();
+    assert_eq!((end.width(), end.height()), (30, 18));
+    for y in 0..18 {
+        for x in 0..30 {
+            let want = tidepool::output::halfblock::pixel_rgb(&end, x as u32, y as u32);
+            if (x, y / 2) == (26, 4) {
+                assert_eq!(resized.cell(x, y / 2).ch, '+', "the aim marker is still shown");
+                continue;
+            }
+            assert_eq!(resized.pixel(x, y), Some(want), "({x}, {y}) after the resize");
+        }
+    }
+    assert!(resized.row_text(9).contains("pool"), "the status line moved to the new last row");
+}
+
+/// `--max-bps` lowers the frame rate so the output fits the budget, however busy the water.
+#[test]
+fn max_bps_caps_the_output_rate() {
+    let mut p = started("max-bps", &["--rain", "2", "--max-bps", "20k"], &[]);
+    std::thread::sleep(Duration::from_millis(1000));
+    let from = p.len();
+    std::thread::sleep(Duration::from_millis(3000));
+    let window = p.len() - from;
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+    // 3 s at 20 kB/s, plus at most one frame of slack (a 40x12 frame is under 20 kB).
+    assert!(window <= 3 * 20_000 + 20_000, "{window} bytes in 3 s");
+    assert!(window >= 3 * 20_000 / 4, "busy water still uses the budget: {window} bytes in 3 s");
+}

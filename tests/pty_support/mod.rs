@@ -1,0 +1,167 @@
+//! Runs the `tidepool` binary in a real pseudo-terminal and collects everything it writes.
+
+#![allow(dead_code)] // each test binary uses a different part
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use portable_pty::{Child, CommandBuilder, ExitStatus, MasterPty, PtySize, native_pty_system};
+use tidepool::output::vt::Screen;
+
+/// A player running in a pty.
+pub struct Player {
+    pub child: Box<dyn Child + Send + Sync>,
+    pub master: Box<dyn MasterPty + Send>,
+    writer: Box<dyn Write + Send>,
+    output: Arc<Mutex<Vec<u8>>>,
+    pub dir: PathBuf,
+    pub cols: u16,
+    pub rows: u16,
+}
+
+/// A fresh empty folder under the target directory.
+pub fn temp_dir(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+impl Player {
+    /// Starts `tidepool ARGS` in a `cols x rows` pty, in folder `dir`, with truecolor and no SSH.
+    pub fn spawn(dir: &Path, cols: u16, rows: u16, args: &[&str], env: &[(&str, &str)]) -> Player {
+        let pty = native_pty_system();
+        let pair = pty.openpty(PtySize { rows, cols, pixel_width: 0, pixel_height: 0 }).unwrap();
+        let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_tidepool"));
+        cmd.args(args);
+        cmd.cwd(dir);
+        cmd.env("TERM", "xterm-256color");
+        cmd.env("COLORTERM", "truecolor");
+        cmd.env_remove("SSH_CONNECTION");
+        cmd.env_remove("TIDEPOOL_TEST_PANIC");
+        for (k, v) in env {
+            cmd.env(k, v);
+        }
+        let child = pair.slave.spawn_command(cmd).unwrap();
+        drop(pair.slave);
+        let mut reader = pair.master.try_clone_reader().unwrap();
+        let writer = pair.master.take_writer().unwrap();
+        let output = Arc::new(Mutex::new(Vec::new()));
+        let sink = Arc::clone(&output);
+        std::thread::spawn(move || {
+            let mut buf = [0u8; 65536];
+            while let Ok(n) = reader.read(&mut buf) {
+                if n == 0 {
+                    break;
+                }
+                sink.lock().unwrap().extend_from_slice(&buf[..n]);
+            }
+        });
+        Player { child, master: pair.master, writer, output, dir: dir.to_owned(), cols, rows }
+    }
+
+    /// Types bytes into the terminal.
+    pub fn send(&mut self, bytes: &[u8]) {
+        self.writer.write_all(bytes).unwrap();
+        self.writer.flush().unwrap();
+    }
+
+    /// Everything written so far.
+    pub fn output(&self) -> Vec<u8> {
+        self.output.lock().unwrap().clone()
+    }
+
+    /// How many bytes were written so far.
+    pub fn len(&self) -> usize {
+        self.output.lock().unwrap().len()
+    }
+
+    /// Waits until the output from `from` on contains `needle`; returns where it ends.
+    pub fn wait_for(&self, needle: &[u8], from: usize, timeout: Duration) -> usize {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let out = self.output();
+            if let Some(i) = find(&out[from.min(out.len())..], needle) {
+                return from + i + needle.len();
+            }
+            assert!(Instant::now() < deadline, "no {:?} within {timeout:?}", String::from_utf8_lossy(needle));
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+
+    /// The screen the output so far draws (raw mode: a line feed keeps the column).
+    pub fn screen(&self) -> Screen {
+        let mut s = Screen::new(self.cols.into(), self.rows.into());
+        s.lf_returns = false;
+        s.feed(&self.output());
+        s
+    }
+
+    /// Waits until the screen's last row contains `text`.
+    pub fn wait_for_status(&self, text: &str, timeout: Duration) {
+        let deadline = Instant::now() + timeout;
+        loop {
+            let s = self.screen();
+            if s.row_text(s.rows() - 1).contains(text) {
+                return;
+            }
+            assert!(Instant::now() < deadline, "status never said {text:?}: {:?}", s.row_text(s.rows() - 1));
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    /// Waits for the process to end.
+    pub fn wait_exit(&mut self, timeout: Duration) -> ExitStatus {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if let Some(status) = self.child.try_wait().unwrap() {
+                // Let the reader drain what is left.
+                std::thread::sleep(Duration::from_millis(100));
+                return status;
+            }
+            if Instant::now() > deadline {
+                let _ = self.child.kill();
+                panic!("the player did not exit within {timeout:?}");
+            }
+            std::thread::sleep(Duration::from_millis(10));
+        }
+    }
+
+    /// Sends a signal to the player.
+    pub fn signal(&self, name: &str) {
+        let pid = self.child.process_id().unwrap().to_string();
+        let ok = std::process::Command::new("kill").args([&format!("-{name}"), &pid]).status().unwrap();
+        assert!(ok.success());
+    }
+
+    /// The pty's mode as `stty -a` prints it.
+    pub fn stty(&self) -> String {
+        let tty = self.master.tty_name().expect("the pty has a name");
+        let out = std::process::Command::new("stty").arg("-F").arg(&tty).arg("-a").output().unwrap();
+        String::from_utf8_lossy(&out.stdout).into_owned()
+    }
+}
+
+impl Drop for Player {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+    }
+}
+
+/// Where `needle` first occurs in `haystack`.
+pub fn find(haystack: &[u8], needle: &[u8]) -> Option<usize> {
+    haystack.windows(needle.len()).position(|w| w == needle)
+}
+
+/// Where `needle` last occurs in `haystack`.
+pub fn rfind(haystack: &[u8], needle: &[u8]) -> Option<usize> {
+    haystack.windows(needle.len()).rposition(|w| w == needle)
+}
+
+/// Whether `stty -a` output shows a cooked terminal (canonical mode with echo).
+pub fn cooked(stty: &str) -> bool {
+    let words: Vec<&str> = stty.split_whitespace().collect();
+    words.contains(&"icanon") && words.contains(&"echo")
+}
