@@ -49,6 +49,10 @@ fn same_flags_same_bytes_and_time_moves_the_sea() {
     };
     assert_eq!(render("a.png", "2"), render("b.png", "2"));
     assert_ne!(render("a.png", "2"), render("c.png", "3"));
+    // Negative values are values, not flags: the sea before t = 0, a wind from -90° (west).
+    let out =
+        run_in(&dir, &["render", "ocean", "--size", "32x18", "--time", "-5", "--direction", "-90", "--out", "n.png"]);
+    assert!(out.status.success(), "{}", stderr(&out));
 }
 
 /// Reads a float32 NPY written by tidepool: (rows, columns, values).

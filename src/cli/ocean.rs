@@ -54,21 +54,21 @@ pub struct RenderOcean {
 
     /// Where the wind comes FROM, degrees clockwise from north (meteorological convention);
     /// the waves travel downwind.
-    #[arg(long, value_name = "DEG", default_value = "330", value_parser = parse_degrees)]
+    #[arg(long, value_name = "DEG", default_value = "330", value_parser = parse_degrees, allow_hyphen_values = true)]
     pub direction: f64,
 
     /// The sun: azimuth (degrees clockwise from north) and elevation (0..=90 degrees).
-    #[arg(long, value_name = "AZ,EL", default_value = "15,22", value_parser = parse_sun)]
+    #[arg(long, value_name = "AZ,EL", default_value = "15,22", value_parser = parse_sun, allow_hyphen_values = true)]
     pub sun: (f64, f64),
 
     /// The camera: height above the sea in metres (0.5..=10000), tilt below the horizontal in
     /// degrees (-45..=89), horizontal field of view in degrees (5..=150) and heading in
     /// degrees clockwise from north. [default: 25,8,70,0]
-    #[arg(long, value_name = "H,PITCH,HFOV[,HEADING]", value_parser = parse_camera)]
+    #[arg(long, value_name = "H,PITCH,HFOV[,HEADING]", value_parser = parse_camera, allow_hyphen_values = true)]
     pub camera: Option<CameraPose>,
 
     /// Physical time in seconds: the sea at t and t + 1 is one second apart.
-    #[arg(long, value_name = "SECONDS", default_value_t = 0.0, value_parser = parse_time)]
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.0, value_parser = parse_time, allow_hyphen_values = true)]
     pub time: f64,
 
     /// A PNG or JPEG stretched over the sea, one copy every 48 m. [default: the built-in one]
