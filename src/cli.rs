@@ -8,6 +8,8 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+pub mod ocean;
+
 use crate::sim::ripple::{Damping, Stone};
 
 /// The largest picture side tidepool renders.
@@ -39,6 +41,8 @@ pub struct Cli {
 pub enum Command {
     /// Render a scene headless to a PNG file or half-block text (no terminal needed).
     Render(RenderCommand),
+    /// Print the Pierson–Moskowitz sea state of a wind (peak, Hs, Beaufort, WMO code), or plot it.
+    Spectrum(ocean::SpectrumCommand),
     /// Play with the water full-screen in this terminal: keys and the mouse drop stones.
     Play(PlayCommand),
     /// Measure how fast this machine runs tidepool, stage by stage (a few seconds).
@@ -175,6 +179,8 @@ pub struct RenderCommand {
 pub enum RenderScene {
     /// The ripple pool: stones and rain on water over a tiled floor.
     Pool(RenderPool),
+    /// The ocean: a wind-driven Pierson–Moskowitz sea under a sky, as a flat-shaded mesh.
+    Ocean(ocean::RenderOcean),
 }
 
 /// `tidepool render pool`.

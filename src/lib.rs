@@ -1,7 +1,7 @@
 //! tidepool: water you can play with in any terminal, simulated and drawn on the CPU.
 //!
 //! Data flows one way: **simulation -> renderer -> pixels -> output**.
-//! - [`sim`]: simulations (the ripple pool, rain); no drawing, no I/O.
+//! - [`sim`]: simulations (the ripple pool, rain, the wind-driven sea); no drawing, no I/O.
 //! - [`render`]: simulation state -> `tiny_skia::Pixmap`.
 //! - [`output`]: pixels -> PNG, half-block text, heightmaps; atomic file writes.
 //! - [`scene`]: a simulation together with its renderer, driven alike by the headless

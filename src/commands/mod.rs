@@ -1,9 +1,11 @@
 //! The subcommands: validated flags in, files and terminal output out.
 
 pub mod bench;
+pub mod ocean;
 pub mod play;
 pub mod render;
 pub mod replay;
+pub mod spectrum;
 
 use crate::cli::{Cli, Command};
 use crate::error::Result;
@@ -17,6 +19,8 @@ tidepool: water you can play with in any terminal.
   tidepool render pool --out - --size 120x60
                                         draw it in this terminal as half-block text
   tidepool render pool --help           every flag, with defaults and units
+  tidepool render ocean --beaufort 6    a wind-driven sea in ocean.png
+  tidepool spectrum --wind 10           the sea state a 10 m/s wind raises
   tidepool --help                       all commands";
 
 /// Runs a parsed command line.
@@ -24,6 +28,7 @@ pub fn run(cli: Cli) -> Result<()> {
     crate::signals::install();
     match cli.command {
         Some(Command::Render(render)) => render::run(render),
+        Some(Command::Spectrum(args)) => spectrum::run(args),
         Some(Command::Bench(args)) => bench::run(args),
         Some(Command::Play(play)) => play::run(play),
         None => match <Cli as clap::Parser>::try_parse_from(["tidepool", "play"]) {

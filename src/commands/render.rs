@@ -24,6 +24,7 @@ pub const DEFAULT_TEXT_SIZE: Size = Size { width: 80, height: 48 };
 pub fn run(command: RenderCommand) -> Result<()> {
     match command.scene {
         RenderScene::Pool(args) => render_pool(args),
+        RenderScene::Ocean(args) => super::ocean::render_ocean(args),
     }
 }
 

@@ -1,5 +1,6 @@
 //! Scenes: a simulation together with the renderer that draws it. The headless renderer and
 //! the terminal player drive the same scene values the same way.
 
+pub mod ocean;
 pub mod playable;
 pub mod pool;

@@ -1,5 +1,10 @@
 //! Simulations: state that advances in time. Nothing here draws or does I/O.
 
+pub mod fbm;
+pub mod ocean;
 pub mod rain;
 pub mod ripple;
+pub mod sea_state;
+pub mod spectrum;
 pub mod stepper;
+pub mod surface;

@@ -1,0 +1,81 @@
+//! `tidepool render ocean`: a wind-driven sea to a PNG, half-block text and a heightmap.
+
+use std::io::IsTerminal;
+use std::time::Instant;
+
+use crate::cli::ocean::RenderOcean;
+use crate::cli::{Format, check_pixels};
+use crate::commands::render::{OutputPlan, Stats, terminal_pixels};
+use crate::error::{Error, Result};
+use crate::render::background;
+use crate::render::camera::CameraPose;
+use crate::render::ocean::OceanView;
+use crate::render::supersample::Downsample;
+use crate::render::texture::{SEA_TEXTURE_TILE_M, SeaTexture};
+use crate::scene::ocean::{OceanScene, OceanSettings, default_extent_m};
+use crate::sim::ocean::SeaParams;
+
+/// Heightmap PNG levels per metre: centimetres.
+pub const HEIGHTMAP_PNG_SCALE: f32 = 100.0;
+
+/// The supersampling used when `--ssaa` is not given: 2 for PNG, 1 for text.
+pub fn default_ssaa(format: Format) -> u32 {
+    if format == Format::Png { 2 } else { 1 }
+}
+
+/// The validated settings of a `render ocean` command line.
+pub fn settings(args: &RenderOcean, format: Format) -> OceanSettings {
+    OceanSettings {
+        sea: SeaParams { wind_m_s: args.wind.speed_m_s(), wind_from_deg: args.direction, seed: args.seed },
+        view: OceanView {
+            camera: args.camera.unwrap_or(CameraPose::DEFAULT),
+            sun_azimuth_deg: args.sun.0 as f32,
+            sun_elevation_deg: args.sun.1 as f32,
+            ssaa: args.ssaa.unwrap_or_else(|| default_ssaa(format)),
+            downsample: Downsample::Box,
+        },
+    }
+}
+
+/// Runs `tidepool render ocean`.
+pub fn render_ocean(args: RenderOcean) -> Result<()> {
+    let plan = OutputPlan::new(&args.output_args(), "ocean", std::io::stdout().is_terminal(), terminal_pixels())?;
+    if args.extent.is_some() && plan.heightmap.is_none() {
+        return Err(Error::arg(
+            "--extent",
+            "only sizes the --heightmap patch; add --heightmap FILE.npy or drop --extent",
+        ));
+    }
+    let settings = settings(&args, plan.format);
+    check_pixels(plan.size, settings.view.ssaa).map_err(|e| Error::arg("--size", format!("{e} (or lower --ssaa)")))?;
+    let texture = match &args.texture {
+        Some(path) => SeaTexture::from_pixmap(&background::load("--texture", path)?, SEA_TEXTURE_TILE_M),
+        None => SeaTexture::builtin(),
+    };
+    let (width, height) = (plan.size.width, plan.size.height);
+    let mut scene = OceanScene::new(settings, width, height, texture).ok_or_else(|| {
+        Error::arg("--size", format!("cannot allocate a {width}x{height} picture; choose a smaller size or --ssaa"))
+    })?;
+    scene.set_time(args.time);
+    let mut stats = Stats::default();
+    let started = Instant::now();
+    let picture = scene.snapshot();
+    let ssaa = scene.renderer().view().ssaa;
+    let triangles = scene.renderer().triangle_count();
+    stats.record("render", started, format!("{width}x{height}, ssaa {ssaa}, {triangles} triangles"));
+    let started = Instant::now();
+    let heights = plan.heightmap.is_some().then(|| {
+        let extent = args.extent.unwrap_or_else(|| default_extent_m(scene.sea()));
+        scene.heightmap(extent, width as usize, height as usize)
+    });
+    if heights.is_some() {
+        stats.record("sample", started, format!("heightmap {width}x{height}"));
+    }
+    // The supersampled buffer is the largest allocation; free it before encoding.
+    drop(scene);
+    plan.write_timed(&picture, heights.as_ref(), HEIGHTMAP_PNG_SCALE, &mut stats)?;
+    if args.stats {
+        eprint!("{}", stats.report());
+    }
+    Ok(())
+}

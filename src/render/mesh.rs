@@ -1,0 +1,416 @@
+//! The water mesh renderer: "one renderer, two height sources".
+//!
+//! Anything that implements [`crate::sim::surface::Surface`] (the ocean's
+//! [`crate::sim::ocean::SeaFrame`], the lake's noise field) is drawn the same way:
+//!
+//! 1. **Sampling** ([`MeshTopology::build`], once per camera): points on a jittered triangular
+//!    lattice in screen space, `spacing_px` apart (fixed sampling of the picture), unprojected
+//!    onto the mean water level, which makes the sampling of the sea view-dependent: dense
+//!    near the camera, sparse towards the horizon. The lattice overhangs the picture on the
+//!    sides and below, so waves lifted into view are not cut off, and stops at the real
+//!    horizon distance. Each point also gets its [`Footprint`], the ground step to its
+//!    neighbours, which the surface uses to leave out waves the lattice cannot carry.
+//!    (Packing rows tighter near the horizon was tried and dropped: tall distant waves then
+//!    lift rows past their neighbours on the screen and the mesh folds into a saw-tooth.)
+//! 2. **Triangulation**: spade's Delaunay triangulation of the screen positions, sorted far to
+//!    near once (painter's order for a height field seen from above: the horizontal distance
+//!    of a triangle does not change when heights do). Kept while the camera does not move.
+//! 3. **Per frame** ([`MeshRenderer::draw`]): sample the surface at every point (on all cores),
+//!    displace, project, and fill each triangle with one colour from its face normal
+//!    ([`crate::render::shade::shade_facet`]) with tiny-skia, anti-aliasing off (triangles
+//!    that turned over on the screen are back faces and skipped): AA fills leave
+//!    half-transparent seams along shared edges, non-AA fills of a mesh are watertight. Smooth
+//!    edges come from supersampling ([`crate::render::supersample`]).
+//!
+//! # Reusing it (the lake)
+//!
+//! ```text
+//! impl Surface for LakeFrame { fn sample(&self, x, y, footprint) -> SurfaceSample { .. } }
+//! struct SkyAndShore { sky: Sky, .. }   impl Environment for SkyAndShore { fn radiance(..) }
+//!
+//! let camera = Camera::new(pose, width * ssaa, height * ssaa);     // once per view
+//! let mut mesh = MeshRenderer::new();                               // keep between frames
+//! // each frame:
+//! sky.draw(&camera, far_water_colour, &mut big);                    // or your own background
+//! mesh.prepare(&camera, spacing_px * ssaa as f32);                  // no-op if nothing moved
+//! mesh.draw(&lake_frame, &Shading { environment: &sky_and_shore, light: sky.light(),
+//!                                   look: WaterLook { .. }, texture: &texture }, &mut big);
+//! supersample::downsample(&big, ssaa, Downsample::Box, &mut out);
+//! ```
+//!
+//! - [`Surface`] returns heights in metres plus foam cover and the slope variance the mesh
+//!   cannot show (0 for a smooth lake); its [`Footprint`] says what the mesh can carry.
+//! - [`Environment`] is what the water reflects: [`crate::render::sky::Sky`] alone for the
+//!   ocean; the lake answers with its shore for directions that hit the shore.
+//! - [`WaterLook`] holds the colours and strengths (body light, glint, foam, haze distance);
+//!   [`SeaTexture`] is any image tiled over the water in metres (`SeaTexture::from_pixmap`).
+//! - [`crate::render::ocean::OceanRenderer`] is the ocean's use of all this, in 60 lines.
+
+use rayon::prelude::*;
+use spade::{DelaunayTriangulation, Point2, Triangulation};
+use tiny_skia::{BlendMode, Paint, Pixmap, PixmapMut};
+
+use super::camera::Camera;
+use super::raster::TriangleFiller;
+use super::shade::{Facet, Light, WaterLook, shade_facet, to_srgb8};
+use super::sky::Environment;
+use super::texture::SeaTexture;
+use super::vec3::{Vec3, cross, length, normalize, scale, sub};
+use crate::sim::surface::{Footprint, Surface, SurfaceSample};
+
+/// How far the lattice overhangs the picture left and right, as a fraction of its width.
+pub const SIDE_MARGIN: f32 = 0.05;
+/// How far the lattice overhangs the picture below, as a fraction of its height.
+pub const BOTTOM_MARGIN: f32 = 0.2;
+
+/// The sample points and triangles for one camera.
+#[derive(Clone, Debug)]
+pub struct MeshTopology {
+    camera: Camera,
+    spacing_px: f32,
+    ground: Vec<[f32; 2]>,
+    footprints: Vec<Footprint>,
+    triangles: Vec<[u32; 3]>,
+}
+
+/// A small deterministic hash to jitter the lattice (the same picture every run).
+fn jitter(row: i32, col: i32, salt: u32) -> f32 {
+    let mut h = (row as u32).wrapping_mul(0x9E37_79B1) ^ (col as u32).wrapping_mul(0x85EB_CA77) ^ salt;
+    h ^= h >> 15;
+    h = h.wrapping_mul(0x2C1B_3C6D);
+    h ^= h >> 12;
+    h = h.wrapping_mul(0x297A_2D39);
+    h ^= h >> 15;
+    (h >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+}
+
+impl MeshTopology {
+    /// Samples and triangulates the water in view of `camera`, about `spacing_px` pixels apart.
+    pub fn build(camera: &Camera, spacing_px: f32) -> MeshTopology {
+        let (w, h) = (camera.width() as f32, camera.height() as f32);
+        let s = spacing_px.max(1.0);
+        let max_m = camera.horizon_distance_m().max(2_000.0);
+        let eye = camera.eye();
+        let horizon = camera.horizon_y();
+        // The screen row of the farthest water: the point at max_m straight ahead.
+        let f = camera.forward();
+        let flat = normalize([f[0], f[1], 0.0]);
+        let far = [eye[0] + flat[0] * max_m, eye[1] + flat[1] * max_m, 0.0];
+        let y_far = camera.project(far).map_or(horizon + 1.0, |(_, y, _)| y).max(horizon + 0.05);
+        let (y_start, y_end) = (y_far.max(-0.1 * h), h * (1.0 + BOTTOM_MARGIN));
+        let mut screen = Vec::new();
+        let mut ground = Vec::new();
+        let mut footprints = Vec::new();
+        let mut y = y_start;
+        let mut row = 0i32;
+        while y <= y_end {
+            let dy = s;
+            let x0 = -SIDE_MARGIN * w + if row % 2 == 1 { s / 2.0 } else { 0.0 };
+            let mut col = 0i32;
+            let mut x = x0;
+            while x <= w * (1.0 + SIDE_MARGIN) {
+                let px = x + 0.3 * s * jitter(row, col, 1);
+                let py = if row == 0 { y } else { y + 0.3 * dy * jitter(row, col, 2) };
+                if let Some(g) = camera.ground_point(px, py) {
+                    let d = length([g[0] - eye[0], g[1] - eye[1], 0.0]);
+                    if d <= max_m * 1.01 {
+                        let across = camera.ground_point(px + s, py).map(|a| [a[0] - g[0], a[1] - g[1]]);
+                        let along = camera.ground_point(px, py + dy).map(|b| [b[0] - g[0], b[1] - g[1]]);
+                        let fp = Footprint {
+                            across: across.unwrap_or([s * d / camera.focal_px(), 0.0]),
+                            along: along.unwrap_or([0.0, max_m]),
+                        };
+                        screen.push(Point2::new(f64::from(px), f64::from(py)));
+                        ground.push(g);
+                        footprints.push(fp);
+                    }
+                }
+                col += 1;
+                x = x0 + col as f32 * s;
+            }
+            row += 1;
+            y += dy;
+        }
+        let mut triangles: Vec<[u32; 3]> = match DelaunayTriangulation::<Point2<f64>>::bulk_load_stable(screen) {
+            Ok(t) => t.inner_faces().map(|face| face.vertices().map(|v| v.fix().index() as u32)).collect(),
+            Err(_) => Vec::new(),
+        };
+        let dist = |t: &[u32; 3]| {
+            let c = t.iter().fold([0.0f32; 2], |a, &i| [a[0] + ground[i as usize][0], a[1] + ground[i as usize][1]]);
+            let (dx, dy) = (c[0] / 3.0 - eye[0], c[1] / 3.0 - eye[1]);
+            dx * dx + dy * dy
+        };
+        triangles.sort_by(|a, b| dist(b).total_cmp(&dist(a)));
+        MeshTopology { camera: *camera, spacing_px, ground, footprints, triangles }
+    }
+
+    /// The camera it was built for.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// Sample points (east, north metres).
+    pub fn points(&self) -> &[[f32; 2]] {
+        &self.ground
+    }
+
+    /// Each point's footprint.
+    pub fn footprints(&self) -> &[Footprint] {
+        &self.footprints
+    }
+
+    /// Triangles as point indices, far to near.
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+}
+
+/// Draws a water surface as a flat-shaded mesh; keeps the triangulation while the camera stays.
+#[derive(Debug, Default)]
+pub struct MeshRenderer {
+    topology: Option<MeshTopology>,
+    samples: Vec<SurfaceSample>,
+    projected: Vec<Option<(f32, f32)>>,
+    world: Vec<Vec3>,
+    faces: Vec<Option<Face>>,
+}
+
+/// Everything about the water's appearance the mesh renderer needs besides the surface.
+#[derive(Clone, Copy, Debug)]
+pub struct Shading<'a, E: Environment + ?Sized> {
+    /// What the water reflects.
+    pub environment: &'a E,
+    /// The sun and sky light.
+    pub light: Light,
+    /// Colours and strengths.
+    pub look: WaterLook,
+    /// The image stretched over the water.
+    pub texture: &'a SeaTexture,
+}
+
+impl MeshRenderer {
+    /// A renderer with no triangulation yet.
+    pub fn new() -> MeshRenderer {
+        MeshRenderer::default()
+    }
+
+    /// Builds the triangulation for `camera` and `spacing_px` unless it is already there.
+    /// Returns true when it had to be built.
+    pub fn prepare(&mut self, camera: &Camera, spacing_px: f32) -> bool {
+        let fresh = self.topology.as_ref().is_some_and(|t| t.camera == *camera && t.spacing_px == spacing_px);
+        if !fresh {
+            self.topology = Some(MeshTopology::build(camera, spacing_px));
+        }
+        !fresh
+    }
+
+    /// The current triangulation, if any.
+    pub fn topology(&self) -> Option<&MeshTopology> {
+        self.topology.as_ref()
+    }
+
+    /// Triangles in the current triangulation.
+    pub fn triangle_count(&self) -> usize {
+        self.topology.as_ref().map_or(0, |t| t.triangles.len())
+    }
+
+    /// Samples `surface`, then fills the mesh back to front into `out` (the camera's size) over
+    /// whatever is already there. Call [`MeshRenderer::prepare`] first.
+    ///
+    /// # Panics
+    /// Without a prior `prepare` (a programming error).
+    pub fn draw<S: Surface + ?Sized, E: Environment + ?Sized>(
+        &mut self,
+        surface: &S,
+        shading: &Shading<'_, E>,
+        out: &mut Pixmap,
+    ) {
+        let topo = self.topology.as_ref().expect("MeshRenderer::prepare before draw");
+        let n = topo.ground.len();
+        self.samples.resize(n, SurfaceSample::default());
+        sample_all(surface, &topo.ground, &topo.footprints, &mut self.samples);
+        let camera = &topo.camera;
+        self.world.clear();
+        self.projected.clear();
+        for (g, s) in topo.ground.iter().zip(&self.samples) {
+            let p = [g[0], g[1], s.height_m];
+            self.world.push(p);
+            self.projected.push(camera.project(p).map(|(x, y, _)| (x, y)));
+        }
+        let (w, h) = (out.width() as f32, out.height() as f32);
+        let eye = camera.eye();
+        let (world, projected, samples) = (&self.world, &self.projected, &self.samples);
+        // Shade every visible triangle (in parallel, order kept), then fill bands of rows in
+        // parallel, each band drawing the faces that reach it in painter's order.
+        topo.triangles
+            .par_iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| i as usize);
+                let (pa, pb, pc) = (projected[a]?, projected[b]?, projected[c]?);
+                let (min_x, max_x) = (pa.0.min(pb.0).min(pc.0), pa.0.max(pb.0).max(pc.0));
+                let (min_y, max_y) = (pa.1.min(pb.1).min(pc.1), pa.1.max(pb.1).max(pc.1));
+                if max_x < 0.0 || max_y < 0.0 || min_x > w || min_y > h {
+                    return None;
+                }
+                // spade's faces are counter-clockwise; a displaced triangle that turned over on
+                // the screen shows its underside (the far slope of a crest, folded over by a
+                // tall wave far away). A nearer front face covers that spot, so skip it.
+                if (pb.0 - pa.0) * (pc.1 - pa.1) - (pb.1 - pa.1) * (pc.0 - pa.0) <= 0.0 {
+                    return None;
+                }
+                let (wa, wb, wc) = (world[a], world[b], world[c]);
+                let mut normal = normalize(cross(sub(wb, wa), sub(wc, wa)));
+                if normal[2] < 0.0 {
+                    normal = scale(normal, -1.0);
+                }
+                let centroid = scale([wa[0] + wb[0] + wc[0], wa[1] + wb[1] + wc[1], wa[2] + wb[2] + wc[2]], 1.0 / 3.0);
+                let to_eye = sub(eye, centroid);
+                let distance_m = length(to_eye);
+                let (sa, sb, sc) = (&samples[a], &samples[b], &samples[c]);
+                let size_m =
+                    (topo.footprints[a].mean_m() + topo.footprints[b].mean_m() + topo.footprints[c].mean_m()) / 3.0;
+                let facet = Facet {
+                    normal,
+                    to_eye: scale(to_eye, 1.0 / distance_m.max(1e-6)),
+                    distance_m,
+                    albedo: shading.texture.sample(centroid[0], centroid[1], size_m),
+                    foam: (sa.foam + sb.foam + sc.foam) / 3.0,
+                    slope_variance: (sa.unresolved_slope_variance
+                        + sb.unresolved_slope_variance
+                        + sc.unresolved_slope_variance)
+                        / 3.0,
+                };
+                let colour = to_srgb8(shade_facet(&shading.look, &shading.light, shading.environment, &facet));
+                Some(Face { points: [pa, pb, pc], min_y, max_y, colour })
+            })
+            .collect_into_vec(&mut self.faces);
+        let faces = &self.faces;
+        let width = out.width();
+        let rows = out.height() as usize;
+        out.data_mut().par_chunks_mut(BAND_ROWS * width as usize * 4).enumerate().for_each(|(band, bytes)| {
+            let y0 = (band * BAND_ROWS) as f32;
+            let band_rows = (rows - band * BAND_ROWS).min(BAND_ROWS);
+            let y1 = y0 + band_rows as f32;
+            let Some(mut pixmap) = PixmapMut::from_bytes(bytes, width, band_rows as u32) else { return };
+            let mut paint = Paint { anti_alias: false, blend_mode: BlendMode::Source, ..Paint::default() };
+            let mut filler = TriangleFiller::new();
+            for face in faces.iter().flatten().filter(|f| f.max_y >= y0 && f.min_y <= y1) {
+                let [r, g, b] = face.colour;
+                paint.set_color_rgba8(r, g, b, 255);
+                filler.fill(&mut pixmap, &paint, face.points.map(|(x, y)| (x, y - y0)));
+            }
+        });
+    }
+}
+
+/// Rows per band of the parallel fill. Fixed, so the picture does not depend on the number of
+/// cores (a face is translated by the band's origin before filling).
+pub const BAND_ROWS: usize = 128;
+
+/// A shaded triangle ready to fill: screen points, vertical extent, colour.
+#[derive(Clone, Copy, Debug)]
+struct Face {
+    points: [(f32, f32); 3],
+    min_y: f32,
+    max_y: f32,
+    colour: [u8; 3],
+}
+
+/// Samples the surface at every point, in parallel chunks (the result does not depend on how
+/// the chunks are spread over cores: each point is sampled alone).
+fn sample_all<S: Surface + ?Sized>(
+    surface: &S,
+    ground: &[[f32; 2]],
+    footprints: &[Footprint],
+    out: &mut [SurfaceSample],
+) {
+    const CHUNK: usize = 512;
+    out.par_chunks_mut(CHUNK).enumerate().for_each(|(i, chunk)| {
+        let start = i * CHUNK;
+        for (k, o) in chunk.iter_mut().enumerate() {
+            let (g, f) = (ground[start + k], &footprints[start + k]);
+            *o = surface.sample(g[0], g[1], f);
+        }
+    });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::camera::CameraPose;
+    use crate::render::sky::Sky;
+
+    /// A tilted plane and a calm, for checking the mesh without the ocean.
+    struct Flat(f32);
+    impl Surface for Flat {
+        fn sample(&self, x: f32, _y: f32, _f: &Footprint) -> SurfaceSample {
+            SurfaceSample { height_m: self.0 * x, ..SurfaceSample::default() }
+        }
+    }
+
+    fn camera() -> Camera {
+        Camera::new(CameraPose::DEFAULT, 160, 96)
+    }
+
+    #[test]
+    fn the_lattice_is_dense_near_and_sparse_far() {
+        let topo = MeshTopology::build(&camera(), 4.0);
+        assert!(topo.triangles().len() > 1000, "{}", topo.triangles().len());
+        let eye = camera().eye();
+        let (mut near, mut far) = (f32::MAX, 0.0f32);
+        for (g, f) in topo.points().iter().zip(topo.footprints()) {
+            let d = ((g[0] - eye[0]).powi(2) + (g[1] - eye[1]).powi(2)).sqrt();
+            if d < 100.0 {
+                near = near.min(f.min_m().max(1e-3)).min(near);
+            }
+            if d > 5000.0 {
+                far = far.max(f.mean_m());
+            }
+        }
+        assert!(far > 50.0 * near, "near {near} m, far {far} m");
+        // Far to near: the first triangle is the farthest.
+        let d = |t: &[u32; 3]| topo.points()[t[0] as usize][1];
+        assert!(d(&topo.triangles()[0]) > d(topo.triangles().last().unwrap()));
+    }
+
+    #[test]
+    fn a_calm_mesh_covers_the_sea_without_gaps() {
+        let cam = camera();
+        let sky = Sky::new(30.0, 30.0);
+        let texture = SeaTexture::builtin();
+        let mut out = Pixmap::new(160, 96).unwrap();
+        // Paint a marker colour first: any pixel left below the horizon is a hole in the mesh.
+        out.fill(tiny_skia::Color::from_rgba8(255, 0, 255, 255));
+        let mut renderer = MeshRenderer::new();
+        assert!(renderer.prepare(&cam, 4.0));
+        assert!(!renderer.prepare(&cam, 4.0), "the triangulation is kept");
+        let shading = Shading { environment: &sky, light: sky.light(), look: WaterLook::default(), texture: &texture };
+        renderer.draw(&Flat(0.0), &shading, &mut out);
+        // Near the horizon the lattice stops at the horizon distance, which at the sides of the
+        // picture is reached lower down; that sliver is the sky's far-sea colour (see Sky::draw).
+        let first_row = (cam.horizon_y() + 0.1 * 96.0).ceil() as usize;
+        for y in first_row..96 {
+            for x in 0..160 {
+                let p = out.pixels()[y * 160 + x];
+                assert!(!(p.red() == 255 && p.green() == 0 && p.blue() == 255), "hole at ({x}, {y})");
+            }
+        }
+    }
+
+    #[test]
+    fn tilting_the_surface_changes_the_picture() {
+        let cam = camera();
+        let sky = Sky::new(0.0, 20.0);
+        let texture = SeaTexture::builtin();
+        let shading = Shading { environment: &sky, light: sky.light(), look: WaterLook::default(), texture: &texture };
+        let draw = |s: &dyn Surface| {
+            let mut out = Pixmap::new(160, 96).unwrap();
+            let mut r = MeshRenderer::new();
+            r.prepare(&cam, 4.0);
+            r.draw(s, &shading, &mut out);
+            out
+        };
+        assert_ne!(draw(&Flat(0.0)).data(), draw(&Flat(0.05)).data());
+        assert_eq!(draw(&Flat(0.05)).data(), draw(&Flat(0.05)).data());
+    }
+}

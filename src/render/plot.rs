@@ -1,0 +1,214 @@
+//! The plot of `tidepool spectrum --out`: E(f) and the spreading D(theta) at the peak, side by
+//! side, with axes, ticks and labels in an embedded 8x8 bitmap font (`font8x8`, drawn at twice
+//! its size so it reads at a glance).
+
+use font8x8::UnicodeFonts;
+use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
+
+use crate::sim::spectrum::{PiersonMoskowitz, spreading};
+
+/// Plot width, px.
+pub const WIDTH: u32 = 1000;
+/// Plot height, px.
+pub const HEIGHT: u32 = 440;
+const SCALE: i32 = 2;
+const INK: [u8; 3] = [30, 34, 40];
+const GRID: [u8; 3] = [222, 226, 232];
+const CURVE: [u8; 3] = [20, 96, 170];
+
+/// Draws `text` with its top-left corner at (x, y), `SCALE` pixels per font pixel.
+pub fn draw_text(out: &mut Pixmap, x: i32, y: i32, text: &str, [r, g, b]: [u8; 3]) {
+    let (w, h) = (out.width() as i32, out.height() as i32);
+    let colour = tiny_skia::PremultipliedColorU8::from_rgba(r, g, b, 255).expect("opaque");
+    let pixels = out.pixels_mut();
+    for (i, ch) in text.chars().enumerate() {
+        let glyph = font8x8::BASIC_FONTS.get(ch).unwrap_or([0; 8]);
+        for (row, bits) in glyph.iter().enumerate() {
+            for col in 0..8 {
+                if bits >> col & 1 == 1 {
+                    for dy in 0..SCALE {
+                        for dx in 0..SCALE {
+                            let px = x + (i as i32 * 8 + col) * SCALE + dx;
+                            let py = y + row as i32 * SCALE + dy;
+                            if px >= 0 && py >= 0 && px < w && py < h {
+                                pixels[(py * w + px) as usize] = colour;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The pixel width of `text`.
+pub fn text_width(text: &str) -> i32 {
+    text.chars().count() as i32 * 8 * SCALE
+}
+
+/// About five round tick values covering `lo..=hi`.
+pub fn ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
+        return vec![lo];
+    }
+    let raw = (hi - lo) / 5.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 2.5, 5.0, 10.0].iter().map(|m| m * mag).find(|&s| s >= raw).unwrap_or(10.0 * mag);
+    let mut v = (lo / step).ceil() * step;
+    let mut out = Vec::new();
+    while v <= hi + step * 1e-9 {
+        out.push(if v.abs() < step * 1e-9 { 0.0 } else { v });
+        v += step;
+    }
+    out
+}
+
+fn label(v: f64) -> String {
+    let s = format!("{v:.4}");
+    let s = s.trim_end_matches('0').trim_end_matches('.');
+    if s == "-0" { "0".into() } else { s.into() }
+}
+
+fn paint(rgb: [u8; 3]) -> Paint<'static> {
+    let mut p = Paint::default();
+    p.set_color_rgba8(rgb[0], rgb[1], rgb[2], 255);
+    p
+}
+
+/// One panel: a frame at `rect`, ticks on both axes, the curve `points` (data units).
+struct Panel {
+    rect: Rect,
+    x: (f64, f64),
+    y: (f64, f64),
+    x_ticks: Option<Vec<f64>>,
+}
+
+impl Panel {
+    fn to_px(&self, x: f64, y: f64) -> (f32, f32) {
+        let fx = ((x - self.x.0) / (self.x.1 - self.x.0)) as f32;
+        let fy = ((y - self.y.0) / (self.y.1 - self.y.0)) as f32;
+        (self.rect.left() + fx * self.rect.width(), self.rect.bottom() - fy * self.rect.height())
+    }
+
+    fn draw(&self, out: &mut Pixmap, title: &str, x_label: &str, y_label: &str, points: &[(f64, f64)]) {
+        let stroke = Stroke { width: 1.0, ..Stroke::default() };
+        let r = self.rect;
+        for tx in self.x_ticks.clone().unwrap_or_else(|| ticks(self.x.0, self.x.1)) {
+            let (px, _) = self.to_px(tx, 0.0);
+            line(out, (px, r.top()), (px, r.bottom()), GRID, &stroke);
+            line(out, (px, r.bottom()), (px, r.bottom() + 5.0), INK, &stroke);
+            let text = label(tx);
+            draw_text(out, px as i32 - text_width(&text) / 2, r.bottom() as i32 + 9, &text, INK);
+        }
+        for ty in ticks(self.y.0, self.y.1) {
+            let (_, py) = self.to_px(0.0, ty);
+            line(out, (r.left(), py), (r.right(), py), GRID, &stroke);
+            line(out, (r.left() - 5.0, py), (r.left(), py), INK, &stroke);
+            let text = label(ty);
+            draw_text(out, r.left() as i32 - 8 - text_width(&text), py as i32 - 8, &text, INK);
+        }
+        if let Some(path) = PathBuilder::from_rect(r).into() {
+            out.stroke_path(&path, &paint(INK), &stroke, Transform::identity(), None);
+        }
+        let mut pb = PathBuilder::new();
+        for (i, &(x, y)) in points.iter().enumerate() {
+            let (px, py) = self.to_px(x, y);
+            if i == 0 { pb.move_to(px, py) } else { pb.line_to(px, py) }
+        }
+        if let Some(path) = pb.finish() {
+            out.stroke_path(
+                &path,
+                &paint(CURVE),
+                &Stroke { width: 2.5, ..Stroke::default() },
+                Transform::identity(),
+                None,
+            );
+        }
+        draw_text(out, r.left() as i32, r.top() as i32 - 44, title, INK);
+        draw_text(
+            out,
+            (r.left() + r.width() / 2.0) as i32 - text_width(x_label) / 2,
+            r.bottom() as i32 + 32,
+            x_label,
+            INK,
+        );
+        draw_text(out, r.left() as i32, r.top() as i32 - 22, y_label, INK);
+    }
+}
+
+fn line(out: &mut Pixmap, a: (f32, f32), b: (f32, f32), rgb: [u8; 3], stroke: &Stroke) {
+    let mut pb = PathBuilder::new();
+    pb.move_to(a.0, a.1);
+    pb.line_to(b.0, b.1);
+    if let Some(path) = pb.finish() {
+        out.stroke_path(&path, &paint(rgb), stroke, Transform::identity(), None);
+    }
+}
+
+/// The plot of `sea`: E(f) from 0 to 3·fm, and D(theta) at fm over -180..180 degrees.
+pub fn spectrum_plot(sea: &PiersonMoskowitz) -> Pixmap {
+    let mut out = Pixmap::new(WIDTH, HEIGHT).expect("a fixed, valid size");
+    out.fill(Color::WHITE);
+    let heading =
+        format!("Pierson-Moskowitz sea, U = {} m/s, Hs = {:.2} m", label(sea.wind_m_s()), sea.significant_height_m());
+    draw_text(&mut out, 20, 12, &heading, INK);
+    let Some(fm) = sea.peak_hz() else {
+        draw_text(&mut out, 20, 200, "calm: no wind, no waves (E = 0 everywhere)", INK);
+        return out;
+    };
+    let n = 400;
+    let energy: Vec<(f64, f64)> = (0..=n)
+        .map(|i| {
+            let f = 3.0 * fm * i as f64 / n as f64;
+            (f, sea.energy(f))
+        })
+        .collect();
+    let e_max = energy.iter().map(|p| p.1).fold(0.0, f64::max);
+    let s = sea.spreading_exponent(fm);
+    let spread: Vec<(f64, f64)> = (0..=n)
+        .map(|i| {
+            let deg = -180.0 + 360.0 * i as f64 / n as f64;
+            (deg, spreading(s, deg.to_radians()))
+        })
+        .collect();
+    let d_max = spread.iter().map(|p| p.1).fold(0.0, f64::max);
+    let left = Panel {
+        rect: Rect::from_ltrb(120.0, 110.0, 470.0, 360.0).unwrap(),
+        x: (0.0, 3.0 * fm),
+        y: (0.0, e_max * 1.1),
+        x_ticks: None,
+    };
+    left.draw(&mut out, "E(f)", "frequency f, Hz", "m^2/Hz", &energy);
+    let right = Panel {
+        rect: Rect::from_ltrb(590.0, 110.0, 940.0, 360.0).unwrap(),
+        x: (-180.0, 180.0),
+        y: (0.0, d_max * 1.1),
+        x_ticks: Some(vec![-180.0, -90.0, 0.0, 90.0, 180.0]),
+    };
+    right.draw(&mut out, &format!("D(theta) at fm, s = {:.2}", s), "theta to the wind, degrees", "1/rad", &spread);
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_are_round() {
+        assert_eq!(ticks(0.0, 10.0), vec![0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
+        assert_eq!(ticks(-1.0, 1.5), vec![-1.0, -0.5, 0.0, 0.5, 1.0, 1.5]);
+        assert_eq!(label(0.25), "0.25");
+        assert_eq!(label(3.0), "3");
+    }
+
+    #[test]
+    fn the_plot_has_ink_and_a_curve() {
+        let p = spectrum_plot(&PiersonMoskowitz::new(10.0));
+        assert_eq!((p.width(), p.height()), (WIDTH, HEIGHT));
+        let curve = p.pixels().iter().filter(|c| c.red() < 60 && c.blue() > 140).count();
+        let ink = p.pixels().iter().filter(|c| c.red() < 60 && c.blue() < 60).count();
+        assert!(curve > 500 && ink > 2000, "curve {curve}, ink {ink}");
+        let calm = spectrum_plot(&PiersonMoskowitz::new(0.0));
+        assert!(calm.pixels().iter().all(|c| !(c.red() < 60 && c.blue() > 140)));
+    }
+}

@@ -1,0 +1,230 @@
+//! Flat shading of one water facet: one colour per triangle from its face normal.
+//!
+//! The paper lights its sea mesh with ambient + diffuse + specular and stretches a sea photo
+//! over it; tidepool keeps those terms and adds what makes water read as water:
+//!
+//! ```text
+//! body    = albedo · (ambient·sky + diffuse·sun·max(n·l, 0))     light scattered up from below
+//! colour  = (1 - F)·body + F·env(reflect(v, n')) + glint          F: Schlick, F0 = 0.02
+//! n'      = n tilted towards the eye by σ (the unresolved facets that face the eye)
+//! glint   = E_sun · F(v·h) · p(h) / (4 · (n·v) · (n·h)⁴)           Cox–Munk glitter
+//! p(h)    = exp(-tan²θh / 2σ²) / (2πσ²)                           σ²: slope variance per axis
+//! colour  = mix(colour, foam·(ambient·sky + sun·max(n·l,0)), foam cover)
+//! colour  = mix(colour, haze(view), 1 - exp(-distance / haze_m))
+//! ```
+//!
+//! σ² is the slope variance the mesh cannot show (small near the camera, where facets carry the
+//! waves; large far away, where they are filtered out), so the sun makes sharp sparkles on near
+//! facets and a broad glitter path towards the horizon, as on a real sea. Colours are linear
+//! RGB floats; [`to_srgb8`] tone-maps and encodes them once per triangle.
+
+use super::sky::Environment;
+use super::vec3::{Vec3, dot, normalize, reflect};
+
+/// A linear RGB colour (1.0 = white paper in full light; highlights go above 1).
+pub type Rgb = [f32; 3];
+
+/// Water's reflectance at normal incidence (refractive index 1.33).
+pub const WATER_F0: f32 = 0.02;
+
+/// Colour `a` mixed towards `b` by `t` (0 = a, 1 = b).
+#[inline(always)]
+pub fn mix(a: Rgb, b: Rgb, t: f32) -> Rgb {
+    [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t]
+}
+
+/// Schlick's Fresnel reflectance for a cosine of incidence `cos`.
+#[inline(always)]
+pub fn fresnel(cos: f32) -> f32 {
+    let m = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
+    WATER_F0 + (1.0 - WATER_F0) * m
+}
+
+/// The sRGB encoding of a linear value in 0..=1.
+#[inline(always)]
+pub fn srgb_encode(v: f32) -> f32 {
+    let v = v.clamp(0.0, 1.0);
+    if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 }
+}
+
+/// The linear value of an sRGB level 0..=255.
+pub fn srgb_decode(level: u8) -> f32 {
+    let v = f32::from(level) / 255.0;
+    if v <= 0.040_45 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Linear colour to 8-bit sRGB: values up to 0.8 pass unchanged, brighter ones roll off
+/// smoothly towards 1 (so a glint saturates to white without a hard edge).
+#[inline(always)]
+pub fn to_srgb8(c: Rgb) -> [u8; 3] {
+    let tone = |v: f32| {
+        let v = v.max(0.0);
+        if v <= 0.8 { v } else { 0.8 + 0.2 * (1.0 - (-(v - 0.8) / 0.2).exp()) }
+    };
+    c.map(|v| (srgb_encode(tone(v)) * 255.0 + 0.5) as u8)
+}
+
+/// How water is lit and coloured.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WaterLook {
+    /// Weight of the sky's light on the water body.
+    pub ambient: f32,
+    /// Weight of the sun's light on the water body.
+    pub diffuse: f32,
+    /// The sun's irradiance relative to the sky's radiance (the glint's strength).
+    pub sun_irradiance: f32,
+    /// Slope variance (per axis) always added to the glint: capillary waves no mesh shows.
+    pub base_slope_variance: f32,
+    /// Foam's albedo.
+    pub foam: Rgb,
+    /// Distance over which haze takes 63 % of the colour, m.
+    pub haze_m: f32,
+}
+
+impl Default for WaterLook {
+    fn default() -> Self {
+        WaterLook {
+            ambient: 1.0,
+            diffuse: 0.6,
+            sun_irradiance: 0.9,
+            base_slope_variance: 0.0008,
+            foam: [0.74, 0.79, 0.82],
+            haze_m: 20_000.0,
+        }
+    }
+}
+
+/// Everything about one facet the shading needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Facet {
+    /// Unit face normal (pointing up).
+    pub normal: Vec3,
+    /// Unit vector from the facet to the eye.
+    pub to_eye: Vec3,
+    /// Distance from the eye, m.
+    pub distance_m: f32,
+    /// The water body's albedo here (from the texture), linear.
+    pub albedo: Rgb,
+    /// Foam cover 0..=1.
+    pub foam: f32,
+    /// Unresolved slope variance per axis.
+    pub slope_variance: f32,
+}
+
+/// The light falling on the water.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// Unit direction towards the sun.
+    pub sun_dir: Vec3,
+    /// The sun's colour (times [`WaterLook::sun_irradiance`] for the glint).
+    pub sun: Rgb,
+    /// The average sky light on a level surface.
+    pub sky: Rgb,
+}
+
+/// The colour of one facet, linear RGB.
+#[inline]
+pub fn shade_facet<E: Environment + ?Sized>(look: &WaterLook, light: &Light, env: &E, f: &Facet) -> Rgb {
+    let n = f.normal;
+    let v = f.to_eye;
+    let l = light.sun_dir;
+    let n_dot_v = dot(n, v).max(0.02);
+    let n_dot_l = dot(n, l).max(0.0);
+    // Unresolved roughness: of the small facets inside this one, those tilted towards the eye
+    // are seen most, so reflect with the normal tilted that way by one standard deviation.
+    // This is what keeps a rough sea darker than the sky at the horizon.
+    let sigma = f.slope_variance.sqrt();
+    let toward = normalize([v[0], v[1], 0.0]);
+    let rough_n = normalize([n[0] + sigma * toward[0], n[1] + sigma * toward[1], n[2]]);
+    let fr = fresnel(dot(rough_n, v).max(0.02));
+    let mut r = reflect(v, rough_n);
+    if r[2] < 0.0 {
+        // A facet tilted away from the eye reflects the sea; show the horizon instead.
+        r = normalize([r[0], r[1], 0.0]);
+    }
+    let sky = env.radiance(r);
+    let lit = |c: f32, i: usize| c * (look.ambient * light.sky[i] + look.diffuse * light.sun[i] * n_dot_l);
+    let body = [lit(f.albedo[0], 0), lit(f.albedo[1], 1), lit(f.albedo[2], 2)];
+    let mut colour = mix(body, sky, fr);
+    if l[2] > 0.0 {
+        let h = normalize([l[0] + v[0], l[1] + v[1], l[2] + v[2]]);
+        let n_dot_h = dot(n, h).max(1e-3);
+        let s2 = f.slope_variance + look.base_slope_variance;
+        let tan2 = (1.0 - n_dot_h * n_dot_h) / (n_dot_h * n_dot_h);
+        let p = (-tan2 / (2.0 * s2)).exp() / (2.0 * std::f32::consts::PI * s2);
+        let g = look.sun_irradiance * fresnel(dot(v, h)) * p / (4.0 * n_dot_v * n_dot_h.powi(4));
+        let g = g.min(50.0);
+        colour = [colour[0] + g * light.sun[0], colour[1] + g * light.sun[1], colour[2] + g * light.sun[2]];
+    }
+    if f.foam > 0.0 {
+        let foam = [0, 1, 2].map(|i| look.foam[i] * (look.ambient * light.sky[i] + light.sun[i] * n_dot_l));
+        // Foam is a froth of bubbles over water, never a solid sheet: at most 85 % cover.
+        colour = mix(colour, foam, 0.85 * f.foam.min(1.0));
+    }
+    let haze = 1.0 - (-f.distance_m / look.haze_m).exp();
+    let away = normalize([-v[0], -v[1], 0.0]);
+    mix(colour, env.radiance(away), haze)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::render::sky::Sky;
+
+    fn facet(normal: Vec3, to_eye: Vec3) -> Facet {
+        Facet { normal, to_eye, distance_m: 100.0, albedo: [0.01, 0.04, 0.06], foam: 0.0, slope_variance: 0.001 }
+    }
+
+    #[test]
+    fn fresnel_rises_to_one_at_grazing_angles() {
+        assert!((fresnel(1.0) - WATER_F0).abs() < 1e-6);
+        assert!((fresnel(0.0) - 1.0).abs() < 1e-6);
+        assert!(fresnel(0.2) > fresnel(0.6));
+    }
+
+    #[test]
+    fn tone_mapping_is_monotonic_and_saturates() {
+        assert_eq!(to_srgb8([0.0, 0.5, 100.0]), [0, 188, 255]);
+        assert!(to_srgb8([1.0; 3])[0] > 240);
+        let mut last = 0;
+        for i in 0..200 {
+            let v = to_srgb8([i as f32 / 50.0; 3])[0];
+            assert!(v >= last);
+            last = v;
+        }
+        assert_eq!(srgb_encode(srgb_decode(128)), 128.0 / 255.0);
+    }
+
+    #[test]
+    fn the_sun_glints_where_the_facet_mirrors_it() {
+        let sky = Sky::new(0.0, 20.0);
+        let light = sky.light();
+        let look = WaterLook::default();
+        let up = [0.0, 0.0, 1.0];
+        // Looking north-down at 20°, the level sea mirrors the sun (north, 20° up).
+        let mirror = normalize([0.0, -(20f32.to_radians().cos()), 20f32.to_radians().sin()]);
+        let aside = normalize([0.7, -0.7, 0.36]);
+        let glint = shade_facet(&look, &light, &sky, &facet(up, mirror));
+        let plain = shade_facet(&look, &light, &sky, &facet(up, aside));
+        assert!(glint[0] > 1.0 && glint[0] > 5.0 * plain[0], "{glint:?} vs {plain:?}");
+        // Grazing views reflect more sky than steep ones.
+        let steep = shade_facet(&look, &light, &sky, &facet(up, normalize([0.0, 0.2, 1.0])));
+        let grazing = shade_facet(&look, &light, &sky, &facet(up, normalize([0.0, 0.95, 0.05])));
+        assert!(grazing[2] > steep[2]);
+    }
+
+    #[test]
+    fn foam_is_white_and_haze_takes_over_far_away() {
+        let sky = Sky::new(90.0, 40.0);
+        let (light, look) = (sky.light(), WaterLook::default());
+        let mut f = facet([0.0, 0.0, 1.0], normalize([0.0, -0.5, 0.3]));
+        let water = shade_facet(&look, &light, &sky, &f);
+        f.foam = 1.0;
+        let foam = shade_facet(&look, &light, &sky, &f);
+        assert!(foam[0] > 3.0 * water[0]);
+        f.distance_m = 1e7;
+        let far = shade_facet(&look, &light, &sky, &f);
+        let horizon = sky.radiance(normalize([0.0, 0.5, 0.0]));
+        assert!((0..3).all(|i| (far[i] - horizon[i]).abs() < 1e-3));
+    }
+}

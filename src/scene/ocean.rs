@@ -1,0 +1,187 @@
+//! The ocean scene: a wind-driven sea, the clock, and the renderer that draws it.
+
+use tiny_skia::Pixmap;
+
+use crate::output::heightmap::Heightmap;
+use crate::render::ocean::{OceanRenderer, OceanView};
+use crate::render::texture::SeaTexture;
+use crate::sim::ocean::{Sea, SeaParams};
+
+/// Everything about an ocean picture except its size and texture.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct OceanSettings {
+    /// Wind and seed.
+    pub sea: SeaParams,
+    /// Camera, sun and supersampling.
+    pub view: OceanView,
+}
+
+/// A sea, its clock (physical seconds) and its renderer.
+#[derive(Debug)]
+pub struct OceanScene {
+    sea: Sea,
+    renderer: OceanRenderer,
+    texture: SeaTexture,
+    time_s: f64,
+}
+
+/// The heightmap's east-west extent when none is given: 8 peak wavelengths (100 m for a calm).
+pub fn default_extent_m(sea: &Sea) -> f64 {
+    sea.spectrum().peak_wavelength_m().map_or(100.0, |l| 8.0 * l)
+}
+
+impl OceanScene {
+    /// A scene at time 0 drawing `width x height` pictures.
+    ///
+    /// Returns `None` when the (supersampled) size is zero or too large for a pixmap.
+    pub fn new(settings: OceanSettings, width: u32, height: u32, texture: SeaTexture) -> Option<OceanScene> {
+        let renderer = OceanRenderer::new(settings.view, width, height, texture.clone())?;
+        Some(OceanScene { sea: Sea::new(settings.sea), renderer, texture, time_s: 0.0 })
+    }
+
+    /// The sea.
+    pub fn sea(&self) -> &Sea {
+        &self.sea
+    }
+
+    /// The renderer (camera, sky, triangle count).
+    pub fn renderer(&self) -> &OceanRenderer {
+        &self.renderer
+    }
+
+    /// The renderer, to move the camera.
+    pub fn renderer_mut(&mut self) -> &mut OceanRenderer {
+        &mut self.renderer
+    }
+
+    /// Output width, px.
+    pub fn width(&self) -> u32 {
+        self.renderer.width()
+    }
+
+    /// Output height, px.
+    pub fn height(&self) -> u32 {
+        self.renderer.height()
+    }
+
+    /// Physical time, s.
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+
+    /// Sets the clock.
+    pub fn set_time(&mut self, time_s: f64) {
+        self.time_s = time_s;
+    }
+
+    /// Moves the clock on by `dt_s` seconds: the sea moves exactly that much.
+    pub fn advance(&mut self, dt_s: f64) {
+        self.time_s += dt_s;
+    }
+
+    /// Replaces the sea (new wind, direction or seed); the clock and camera stay.
+    pub fn set_sea(&mut self, params: SeaParams) {
+        self.sea = Sea::new(params);
+    }
+
+    /// Draws the sea at the current time into `out` (the scene's size).
+    pub fn render(&mut self, out: &mut Pixmap) {
+        let frame = self.sea.frame(self.time_s);
+        self.renderer.render(&frame, out);
+    }
+
+    /// A new picture of the current sea.
+    pub fn snapshot(&mut self) -> Pixmap {
+        let mut out = Pixmap::new(self.width(), self.height()).expect("the scene's size is a valid pixmap size");
+        self.render(&mut out);
+        out
+    }
+
+    /// Starts drawing at a new size (same sea, clock and camera).
+    ///
+    /// Returns `false` (and changes nothing) when the size is zero or too large.
+    pub fn resize(&mut self, width: u32, height: u32) -> bool {
+        let mut view = self.renderer.view();
+        view.camera = self.renderer.camera().pose();
+        match OceanRenderer::new(view, width, height, self.texture.clone()) {
+            Some(r) => {
+                self.renderer = r;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The full surface height (m) on a `width x height` grid covering `extent_m` metres
+    /// east-west and `extent_m·height/width` north-south, centred under the camera, at cell
+    /// centres; columns run east, row 0 is the north edge.
+    pub fn heightmap(&self, extent_m: f64, width: usize, height: usize) -> Heightmap {
+        let frame = self.sea.frame(self.time_s);
+        let pose = self.renderer.camera().pose();
+        let cell = extent_m / width.max(1) as f64;
+        let (west, north) = (pose.east_m - extent_m / 2.0, pose.north_m + cell * height as f64 / 2.0);
+        let mut values = vec![0.0f32; width * height];
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).clamp(1, 8);
+        let rows_per = height.div_ceil(threads).max(1);
+        std::thread::scope(|scope| {
+            for (chunk, rows) in values.chunks_mut((rows_per * width).max(1)).enumerate() {
+                let frame = &frame;
+                scope.spawn(move || {
+                    for (i, v) in rows.iter_mut().enumerate() {
+                        let (row, col) = (chunk * rows_per + i / width, i % width);
+                        let x = west + (col as f64 + 0.5) * cell;
+                        let y = north - (row as f64 + 0.5) * cell;
+                        *v = frame.height(x as f32, y as f32);
+                    }
+                });
+            }
+        });
+        Heightmap { width, height, values }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(wind: f64) -> OceanScene {
+        let settings = OceanSettings {
+            sea: SeaParams { wind_m_s: wind, wind_from_deg: 0.0, seed: 5 },
+            view: OceanView::default(),
+        };
+        OceanScene::new(settings, 64, 36, SeaTexture::builtin()).unwrap()
+    }
+
+    #[test]
+    fn time_moves_the_sea() {
+        let mut s = scene(8.0);
+        let a = s.snapshot();
+        s.advance(1.5);
+        assert_eq!(s.time_s(), 1.5);
+        assert_ne!(a.data(), s.snapshot().data());
+        s.set_time(0.0);
+        assert_eq!(a.data(), s.snapshot().data(), "the same time gives the same picture");
+    }
+
+    #[test]
+    fn heightmaps_are_oriented_and_sized() {
+        let s = scene(10.0);
+        let map = s.heightmap(800.0, 40, 20);
+        assert_eq!((map.width, map.height, map.values.len()), (40, 20, 800));
+        let frame = s.sea().frame(0.0);
+        // Row 0 is north, column 0 is west: cell (0, 0) is centred at (-390, 190).
+        assert_eq!(map.values[0], frame.height(-390.0, 190.0));
+        assert_eq!(map.values[19 * 40 + 39], frame.height(390.0, -190.0));
+        assert!((default_extent_m(s.sea()) - 8.0 * s.sea().spectrum().peak_wavelength_m().unwrap()).abs() < 1e-9);
+        assert!(scene(0.0).heightmap(10.0, 3, 3).values.iter().all(|&v| v == 0.0));
+    }
+
+    #[test]
+    fn resize_keeps_the_sea() {
+        let mut s = scene(6.0);
+        assert!(s.resize(32, 20));
+        assert_eq!((s.width(), s.height()), (32, 20));
+        assert_eq!(s.snapshot().width(), 32);
+        assert!(!s.resize(0, 5));
+    }
+}
