@@ -8,6 +8,7 @@ use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
+pub mod lake;
 pub mod ocean;
 
 use crate::sim::ripple::{Damping, Stone};
@@ -129,6 +130,8 @@ pub const PLAYER_DAMPING: &str = "4";
 pub enum PlayScene {
     /// The ripple pool.
     Pool,
+    /// The lake (keys: w/W wind, o/O octaves, ./, persistence, n noise, c calm).
+    Lake,
 }
 
 /// `--color`.
@@ -181,6 +184,8 @@ pub enum RenderScene {
     Pool(RenderPool),
     /// The ocean: a wind-driven Pierson–Moskowitz sea under a sky, as a flat-shaded mesh.
     Ocean(ocean::RenderOcean),
+    /// The lake: Perlin-noise water mirroring its wooded shore; wind breaks the mirror.
+    Lake(lake::RenderLake),
 }
 
 /// `tidepool render pool`.

@@ -26,6 +26,7 @@ use std::path::{Path, PathBuf};
 use serde_json::{Value, json};
 
 use crate::error::{Error, Result};
+use crate::sim::noise::NoiseKind;
 use crate::sim::ripple::{Damping, Stone};
 
 /// The replay format this tidepool writes and reads.
@@ -63,6 +64,17 @@ pub enum Event {
     Screenshot(String),
     /// The session ended.
     End,
+    /// The wind changed, m/s (the lake).
+    Wind(f64),
+    /// The lake's noise changed.
+    Noise {
+        /// Octaves summed.
+        octaves: u32,
+        /// Amplitude ratio between octaves.
+        persistence: f64,
+        /// Value or gradient noise.
+        kind: NoiseKind,
+    },
 }
 
 /// An event and the step it happened at.
@@ -114,6 +126,10 @@ pub fn event_line(entry: &Entry) -> String {
         Event::Resize(size) => json!({"step": step, "resize": size}),
         Event::Screenshot(file) => json!({"step": step, "screenshot": file}),
         Event::End => json!({"step": step, "end": true}),
+        Event::Wind(w) => json!({"step": step, "wind": w}),
+        Event::Noise { octaves, persistence, kind } => {
+            json!({"step": step, "noise": {"octaves": octaves, "persistence": persistence, "kind": kind.name()}})
+        }
     }
     .to_string()
 }
@@ -235,9 +251,30 @@ fn parse_event(line: &str) -> Result<Entry, String> {
         "end" => Event::End,
         "resize" => Event::Resize(parse_size(&value).ok_or("\"resize\" must be [WIDTH, HEIGHT], each at least 1")?),
         "screenshot" => Event::Screenshot(value.as_str().ok_or("\"screenshot\" must be a file name")?.to_owned()),
+        "wind" => {
+            let w = value.as_f64().ok_or("\"wind\" must be a number of metres per second")?;
+            Event::Wind(crate::cli::lake::parse_lake_wind(&w.to_string()).map_err(|e| format!("bad wind: {e}"))?)
+        }
+        "noise" => {
+            let field = |name: &str| value.get(name).ok_or(format!("\"noise\" needs \"{name}\""));
+            let octaves = field("octaves")?.to_string();
+            let persistence = field("persistence")?.to_string();
+            let kind = field("kind")?.as_str().ok_or("\"kind\" must be \"value\" or \"gradient\"")?;
+            let kind = match kind {
+                "value" => NoiseKind::Value,
+                "gradient" => NoiseKind::Gradient,
+                other => return Err(format!("bad noise: unknown kind \"{other}\"; use \"value\" or \"gradient\"")),
+            };
+            Event::Noise {
+                octaves: crate::cli::lake::parse_octaves(&octaves).map_err(|e| format!("bad noise: {e}"))?,
+                persistence: crate::cli::lake::parse_persistence(&persistence)
+                    .map_err(|e| format!("bad noise: {e}"))?,
+                kind,
+            }
+        }
         other => {
             return Err(format!(
-                "unknown event \"{other}\"; this tidepool knows stone, rain, damping, clear, resize, screenshot and end"
+                "unknown event \"{other}\"; this tidepool knows stone, rain, damping, clear, resize, screenshot, wind, noise and end"
             ));
         }
     };
@@ -345,6 +382,8 @@ mod tests {
             Entry { step: 4, event: Event::Clear },
             Entry { step: 9, event: Event::Resize([30, 12]) },
             Entry { step: 9, event: Event::Screenshot("a b.png".into()) },
+            Entry { step: 10, event: Event::Wind(4.5) },
+            Entry { step: 11, event: Event::Noise { octaves: 6, persistence: 0.55, kind: NoiseKind::Gradient } },
             Entry { step: 12, event: Event::End },
         ];
         let replay = parse(Path::new("r"), &text(&entries)).unwrap();
@@ -369,6 +408,11 @@ mod tests {
         assert!(err(&bad_event).contains("line 2: unknown event \"splash\""));
         let bad_stone = good.replacen("\"clear\":true", "\"stone\":[1,2,0,3]", 1);
         assert!(err(&bad_stone).contains("line 2: bad stone: the radius 0"), "{}", err(&bad_stone));
+        let bad_wind = good.replacen("\"clear\":true", "\"wind\":-2", 1);
+        assert!(err(&bad_wind).contains("line 2: bad wind: the wind speed -2"), "{}", err(&bad_wind));
+        let bad_noise =
+            good.replacen("\"clear\":true", "\"noise\":{\"octaves\":0,\"persistence\":0.5,\"kind\":\"value\"}", 1);
+        assert!(err(&bad_noise).contains("line 2: bad noise: the octave count 0"), "{}", err(&bad_noise));
         let backwards = good.replacen("\"step\":5", "\"step\":0", 1);
         assert!(err(&backwards).contains("line 3: step 0 comes after step 1"));
         let after_end = good.clone() + &event_line(&end) + "\n";

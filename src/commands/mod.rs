@@ -1,6 +1,7 @@
 //! The subcommands: validated flags in, files and terminal output out.
 
 pub mod bench;
+pub mod lake;
 pub mod ocean;
 pub mod play;
 pub mod render;
@@ -21,6 +22,7 @@ tidepool: water you can play with in any terminal.
   tidepool render pool --help           every flag, with defaults and units
   tidepool render ocean --beaufort 6    a wind-driven sea in ocean.png
   tidepool spectrum --wind 10           the sea state a 10 m/s wind raises
+  tidepool render lake --wind 0         a calm lake mirroring its shore in lake.png
   tidepool --help                       all commands";
 
 /// Runs a parsed command line.

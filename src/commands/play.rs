@@ -10,8 +10,10 @@ use crate::error::{Error, Result};
 use crate::output::color::ColorMode;
 use crate::output::diff::EncodeOptions;
 use crate::render::background;
+use crate::scene::lake::{LakeScene, LakeSettings};
 use crate::scene::playable::Playable;
 use crate::scene::pool::{PoolScene, PoolSettings};
+use crate::sim::lake::LakeParams;
 use crate::term::app::{self, PlayerConfig, SceneFactory};
 
 /// The player's rain when `--rain` is not given: about one drop a second at 60 steps/s.
@@ -23,6 +25,12 @@ pub const SSH_COLOR_THRESHOLD: u8 = 3;
 /// `--color-threshold` when not given: 0 (exact) locally, [`SSH_COLOR_THRESHOLD`] over SSH.
 pub fn default_threshold(ssh_connection: Option<&str>) -> u8 {
     if ssh_connection.is_some_and(|v| !v.trim().is_empty()) { SSH_COLOR_THRESHOLD } else { 0 }
+}
+
+/// The lake the player starts with: the default breeze and noise, no supersampling (a
+/// terminal cell is two pixels; the frame budget goes to the water instead).
+pub fn lake_settings(seed: u64) -> LakeSettings {
+    LakeSettings { lake: LakeParams { seed, ..LakeParams::default() }, ssaa: 1 }
 }
 
 /// Runs the player.
@@ -40,6 +48,12 @@ pub fn run(command: PlayCommand) -> Result<()> {
         ColorChoice::Palette16 => ColorMode::Palette16,
     };
     let threshold = command.color_threshold.unwrap_or(default_threshold(env("SSH_CONNECTION").as_deref()));
+    if command.record.is_some() && command.scene != PlayScene::Pool {
+        return Err(Error::arg(
+            "--record",
+            "replays hold pool sessions only so far; play the pool (`tidepool play pool --record FILE`) or drop --record",
+        ));
+    }
     let floor = match &command.pool.background {
         Some(path) => background::load("--background", path)?,
         None => background::pool_floor(),
@@ -51,6 +65,9 @@ pub fn run(command: PlayCommand) -> Result<()> {
         PlayScene::Pool => PoolScene::new(width, height, floor.clone(), settings)
             .map(|scene| Box::new(scene) as Box<dyn Playable>)
             .ok_or_else(|| Error::Usage(format!("cannot allocate a {width}x{height} pool; use a smaller terminal"))),
+        PlayScene::Lake => LakeScene::new(lake_settings(command.seed), width, height)
+            .map(|scene| Box::new(scene) as Box<dyn Playable>)
+            .ok_or_else(|| Error::Usage(format!("cannot allocate a {width}x{height} lake; use a smaller terminal"))),
     });
     let config = PlayerConfig {
         fps: command.fps,

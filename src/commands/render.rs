@@ -25,6 +25,7 @@ pub fn run(command: RenderCommand) -> Result<()> {
     match command.scene {
         RenderScene::Pool(args) => render_pool(args),
         RenderScene::Ocean(args) => super::ocean::render_ocean(args),
+        RenderScene::Lake(args) => super::lake::render_lake(args),
     }
 }
 

@@ -69,6 +69,31 @@ impl Camera {
         Camera { pose, width, height, focal_px, eye, right, up, forward }
     }
 
+    /// The camera of the mirror image in the still water plane (z = 0): the eye as far below
+    /// the water as this one is above it, looking up as much as this one looks down.
+    ///
+    /// What it sees, turned upside down (row y to row `height - 1 - y`), is exactly what a
+    /// calm surface shows this camera at the same pixel: the paper's stencil-buffer reflection.
+    pub fn mirrored(&self) -> Camera {
+        let pose = CameraPose { height_m: -self.pose.height_m, pitch_down_deg: -self.pose.pitch_down_deg, ..self.pose };
+        Camera {
+            pose,
+            forward: [self.forward[0], self.forward[1], -self.forward[2]],
+            up: cross(self.right, [self.forward[0], self.forward[1], -self.forward[2]]),
+            eye: [self.eye[0], self.eye[1], -self.eye[2]],
+            ..*self
+        }
+    }
+
+    /// The same camera drawing a picture `pad_x` pixels wider on each side and `pad_y` taller
+    /// at the top and bottom: same eye, direction, focal length and centre, so pixel (x, y)
+    /// here is pixel (x - pad_x, y - pad_y) of this camera.
+    pub fn padded(&self, pad_x: u32, pad_y: u32) -> Camera {
+        let width = self.width + 2 * pad_x;
+        let hfov_deg = 2.0 * (f64::from(width) / 2.0 / f64::from(self.focal_px)).atan().to_degrees();
+        Camera { pose: CameraPose { hfov_deg, ..self.pose }, width, height: self.height + 2 * pad_y, ..*self }
+    }
+
     /// The pose.
     pub fn pose(&self) -> CameraPose {
         self.pose
@@ -97,6 +122,16 @@ impl Camera {
     /// The unit view direction.
     pub fn forward(&self) -> Vec3 {
         self.forward
+    }
+
+    /// The unit direction of the picture's x axis (level: the camera has no roll).
+    pub fn right(&self) -> Vec3 {
+        self.right
+    }
+
+    /// The unit direction of the picture's upward axis.
+    pub fn up(&self) -> Vec3 {
+        self.up
     }
 
     /// The screen row of the flat sea's horizon (may lie outside the picture).
@@ -181,6 +216,29 @@ mod tests {
         let (x, _, _) = east.project([100.0, -10.0, 25.0]).unwrap();
         assert!(x > 50.0);
         assert!(east.project([-100.0, 0.0, 25.0]).is_none(), "behind the camera");
+    }
+
+    #[test]
+    fn the_mirror_camera_sees_reflections_upside_down() {
+        let c = Camera::new(
+            CameraPose { height_m: 3.0, pitch_down_deg: 3.0, hfov_deg: 60.0, ..CameraPose::DEFAULT },
+            200,
+            120,
+        );
+        let m = c.mirrored();
+        // A point on a hill: its reflection, seen by c, is where m sees the point, flipped.
+        let p = [14.0, 300.0, 40.0];
+        let (rx, ry, _) = c.project([p[0], p[1], -p[2]]).unwrap();
+        let (mx, my, _) = m.project(p).unwrap();
+        assert!((rx - mx).abs() < 1e-3 && (ry - (120.0 - my)).abs() < 1e-3, "({rx}, {ry}) vs ({mx}, {})", 120.0 - my);
+        assert_eq!(m.mirrored(), c);
+        // Padding keeps every point where it was, shifted by the padding.
+        let big = c.padded(10, 7);
+        assert_eq!((big.width(), big.height()), (220, 134));
+        let (x, y, _) = c.project(p).unwrap();
+        let (bx, by, _) = big.project(p).unwrap();
+        assert!((bx - x - 10.0).abs() < 1e-3 && (by - y - 7.0).abs() < 1e-3);
+        assert!((big.focal_px() - c.focal_px()).abs() < 1e-3);
     }
 
     #[test]

@@ -21,6 +21,14 @@
 //!    that turned over on the screen are back faces and skipped): AA fills leave
 //!    half-transparent seams along shared edges, non-AA fills of a mesh are watertight. Smooth
 //!    edges come from supersampling ([`crate::render::supersample`]).
+//! 4. **Or deferred** ([`MeshRenderer::draw_ids`]): the same faces, but each pixel gets the
+//!    number of the face it shows ([`FaceIds`]) and [`MeshRenderer::facet`] gives that face's
+//!    [`Facet`], for a renderer that shades per pixel (the lake's mirror looks up its
+//!    reflection per pixel with the face's normal). The numbers are written by
+//!    [`crate::render::raster::fill_triangle_ids`], an exact integer fill with the same
+//!    coverage as tiny-skia's non-AA fill (pixel centres, watertight); tiny-skia would need the
+//!    ids as colours and allocates an edge list for every triangle, and the player's frames
+//!    must not allocate.
 //!
 //! # Reusing it (the lake)
 //!
@@ -51,7 +59,7 @@ use spade::{DelaunayTriangulation, Point2, Triangulation};
 use tiny_skia::{BlendMode, Paint, Pixmap, PixmapMut};
 
 use super::camera::Camera;
-use super::raster::TriangleFiller;
+use super::raster::{TriangleFiller, fill_triangle_ids};
 use super::shade::{Facet, Light, WaterLook, shade_facet, to_srgb8};
 use super::sky::Environment;
 use super::texture::SeaTexture;
@@ -225,7 +233,87 @@ impl MeshRenderer {
         shading: &Shading<'_, E>,
         out: &mut Pixmap,
     ) {
-        let topo = self.topology.as_ref().expect("MeshRenderer::prepare before draw");
+        self.shade_faces(surface, Some(shading.texture), |facet| {
+            to_srgb8(shade_facet(&shading.look, &shading.light, shading.environment, facet))
+        });
+        let faces = &self.faces;
+        let width = out.width();
+        let rows = out.height() as usize;
+        out.data_mut().par_chunks_mut(BAND_ROWS * width as usize * 4).enumerate().for_each(|(band, bytes)| {
+            let y0 = (band * BAND_ROWS) as f32;
+            let band_rows = (rows - band * BAND_ROWS).min(BAND_ROWS);
+            let y1 = y0 + band_rows as f32;
+            let Some(mut pixmap) = PixmapMut::from_bytes(bytes, width, band_rows as u32) else { return };
+            let mut paint = Paint { anti_alias: false, blend_mode: BlendMode::Source, ..Paint::default() };
+            let mut filler = TriangleFiller::new();
+            for face in faces.iter().flatten().filter(|f| f.max_y >= y0 && f.min_y <= y1) {
+                let [r, g, b] = face.colour;
+                paint.set_color_rgba8(r, g, b, 255);
+                filler.fill(&mut pixmap, &paint, face.points.map(|(x, y)| (x, y - y0)));
+            }
+        });
+    }
+
+    /// Samples `surface`, then writes into `ids` (the camera's size) the number of the face
+    /// each pixel shows: triangle `i` of the topology as `i + 1`, back to front, so the nearest
+    /// face wins. Pixels no face covers keep their value ([`FaceIds::clear`] them first, or
+    /// reset them as they are read). Afterwards [`MeshRenderer::facet`]`(i)` describes face
+    /// `i + 1`; its `albedo` is black (no texture is read).
+    ///
+    /// # Panics
+    /// Without a prior `prepare`, or when `ids` is not the camera's size (programming errors).
+    pub fn draw_ids<S: Surface + ?Sized>(&mut self, surface: &S, ids: &mut FaceIds) {
+        let camera = self.topology.as_ref().expect("MeshRenderer::prepare before draw_ids").camera;
+        assert_eq!((ids.width, ids.height), (camera.width() as usize, camera.height() as usize), "face id size");
+        self.shade_faces(surface, None, |_| [0; 3]);
+        let faces = &self.faces;
+        let (width, rows) = (ids.width, ids.height);
+        if width == 0 {
+            return;
+        }
+        ids.ids.par_chunks_mut(BAND_ROWS * width).enumerate().for_each(|(band, band_ids)| {
+            let y0 = (band * BAND_ROWS) as f32;
+            let band_rows = (rows - band * BAND_ROWS).min(BAND_ROWS);
+            let y1 = y0 + band_rows as f32;
+            for (i, face) in faces.iter().enumerate() {
+                if let Some(face) = face.as_ref().filter(|f| f.max_y >= y0 && f.min_y <= y1) {
+                    let id = u32::try_from(i + 1).unwrap_or(0);
+                    fill_triangle_ids(band_ids, width, band_rows, face.points.map(|(x, y)| (x, y - y0)), id);
+                }
+            }
+        });
+    }
+
+    /// The facet of triangle `i` as last drawn, or `None` when it was off screen or turned
+    /// away (or does not exist).
+    pub fn facet(&self, i: usize) -> Option<&Facet> {
+        self.faces.get(i)?.as_ref().map(|f| &f.facet)
+    }
+
+    /// Triangles described by the last draw (`facet` takes 0 up to this).
+    pub fn face_count(&self) -> usize {
+        self.faces.len()
+    }
+
+    /// The screen corners of triangle `i` as last drawn (corner k is the topology's vertex
+    /// `triangles()[i][k]`), or `None` when it was not drawn.
+    pub fn face_points(&self, i: usize) -> Option<[(f32, f32); 3]> {
+        self.faces.get(i)?.as_ref().map(|f| f.points)
+    }
+
+    /// What the surface was at every topology point in the last draw.
+    pub fn vertex_samples(&self) -> &[SurfaceSample] {
+        &self.samples
+    }
+
+    /// Samples the surface, projects it and describes every visible triangle, with the colour
+    /// `colour` gives its facet. `texture: None` leaves the albedo black.
+    fn shade_faces<S, F>(&mut self, surface: &S, texture: Option<&SeaTexture>, colour: F)
+    where
+        S: Surface + ?Sized,
+        F: Fn(&Facet) -> [u8; 3] + Sync,
+    {
+        let topo = self.topology.as_ref().expect("MeshRenderer::prepare before drawing");
         let n = topo.ground.len();
         self.samples.resize(n, SurfaceSample::default());
         sample_all(surface, &topo.ground, &topo.footprints, &mut self.samples);
@@ -237,7 +325,7 @@ impl MeshRenderer {
             self.world.push(p);
             self.projected.push(camera.project(p).map(|(x, y, _)| (x, y)));
         }
-        let (w, h) = (out.width() as f32, out.height() as f32);
+        let (w, h) = (camera.width() as f32, camera.height() as f32);
         let eye = camera.eye();
         let (world, projected, samples) = (&self.world, &self.projected, &self.samples);
         // Shade every visible triangle (in parallel, order kept), then fill bands of rows in
@@ -273,33 +361,57 @@ impl MeshRenderer {
                     normal,
                     to_eye: scale(to_eye, 1.0 / distance_m.max(1e-6)),
                     distance_m,
-                    albedo: shading.texture.sample(centroid[0], centroid[1], size_m),
+                    albedo: texture.map_or([0.0; 3], |t| t.sample(centroid[0], centroid[1], size_m)),
                     foam: (sa.foam + sb.foam + sc.foam) / 3.0,
                     slope_variance: (sa.unresolved_slope_variance
                         + sb.unresolved_slope_variance
                         + sc.unresolved_slope_variance)
                         / 3.0,
+                    height_m: centroid[2],
                 };
-                let colour = to_srgb8(shade_facet(&shading.look, &shading.light, shading.environment, &facet));
-                Some(Face { points: [pa, pb, pc], min_y, max_y, colour })
+                Some(Face { points: [pa, pb, pc], min_y, max_y, colour: colour(&facet), facet })
             })
             .collect_into_vec(&mut self.faces);
-        let faces = &self.faces;
-        let width = out.width();
-        let rows = out.height() as usize;
-        out.data_mut().par_chunks_mut(BAND_ROWS * width as usize * 4).enumerate().for_each(|(band, bytes)| {
-            let y0 = (band * BAND_ROWS) as f32;
-            let band_rows = (rows - band * BAND_ROWS).min(BAND_ROWS);
-            let y1 = y0 + band_rows as f32;
-            let Some(mut pixmap) = PixmapMut::from_bytes(bytes, width, band_rows as u32) else { return };
-            let mut paint = Paint { anti_alias: false, blend_mode: BlendMode::Source, ..Paint::default() };
-            let mut filler = TriangleFiller::new();
-            for face in faces.iter().flatten().filter(|f| f.max_y >= y0 && f.min_y <= y1) {
-                let [r, g, b] = face.colour;
-                paint.set_color_rgba8(r, g, b, 255);
-                filler.fill(&mut pixmap, &paint, face.points.map(|(x, y)| (x, y - y0)));
-            }
-        });
+    }
+}
+
+/// The number of the mesh face each pixel shows (0 where none has been drawn), row-major.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct FaceIds {
+    width: usize,
+    height: usize,
+    ids: Vec<u32>,
+}
+
+impl FaceIds {
+    /// A `width x height` picture of zeros.
+    pub fn new(width: usize, height: usize) -> FaceIds {
+        FaceIds { width, height, ids: vec![0; width * height] }
+    }
+
+    /// Columns.
+    pub fn width(&self) -> usize {
+        self.width
+    }
+
+    /// Rows.
+    pub fn height(&self) -> usize {
+        self.height
+    }
+
+    /// The numbers, row-major.
+    pub fn ids(&self) -> &[u32] {
+        &self.ids
+    }
+
+    /// The numbers, to read and reset.
+    pub fn ids_mut(&mut self) -> &mut [u32] {
+        &mut self.ids
+    }
+
+    /// Sets every number to 0.
+    pub fn clear(&mut self) {
+        self.ids.fill(0);
     }
 }
 
@@ -307,13 +419,15 @@ impl MeshRenderer {
 /// cores (a face is translated by the band's origin before filling).
 pub const BAND_ROWS: usize = 128;
 
-/// A shaded triangle ready to fill: screen points, vertical extent, colour.
+/// A shaded triangle ready to fill: screen points, vertical extent, colour, and what the
+/// colour was made from.
 #[derive(Clone, Copy, Debug)]
 struct Face {
     points: [(f32, f32); 3],
     min_y: f32,
     max_y: f32,
     colour: [u8; 3],
+    facet: Facet,
 }
 
 /// Samples the surface at every point, in parallel chunks (the result does not depend on how
@@ -395,6 +509,36 @@ mod tests {
                 assert!(!(p.red() == 255 && p.green() == 0 && p.blue() == 255), "hole at ({x}, {y})");
             }
         }
+    }
+
+    #[test]
+    fn face_ids_cover_the_sea_and_name_their_facets() {
+        let cam = camera();
+        let mut renderer = MeshRenderer::new();
+        renderer.prepare(&cam, 4.0);
+        let mut ids = FaceIds::new(160, 96);
+        renderer.draw_ids(&Flat(0.02), &mut ids);
+        assert_eq!(renderer.face_count(), renderer.triangle_count());
+        let first_row = (cam.horizon_y() + 0.1 * 96.0).ceil() as usize;
+        let want = normalize([-0.02, 0.0, 1.0]);
+        let mut seen = std::collections::HashSet::new();
+        for y in first_row..96 {
+            for x in 0..160 {
+                let id = ids.ids()[y * 160 + x];
+                assert!(id > 0, "no face at ({x}, {y})");
+                let f = renderer.facet(id as usize - 1).expect("a drawn face has a facet");
+                assert!((0..3).all(|i| (f.normal[i] - want[i]).abs() < 1e-3), "{:?}", f.normal);
+                assert_eq!(f.albedo, [0.0; 3]);
+                seen.insert(id);
+            }
+        }
+        assert!(seen.len() > 500, "many faces: {}", seen.len());
+        // The facet's height is its centroid's: the tilted plane's height there.
+        let f = renderer.facet(*seen.iter().next().unwrap() as usize - 1).unwrap();
+        let centroid = sub(cam.eye(), scale(f.to_eye, f.distance_m));
+        assert!((f.height_m - 0.02 * centroid[0]).abs() < 1e-3);
+        assert!((centroid[2] - f.height_m).abs() < 1e-3);
+        assert!(renderer.facet(usize::MAX).is_none());
     }
 
     #[test]

@@ -8,12 +8,16 @@
 pub mod background;
 pub mod camera;
 pub mod caustics;
+pub mod clouds;
+pub mod lake;
 pub mod mesh;
+pub mod mirror;
 pub mod ocean;
 pub mod plot;
 pub mod pool;
 pub mod raster;
 pub mod shade;
+pub mod shore;
 pub mod sky;
 pub mod supersample;
 pub mod texture;

@@ -140,6 +140,7 @@ impl OceanRenderer {
             albedo: self.texture.mean(),
             foam: 0.0,
             slope_variance: (cox_munk_slope_variance(wind_m_s) / 2.0) as f32,
+            height_m: 0.0,
         };
         shade_facet(&self.look, &self.sky.light(), &self.sky, &facet)
     }

@@ -109,6 +109,8 @@ pub struct Facet {
     pub foam: f32,
     /// Unresolved slope variance per axis.
     pub slope_variance: f32,
+    /// Mean height of the facet above the still water level, m (the lake colours by it).
+    pub height_m: f32,
 }
 
 /// The light falling on the water.
@@ -122,13 +124,31 @@ pub struct Light {
     pub sky: Rgb,
 }
 
+/// The sun's glint on a facet with unit normal `n` seen from the unit direction `v` (towards
+/// the eye), as a multiple of the sun's colour: Cox–Munk glitter with the facet's unresolved
+/// `slope_variance` plus [`WaterLook::base_slope_variance`], at most 50. 0 when the sun is down.
+#[inline]
+pub fn glint(look: &WaterLook, light: &Light, n: Vec3, v: Vec3, slope_variance: f32) -> f32 {
+    let l = light.sun_dir;
+    if l[2] <= 0.0 {
+        return 0.0;
+    }
+    let n_dot_v = dot(n, v).max(0.02);
+    let h = normalize([l[0] + v[0], l[1] + v[1], l[2] + v[2]]);
+    let n_dot_h = dot(n, h).max(1e-3);
+    let s2 = slope_variance + look.base_slope_variance;
+    let tan2 = (1.0 - n_dot_h * n_dot_h) / (n_dot_h * n_dot_h);
+    let p = (-tan2 / (2.0 * s2)).exp() / (2.0 * std::f32::consts::PI * s2);
+    let g = look.sun_irradiance * fresnel(dot(v, h)) * p / (4.0 * n_dot_v * n_dot_h.powi(4));
+    g.min(50.0)
+}
+
 /// The colour of one facet, linear RGB.
 #[inline]
 pub fn shade_facet<E: Environment + ?Sized>(look: &WaterLook, light: &Light, env: &E, f: &Facet) -> Rgb {
     let n = f.normal;
     let v = f.to_eye;
     let l = light.sun_dir;
-    let n_dot_v = dot(n, v).max(0.02);
     let n_dot_l = dot(n, l).max(0.0);
     // Unresolved roughness: of the small facets inside this one, those tilted towards the eye
     // are seen most, so reflect with the normal tilted that way by one standard deviation.
@@ -147,13 +167,7 @@ pub fn shade_facet<E: Environment + ?Sized>(look: &WaterLook, light: &Light, env
     let body = [lit(f.albedo[0], 0), lit(f.albedo[1], 1), lit(f.albedo[2], 2)];
     let mut colour = mix(body, sky, fr);
     if l[2] > 0.0 {
-        let h = normalize([l[0] + v[0], l[1] + v[1], l[2] + v[2]]);
-        let n_dot_h = dot(n, h).max(1e-3);
-        let s2 = f.slope_variance + look.base_slope_variance;
-        let tan2 = (1.0 - n_dot_h * n_dot_h) / (n_dot_h * n_dot_h);
-        let p = (-tan2 / (2.0 * s2)).exp() / (2.0 * std::f32::consts::PI * s2);
-        let g = look.sun_irradiance * fresnel(dot(v, h)) * p / (4.0 * n_dot_v * n_dot_h.powi(4));
-        let g = g.min(50.0);
+        let g = glint(look, light, n, v, f.slope_variance);
         colour = [colour[0] + g * light.sun[0], colour[1] + g * light.sun[1], colour[2] + g * light.sun[2]];
     }
     if f.foam > 0.0 {
@@ -166,13 +180,46 @@ pub fn shade_facet<E: Environment + ?Sized>(look: &WaterLook, light: &Light, env
     mix(colour, env.radiance(away), haze)
 }
 
+/// [`to_srgb8`] for one channel through a table, for per-pixel work: 16,384 steps per unit of linear light up to 4
+/// (fine enough that the darkest water has no bands: one step is under 0.1 of an 8-bit level).
+pub struct SrgbTable {
+    levels: Vec<u8>,
+}
+
+impl SrgbTable {
+    const STEPS: f32 = 16_384.0;
+
+    /// The table, built on first use.
+    pub fn shared() -> &'static SrgbTable {
+        static TABLE: std::sync::OnceLock<SrgbTable> = std::sync::OnceLock::new();
+        TABLE.get_or_init(|| SrgbTable {
+            levels: (0..65_536).map(|i| to_srgb8([(i as f32 + 0.5) / Self::STEPS, 0.0, 0.0])[0]).collect(),
+        })
+    }
+
+    /// The 8-bit sRGB level of a linear value (NaN and negatives give 0).
+    #[inline(always)]
+    pub fn encode(&self, v: f32) -> u8 {
+        // `as usize` sends NaN and negatives to 0.
+        self.levels[((v * Self::STEPS) as usize).min(self.levels.len() - 1)]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::render::sky::Sky;
 
     fn facet(normal: Vec3, to_eye: Vec3) -> Facet {
-        Facet { normal, to_eye, distance_m: 100.0, albedo: [0.01, 0.04, 0.06], foam: 0.0, slope_variance: 0.001 }
+        Facet {
+            normal,
+            to_eye,
+            distance_m: 100.0,
+            albedo: [0.01, 0.04, 0.06],
+            foam: 0.0,
+            slope_variance: 0.001,
+            height_m: 0.0,
+        }
     }
 
     #[test]
@@ -226,5 +273,16 @@ mod tests {
         let far = shade_facet(&look, &light, &sky, &f);
         let horizon = sky.radiance(normalize([0.0, 0.5, 0.0]));
         assert!((0..3).all(|i| (far[i] - horizon[i]).abs() < 1e-3));
+    }
+
+    #[test]
+    fn the_table_matches_to_srgb8() {
+        let t = SrgbTable::shared();
+        for v in [0.0f32, 0.0004, 0.01, 0.2, 0.79, 0.81, 1.5, 3.9, 10.0] {
+            let want = to_srgb8([v, 0.0, 0.0])[0];
+            assert!(t.encode(v).abs_diff(want) <= 1, "{v}: {} vs {want}", t.encode(v));
+        }
+        assert_eq!(t.encode(f32::NAN), 0);
+        assert_eq!(t.encode(-1.0), 0);
     }
 }

@@ -1,6 +1,8 @@
 //! Simulations: state that advances in time. Nothing here draws or does I/O.
 
 pub mod fbm;
+pub mod lake;
+pub mod noise;
 pub mod ocean;
 pub mod rain;
 pub mod ripple;

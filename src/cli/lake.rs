@@ -1,0 +1,195 @@
+//! Flags of the lake: `tidepool render lake`.
+
+use std::path::PathBuf;
+
+use clap::{Args, ValueEnum};
+
+use super::{Format, OutputArgs, Size, parse_size};
+use crate::scene::lake::MAX_LAKE_WIND_M_S;
+use crate::sim::noise::{MAX_OCTAVES, NoiseKind};
+
+const LAKE_EXAMPLES: &str = "\
+Examples:
+  tidepool render lake                                 # lake.png, 640x360, a 3 m/s breeze
+  tidepool render lake --wind 0 --size 1280x720 --out calm.png     # a mirror
+  tidepool render lake --wind 7 --time 2.5 --out windy.png
+  tidepool render lake --noise gradient --octaves 7 --persistence 0.6 --out rough.png
+  tidepool render lake --out - --size 160x96           # in this terminal
+  tidepool render lake --wind 5 --heightmap lake.npy --size 600x300";
+
+/// `--noise`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum NoiseArg {
+    /// Hashed lattice values, smoothed 3x3 and cosine-interpolated (the paper's).
+    Value,
+    /// Hashed lattice gradients (the paper's figure 1).
+    Gradient,
+}
+
+impl From<NoiseArg> for NoiseKind {
+    fn from(arg: NoiseArg) -> NoiseKind {
+        match arg {
+            NoiseArg::Value => NoiseKind::Value,
+            NoiseArg::Gradient => NoiseKind::Gradient,
+        }
+    }
+}
+
+/// `tidepool render lake`.
+#[derive(Args, Debug)]
+#[command(after_help = LAKE_EXAMPLES)]
+pub struct RenderLake {
+    /// Wind speed at 10 m, m/s (0..=30): 0 is a mirror calm; the ripples' height and length
+    /// follow the wind over the lake's 300 m fetch.
+    #[arg(long, value_name = "M/S", default_value = "3", value_parser = parse_lake_wind, allow_hyphen_values = true)]
+    pub wind: f64,
+
+    /// Octaves of noise summed (1..=12), each half the size of the one before.
+    #[arg(long, value_name = "N", default_value = "5", value_parser = parse_octaves, allow_hyphen_values = true)]
+    pub octaves: u32,
+
+    /// Amplitude ratio from one octave to the next (0..=1): higher is rougher, 0.5 follows the
+    /// k^-3 slope of real wind ripples.
+    #[arg(long, value_name = "P", default_value = "0.5", value_parser = parse_persistence, allow_hyphen_values = true)]
+    pub persistence: f64,
+
+    /// The lattice noise: hashed values (smoothed, cosine-interpolated) or hashed gradients.
+    #[arg(long, value_enum, value_name = "KIND", default_value = "value")]
+    pub noise: NoiseArg,
+
+    /// Time in seconds: the water at t and t + 1 is one second apart.
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.0, value_parser = super::ocean::parse_time, allow_hyphen_values = true)]
+    pub time: f64,
+
+    /// Supersampling: render N times larger in each direction and average down (1..=4).
+    /// [default: 2 for PNG, 1 for text]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4))]
+    pub ssaa: Option<u32>,
+
+    /// Picture size in pixels, WIDTHxHEIGHT (at most 64 megapixels including supersampling).
+    /// [default: 640x360 for PNG; for text, the terminal's size when writing to it, else 80x48]
+    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    pub size: Option<Size>,
+
+    /// Seed of the noise and of the shore's hills and trees; the same seed and flags give the
+    /// same bytes.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub seed: u64,
+
+    /// Output file, or - for standard output. The format follows the extension: .png, or
+    /// .ans/.txt for half-block text. [default: lake.png, or lake.ans with --format ansi]
+    #[arg(long, value_name = "FILE|-")]
+    pub out: Option<PathBuf>,
+
+    /// Output format; overrides the extension. Standard output defaults to ansi.
+    #[arg(long, value_enum, value_name = "FORMAT")]
+    pub format: Option<Format>,
+
+    /// Also write the water's height, sampled at the picture's size on square cells over the
+    /// lake from the far shore (row 0, 300 m north) to the near shore, centred on the camera:
+    /// FILE.npy (float32 metres) or FILE.png (16-bit grey, value = round(height·1000) + 32768,
+    /// i.e. millimetres).
+    #[arg(long, value_name = "FILE")]
+    pub heightmap: Option<PathBuf>,
+
+    /// Print how long each stage took (picture, heightmap, encoding, writing) and the triangle
+    /// count to standard error.
+    #[arg(long)]
+    pub stats: bool,
+}
+
+impl RenderLake {
+    /// The flags every scene shares, for [`crate::commands::render::OutputPlan`].
+    pub fn output_args(&self) -> OutputArgs {
+        OutputArgs {
+            size: self.size,
+            seed: self.seed,
+            out: self.out.clone(),
+            format: self.format,
+            heightmap: self.heightmap.clone(),
+            stats: self.stats,
+        }
+    }
+}
+
+fn number(text: &str, what: &str, example: &str) -> Result<f64, String> {
+    let v: f64 =
+        text.trim().parse().map_err(|_| format!("the {what} '{}' is not a number; e.g. {example}", text.trim()))?;
+    if !v.is_finite() {
+        return Err(format!("the {what} must be a finite number; e.g. {example}"));
+    }
+    Ok(v)
+}
+
+/// Parses the lake's wind, 0..=30 m/s.
+pub fn parse_lake_wind(text: &str) -> Result<f64, String> {
+    let v = number(text, "wind speed", "3")?;
+    if !(0.0..=MAX_LAKE_WIND_M_S).contains(&v) {
+        return Err(format!(
+            "the wind speed {v} is outside 0..={MAX_LAKE_WIND_M_S} m/s; use 0 for a mirror calm, 3 for a breeze, 10 for a strong wind"
+        ));
+    }
+    Ok(v)
+}
+
+/// Parses an octave count, 1..=12.
+pub fn parse_octaves(text: &str) -> Result<u32, String> {
+    let v: i64 =
+        text.trim().parse().map_err(|_| format!("the octave count '{}' is not a whole number; e.g. 5", text.trim()))?;
+    if !(1..=MAX_OCTAVES as i64).contains(&v) {
+        return Err(format!("the octave count {v} is outside 1..={MAX_OCTAVES}; 5 is the default"));
+    }
+    Ok(v as u32)
+}
+
+/// Parses a persistence, 0..=1.
+pub fn parse_persistence(text: &str) -> Result<f64, String> {
+    let v = number(text, "persistence", "0.5")?;
+    if !(0.0..=1.0).contains(&v) {
+        return Err(format!(
+            "the persistence {v} is outside 0..=1; 0.5 halves each octave (the default), higher is rougher"
+        ));
+    }
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn winds_octaves_and_persistence() {
+        assert_eq!(parse_lake_wind("0"), Ok(0.0));
+        assert_eq!(parse_lake_wind(" 30 "), Ok(30.0));
+        for bad in ["-1", "30.5", "nan", "inf", "calm", ""] {
+            assert!(parse_lake_wind(bad).is_err(), "{bad}");
+        }
+        assert!(parse_lake_wind("31").unwrap_err().contains("0..=30 m/s"));
+        assert_eq!(parse_octaves("1"), Ok(1));
+        assert_eq!(parse_octaves("12"), Ok(12));
+        for bad in ["0", "13", "-2", "2.5", "x"] {
+            assert!(parse_octaves(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_persistence("0"), Ok(0.0));
+        assert_eq!(parse_persistence("1"), Ok(1.0));
+        for bad in ["-0.1", "1.01", "NaN", "half"] {
+            assert!(parse_persistence(bad).is_err(), "{bad}");
+        }
+        assert!(parse_persistence("2").unwrap_err().contains("rougher"));
+    }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        proptest! {
+            /// No text makes a parser panic.
+            #[test]
+            fn parsers_never_panic(text in "\\PC{0,40}") {
+                let _ = parse_lake_wind(&text);
+                let _ = parse_octaves(&text);
+                let _ = parse_persistence(&text);
+            }
+        }
+    }
+}

@@ -1,0 +1,290 @@
+//! The lake scene: the noise water, its clock, and the renderer with its shore and mirror.
+
+use tiny_skia::Pixmap;
+
+use crate::output::heightmap::Heightmap;
+use crate::render::lake::LakeRenderer;
+use crate::replay::Event;
+use crate::scene::playable::{Action, Playable};
+use crate::sim::lake::{FAR_SHORE_M, Lake, LakeParams};
+use crate::sim::noise::{MAX_OCTAVES, NoiseKind};
+
+/// The strongest wind the lake takes, m/s (a storm; beyond it a lake is all spray).
+pub const MAX_LAKE_WIND_M_S: f64 = 30.0;
+/// How much `w` and `W` change the wind in the player, m/s.
+pub const WIND_STEP_M_S: f64 = 1.0;
+/// How much `.` and `,` change the persistence in the player.
+pub const PERSISTENCE_STEP: f64 = 0.05;
+/// Simulated time per player step: the player steps 30 times a second, in real time.
+pub const PLAYER_STEP_S: f64 = 1.0 / 30.0;
+
+/// Everything about a lake picture except its size.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LakeSettings {
+    /// Wind, seed and noise.
+    pub lake: LakeParams,
+    /// Supersampling per axis, 1..=4.
+    pub ssaa: u32,
+}
+
+/// A lake, its clock (seconds) and its renderer.
+#[derive(Debug)]
+pub struct LakeScene {
+    lake: Lake,
+    renderer: LakeRenderer,
+    ssaa: u32,
+    time_s: f64,
+}
+
+impl LakeScene {
+    /// A scene at time 0 drawing `width x height` pictures.
+    ///
+    /// Returns `None` when the (supersampled) size is zero or too large for a pixmap.
+    pub fn new(settings: LakeSettings, width: u32, height: u32) -> Option<LakeScene> {
+        let renderer = LakeRenderer::new(width, height, settings.ssaa, settings.lake.seed)?;
+        Some(LakeScene { lake: Lake::new(settings.lake), renderer, ssaa: settings.ssaa, time_s: 0.0 })
+    }
+
+    /// The lake.
+    pub fn lake(&self) -> &Lake {
+        &self.lake
+    }
+
+    /// The renderer.
+    pub fn renderer(&self) -> &LakeRenderer {
+        &self.renderer
+    }
+
+    /// Output width, px.
+    pub fn width(&self) -> u32 {
+        self.renderer.width()
+    }
+
+    /// Output height, px.
+    pub fn height(&self) -> u32 {
+        self.renderer.height()
+    }
+
+    /// Time, s.
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+
+    /// Sets the clock.
+    pub fn set_time(&mut self, time_s: f64) {
+        self.time_s = time_s;
+    }
+
+    /// Moves the clock on by `dt_s` seconds.
+    pub fn advance(&mut self, dt_s: f64) {
+        self.time_s += dt_s;
+    }
+
+    /// New wind or noise; the clock and the shore stay (the shore's seed is the scene's).
+    pub fn set_params(&mut self, params: LakeParams) {
+        self.lake = Lake::new(LakeParams { seed: self.lake.params().seed, ..params });
+    }
+
+    /// Draws the lake at the current time into `out` (the scene's size).
+    pub fn render(&mut self, out: &mut Pixmap) {
+        let frame = self.lake.frame(self.time_s);
+        self.renderer.render(&frame, out);
+    }
+
+    /// A new picture of the lake now.
+    pub fn snapshot(&mut self) -> Pixmap {
+        let mut out = Pixmap::new(self.width(), self.height()).expect("the scene's size is a valid pixmap size");
+        self.render(&mut out);
+        out
+    }
+
+    /// Starts drawing at a new size (same lake and clock).
+    ///
+    /// Returns `false` (and changes nothing) when the size is zero or too large.
+    pub fn resize(&mut self, width: u32, height: u32) -> bool {
+        match LakeRenderer::new(width, height, self.ssaa, self.lake.params().seed) {
+            Some(r) => {
+                self.renderer = r;
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The full surface height (m) on a `width x height` grid of square cells covering the
+    /// lake from the far shore (row 0) to the camera's shore ([`FAR_SHORE_M`] north-south,
+    /// `FAR_SHORE_M·width/height` east-west, centred on the camera), at cell centres; columns
+    /// run east.
+    pub fn heightmap(&self, width: usize, height: usize) -> Heightmap {
+        let frame = self.lake.frame(self.time_s);
+        let cell = f64::from(FAR_SHORE_M) / height.max(1) as f64;
+        let west = -cell * width as f64 / 2.0;
+        let north = f64::from(FAR_SHORE_M);
+        let mut values = vec![0.0f32; width * height];
+        use rayon::prelude::*;
+        values.par_chunks_mut(width.max(1)).enumerate().for_each(|(row, line)| {
+            let y = north - (row as f64 + 0.5) * cell;
+            for (col, v) in line.iter_mut().enumerate() {
+                *v = frame.height((west + (col as f64 + 0.5) * cell) as f32, y as f32);
+            }
+        });
+        Heightmap { width, height, values }
+    }
+}
+
+impl Playable for LakeScene {
+    fn name(&self) -> &'static str {
+        "lake"
+    }
+
+    /// One step is 1/30 s of lake time: the water moves in real time.
+    fn steps_per_second(&self) -> f64 {
+        1.0 / PLAYER_STEP_S
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (self.width(), self.height())
+    }
+
+    fn step(&mut self) {
+        self.advance(PLAYER_STEP_S);
+    }
+
+    fn render(&mut self, out: &mut Pixmap) {
+        LakeScene::render(self, out);
+    }
+
+    /// Stones, stirring, rain and damping mean nothing to noise water (it has no wave
+    /// equation); `c` calms it.
+    fn resolve(&self, action: Action) -> Vec<Event> {
+        let p = self.lake.params();
+        let wind = |w: f64| vec![Event::Wind((w * 10.0).round() / 10.0)];
+        let noise = |octaves: u32, persistence: f64, kind: NoiseKind| {
+            let persistence = (persistence.clamp(0.0, 1.0) * 100.0).round() / 100.0;
+            vec![Event::Noise { octaves: octaves.clamp(1, MAX_OCTAVES as u32), persistence, kind }]
+        };
+        match action {
+            Action::Clear => wind(0.0),
+            Action::Key('w') => wind((p.wind_m_s + WIND_STEP_M_S).min(MAX_LAKE_WIND_M_S)),
+            Action::Key('W') => wind((p.wind_m_s - WIND_STEP_M_S).max(0.0)),
+            Action::Key('o') => noise(p.octaves + 1, p.persistence, p.noise),
+            Action::Key('O') => noise(p.octaves.saturating_sub(1), p.persistence, p.noise),
+            Action::Key('.') => noise(p.octaves, p.persistence + PERSISTENCE_STEP, p.noise),
+            Action::Key(',') => noise(p.octaves, p.persistence - PERSISTENCE_STEP, p.noise),
+            Action::Key('n') => {
+                let other = if p.noise == NoiseKind::Value { NoiseKind::Gradient } else { NoiseKind::Value };
+                noise(p.octaves, p.persistence, other)
+            }
+            _ => Vec::new(),
+        }
+    }
+
+    fn apply(&mut self, event: &Event) {
+        let p = self.lake.params();
+        match *event {
+            Event::Wind(w) => self.set_params(LakeParams { wind_m_s: w.clamp(0.0, MAX_LAKE_WIND_M_S), ..p }),
+            Event::Noise { octaves, persistence, kind } => {
+                self.set_params(LakeParams { octaves, persistence, noise: kind, ..p });
+            }
+            Event::Resize([w, h]) => {
+                self.resize(w, h);
+            }
+            _ => {}
+        }
+    }
+
+    fn status(&self, out: &mut String) {
+        use std::fmt::Write;
+        let p = self.lake.params();
+        out.clear();
+        let _ = write!(
+            out,
+            "wind {:.0} m/s \u{b7} {} octaves \u{b7} persistence {:.2} \u{b7} {} noise",
+            p.wind_m_s,
+            p.octaves,
+            p.persistence,
+            p.noise.name()
+        );
+    }
+
+    fn help(&self) -> Vec<(&'static str, &'static str)> {
+        vec![
+            ("w W", "more / less wind (1 m/s)"),
+            ("c", "calm: no wind, a mirror"),
+            ("o O", "more / fewer noise octaves"),
+            (". ,", "rougher / smoother (persistence)"),
+            ("n", "value / gradient noise"),
+        ]
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn scene(wind: f64) -> LakeScene {
+        let settings = LakeSettings { lake: LakeParams { wind_m_s: wind, ..LakeParams::default() }, ssaa: 1 };
+        LakeScene::new(settings, 64, 40).unwrap()
+    }
+
+    #[test]
+    fn time_moves_the_water_and_calm_stays_still() {
+        let mut s = scene(5.0);
+        let a = s.snapshot();
+        Playable::step(&mut s);
+        assert!((s.time_s() - PLAYER_STEP_S).abs() < 1e-12);
+        assert!(a.data() != s.snapshot().data());
+        s.set_time(0.0);
+        assert!(a.data() == s.snapshot().data(), "the same time, the same picture");
+        let mut calm = scene(0.0);
+        let still = calm.snapshot();
+        calm.advance(3.0);
+        assert!(still.data() == calm.snapshot().data(), "a calm lake does not move");
+    }
+
+    #[test]
+    fn keys_change_the_wind_and_the_noise() {
+        let mut s = scene(3.0);
+        let up = s.resolve(Action::Key('w'));
+        assert_eq!(up, vec![Event::Wind(4.0)]);
+        s.apply(&up[0]);
+        assert_eq!(s.lake().params().wind_m_s, 4.0);
+        assert_eq!(s.resolve(Action::Clear), vec![Event::Wind(0.0)]);
+        assert_eq!(s.resolve(Action::Key('W')), vec![Event::Wind(3.0)]);
+        let n = s.resolve(Action::Key('n'));
+        assert_eq!(n, vec![Event::Noise { octaves: 5, persistence: 0.5, kind: NoiseKind::Gradient }]);
+        s.apply(&n[0]);
+        assert_eq!(s.lake().params().noise, NoiseKind::Gradient);
+        s.apply(&s.resolve(Action::Key('O'))[0]);
+        s.apply(&s.resolve(Action::Key('.'))[0]);
+        assert_eq!((s.lake().params().octaves, s.lake().params().persistence), (4, 0.55));
+        assert!(s.resolve(Action::Stone { x: 1, y: 1, radius: 2, big: false }).is_empty());
+        assert!(s.resolve(Action::ToggleRain).is_empty());
+        let mut status = String::new();
+        s.status(&mut status);
+        assert_eq!(status, "wind 4 m/s \u{b7} 4 octaves \u{b7} persistence 0.55 \u{b7} gradient noise");
+        // Limits hold: no wind below 0, at most MAX_OCTAVES octaves.
+        let mut calm = scene(0.0);
+        assert_eq!(calm.resolve(Action::Key('W')), vec![Event::Wind(0.0)]);
+        for _ in 0..20 {
+            let e = calm.resolve(Action::Key('o'));
+            calm.apply(&e[0]);
+        }
+        assert_eq!(calm.lake().params().octaves, MAX_OCTAVES as u32);
+        calm.apply(&Event::Resize([30, 20]));
+        assert_eq!(Playable::size(&calm), (30, 20));
+    }
+
+    #[test]
+    fn heightmaps_cover_the_lake() {
+        let s = scene(6.0);
+        let map = s.heightmap(40, 20);
+        assert_eq!((map.width, map.height, map.values.len()), (40, 20, 800));
+        // Cells of 15 m: row 0 is the far shore, column 0 the west edge.
+        let frame = s.lake().frame(0.0);
+        assert_eq!(map.values[0], frame.height(-292.5, 292.5));
+        assert_eq!(map.values[19 * 40 + 39], frame.height(292.5, 7.5));
+        assert!(map.values.iter().all(|v| v.abs() < 0.2));
+        assert!(scene(0.0).heightmap(4, 4).values.iter().all(|&v| v == 0.0));
+    }
+}
