@@ -1,6 +1,7 @@
 //! The interactive loop's steady state must not allocate: a frame (stones, steps, picture)
-//! reuses every buffer. A counting allocator checks it, including rayon's worker threads.
-//! This binary holds a single test so no other test's allocations are counted.
+//! reuses every buffer, for the pool and for the lake. A counting allocator checks it,
+//! including rayon's worker threads. This binary holds a single test so no other test's
+//! allocations are counted.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -38,6 +39,60 @@ static ALLOCATOR: Counting = Counting;
 fn frames_allocate_nothing_after_warm_up() {
     pool_frames();
     player_frames();
+    lake_player_frames();
+}
+
+/// The player's frame path with the lake: time steps, the mesh (sampling, face ids, per-face
+/// shading, the per-pixel mirror), cells with the status line, diff encoding; a wind change
+/// in the middle (a new lake, nothing reallocated).
+fn lake_player_frames() {
+    use tidepool::output::color::ColorMode;
+    use tidepool::output::diff::{EncodeOptions, Shown, encode_into};
+    use tidepool::scene::lake::LakeScene;
+    use tidepool::scene::playable::{Action, Playable};
+    use tidepool::term::screen::{FrameBuilder, Overlay};
+
+    let (cols, rows) = (160u16, 48u16);
+    let (w, h) = tidepool::term::app::picture_size(cols, rows);
+    let mut scene = LakeScene::new(tidepool::commands::play::lake_settings(3), w, h).unwrap();
+    let mut pixmap = tiny_skia::Pixmap::new(w, h).unwrap();
+    let mut builder = FrameBuilder::default();
+    let mut shown = Shown::UNKNOWN;
+    let mut bytes = Vec::new();
+    let options = EncodeOptions { threshold: 0, sync: true };
+    let mut run_frames = |scene: &mut LakeScene, frames: u32| {
+        for k in 0..frames {
+            Playable::step(scene);
+            let overlay = Overlay {
+                aim: None,
+                help: None,
+                message: None,
+                fps: 30,
+                bytes_per_second: 500_000 + u64::from(k),
+                stone: 3,
+                paused: false,
+            };
+            let frame = builder.build((cols, rows), scene, &mut pixmap, ColorMode::TrueColor, &overlay);
+            bytes.clear();
+            encode_into(&mut shown, frame, options, &mut bytes);
+        }
+    };
+    rayon::scope(|_| {
+        run_frames(&mut scene, 10);
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        run_frames(&mut scene, 30);
+        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert_eq!(during, 0, "lake frames at {cols}x{rows}: {during} allocations in 30 steady-state frames");
+        // More wind: the events allocate (once), the frames after them do not.
+        for event in scene.resolve(Action::Key('w')) {
+            scene.apply(&event);
+        }
+        run_frames(&mut scene, 2);
+        let before = ALLOCATIONS.load(Ordering::Relaxed);
+        run_frames(&mut scene, 30);
+        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
+        assert_eq!(during, 0, "lake frames after a wind change: {during} allocations in 30 frames");
+    });
 }
 
 /// The player's frame path: step, picture, cells with status line and overlays, diff encoding.

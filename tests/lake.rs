@@ -1,0 +1,131 @@
+//! The lake through the binary as a user would run it: golden images of a calm and a windy
+//! lake (PNG and half-block text), determinism and motion, heightmaps, and the errors of bad
+//! flags.
+
+mod common;
+
+use common::golden::{self, Tolerance};
+use common::{read_png, run_in, scratch, stderr};
+use tidepool::sim::lake::{Lake, LakeParams};
+
+fn render(dir: &std::path::Path, args: &[&str]) -> Vec<u8> {
+    let out = run_in(dir, &[&["render", "lake"][..], args].concat());
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    out.stdout
+}
+
+fn png_golden(name: &str, wind: &str, time: &str) {
+    let dir = scratch(&format!("lake_golden_{name}"));
+    render(&dir, &["--wind", wind, "--time", time, "--size", "192x108", "--out", "lake.png"]);
+    let picture = read_png(&dir.join("lake.png"));
+    assert_eq!(picture.dimensions(), (192, 108));
+    golden::check_png(name, &picture, Tolerance::default());
+}
+
+#[test]
+fn calm_lake_golden() {
+    png_golden("lake_calm", "0", "0");
+}
+
+#[test]
+fn windy_lake_golden() {
+    png_golden("lake_windy", "6", "2.5");
+}
+
+#[test]
+fn half_block_lake_goldens() {
+    let dir = scratch("lake_ansi");
+    for (name, wind) in [("lake_calm_small", "0"), ("lake_windy_small", "6")] {
+        render(&dir, &["--wind", wind, "--time", "1", "--size", "80x48", "--out", "lake.ans"]);
+        let text = std::fs::read(dir.join("lake.ans")).unwrap();
+        assert_eq!(String::from_utf8_lossy(&text).lines().count(), 24, "two pixel rows per line");
+        golden::check_ansi(name, &text, Tolerance::default());
+    }
+    // Standard output gets the same text.
+    let stdout = render(&dir, &["--wind", "6", "--time", "1", "--size", "80x48", "--out", "-"]);
+    assert_eq!(stdout, std::fs::read(dir.join("lake.ans")).unwrap());
+}
+
+#[test]
+fn same_flags_same_bytes_time_moves_the_water_and_flags_matter() {
+    let dir = scratch("lake_determinism");
+    let picture = |name: &str, extra: &[&str]| {
+        render(&dir, &[&["--size", "96x54", "--out", name][..], extra].concat());
+        std::fs::read(dir.join(name)).unwrap()
+    };
+    let base = picture("a.png", &["--wind", "5", "--time", "2"]);
+    assert_eq!(base, picture("b.png", &["--wind", "5", "--time", "2"]));
+    for (name, extra) in [
+        ("t.png", &["--wind", "5", "--time", "2.2"][..]),
+        ("g.png", &["--wind", "5", "--time", "2", "--noise", "gradient"]),
+        ("o.png", &["--wind", "5", "--time", "2", "--octaves", "2"]),
+        ("p.png", &["--wind", "5", "--time", "2", "--persistence", "0.8"]),
+        ("s.png", &["--wind", "5", "--time", "2", "--seed", "9"]),
+        ("w.png", &["--wind", "4", "--time", "2"]),
+    ] {
+        assert_ne!(base, picture(name, extra), "{extra:?} changes the picture");
+    }
+    // Negative times are values, not flags.
+    render(&dir, &["--size", "32x18", "--time", "-5", "--out", "n.png"]);
+    // A calm lake does not move.
+    assert_eq!(picture("c1.png", &["--wind", "0", "--time", "0"]), picture("c2.png", &["--wind", "0", "--time", "9"]));
+}
+
+/// Reads a float32 NPY written by tidepool: (rows, columns, values).
+fn read_npy(bytes: &[u8]) -> (usize, usize, Vec<f32>) {
+    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+    let shape = header.split("'shape': (").nth(1).unwrap().split(')').next().unwrap();
+    let dims: Vec<usize> = shape.split(',').filter_map(|d| d.trim().parse().ok()).collect();
+    let values = bytes[10 + header_len..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    (dims[0], dims[1], values)
+}
+
+#[test]
+fn heightmaps_hold_the_water_in_metres_and_millimetres() {
+    let dir = scratch("lake_heightmap");
+    render(&dir, &["--wind", "8", "--size", "120x60", "--ssaa", "1", "--heightmap", "h.npy", "--out", "l.png"]);
+    let (rows, cols, values) = read_npy(&std::fs::read(dir.join("h.npy")).unwrap());
+    assert_eq!((rows, cols, values.len()), (60, 120, 7200));
+    let rms = (values.iter().map(|&v| f64::from(v).powi(2)).sum::<f64>() / values.len() as f64).sqrt();
+    let want = Lake::new(LakeParams { wind_m_s: 8.0, ..LakeParams::default() }).significant_height_m() / 4.0;
+    assert!((rms / want - 1.0).abs() < 0.25, "rms {rms:.4} m vs Hs/4 {want:.4} m");
+    // The PNG form is millimetres around 32768; a calm lake is exactly flat.
+    render(&dir, &["--wind", "8", "--size", "64x32", "--heightmap", "h.png", "--out", "l.png"]);
+    let grey = image::open(dir.join("h.png")).unwrap().into_luma16();
+    assert_eq!(grey.dimensions(), (64, 32));
+    assert!(grey.pixels().all(|p| (32768 - 500..32768 + 500).contains(&p.0[0])), "within ±0.5 m");
+    assert!(grey.pixels().any(|p| p.0[0] != 32768));
+    render(&dir, &["--wind", "0", "--size", "16x8", "--heightmap", "c.npy", "--out", "c.png"]);
+    assert!(read_npy(&std::fs::read(dir.join("c.npy")).unwrap()).2.iter().all(|&v| v == 0.0));
+}
+
+#[test]
+fn bad_flags_are_one_line_errors_with_status_2() {
+    let dir = scratch("lake_errors");
+    let cases: &[(&[&str], &str)] = &[
+        (&["--wind", "31"], "--wind"),
+        (&["--wind", "-1"], "0..=30 m/s"),
+        (&["--wind", "gale"], "not a number"),
+        (&["--octaves", "0"], "--octaves"),
+        (&["--octaves", "13"], "1..=12"),
+        (&["--persistence", "1.5"], "--persistence"),
+        (&["--persistence", "nan"], "finite"),
+        (&["--noise", "perlin"], "--noise"),
+        (&["--ssaa", "5"], "--ssaa"),
+        (&["--time", "1e9"], "--time"),
+        (&["--size", "8000x8000", "--ssaa", "2"], "megapixels"),
+        (&["--heightmap", "h.txt"], ".npy"),
+        (&["--out", "lake.jpg"], "--out"),
+    ];
+    for (args, needle) in cases {
+        let out = run_in(&dir, &[&["render", "lake"][..], args].concat());
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        let err = stderr(&out);
+        let first = err.lines().next().unwrap_or("");
+        assert!(first.contains(needle), "{args:?}: the first line names it: {err}");
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+    }
+    assert!(std::fs::read_dir(&dir).unwrap().next().is_none(), "no file written by a refused command");
+}
