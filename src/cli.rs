@@ -88,6 +88,14 @@ pub struct PlayCommand {
     #[command(flatten)]
     pub pool: PoolArgs,
 
+    /// The ocean's wind.
+    #[command(flatten)]
+    pub wind: ocean::WindArgs,
+
+    /// Where the ocean's wind comes FROM, degrees clockwise from north. [default: 330]
+    #[arg(long, value_name = "DEG", value_parser = ocean::parse_degrees, allow_hyphen_values = true)]
+    pub direction: Option<f64>,
+
     /// Seed for everything random (rain, random stones); the same seed and the same inputs
     /// give the same water.
     #[arg(long, value_name = "N", default_value_t = 1)]
@@ -116,7 +124,7 @@ pub struct PlayCommand {
     #[arg(long, value_name = "N", value_parser = parse_bps)]
     pub max_bps: Option<u64>,
 
-    /// Record the session as JSON lines, for `tidepool render pool --replay FILE`.
+    /// Record the session as JSON lines, for `tidepool render pool --replay FILE` (the pool only).
     #[arg(long, value_name = "FILE")]
     pub record: Option<PathBuf>,
 }
@@ -129,6 +137,8 @@ pub const PLAYER_DAMPING: &str = "4";
 pub enum PlayScene {
     /// The ripple pool.
     Pool,
+    /// The open sea under the wind.
+    Ocean,
 }
 
 /// `--color`.
@@ -279,9 +289,10 @@ pub struct PoolArgs {
     pub depth: f32,
 
     /// Where the sun is: azimuth in degrees clockwise from north (the top of the picture) and
-    /// elevation in degrees above the horizon (0..=90).
-    #[arg(long, value_name = "AZ_DEG,EL_DEG", default_value = "315,60", value_parser = parse_sun, allow_hyphen_values = true)]
-    pub sun: crate::render::pool::Sun,
+    /// elevation in degrees above the horizon (0..=90). [default: 315,60 for the pool, the upper
+    /// left; 15,22 for the ocean, ahead and low]
+    #[arg(long, value_name = "AZ_DEG,EL_DEG", value_parser = parse_sun, allow_hyphen_values = true)]
+    pub sun: Option<crate::render::pool::Sun>,
 
     /// The pool floor: a PNG or JPEG, scaled to cover the picture (aspect kept, centred).
     /// [default: the built-in tiled floor]
@@ -297,8 +308,13 @@ impl PoolArgs {
             refraction: self.refraction,
             shading: !self.no_shading,
             caustics: (!self.no_caustics).then(|| CausticsLook { depth_px: self.depth, ..CausticsLook::default() }),
-            sun: self.sun,
+            sun: self.sun(),
         }
+    }
+
+    /// The pool's sun: `--sun`, or the default in the upper left.
+    pub fn sun(&self) -> crate::render::pool::Sun {
+        self.sun.unwrap_or_default()
     }
 }
 

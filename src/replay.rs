@@ -61,6 +61,9 @@ pub enum Event {
     Resize([u32; 2]),
     /// A screenshot was saved to this file.
     Screenshot(String),
+    /// The ocean's wind changed: speed in m/s and where it comes from, degrees clockwise from
+    /// north.
+    Wind([f64; 2]),
     /// The session ended.
     End,
 }
@@ -113,6 +116,7 @@ pub fn event_line(entry: &Entry) -> String {
         Event::Clear => json!({"step": step, "clear": true}),
         Event::Resize(size) => json!({"step": step, "resize": size}),
         Event::Screenshot(file) => json!({"step": step, "screenshot": file}),
+        Event::Wind(wind) => json!({"step": step, "wind": wind}),
         Event::End => json!({"step": step, "end": true}),
     }
     .to_string()
@@ -235,9 +239,17 @@ fn parse_event(line: &str) -> Result<Entry, String> {
         "end" => Event::End,
         "resize" => Event::Resize(parse_size(&value).ok_or("\"resize\" must be [WIDTH, HEIGHT], each at least 1")?),
         "screenshot" => Event::Screenshot(value.as_str().ok_or("\"screenshot\" must be a file name")?.to_owned()),
+        "wind" => {
+            let pair = value.as_array().filter(|a| a.len() == 2).and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]));
+            let [speed, from] = pair.ok_or("\"wind\" must be [SPEED_M_S, FROM_DEG]")?;
+            if !(0.0..=crate::cli::ocean::MAX_WIND_M_S).contains(&speed) || !from.is_finite() {
+                return Err(format!("bad wind: {speed} m/s from {from} degrees"));
+            }
+            Event::Wind([speed, from])
+        }
         other => {
             return Err(format!(
-                "unknown event \"{other}\"; this tidepool knows stone, rain, damping, clear, resize, screenshot and end"
+                "unknown event \"{other}\"; this tidepool knows stone, rain, damping, clear, resize, screenshot, wind and end"
             ));
         }
     };

@@ -222,3 +222,29 @@ fn max_bps_caps_the_output_rate() {
     assert!(window <= 3 * 20_000 + 20_000, "{window} bytes in 3 s");
     assert!(window >= 3 * 20_000 / 4, "busy water still uses the budget: {window} bytes in 3 s");
 }
+
+#[test]
+fn the_ocean_plays_its_wind_keys_and_tab_switches_scenes() {
+    let mut p = Player::spawn(&temp_dir("ocean"), 80, 20, &[ARGS, &["ocean"]].concat(), &[]);
+    p.wait_for_status("Beaufort 5", WAIT);
+    p.send(b"8");
+    p.wait_for_status("Beaufort 8", WAIT);
+    p.send(b".");
+    p.wait_for_status("from 345", WAIT);
+    p.send(b"\t");
+    p.wait_for_status("damping", WAIT);
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+    assert_restored(&p);
+}
+
+#[test]
+fn recording_is_refused_for_scenes_other_than_the_pool() {
+    let dir = temp_dir("record-ocean");
+    let mut p = Player::spawn(&dir, 40, 12, &[ARGS, &["ocean", "--record", "s.jsonl"]].concat(), &[]);
+    let status = p.wait_exit(WAIT);
+    assert_eq!(status.exit_code(), 2);
+    let out = String::from_utf8_lossy(&p.output()).into_owned();
+    assert!(out.contains("--record") && out.contains("pool"), "{out}");
+    assert!(!dir.join("s.jsonl").exists());
+}

@@ -37,31 +37,32 @@ static ALLOCATOR: Counting = Counting;
 #[test]
 fn frames_allocate_nothing_after_warm_up() {
     pool_frames();
-    player_frames();
+    let (w, h) = tidepool::term::app::picture_size(160, 48);
+    let settings = PoolSettings { damping: Damping::PAPERS, rain_rate: 0.3, seed: 5, look: PoolLook::default() };
+    player_frames(Box::new(PoolScene::new(w, h, background::pool_floor(), settings).unwrap()));
 }
 
-/// The player's frame path: step, picture, cells with status line and overlays, diff encoding.
-fn player_frames() {
+/// The player's frame path for a scene: steps, picture, cells with status line and overlays,
+/// diff encoding.
+fn player_frames(mut scene: Box<dyn tidepool::scene::playable::Playable>) {
     use tidepool::output::color::ColorMode;
     use tidepool::output::diff::{EncodeOptions, Shown, encode_into};
-    use tidepool::scene::playable::Playable;
     use tidepool::term::screen::{FrameBuilder, Overlay};
 
     let (cols, rows) = (160u16, 48u16);
     let (w, h) = tidepool::term::app::picture_size(cols, rows);
-    let settings = PoolSettings { damping: Damping::PAPERS, rain_rate: 0.3, seed: 5, look: PoolLook::default() };
-    let mut scene = PoolScene::new(w, h, background::pool_floor(), settings).unwrap();
+    let name = scene.name();
     let mut pixmap = tiny_skia::Pixmap::new(w, h).unwrap();
     let mut builder = FrameBuilder::default();
     let mut shown = Shown::UNKNOWN;
     let mut bytes = Vec::new();
-    let help = tidepool::term::ui::help_lines(&scene.help());
+    let help = tidepool::term::ui::help_lines(&scene.help(), true);
     let message = String::from("saved tidepool-pool-000123.png");
     let options = EncodeOptions { threshold: 0, sync: true };
     let mut run_frames = |frames: u32| {
         for k in 0..frames {
-            Playable::step(&mut scene);
-            Playable::step(&mut scene);
+            scene.step();
+            scene.step();
             let overlay = Overlay {
                 aim: Some((k % w, 10)),
                 help: (k % 3 == 0).then_some(help.as_slice()),
@@ -71,7 +72,7 @@ fn player_frames() {
                 stone: 3,
                 paused: false,
             };
-            let frame = builder.build((cols, rows), &mut scene, &mut pixmap, ColorMode::TrueColor, &overlay);
+            let frame = builder.build((cols, rows), scene.as_mut(), &mut pixmap, ColorMode::TrueColor, &overlay);
             bytes.clear();
             encode_into(&mut shown, frame, options, &mut bytes);
         }
@@ -81,7 +82,7 @@ fn player_frames() {
         let before = ALLOCATIONS.load(Ordering::Relaxed);
         run_frames(60);
         let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
-        assert_eq!(during, 0, "player frames at {cols}x{rows}: {during} allocations in 60 steady-state frames");
+        assert_eq!(during, 0, "{name} player frames at {cols}x{rows}: {during} allocations in 60 steady-state frames");
     });
 }
 

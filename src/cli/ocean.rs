@@ -12,6 +12,9 @@ use crate::sim::sea_state;
 pub const MAX_WIND_M_S: f64 = 60.0;
 /// The default wind, m/s (Beaufort 5, Hs 2.46 m).
 pub const DEFAULT_WIND_M_S: f64 = 10.0;
+/// Where the default wind comes from, degrees clockwise from north (north-north-west: the
+/// waves run towards the camera's right, across the default view).
+pub const DEFAULT_DIRECTION_DEG: f64 = 330.0;
 
 const OCEAN_EXAMPLES: &str = "\
 Examples:

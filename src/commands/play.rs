@@ -10,8 +10,12 @@ use crate::error::{Error, Result};
 use crate::output::color::ColorMode;
 use crate::output::diff::EncodeOptions;
 use crate::render::background;
+use crate::render::ocean::OceanView;
+use crate::render::texture::SeaTexture;
+use crate::scene::ocean::{OceanScene, OceanSettings};
 use crate::scene::playable::Playable;
 use crate::scene::pool::{PoolScene, PoolSettings};
+use crate::sim::ocean::SeaParams;
 use crate::term::app::{self, PlayerConfig, SceneFactory};
 
 /// The player's rain when `--rain` is not given: about one drop a second at 60 steps/s.
@@ -44,13 +48,40 @@ pub fn run(command: PlayCommand) -> Result<()> {
         Some(path) => background::load("--background", path)?,
         None => background::pool_floor(),
     };
+    if command.record.is_some() && command.scene != PlayScene::Pool {
+        return Err(Error::arg(
+            "--record",
+            "replays hold the pool only; record with `tidepool play pool --record FILE`",
+        ));
+    }
     let rain = command.pool.rain.unwrap_or(DEFAULT_PLAYER_RAIN);
+    let default_view = OceanView::default();
+    let ocean = OceanSettings {
+        sea: SeaParams {
+            wind_m_s: command.wind.speed_m_s(),
+            wind_from_deg: command.direction.unwrap_or(crate::cli::ocean::DEFAULT_DIRECTION_DEG),
+            seed: command.seed,
+        },
+        view: OceanView {
+            sun_azimuth_deg: command.pool.sun.map_or(default_view.sun_azimuth_deg, |s| s.azimuth_deg),
+            sun_elevation_deg: command.pool.sun.map_or(default_view.sun_elevation_deg, |s| s.elevation_deg),
+            ssaa: 1,
+            ..default_view
+        },
+    };
+    let texture = SeaTexture::builtin();
     let settings =
         PoolSettings { damping: command.pool.damping, rain_rate: rain, seed: command.seed, look: command.pool.look() };
+    let too_big = |what: &str, width: u32, height: u32| {
+        Error::Usage(format!("cannot allocate a {width}x{height} {what}; use a smaller terminal"))
+    };
     let make: SceneFactory = Box::new(move |kind, width, height| match kind {
         PlayScene::Pool => PoolScene::new(width, height, floor.clone(), settings)
             .map(|scene| Box::new(scene) as Box<dyn Playable>)
-            .ok_or_else(|| Error::Usage(format!("cannot allocate a {width}x{height} pool; use a smaller terminal"))),
+            .ok_or_else(|| too_big("pool", width, height)),
+        PlayScene::Ocean => OceanScene::new(ocean, width, height, texture.clone())
+            .map(|scene| Box::new(scene) as Box<dyn Playable>)
+            .ok_or_else(|| too_big("sea", width, height)),
     });
     let config = PlayerConfig {
         fps: command.fps,

@@ -33,7 +33,7 @@ pub fn pool_options(args: &PoolArgs, rain: f64) -> Map<String, Value> {
         "shading": !args.no_shading,
         "caustics": !args.no_caustics,
         "depth": args.depth,
-        "sun": format!("{},{}", args.sun.azimuth_deg, args.sun.elevation_deg),
+        "sun": format!("{},{}", args.sun().azimuth_deg, args.sun().elevation_deg),
         "background": background,
     });
     match value {
