@@ -47,6 +47,27 @@ pub enum Command {
     Play(PlayCommand),
     /// Measure how fast this machine runs tidepool, stage by stage (a few seconds).
     Bench(BenchArgs),
+    /// Print shell completions: `tidepool completions bash > ~/.local/share/bash-completion/completions/tidepool`.
+    Completions(CompletionsArgs),
+    /// Print the manual page (roff), or write one page per command into a folder.
+    Man(ManArgs),
+}
+
+/// `tidepool completions`.
+#[derive(Args, Debug)]
+pub struct CompletionsArgs {
+    /// The shell to complete for.
+    #[arg(value_enum)]
+    pub shell: clap_complete::Shell,
+}
+
+/// `tidepool man`.
+#[derive(Args, Debug)]
+pub struct ManArgs {
+    /// Write tidepool.1, tidepool-render.1, tidepool-render-pool.1... into this folder instead
+    /// of printing the main page (e.g. `tidepool man --out-dir ~/.local/share/man/man1`).
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: Option<PathBuf>,
 }
 
 /// `tidepool bench`.
@@ -221,6 +242,25 @@ pub struct RenderPool {
     /// size, seed, stones and water flags.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
     pub replay: Option<PathBuf>,
+
+    /// An animation instead of one picture.
+    #[command(flatten)]
+    pub animation: AnimationArgs,
+}
+
+/// Flags of animations, taken by every rendered scene.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct AnimationArgs {
+    /// Render an animation of N frames (1..=100000) instead of one picture, to --out NAME.gif,
+    /// NAME.png (animated PNG) or a pattern such as frames/pool_{frame:04}.png (one PNG a frame).
+    /// The scene advances between frames as the player's does at --fps; for the pool, --steps
+    /// is where the first frame is taken. [default: one picture]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub frames: Option<u32>,
+
+    /// Frames per second of the animation (1..=240; a GIF shows at most 50).
+    #[arg(long, value_name = "F", default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=240))]
+    pub fps: u32,
 }
 
 /// Flags every rendered scene takes.

@@ -208,3 +208,25 @@ fn no_subcommand_without_a_terminal_points_to_render() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("not a terminal") && err.contains("tidepool render pool"), "{err}");
 }
+
+#[test]
+fn completions_and_man_pages_come_from_the_real_flags() {
+    for shell in ["bash", "zsh", "fish"] {
+        let out = run(&["completions", shell]);
+        assert!(out.status.success(), "{shell}");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("render") && text.contains("refraction"), "{shell}");
+    }
+    let page = run(&["man"]);
+    assert!(page.status.success());
+    assert!(String::from_utf8_lossy(&page.stdout).contains(".TH tidepool 1"));
+    let dir = scratch("man_pages");
+    let out = run_in(&dir, &["man", "--out-dir", "."]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for page in ["tidepool.1", "tidepool-render.1", "tidepool-render-pool.1", "tidepool-play.1"] {
+        let text = std::fs::read_to_string(dir.join(page)).unwrap();
+        assert!(text.contains(".TH"), "{page}");
+    }
+    assert!(std::fs::read_to_string(dir.join("tidepool-render-pool.1")).unwrap().contains("caustics"));
+    assert_eq!(run_in(&dir, &["man", "--out-dir", "nope"]).status.code(), Some(2));
+}

@@ -117,6 +117,10 @@ pub struct RenderOcean {
     /// triangle count to standard error.
     #[arg(long)]
     pub stats: bool,
+
+    /// An animation instead of one picture (it starts at --time).
+    #[command(flatten)]
+    pub animation: super::AnimationArgs,
 }
 
 impl RenderOcean {
