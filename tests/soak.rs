@@ -47,7 +47,10 @@ fn a_million_steps_of_heavy_weather() {
         let (x, y) = (rng.random_range(-10..w as i32 + 10), rng.random_range(-10..h as i32 + 10));
         let mut actions = vec![Action::Stone { x, y, radius: rng.random_range(1..=32), big: rng.random_bool(0.1) }];
         if step % 7 == 0 {
-            actions.push(Action::Stir { from: (x, y), to: (x + rng.random_range(-40..40), y + rng.random_range(-20..20)) });
+            actions.push(Action::Stir {
+                from: (x, y),
+                to: (x + rng.random_range(-40..40), y + rng.random_range(-20..20)),
+            });
         }
         match step % 20_011 {
             0 => actions.push(Action::ToggleRain),
