@@ -352,6 +352,24 @@ impl PoolArgs {
         }
     }
 
+    /// The pool's settings from these flags, with `seed` and the rain when `--rain` is not given.
+    pub fn settings(&self, seed: u64, default_rain: f64) -> crate::scene::pool::PoolSettings {
+        crate::scene::pool::PoolSettings {
+            damping: self.damping,
+            rain_rate: self.rain.unwrap_or(default_rain),
+            seed,
+            look: self.look(),
+        }
+    }
+
+    /// The pool floor: `--background` decoded, or the built-in tiles.
+    pub fn floor(&self) -> crate::error::Result<tiny_skia::Pixmap> {
+        match &self.background {
+            Some(path) => crate::render::background::load("--background", path),
+            None => Ok(crate::render::background::pool_floor()),
+        }
+    }
+
     /// The pool's sun: `--sun`, or the default in the upper left.
     pub fn sun(&self) -> crate::render::pool::Sun {
         self.sun.unwrap_or_default()

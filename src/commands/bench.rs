@@ -10,14 +10,14 @@ use crate::cli::BenchArgs;
 use crate::error::Result;
 use crate::output::{halfblock, png};
 use crate::render::background;
-use crate::render::pool::PoolLook;
-use crate::scene::pool::{PoolScene, PoolSettings};
-use crate::sim::ripple::{Damping, RipplePool, Stone};
 use crate::render::ocean::OceanView;
+use crate::render::pool::PoolLook;
 use crate::render::texture::SeaTexture;
 use crate::scene::ocean::{OceanScene, OceanSettings};
 use crate::scene::playable::Playable;
+use crate::scene::pool::{PoolScene, PoolSettings};
 use crate::sim::ocean::SeaParams;
+use crate::sim::ripple::{Damping, RipplePool, Stone};
 use crate::sim::stepper::Kernel;
 
 /// One measured workload.

@@ -9,12 +9,11 @@ use crate::cli::{ColorChoice, PlayCommand, PlayScene};
 use crate::error::{Error, Result};
 use crate::output::color::ColorMode;
 use crate::output::diff::EncodeOptions;
-use crate::render::background;
 use crate::render::ocean::OceanView;
 use crate::render::texture::SeaTexture;
 use crate::scene::ocean::{OceanScene, OceanSettings};
 use crate::scene::playable::Playable;
-use crate::scene::pool::{PoolScene, PoolSettings};
+use crate::scene::pool::PoolScene;
 use crate::sim::ocean::SeaParams;
 use crate::term::app::{self, PlayerConfig, SceneFactory};
 
@@ -44,10 +43,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
         ColorChoice::Palette16 => ColorMode::Palette16,
     };
     let threshold = command.color_threshold.unwrap_or(default_threshold(env("SSH_CONNECTION").as_deref()));
-    let floor = match &command.pool.background {
-        Some(path) => background::load("--background", path)?,
-        None => background::pool_floor(),
-    };
+    let floor = command.pool.floor()?;
     if command.record.is_some() && command.scene != PlayScene::Pool {
         return Err(Error::arg(
             "--record",
@@ -70,8 +66,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
         },
     };
     let texture = SeaTexture::builtin();
-    let settings =
-        PoolSettings { damping: command.pool.damping, rain_rate: rain, seed: command.seed, look: command.pool.look() };
+    let settings = command.pool.settings(command.seed, DEFAULT_PLAYER_RAIN);
     let too_big = |what: &str, width: u32, height: u32| {
         Error::Usage(format!("cannot allocate a {width}x{height} {what}; use a smaller terminal"))
     };

@@ -11,8 +11,7 @@ use crate::error::{Error, Result};
 use crate::output::heightmap::{self, Heightmap};
 use crate::output::{atomic, halfblock, png};
 use crate::progress::Progress;
-use crate::render::background;
-use crate::scene::pool::{PoolScene, PoolSettings};
+use crate::scene::pool::PoolScene;
 use crate::sim::ripple::Stone;
 
 /// The default PNG size.
@@ -279,16 +278,8 @@ fn render_pool(args: RenderPool) -> Result<()> {
         return animate_pool(&args, frames);
     }
     let plan = OutputPlan::new(&args.output, "pool", std::io::stdout().is_terminal(), terminal_pixels())?;
-    let floor = match &args.pool.background {
-        Some(path) => background::load("--background", path)?,
-        None => background::pool_floor(),
-    };
-    let settings = PoolSettings {
-        damping: args.pool.damping,
-        rain_rate: args.pool.rain.unwrap_or(0.0),
-        seed: args.output.seed,
-        look: args.pool.look(),
-    };
+    let floor = args.pool.floor()?;
+    let settings = args.pool.settings(args.output.seed, 0.0);
     let Size { width, height } = plan.size;
     let mut scene = PoolScene::new(width, height, floor, settings).ok_or_else(|| {
         Error::arg("--size", format!("cannot allocate a {width}x{height} picture; choose a smaller size"))
@@ -356,16 +347,8 @@ fn animate_pool(args: &RenderPool, frames: u32) -> Result<()> {
     check_animation_flags(&args.output)?;
     let target = AnimationTarget::from_out(args.output.out.as_deref(), "pool", args.animation.fps)?;
     let size = args.output.size.unwrap_or(DEFAULT_PNG_SIZE);
-    let floor = match &args.pool.background {
-        Some(path) => background::load("--background", path)?,
-        None => background::pool_floor(),
-    };
-    let settings = PoolSettings {
-        damping: args.pool.damping,
-        rain_rate: args.pool.rain.unwrap_or(0.0),
-        seed: args.output.seed,
-        look: args.pool.look(),
-    };
+    let floor = args.pool.floor()?;
+    let settings = args.pool.settings(args.output.seed, 0.0);
     let mut script: Vec<(u64, crate::replay::Event)> = if args.stones.is_empty() {
         default_stones(size).into_iter().map(|(at, s)| (at, crate::replay::Event::Stone(s))).collect()
     } else {
