@@ -78,7 +78,7 @@ pub struct BenchArgs {
     pub seconds: f64,
 
     /// The terminal picture to measure, in pixels (columns x 2 per row).
-    #[arg(long, value_name = "WxH", default_value = "160x94", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", default_value = "160x94", value_parser = parse_size, allow_hyphen_values = true)]
     pub terminal: Size,
 }
 
@@ -268,7 +268,7 @@ pub struct AnimationArgs {
 pub struct OutputArgs {
     /// Picture size in pixels, WIDTHxHEIGHT (each side 1..=16384, at most 64 megapixels).
     /// [default: 640x360 for PNG; for text, the terminal's size when writing to it, else 80x48]
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Option<Size>,
 
     /// Seed for everything random (rain, phases); the same seed and flags give the same bytes.

@@ -37,6 +37,7 @@ fn bad_values_name_the_flag_and_exit_two() {
         (&["--size", "0x0"], "--size"),
         (&["--size", "100000x100000"], "--size"),
         (&["--size", "abc"], "--size"),
+        (&["--size", "-5x10"], "at least 1 pixel"),
         (&["--stone", "10,10,-3"], "--stone"),
         (&["--stone", "10"], "--stone"),
         (&["--stone", "-5,-5,0"], "--stone"),

@@ -27,7 +27,7 @@ Examples:
 #[derive(Args, Debug, Clone)]
 pub struct WindArgs {
     /// Wind speed at 10 m, m/s (0..=60; 0 is a flat calm). [default: 10]
-    #[arg(long, value_name = "M/S", value_parser = parse_wind, conflicts_with = "beaufort")]
+    #[arg(long, value_name = "M/S", value_parser = parse_wind, conflicts_with = "beaufort", allow_negative_numbers = true)]
     pub wind: Option<f64>,
 
     /// Wind as a Beaufort number 0..=12 (0.15, 0.9, 2.45, 4.4, 6.7, 9.35, 12.3, 15.5, 18.95,
@@ -90,7 +90,7 @@ pub struct RenderOcean {
 
     /// Picture size in pixels, WIDTHxHEIGHT (at most 64 megapixels including supersampling).
     /// [default: 640x360 for PNG; for text, the terminal's size when writing to it, else 80x48]
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Option<Size>,
 
     /// Seed of the wave phases and the fine-scale fBm; the same seed and flags give the same bytes.
