@@ -26,6 +26,8 @@ pub struct OceanScene {
     renderer: OceanRenderer,
     texture: SeaTexture,
     time_s: f64,
+    /// The component phases of the last frame, reused.
+    phases: Vec<f32>,
 }
 
 /// The heightmap's east-west extent when none is given: 8 peak wavelengths (100 m for a calm).
@@ -39,7 +41,7 @@ impl OceanScene {
     /// Returns `None` when the (supersampled) size is zero or too large for a pixmap.
     pub fn new(settings: OceanSettings, width: u32, height: u32, texture: SeaTexture) -> Option<OceanScene> {
         let renderer = OceanRenderer::new(settings.view, width, height, texture.clone())?;
-        Some(OceanScene { sea: Sea::new(settings.sea), renderer, texture, time_s: 0.0 })
+        Some(OceanScene { sea: Sea::new(settings.sea), renderer, texture, time_s: 0.0, phases: Vec::new() })
     }
 
     /// The sea.
@@ -89,8 +91,9 @@ impl OceanScene {
 
     /// Draws the sea at the current time into `out` (the scene's size).
     pub fn render(&mut self, out: &mut Pixmap) {
-        let frame = self.sea.frame(self.time_s);
+        let frame = self.sea.frame_in(self.time_s, std::mem::take(&mut self.phases));
         self.renderer.render(&frame, out);
+        self.phases = frame.into_buffer();
     }
 
     /// A new picture of the current sea.
