@@ -48,6 +48,27 @@ pub enum Command {
     Play(PlayCommand),
     /// Measure how fast this machine runs tidepool, stage by stage (a few seconds).
     Bench(BenchArgs),
+    /// Print shell completions: `tidepool completions bash > ~/.local/share/bash-completion/completions/tidepool`.
+    Completions(CompletionsArgs),
+    /// Print the manual page (roff), or write one page per command into a folder.
+    Man(ManArgs),
+}
+
+/// `tidepool completions`.
+#[derive(Args, Debug)]
+pub struct CompletionsArgs {
+    /// The shell to complete for.
+    #[arg(value_enum)]
+    pub shell: clap_complete::Shell,
+}
+
+/// `tidepool man`.
+#[derive(Args, Debug)]
+pub struct ManArgs {
+    /// Write tidepool.1, tidepool-render.1, tidepool-render-pool.1... into this folder instead
+    /// of printing the main page (e.g. `tidepool man --out-dir ~/.local/share/man/man1`).
+    #[arg(long, value_name = "DIR")]
+    pub out_dir: Option<PathBuf>,
 }
 
 /// `tidepool bench`.
@@ -58,7 +79,7 @@ pub struct BenchArgs {
     pub seconds: f64,
 
     /// The terminal picture to measure, in pixels (columns x 2 per row).
-    #[arg(long, value_name = "WxH", default_value = "160x94", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", default_value = "160x94", value_parser = parse_size, allow_hyphen_values = true)]
     pub terminal: Size,
 }
 
@@ -66,12 +87,15 @@ const PLAY_KEYS: &str = "\
 Keys: space stone at random · arrows/hjkl aim, enter drop · r rain · c clear · +/- stone size ·
 [/] damping · p pause · s screenshot (PNG) · tab next scene · ? help · q, Esc, Ctrl-C quit.
 Mouse: left click drops a stone, drag stirs the water, right click drops a big stone.
+The lake: 0-9 wind by Beaufort number · [/] less/more wind · c calm · o/O octaves ·
+</> persistence · n value/gradient noise.
 
 Examples:
   tidepool                                      # the pool, full screen
   tidepool play pool --rain 0.1 --damping 6     # more rain, longer ripples
   tidepool play --max-bps 200k                  # a slow SSH link: cap the output rate
-  tidepool play --record s.jsonl                # then: tidepool render pool --replay s.jsonl";
+  tidepool play --record s.jsonl                # then: tidepool render pool --replay s.jsonl
+  tidepool play lake --wind 0                   # a calm lake mirroring its shore";
 
 /// `tidepool play [scene]`.
 ///
@@ -88,6 +112,15 @@ pub struct PlayCommand {
     /// The water of the pool. [--rain default: 0.02 drops per step]
     #[command(flatten)]
     pub pool: PoolArgs,
+
+    /// The wind: the ocean's (default 10 m/s), and the lake's when given (its default is
+    /// 3 m/s; it takes at most 30).
+    #[command(flatten)]
+    pub wind: ocean::WindArgs,
+
+    /// Where the ocean's wind comes FROM, degrees clockwise from north. [default: 330]
+    #[arg(long, value_name = "DEG", value_parser = ocean::parse_degrees, allow_hyphen_values = true)]
+    pub direction: Option<f64>,
 
     /// Seed for everything random (rain, random stones); the same seed and the same inputs
     /// give the same water.
@@ -117,7 +150,7 @@ pub struct PlayCommand {
     #[arg(long, value_name = "N", value_parser = parse_bps)]
     pub max_bps: Option<u64>,
 
-    /// Record the session as JSON lines, for `tidepool render pool --replay FILE`.
+    /// Record the session as JSON lines, for `tidepool render pool --replay FILE` (the pool only).
     #[arg(long, value_name = "FILE")]
     pub record: Option<PathBuf>,
 }
@@ -130,7 +163,9 @@ pub const PLAYER_DAMPING: &str = "4";
 pub enum PlayScene {
     /// The ripple pool.
     Pool,
-    /// The lake (keys: w/W wind, o/O octaves, ./, persistence, n noise, c calm).
+    /// The open sea under the wind.
+    Ocean,
+    /// The lake under a breeze, mirroring its shore.
     Lake,
 }
 
@@ -216,6 +251,25 @@ pub struct RenderPool {
     /// size, seed, stones and water flags.
     #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
     pub replay: Option<PathBuf>,
+
+    /// An animation instead of one picture.
+    #[command(flatten)]
+    pub animation: AnimationArgs,
+}
+
+/// Flags of animations, taken by every rendered scene.
+#[derive(Args, Debug, Clone, Copy)]
+pub struct AnimationArgs {
+    /// Render an animation of N frames (1..=100000) instead of one picture, to --out NAME.gif,
+    /// NAME.png (animated PNG) or a pattern such as frames/pool_{frame:04}.png (one PNG a frame).
+    /// The scene advances between frames as the player's does at --fps; for the pool, --steps
+    /// is where the first frame is taken. [default: one picture]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100_000))]
+    pub frames: Option<u32>,
+
+    /// Frames per second of the animation (1..=240; a GIF shows at most 50).
+    #[arg(long, value_name = "F", default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=240))]
+    pub fps: u32,
 }
 
 /// Flags every rendered scene takes.
@@ -223,7 +277,7 @@ pub struct RenderPool {
 pub struct OutputArgs {
     /// Picture size in pixels, WIDTHxHEIGHT (each side 1..=16384, at most 64 megapixels).
     /// [default: 640x360 for PNG; for text, the terminal's size when writing to it, else 80x48]
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Option<Size>,
 
     /// Seed for everything random (rain, phases); the same seed and flags give the same bytes.
@@ -284,9 +338,10 @@ pub struct PoolArgs {
     pub depth: f32,
 
     /// Where the sun is: azimuth in degrees clockwise from north (the top of the picture) and
-    /// elevation in degrees above the horizon (0..=90).
-    #[arg(long, value_name = "AZ_DEG,EL_DEG", default_value = "315,60", value_parser = parse_sun, allow_hyphen_values = true)]
-    pub sun: crate::render::pool::Sun,
+    /// elevation in degrees above the horizon (0..=90). [default: 315,60 for the pool, the upper
+    /// left; 15,22 for the ocean, ahead and low]
+    #[arg(long, value_name = "AZ_DEG,EL_DEG", value_parser = parse_sun, allow_hyphen_values = true)]
+    pub sun: Option<crate::render::pool::Sun>,
 
     /// The pool floor: a PNG or JPEG, scaled to cover the picture (aspect kept, centred).
     /// [default: the built-in tiled floor]
@@ -302,8 +357,31 @@ impl PoolArgs {
             refraction: self.refraction,
             shading: !self.no_shading,
             caustics: (!self.no_caustics).then(|| CausticsLook { depth_px: self.depth, ..CausticsLook::default() }),
-            sun: self.sun,
+            sun: self.sun(),
         }
+    }
+
+    /// The pool's settings from these flags, with `seed` and the rain when `--rain` is not given.
+    pub fn settings(&self, seed: u64, default_rain: f64) -> crate::scene::pool::PoolSettings {
+        crate::scene::pool::PoolSettings {
+            damping: self.damping,
+            rain_rate: self.rain.unwrap_or(default_rain),
+            seed,
+            look: self.look(),
+        }
+    }
+
+    /// The pool floor: `--background` decoded, or the built-in tiles.
+    pub fn floor(&self) -> crate::error::Result<tiny_skia::Pixmap> {
+        match &self.background {
+            Some(path) => crate::render::background::load("--background", path),
+            None => Ok(crate::render::background::pool_floor()),
+        }
+    }
+
+    /// The pool's sun: `--sun`, or the default in the upper left.
+    pub fn sun(&self) -> crate::render::pool::Sun {
+        self.sun.unwrap_or_default()
     }
 }
 

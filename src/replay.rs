@@ -62,10 +62,11 @@ pub enum Event {
     Resize([u32; 2]),
     /// A screenshot was saved to this file.
     Screenshot(String),
+    /// The ocean's wind changed: speed in m/s and where it comes from, degrees clockwise from
+    /// north.
+    Wind([f64; 2]),
     /// The session ended.
     End,
-    /// The wind changed, m/s (the lake).
-    Wind(f64),
     /// The lake's noise changed.
     Noise {
         /// Octaves summed.
@@ -125,8 +126,8 @@ pub fn event_line(entry: &Entry) -> String {
         Event::Clear => json!({"step": step, "clear": true}),
         Event::Resize(size) => json!({"step": step, "resize": size}),
         Event::Screenshot(file) => json!({"step": step, "screenshot": file}),
+        Event::Wind(wind) => json!({"step": step, "wind": wind}),
         Event::End => json!({"step": step, "end": true}),
-        Event::Wind(w) => json!({"step": step, "wind": w}),
         Event::Noise { octaves, persistence, kind } => {
             json!({"step": step, "noise": {"octaves": octaves, "persistence": persistence, "kind": kind.name()}})
         }
@@ -252,8 +253,12 @@ fn parse_event(line: &str) -> Result<Entry, String> {
         "resize" => Event::Resize(parse_size(&value).ok_or("\"resize\" must be [WIDTH, HEIGHT], each at least 1")?),
         "screenshot" => Event::Screenshot(value.as_str().ok_or("\"screenshot\" must be a file name")?.to_owned()),
         "wind" => {
-            let w = value.as_f64().ok_or("\"wind\" must be a number of metres per second")?;
-            Event::Wind(crate::cli::lake::parse_lake_wind(&w.to_string()).map_err(|e| format!("bad wind: {e}"))?)
+            let pair = value.as_array().filter(|a| a.len() == 2).and_then(|a| Some([a[0].as_f64()?, a[1].as_f64()?]));
+            let [speed, from] = pair.ok_or("\"wind\" must be [SPEED_M_S, FROM_DEG]")?;
+            if !(0.0..=crate::cli::ocean::MAX_WIND_M_S).contains(&speed) || !from.is_finite() {
+                return Err(format!("bad wind: {speed} m/s from {from} degrees"));
+            }
+            Event::Wind([speed, from])
         }
         "noise" => {
             let field = |name: &str| value.get(name).ok_or(format!("\"noise\" needs \"{name}\""));
@@ -382,7 +387,7 @@ mod tests {
             Entry { step: 4, event: Event::Clear },
             Entry { step: 9, event: Event::Resize([30, 12]) },
             Entry { step: 9, event: Event::Screenshot("a b.png".into()) },
-            Entry { step: 10, event: Event::Wind(4.5) },
+            Entry { step: 10, event: Event::Wind([4.5, 0.0]) },
             Entry { step: 11, event: Event::Noise { octaves: 6, persistence: 0.55, kind: NoiseKind::Gradient } },
             Entry { step: 12, event: Event::End },
         ];
@@ -408,8 +413,6 @@ mod tests {
         assert!(err(&bad_event).contains("line 2: unknown event \"splash\""));
         let bad_stone = good.replacen("\"clear\":true", "\"stone\":[1,2,0,3]", 1);
         assert!(err(&bad_stone).contains("line 2: bad stone: the radius 0"), "{}", err(&bad_stone));
-        let bad_wind = good.replacen("\"clear\":true", "\"wind\":-2", 1);
-        assert!(err(&bad_wind).contains("line 2: bad wind: the wind speed -2"), "{}", err(&bad_wind));
         let bad_noise =
             good.replacen("\"clear\":true", "\"noise\":{\"octaves\":0,\"persistence\":0.5,\"kind\":\"value\"}", 1);
         assert!(err(&bad_noise).contains("line 2: bad noise: the octave count 0"), "{}", err(&bad_noise));

@@ -37,6 +37,7 @@ fn bad_values_name_the_flag_and_exit_two() {
         (&["--size", "0x0"], "--size"),
         (&["--size", "100000x100000"], "--size"),
         (&["--size", "abc"], "--size"),
+        (&["--size", "-5x10"], "at least 1 pixel"),
         (&["--stone", "10,10,-3"], "--stone"),
         (&["--stone", "10"], "--stone"),
         (&["--stone", "-5,-5,0"], "--stone"),
@@ -207,4 +208,26 @@ fn no_subcommand_without_a_terminal_points_to_render() {
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("not a terminal") && err.contains("tidepool render pool"), "{err}");
+}
+
+#[test]
+fn completions_and_man_pages_come_from_the_real_flags() {
+    for shell in ["bash", "zsh", "fish"] {
+        let out = run(&["completions", shell]);
+        assert!(out.status.success(), "{shell}");
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("render") && text.contains("refraction"), "{shell}");
+    }
+    let page = run(&["man"]);
+    assert!(page.status.success());
+    assert!(String::from_utf8_lossy(&page.stdout).contains(".TH tidepool 1"));
+    let dir = scratch("man_pages");
+    let out = run_in(&dir, &["man", "--out-dir", "."]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    for page in ["tidepool.1", "tidepool-render.1", "tidepool-render-pool.1", "tidepool-play.1"] {
+        let text = std::fs::read_to_string(dir.join(page)).unwrap();
+        assert!(text.contains(".TH"), "{page}");
+    }
+    assert!(std::fs::read_to_string(dir.join("tidepool-render-pool.1")).unwrap().contains("caustics"));
+    assert_eq!(run_in(&dir, &["man", "--out-dir", "nope"]).status.code(), Some(2));
 }

@@ -222,3 +222,66 @@ fn max_bps_caps_the_output_rate() {
     assert!(window <= 3 * 20_000 + 20_000, "{window} bytes in 3 s");
     assert!(window >= 3 * 20_000 / 4, "busy water still uses the budget: {window} bytes in 3 s");
 }
+
+#[test]
+fn the_ocean_plays_its_wind_keys_and_tab_switches_scenes() {
+    let mut p = Player::spawn(&temp_dir("ocean"), 80, 20, &[ARGS, &["ocean"]].concat(), &[]);
+    p.wait_for_status("Beaufort 5", WAIT);
+    p.send(b"8");
+    p.wait_for_status("Beaufort 8", WAIT);
+    p.send(b".");
+    p.wait_for_status("from 345", WAIT);
+    p.send(b"\t");
+    p.wait_for_status("damping", WAIT);
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+    assert_restored(&p);
+}
+
+#[test]
+fn recording_is_refused_for_scenes_other_than_the_pool() {
+    let dir = temp_dir("record-ocean");
+    let mut p = Player::spawn(&dir, 40, 12, &[ARGS, &["ocean", "--record", "s.jsonl"]].concat(), &[]);
+    let status = p.wait_exit(WAIT);
+    assert_eq!(status.exit_code(), 2);
+    let out = String::from_utf8_lossy(&p.output()).into_owned();
+    assert!(out.contains("--record") && out.contains("pool"), "{out}");
+    assert!(!dir.join("s.jsonl").exists());
+}
+
+#[test]
+fn hostile_terminals_do_not_break_the_player() {
+    // A storm of resizes (sizes from 1x1 to 500x200, many a second), then q.
+    let mut p = started("resize-storm", &[], &[]);
+    let sizes = [(1u16, 1u16), (500, 200), (3, 2), (80, 24), (9, 4), (10, 5), (200, 60), (1, 80), (120, 1), (40, 12)];
+    for round in 0..6 {
+        for &(cols, rows) in &sizes {
+            p.master.resize(portable_pty::PtySize { rows, cols, pixel_width: 0, pixel_height: 0 }).unwrap();
+            std::thread::sleep(Duration::from_millis(if round == 0 { 30 } else { 4 }));
+        }
+    }
+    let settled = p.len();
+    p.wait_for(SYNC_END, settled, WAIT);
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0, "a resize storm ends in a clean quit");
+    assert_restored(&p);
+
+    // Born tiny (1x1) and born huge (500x200): a notice, or the picture, and a clean exit.
+    for (cols, rows) in [(1u16, 1u16), (500, 200)] {
+        let mut p = Player::spawn(&temp_dir(&format!("size-{cols}x{rows}")), cols, rows, ARGS, &[]);
+        p.wait_for(SYNC_END, 0, WAIT);
+        p.send(b" ");
+        p.send(b"q");
+        assert_eq!(p.wait_exit(WAIT).exit_code(), 0, "{cols}x{rows}");
+        assert_restored(&p);
+    }
+
+    // TERM=dumb and no COLORTERM: colours fall back to the 16 basic ones, nothing breaks.
+    let mut p = Player::spawn(&temp_dir("dumb"), 40, 12, &["play"], &[("TERM", "dumb"), ("COLORTERM", "")]);
+    p.wait_for(SYNC_END, 0, WAIT);
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+    let out = String::from_utf8_lossy(&p.output()).into_owned();
+    assert!(!out.contains("38;2;"), "no truecolor codes for TERM=dumb");
+    assert_restored(&p);
+}

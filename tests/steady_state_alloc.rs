@@ -1,13 +1,13 @@
 //! The interactive loop's steady state must not allocate: a frame (stones, steps, picture)
-//! reuses every buffer, for the pool and for the lake. A counting allocator checks it,
-//! including rayon's worker threads. This binary holds a single test so no other test's
-//! allocations are counted.
+//! reuses every buffer, for the pool and the lake. A counting allocator checks it, including rayon's worker threads.
+//! This binary holds a single test so no other test's allocations are counted.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use tidepool::render::background;
 use tidepool::render::pool::PoolLook;
+use tidepool::scene::lake::LakeScene;
 use tidepool::scene::pool::{PoolScene, PoolSettings};
 use tidepool::sim::ripple::{Damping, Stone};
 
@@ -38,85 +38,60 @@ static ALLOCATOR: Counting = Counting;
 #[test]
 fn frames_allocate_nothing_after_warm_up() {
     pool_frames();
-    player_frames();
-    lake_player_frames();
+    let (w, h) = tidepool::term::app::picture_size(160, 48);
+    let settings = PoolSettings { damping: Damping::PAPERS, rain_rate: 0.3, seed: 5, look: PoolLook::default() };
+    player_frames(Box::new(PoolScene::new(w, h, background::pool_floor(), settings).unwrap()));
+    let lake = LakeScene::new(tidepool::commands::play::lake_settings(3), w, h).unwrap();
+    player_frames(Box::new(lake));
+    lake_frames_after_a_wind_change();
 }
 
-/// The player's frame path with the lake: time steps, the mesh (sampling, face ids, per-face
-/// shading, the per-pixel mirror), cells with the status line, diff encoding; a wind change
-/// in the middle (a new lake, nothing reallocated).
-fn lake_player_frames() {
-    use tidepool::output::color::ColorMode;
-    use tidepool::output::diff::{EncodeOptions, Shown, encode_into};
-    use tidepool::scene::lake::LakeScene;
+/// A wind change makes a new lake (its events allocate, once); the frames after it reuse
+/// every buffer as before.
+fn lake_frames_after_a_wind_change() {
     use tidepool::scene::playable::{Action, Playable};
-    use tidepool::term::screen::{FrameBuilder, Overlay};
-
-    let (cols, rows) = (160u16, 48u16);
-    let (w, h) = tidepool::term::app::picture_size(cols, rows);
+    let (w, h) = tidepool::term::app::picture_size(160, 48);
     let mut scene = LakeScene::new(tidepool::commands::play::lake_settings(3), w, h).unwrap();
     let mut pixmap = tiny_skia::Pixmap::new(w, h).unwrap();
-    let mut builder = FrameBuilder::default();
-    let mut shown = Shown::UNKNOWN;
-    let mut bytes = Vec::new();
-    let options = EncodeOptions { threshold: 0, sync: true };
-    let mut run_frames = |scene: &mut LakeScene, frames: u32| {
-        for k in 0..frames {
-            Playable::step(scene);
-            let overlay = Overlay {
-                aim: None,
-                help: None,
-                message: None,
-                fps: 30,
-                bytes_per_second: 500_000 + u64::from(k),
-                stone: 3,
-                paused: false,
-            };
-            let frame = builder.build((cols, rows), scene, &mut pixmap, ColorMode::TrueColor, &overlay);
-            bytes.clear();
-            encode_into(&mut shown, frame, options, &mut bytes);
-        }
-    };
     rayon::scope(|_| {
-        run_frames(&mut scene, 10);
-        let before = ALLOCATIONS.load(Ordering::Relaxed);
-        run_frames(&mut scene, 30);
-        let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
-        assert_eq!(during, 0, "lake frames at {cols}x{rows}: {during} allocations in 30 steady-state frames");
-        // More wind: the events allocate (once), the frames after them do not.
-        for event in scene.resolve(Action::Key('w')) {
+        for _ in 0..5 {
+            scene.step();
+            Playable::render(&mut scene, &mut pixmap);
+        }
+        for event in scene.resolve(Action::Damping(false)) {
             scene.apply(&event);
         }
-        run_frames(&mut scene, 2);
         let before = ALLOCATIONS.load(Ordering::Relaxed);
-        run_frames(&mut scene, 30);
+        for _ in 0..30 {
+            scene.step();
+            Playable::render(&mut scene, &mut pixmap);
+        }
         let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
         assert_eq!(during, 0, "lake frames after a wind change: {during} allocations in 30 frames");
     });
 }
 
-/// The player's frame path: step, picture, cells with status line and overlays, diff encoding.
-fn player_frames() {
+/// The player's frame path for a scene: steps, picture, cells with status line and overlays,
+/// diff encoding.
+fn player_frames(mut scene: Box<dyn tidepool::scene::playable::Playable>) {
     use tidepool::output::color::ColorMode;
     use tidepool::output::diff::{EncodeOptions, Shown, encode_into};
-    use tidepool::scene::playable::Playable;
     use tidepool::term::screen::{FrameBuilder, Overlay};
 
     let (cols, rows) = (160u16, 48u16);
     let (w, h) = tidepool::term::app::picture_size(cols, rows);
-    let settings = PoolSettings { damping: Damping::PAPERS, rain_rate: 0.3, seed: 5, look: PoolLook::default() };
-    let mut scene = PoolScene::new(w, h, background::pool_floor(), settings).unwrap();
+    let name = scene.name();
     let mut pixmap = tiny_skia::Pixmap::new(w, h).unwrap();
     let mut builder = FrameBuilder::default();
     let mut shown = Shown::UNKNOWN;
     let mut bytes = Vec::new();
-    let help = tidepool::term::ui::help_lines(&scene.help());
+    let help = tidepool::term::ui::help_lines(&scene.help(), true);
     let message = String::from("saved tidepool-pool-000123.png");
     let options = EncodeOptions { threshold: 0, sync: true };
     let mut run_frames = |frames: u32| {
         for k in 0..frames {
-            Playable::step(&mut scene);
-            Playable::step(&mut scene);
+            scene.step();
+            scene.step();
             let overlay = Overlay {
                 aim: Some((k % w, 10)),
                 help: (k % 3 == 0).then_some(help.as_slice()),
@@ -126,7 +101,7 @@ fn player_frames() {
                 stone: 3,
                 paused: false,
             };
-            let frame = builder.build((cols, rows), &mut scene, &mut pixmap, ColorMode::TrueColor, &overlay);
+            let frame = builder.build((cols, rows), scene.as_mut(), &mut pixmap, ColorMode::TrueColor, &overlay);
             bytes.clear();
             encode_into(&mut shown, frame, options, &mut bytes);
         }
@@ -136,7 +111,7 @@ fn player_frames() {
         let before = ALLOCATIONS.load(Ordering::Relaxed);
         run_frames(60);
         let during = ALLOCATIONS.load(Ordering::Relaxed) - before;
-        assert_eq!(during, 0, "player frames at {cols}x{rows}: {during} allocations in 60 steady-state frames");
+        assert_eq!(during, 0, "{name} player frames at {cols}x{rows}: {during} allocations in 60 steady-state frames");
     });
 }
 

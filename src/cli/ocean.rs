@@ -12,6 +12,9 @@ use crate::sim::sea_state;
 pub const MAX_WIND_M_S: f64 = 60.0;
 /// The default wind, m/s (Beaufort 5, Hs 2.46 m).
 pub const DEFAULT_WIND_M_S: f64 = 10.0;
+/// Where the default wind comes from, degrees clockwise from north (north-north-west: the
+/// waves run towards the camera's right, across the default view).
+pub const DEFAULT_DIRECTION_DEG: f64 = 330.0;
 
 const OCEAN_EXAMPLES: &str = "\
 Examples:
@@ -24,7 +27,7 @@ Examples:
 #[derive(Args, Debug, Clone)]
 pub struct WindArgs {
     /// Wind speed at 10 m, m/s (0..=60; 0 is a flat calm). [default: 10]
-    #[arg(long, value_name = "M/S", value_parser = parse_wind, conflicts_with = "beaufort")]
+    #[arg(long, value_name = "M/S", value_parser = parse_wind, conflicts_with = "beaufort", allow_negative_numbers = true)]
     pub wind: Option<f64>,
 
     /// Wind as a Beaufort number 0..=12 (0.15, 0.9, 2.45, 4.4, 6.7, 9.35, 12.3, 15.5, 18.95,
@@ -87,7 +90,7 @@ pub struct RenderOcean {
 
     /// Picture size in pixels, WIDTHxHEIGHT (at most 64 megapixels including supersampling).
     /// [default: 640x360 for PNG; for text, the terminal's size when writing to it, else 80x48]
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Option<Size>,
 
     /// Seed of the wave phases and the fine-scale fBm; the same seed and flags give the same bytes.
@@ -114,6 +117,10 @@ pub struct RenderOcean {
     /// triangle count to standard error.
     #[arg(long)]
     pub stats: bool,
+
+    /// An animation instead of one picture (it starts at --time).
+    #[command(flatten)]
+    pub animation: super::AnimationArgs,
 }
 
 impl RenderOcean {

@@ -10,8 +10,13 @@ use crate::cli::BenchArgs;
 use crate::error::Result;
 use crate::output::{halfblock, png};
 use crate::render::background;
+use crate::render::ocean::OceanView;
 use crate::render::pool::PoolLook;
+use crate::render::texture::SeaTexture;
+use crate::scene::ocean::{OceanScene, OceanSettings};
+use crate::scene::playable::Playable;
 use crate::scene::pool::{PoolScene, PoolSettings};
+use crate::sim::ocean::SeaParams;
 use crate::sim::ripple::{Damping, RipplePool, Stone};
 use crate::sim::stepper::Kernel;
 
@@ -44,6 +49,19 @@ fn rough_pool(w: usize, h: usize) -> RipplePool {
     }
     pool.advance(10);
     pool
+}
+
+/// The scenes besides the pool, at their defaults, drawing `w x h` with `ssaa` supersampling.
+fn other_scenes(w: u32, h: u32, ssaa: u32) -> Vec<(&'static str, Box<dyn Playable>)> {
+    let mut scenes: Vec<(&'static str, Box<dyn Playable>)> = Vec::new();
+    let ocean = OceanSettings {
+        sea: SeaParams { wind_m_s: crate::cli::ocean::DEFAULT_WIND_M_S, wind_from_deg: 330.0, seed: 1 },
+        view: OceanView { ssaa, ..OceanView::default() },
+    };
+    if let Some(scene) = OceanScene::new(ocean, w, h, SeaTexture::builtin()) {
+        scenes.push(("ocean", Box::new(scene)));
+    }
+    scenes
 }
 
 fn ms(d: Duration) -> f64 {
@@ -119,6 +137,23 @@ pub fn run(args: BenchArgs) -> Result<()> {
                 size: format!("{w}x{h}"),
                 median: png_median,
                 rate: format!("{:.0} KB", png::encode(&frame).len() as f64 / 1024.0),
+            });
+        }
+    }
+
+    // The other scenes, through the same interface the player and animations use.
+    for (w, h, ssaa, label) in [(terminal.width, terminal.height, 1, "terminal"), (1920, 1080, 2, "full HD, ssaa 2")] {
+        for (name, mut scene) in other_scenes(w, h, ssaa) {
+            let mut frame = Pixmap::new(w, h).expect("a valid size");
+            let median = median_time(budget, || {
+                scene.step();
+                scene.render(&mut frame);
+            });
+            rows.push(Row {
+                stage: format!("{name} frame ({label})"),
+                size: format!("{w}x{h}"),
+                median,
+                rate: format!("{:.0} fps", 1.0 / median.as_secs_f64()),
             });
         }
     }

@@ -1,6 +1,8 @@
 //! The subcommands: validated flags in, files and terminal output out.
 
+pub mod animate;
 pub mod bench;
+pub mod docs;
 pub mod lake;
 pub mod ocean;
 pub mod play;
@@ -32,6 +34,8 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Render(render)) => render::run(render),
         Some(Command::Spectrum(args)) => spectrum::run(args),
         Some(Command::Bench(args)) => bench::run(args),
+        Some(Command::Completions(args)) => docs::completions(args),
+        Some(Command::Man(args)) => docs::man(args),
         Some(Command::Play(play)) => play::run(play),
         None => match <Cli as clap::Parser>::try_parse_from(["tidepool", "play"]) {
             Ok(Cli { command: Some(Command::Play(play)) }) => play::run(play),

@@ -39,6 +39,9 @@ pub fn settings(args: &RenderOcean, format: Format) -> OceanSettings {
 
 /// Runs `tidepool render ocean`.
 pub fn render_ocean(args: RenderOcean) -> Result<()> {
+    if let Some(frames) = args.animation.frames {
+        return animate_ocean(&args, frames);
+    }
     let plan = OutputPlan::new(&args.output_args(), "ocean", std::io::stdout().is_terminal(), terminal_pixels())?;
     if args.extent.is_some() && plan.heightmap.is_none() {
         return Err(Error::arg(
@@ -74,6 +77,38 @@ pub fn render_ocean(args: RenderOcean) -> Result<()> {
     // The supersampled buffer is the largest allocation; free it before encoding.
     drop(scene);
     plan.write_timed(&picture, heights.as_ref(), HEIGHTMAP_PNG_SCALE, &mut stats)?;
+    if args.stats {
+        eprint!("{}", stats.report());
+    }
+    Ok(())
+}
+
+/// `tidepool render ocean --frames N`: the sea from `--time` on, 1/60 s a step as in the player.
+fn animate_ocean(args: &RenderOcean, frames: u32) -> Result<()> {
+    use super::animate::{Animation, AnimationTarget, animate};
+    super::render::check_animation_flags(&args.output_args())?;
+    if args.extent.is_some() {
+        return Err(Error::arg("--extent", "only sizes the --heightmap patch, which animations do not write"));
+    }
+    let target = AnimationTarget::from_out(args.out.as_deref(), "ocean", args.animation.fps)?;
+    let size = args.size.unwrap_or(super::render::DEFAULT_PNG_SIZE);
+    let settings = settings(args, crate::cli::Format::Png);
+    check_pixels(size, settings.view.ssaa).map_err(|e| Error::arg("--size", format!("{e} (or lower --ssaa)")))?;
+    let texture = match &args.texture {
+        Some(path) => SeaTexture::from_pixmap(&background::load("--texture", path)?, SEA_TEXTURE_TILE_M),
+        None => SeaTexture::builtin(),
+    };
+    let time = args.time;
+    let mut make = || -> Result<Box<dyn crate::scene::playable::Playable>> {
+        let mut scene = OceanScene::new(settings, size.width, size.height, texture.clone()).ok_or_else(|| {
+            Error::arg("--size", format!("cannot allocate a {size} picture; choose a smaller size or --ssaa"))
+        })?;
+        scene.set_time(time);
+        Ok(Box::new(scene))
+    };
+    let animation = Animation { frames, fps: args.animation.fps, start_step: 0, script: &[] };
+    let mut stats = Stats::default();
+    animate(&mut make, &animation, &target, &mut stats)?;
     if args.stats {
         eprint!("{}", stats.report());
     }

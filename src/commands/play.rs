@@ -9,11 +9,14 @@ use crate::cli::{ColorChoice, PlayCommand, PlayScene};
 use crate::error::{Error, Result};
 use crate::output::color::ColorMode;
 use crate::output::diff::EncodeOptions;
-use crate::render::background;
+use crate::render::ocean::OceanView;
+use crate::render::texture::SeaTexture;
 use crate::scene::lake::{LakeScene, LakeSettings};
+use crate::scene::ocean::{OceanScene, OceanSettings};
 use crate::scene::playable::Playable;
-use crate::scene::pool::{PoolScene, PoolSettings};
+use crate::scene::pool::PoolScene;
 use crate::sim::lake::LakeParams;
+use crate::sim::ocean::SeaParams;
 use crate::term::app::{self, PlayerConfig, SceneFactory};
 
 /// The player's rain when `--rain` is not given: about one drop a second at 60 steps/s.
@@ -48,26 +51,47 @@ pub fn run(command: PlayCommand) -> Result<()> {
         ColorChoice::Palette16 => ColorMode::Palette16,
     };
     let threshold = command.color_threshold.unwrap_or(default_threshold(env("SSH_CONNECTION").as_deref()));
+    let floor = command.pool.floor()?;
     if command.record.is_some() && command.scene != PlayScene::Pool {
         return Err(Error::arg(
             "--record",
-            "replays hold pool sessions only so far; play the pool (`tidepool play pool --record FILE`) or drop --record",
+            "replays hold the pool only; record with `tidepool play pool --record FILE`",
         ));
     }
-    let floor = match &command.pool.background {
-        Some(path) => background::load("--background", path)?,
-        None => background::pool_floor(),
-    };
     let rain = command.pool.rain.unwrap_or(DEFAULT_PLAYER_RAIN);
-    let settings =
-        PoolSettings { damping: command.pool.damping, rain_rate: rain, seed: command.seed, look: command.pool.look() };
+    let default_view = OceanView::default();
+    let ocean = OceanSettings {
+        sea: SeaParams {
+            wind_m_s: command.wind.speed_m_s(),
+            wind_from_deg: command.direction.unwrap_or(crate::cli::ocean::DEFAULT_DIRECTION_DEG),
+            seed: command.seed,
+        },
+        view: OceanView {
+            sun_azimuth_deg: command.pool.sun.map_or(default_view.sun_azimuth_deg, |s| s.azimuth_deg),
+            sun_elevation_deg: command.pool.sun.map_or(default_view.sun_elevation_deg, |s| s.elevation_deg),
+            ssaa: 1,
+            ..default_view
+        },
+    };
+    let texture = SeaTexture::builtin();
+    let mut lake = lake_settings(command.seed);
+    if command.wind.wind.is_some() || command.wind.beaufort.is_some() {
+        lake.lake.wind_m_s = command.wind.speed_m_s().min(crate::scene::lake::MAX_LAKE_WIND_M_S);
+    }
+    let settings = command.pool.settings(command.seed, DEFAULT_PLAYER_RAIN);
+    let too_big = |what: &str, width: u32, height: u32| {
+        Error::Usage(format!("cannot allocate a {width}x{height} {what}; use a smaller terminal"))
+    };
     let make: SceneFactory = Box::new(move |kind, width, height| match kind {
         PlayScene::Pool => PoolScene::new(width, height, floor.clone(), settings)
             .map(|scene| Box::new(scene) as Box<dyn Playable>)
-            .ok_or_else(|| Error::Usage(format!("cannot allocate a {width}x{height} pool; use a smaller terminal"))),
-        PlayScene::Lake => LakeScene::new(lake_settings(command.seed), width, height)
+            .ok_or_else(|| too_big("pool", width, height)),
+        PlayScene::Ocean => OceanScene::new(ocean, width, height, texture.clone())
             .map(|scene| Box::new(scene) as Box<dyn Playable>)
-            .ok_or_else(|| Error::Usage(format!("cannot allocate a {width}x{height} lake; use a smaller terminal"))),
+            .ok_or_else(|| too_big("sea", width, height)),
+        PlayScene::Lake => LakeScene::new(lake, width, height)
+            .map(|scene| Box::new(scene) as Box<dyn Playable>)
+            .ok_or_else(|| too_big("lake", width, height)),
     });
     let config = PlayerConfig {
         fps: command.fps,

@@ -11,8 +11,7 @@ use crate::error::{Error, Result};
 use crate::output::heightmap::{self, Heightmap};
 use crate::output::{atomic, halfblock, png};
 use crate::progress::Progress;
-use crate::render::background;
-use crate::scene::pool::{PoolScene, PoolSettings};
+use crate::scene::pool::PoolScene;
 use crate::sim::ripple::Stone;
 
 /// The default PNG size.
@@ -276,17 +275,12 @@ fn render_pool(args: RenderPool) -> Result<()> {
     if let Some(path) = &args.replay {
         return super::replay::render(&args, path);
     }
+    if let Some(frames) = args.animation.frames {
+        return animate_pool(&args, frames);
+    }
     let plan = OutputPlan::new(&args.output, "pool", std::io::stdout().is_terminal(), terminal_pixels())?;
-    let floor = match &args.pool.background {
-        Some(path) => background::load("--background", path)?,
-        None => background::pool_floor(),
-    };
-    let settings = PoolSettings {
-        damping: args.pool.damping,
-        rain_rate: args.pool.rain.unwrap_or(0.0),
-        seed: args.output.seed,
-        look: args.pool.look(),
-    };
+    let floor = args.pool.floor()?;
+    let settings = args.pool.settings(args.output.seed, 0.0);
     let Size { width, height } = plan.size;
     let mut scene = PoolScene::new(width, height, floor, settings).ok_or_else(|| {
         Error::arg("--size", format!("cannot allocate a {width}x{height} picture; choose a smaller size"))
@@ -327,6 +321,49 @@ fn render_pool(args: RenderPool) -> Result<()> {
     stats.record("render", started, format!("{width}x{height}"));
     let heights = plan.heightmap.is_some().then(|| scene.heightmap());
     plan.write_timed(&picture, heights.as_ref(), 1.0, &mut stats)?;
+    if args.output.stats {
+        eprint!("{}", stats.report());
+    }
+    Ok(())
+}
+
+/// Refuses flags that mean nothing for an animation.
+pub fn check_animation_flags(output: &OutputArgs) -> Result<()> {
+    if output.format.is_some() {
+        return Err(Error::arg(
+            "--format",
+            "an animation takes its format from --out (.gif, .png or a {frame} pattern)",
+        ));
+    }
+    if output.heightmap.is_some() {
+        return Err(Error::arg("--heightmap", "is written for single pictures; drop --frames or --heightmap"));
+    }
+    Ok(())
+}
+
+/// `tidepool render pool --frames N`: the stones (given or default) land at their steps, the
+/// first frame after `--steps` steps (default 0, so the stones are seen falling).
+fn animate_pool(args: &RenderPool, frames: u32) -> Result<()> {
+    use super::animate::{Animation, AnimationTarget, animate};
+    check_animation_flags(&args.output)?;
+    let target = AnimationTarget::from_out(args.output.out.as_deref(), "pool", args.animation.fps)?;
+    let size = args.output.size.unwrap_or(DEFAULT_PNG_SIZE);
+    let floor = args.pool.floor()?;
+    let settings = args.pool.settings(args.output.seed, 0.0);
+    let mut script: Vec<(u64, crate::replay::Event)> = if args.stones.is_empty() {
+        default_stones(size).into_iter().map(|(at, s)| (at, crate::replay::Event::Stone(s))).collect()
+    } else {
+        args.stones.iter().map(|&s| (0, crate::replay::Event::Stone(s))).collect()
+    };
+    script.sort_by_key(|(at, _)| *at);
+    let mut make = || -> Result<Box<dyn crate::scene::playable::Playable>> {
+        PoolScene::new(size.width, size.height, floor.clone(), settings)
+            .map(|scene| Box::new(scene) as Box<dyn crate::scene::playable::Playable>)
+            .ok_or_else(|| Error::arg("--size", format!("cannot allocate a {size} picture; choose a smaller size")))
+    };
+    let animation = Animation { frames, fps: args.animation.fps, start_step: args.steps.unwrap_or(0), script: &script };
+    let mut stats = Stats::default();
+    animate(&mut make, &animation, &target, &mut stats)?;
     if args.output.stats {
         eprint!("{}", stats.report());
     }

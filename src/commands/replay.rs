@@ -33,7 +33,7 @@ pub fn pool_options(args: &PoolArgs, rain: f64) -> Map<String, Value> {
         "shading": !args.no_shading,
         "caustics": !args.no_caustics,
         "depth": args.depth,
-        "sun": format!("{},{}", args.sun.azimuth_deg, args.sun.elevation_deg),
+        "sun": format!("{},{}", args.sun().azimuth_deg, args.sun().elevation_deg),
         "background": background,
     });
     match value {
@@ -133,9 +133,46 @@ pub fn simulate(path: &Path, replay: &Replay, steps: Option<u64>) -> Result<Pool
 /// Runs `tidepool render pool --replay FILE`.
 pub fn render(args: &RenderPool, path: &Path) -> Result<()> {
     let replay = replay::read(path)?;
+    if let Some(frames) = args.animation.frames {
+        return animate(args, path, &replay, frames);
+    }
     let mut plan = OutputPlan::new(&args.output, "pool", std::io::stdout().is_terminal(), terminal_pixels())?;
     let mut scene = simulate(path, &replay, args.steps)?;
     plan.size = Size { width: scene.width(), height: scene.height() };
     let heights = plan.heightmap.is_some().then(|| scene.heightmap());
     plan.write(&scene.snapshot(), heights.as_ref(), 1.0)
+}
+
+/// `tidepool render pool --replay FILE --frames N`: the session as an animation, from step 0
+/// (or `--steps`), each event at its step.
+fn animate(args: &RenderPool, path: &Path, replay: &Replay, frames: u32) -> Result<()> {
+    use super::animate::{Animation, AnimationTarget};
+    super::render::check_animation_flags(&args.output)?;
+    if replay.header.scene != "pool" {
+        return Err(Error::Replay {
+            path: path.to_owned(),
+            line: 1,
+            message: format!("this is a replay of the {0}; use `tidepool render {0} --replay`", replay.header.scene),
+        });
+    }
+    let target = AnimationTarget::from_out(args.output.out.as_deref(), "pool", args.animation.fps)?;
+    let (settings, background) = pool_settings(path, replay)?;
+    let floor = match &background {
+        Some(file) => background::load("--replay (its background)", file)?,
+        None => background::pool_floor(),
+    };
+    let [w, h] = replay.header.size;
+    let script: Vec<(u64, Event)> = replay.entries.iter().map(|e| (e.step, e.event.clone())).collect();
+    let mut make = || -> Result<Box<dyn Playable>> {
+        PoolScene::new(w, h, floor.clone(), settings).map(|s| Box::new(s) as Box<dyn Playable>).ok_or_else(|| {
+            Error::Replay { path: path.to_owned(), line: 1, message: format!("cannot allocate a {w}x{h} pool") }
+        })
+    };
+    let animation = Animation { frames, fps: args.animation.fps, start_step: args.steps.unwrap_or(0), script: &script };
+    let mut stats = super::render::Stats::default();
+    super::animate::animate(&mut make, &animation, &target, &mut stats)?;
+    if args.output.stats {
+        eprint!("{}", stats.report());
+    }
+    Ok(())
 }

@@ -33,6 +33,68 @@ pub fn write_file(path: &Path, bytes: &[u8]) -> Result<()> {
     result
 }
 
+/// A file written in pieces (an animation, frame by frame) that appears under its name only
+/// when [`AtomicFile::commit`] is called; dropped without a commit, it leaves nothing behind.
+#[derive(Debug)]
+pub struct AtomicFile {
+    path: PathBuf,
+    temp: PathBuf,
+    file: Option<std::io::BufWriter<std::fs::File>>,
+}
+
+impl AtomicFile {
+    /// Starts writing `path` (checks the folder first; the bytes go to a temporary file).
+    pub fn create(path: &Path) -> Result<AtomicFile> {
+        let temp = temp_path(path)?;
+        signals::register_temp_file(&temp);
+        let file = OpenOptions::new().write(true).create_new(true).open(&temp).map_err(|e| {
+            signals::unregister_temp_file(&temp);
+            Error::io("cannot write", path, e)
+        })?;
+        Ok(AtomicFile { path: path.to_owned(), temp, file: Some(std::io::BufWriter::new(file)) })
+    }
+
+    /// The name the file will have.
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    /// Flushes, syncs and renames the file into place.
+    pub fn commit(mut self) -> Result<()> {
+        let file = self.file.take().expect("a file until committed");
+        let io = |e| Error::io("cannot write", &self.path, e);
+        let file = file.into_inner().map_err(|e| io(e.into_error()))?;
+        file.sync_all().map_err(io)?;
+        drop(file);
+        if self.path.is_dir() {
+            return Err(Error::Usage(format!(
+                "cannot write {}: it is a directory; give a file name",
+                self.path.display()
+            )));
+        }
+        std::fs::rename(&self.temp, &self.path).map_err(io)
+    }
+}
+
+impl std::io::Write for AtomicFile {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.file.as_mut().expect("a file until committed").write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.file.as_mut().expect("a file until committed").flush()
+    }
+}
+
+impl Drop for AtomicFile {
+    fn drop(&mut self) {
+        // Committed or not, the temporary name is gone afterwards.
+        drop(self.file.take());
+        let _ = std::fs::remove_file(&self.temp);
+        signals::unregister_temp_file(&self.temp);
+    }
+}
+
 fn write_then_rename(temp: &Path, path: &Path, bytes: &[u8]) -> Result<()> {
     let mut file =
         OpenOptions::new().write(true).create_new(true).open(temp).map_err(|e| Error::io("cannot write", path, e))?;
@@ -105,6 +167,26 @@ mod tests {
         assert!(err.contains("directory"), "{err}");
         assert!(target.is_dir());
         assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "no temporary file left");
+    }
+
+    #[test]
+    fn streamed_files_appear_only_when_committed() {
+        use std::io::Write;
+        let dir = scratch("streamed");
+        let target = dir.join("anim.gif");
+        std::fs::write(&target, b"old").unwrap();
+        {
+            let mut file = AtomicFile::create(&target).unwrap();
+            file.write_all(b"half an animation").unwrap();
+            // Dropped without commit: an error or Ctrl-C half way.
+        }
+        assert_eq!(std::fs::read(&target).unwrap(), b"old");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1, "no temporary file left");
+        let mut file = AtomicFile::create(&target).unwrap();
+        file.write_all(b"new").unwrap();
+        file.commit().unwrap();
+        assert_eq!(std::fs::read(&target).unwrap(), b"new");
+        assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 1);
     }
 
     #[test]

@@ -443,4 +443,63 @@ mod tests {
         assert!(!bytes.is_empty());
         assert_eq!(shown.frame.as_ref().map(Frame::cols), Some(5));
     }
+
+    mod properties {
+        use super::*;
+        use proptest::prelude::*;
+
+        fn color() -> impl Strategy<Value = Color> {
+            prop_oneof![
+                // Few distinct values, so neighbouring cells often share colours (the elision paths).
+                (0u8..4, 0u8..4, 0u8..4).prop_map(|(r, g, b)| Color::Rgb([r * 80, g * 80, b * 80])),
+                (0u8..=255).prop_map(Color::Index),
+                Just(Color::Default),
+            ]
+        }
+
+        fn cell() -> impl Strategy<Value = Cell> {
+            prop_oneof![
+                4 => (color(), color()).prop_map(|(top, bottom)| Cell::Pixels { top, bottom }),
+                1 => (prop::sample::select(vec![' ', 'a', '+', '\u{b7}']), color(), color())
+                    .prop_map(|(ch, fg, bg)| Cell::Text { ch, fg, bg }),
+            ]
+        }
+
+        fn frame(cols: usize, rows: usize) -> impl Strategy<Value = Frame> {
+            proptest::collection::vec(cell(), cols * rows).prop_map(move |cells| {
+                let mut f = Frame::new(cols, rows);
+                for (i, c) in cells.into_iter().enumerate() {
+                    f.set(i % cols, i / cols, c);
+                }
+                f
+            })
+        }
+
+        proptest! {
+            #![proptest_config(ProptestConfig::with_cases(96))]
+
+            /// Whatever the frames, the diff of each against the one before, fed to a terminal
+            /// that shows the one before, shows exactly the new one (colours exact at threshold
+            /// 0), with synchronized output opened and closed.
+            #[test]
+            fn diffs_reproduce_the_next_frame(
+                (cols, rows, frames) in (1usize..14, 1usize..7).prop_flat_map(|(c, r)| {
+                    (Just(c), Just(r), proptest::collection::vec(frame(c, r), 1..5))
+                }),
+                sync in any::<bool>(),
+            ) {
+                let mut screen = model(cols, rows + 1);
+                let mut shown = Shown::UNKNOWN;
+                for frame in &frames {
+                    let (bytes, next) = encode(&shown, frame, EncodeOptions { threshold: 0, sync });
+                    screen.feed(&bytes);
+                    assert_screen_shows(&screen, frame);
+                    shown = next;
+                }
+                // A frame identical to what is shown costs nothing but the sync markers.
+                let (again, _) = encode(&shown, frames.last().unwrap(), EncodeOptions { threshold: 0, sync: false });
+                prop_assert!(again.is_empty(), "{:?}", String::from_utf8_lossy(&again));
+            }
+        }
+    }
 }

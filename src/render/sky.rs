@@ -25,6 +25,19 @@ pub fn sky_grid_px(height: u32) -> usize {
 /// terminal sizes).
 pub const SUN_RADIUS_DEG: f32 = 0.5;
 
+/// Buffers the sky's drawing reuses, one set per thread: a steady stream of frames allocates
+/// nothing.
+#[derive(Default)]
+struct SkyScratch {
+    grid: Vec<Rgb>,
+    row_levels: Vec<[u32; 3]>,
+    weights: Vec<u32>,
+}
+
+thread_local! {
+    static SKY_SCRATCH: std::cell::RefCell<SkyScratch> = std::cell::RefCell::new(SkyScratch::default());
+}
+
 /// The light arriving from a direction: what water reflects.
 pub trait Environment: Sync {
     /// Linear radiance arriving along the unit direction `dir` (pointing away from the
@@ -65,6 +78,39 @@ impl Sky {
     /// The unit direction towards the sun.
     pub fn sun_direction(&self) -> Vec3 {
         self.sun_dir
+    }
+
+    /// Per row: the grid colours at this height, tone-mapped, then integer interpolation along
+    /// the row (the sky changes slowly; this keeps a 4K sky to a few milliseconds).
+    #[allow(clippy::too_many_arguments)] // the pieces of one drawing pass
+    fn fill_rows(
+        &self,
+        pixels: &mut [PremultipliedColorU8],
+        w: usize,
+        sky_rows: usize,
+        g: usize,
+        gw: usize,
+        lut: &ToneTable,
+        grid: &[Rgb],
+        row_levels: &mut [[u32; 3]],
+        weights: &[u32],
+    ) {
+        let inv = 1.0 / g as f32;
+        for y in 0..sky_rows {
+            let (gy, ty) = (y / g, (y % g) as f32 * inv);
+            for (gx, level) in row_levels.iter_mut().enumerate() {
+                let c = mix(grid[gy * gw + gx], grid[(gy + 1) * gw + gx], ty);
+                *level = [0, 1, 2].map(|i| u32::from(lut.level(c[i])));
+            }
+            let row = &mut pixels[y * w..(y + 1) * w];
+            for (block, pair) in row.chunks_mut(g).zip(row_levels.windows(2)) {
+                let (a, b) = (pair[0], pair[1]);
+                for (p, &wb) in block.iter_mut().zip(weights) {
+                    let lerp = |i: usize| ((a[i] * (65536 - wb) + b[i] * wb + 32768) >> 16) as u8;
+                    *p = pixel([lerp(0), lerp(1), lerp(2)]);
+                }
+            }
+        }
     }
 
     /// The light the water gets: the sun and the sky's average.
@@ -108,34 +154,22 @@ impl Sky {
         }
         let g = sky_grid_px(h as u32);
         let (gw, gh) = (w.div_ceil(g) + 1, sky_rows.div_ceil(g) + 1);
-        let mut grid = Vec::with_capacity(gw * gh);
-        for gy in 0..gh {
-            for gx in 0..gw {
-                let d = camera.ray((gx * g) as f32 + 0.5, ((gy * g) as f32 + 0.5).min(camera.horizon_y()));
-                grid.push(self.smooth(d));
-            }
-        }
-        // Per row: the grid colours at this height, tone-mapped, then integer interpolation
-        // along the row (the sky changes slowly; this keeps a 4K sky to a few milliseconds).
-        let inv = 1.0 / g as f32;
-        let mut row_levels = vec![[0u32; 3]; gw];
-        // 16.16 fixed-point weight of the right-hand grid point at each offset in a cell.
-        let weights: Vec<u32> = (0..g as u32).map(|t| (t << 16) / g as u32).collect();
-        for y in 0..sky_rows {
-            let (gy, ty) = (y / g, (y % g) as f32 * inv);
-            for (gx, level) in row_levels.iter_mut().enumerate() {
-                let c = mix(grid[gy * gw + gx], grid[(gy + 1) * gw + gx], ty);
-                *level = [0, 1, 2].map(|i| u32::from(lut.level(c[i])));
-            }
-            let row = &mut pixels[y * w..(y + 1) * w];
-            for (block, pair) in row.chunks_mut(g).zip(row_levels.windows(2)) {
-                let (a, b) = (pair[0], pair[1]);
-                for (p, &wb) in block.iter_mut().zip(&weights) {
-                    let lerp = |i: usize| ((a[i] * (65536 - wb) + b[i] * wb + 32768) >> 16) as u8;
-                    *p = pixel([lerp(0), lerp(1), lerp(2)]);
+        SKY_SCRATCH.with_borrow_mut(|scratch| {
+            let SkyScratch { grid, row_levels, weights } = scratch;
+            grid.clear();
+            for gy in 0..gh {
+                for gx in 0..gw {
+                    let d = camera.ray((gx * g) as f32 + 0.5, ((gy * g) as f32 + 0.5).min(camera.horizon_y()));
+                    grid.push(self.smooth(d));
                 }
             }
-        }
+            row_levels.clear();
+            row_levels.resize(gw, [0u32; 3]);
+            // 16.16 fixed-point weight of the right-hand grid point at each offset in a cell.
+            weights.clear();
+            weights.extend((0..g as u32).map(|t| (t << 16) / g as u32));
+            self.fill_rows(pixels, w, sky_rows, g, gw, lut, grid, row_levels, weights);
+        });
         // The sun, exactly, where its disc and tight glow matter (within about 4°).
         if let Some((sx, sy, _)) = camera.project(add_eye(camera, self.sun_dir)) {
             let r = (4f32.to_radians().tan() * camera.focal_px()).ceil();

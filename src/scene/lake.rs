@@ -8,12 +8,13 @@ use crate::replay::Event;
 use crate::scene::playable::{Action, Playable};
 use crate::sim::lake::{FAR_SHORE_M, Lake, LakeParams};
 use crate::sim::noise::{MAX_OCTAVES, NoiseKind};
+use crate::sim::sea_state::beaufort_speed_m_s;
 
 /// The strongest wind the lake takes, m/s (a storm; beyond it a lake is all spray).
 pub const MAX_LAKE_WIND_M_S: f64 = 30.0;
-/// How much `w` and `W` change the wind in the player, m/s.
+/// How much `[` and `]` change the wind in the player, m/s.
 pub const WIND_STEP_M_S: f64 = 1.0;
-/// How much `.` and `,` change the persistence in the player.
+/// How much `>` and `<` change the persistence in the player.
 pub const PERSISTENCE_STEP: f64 = 0.05;
 /// Simulated time per player step: the player steps 30 times a second, in real time.
 pub const PLAYER_STEP_S: f64 = 1.0 / 30.0;
@@ -154,23 +155,26 @@ impl Playable for LakeScene {
         LakeScene::render(self, out);
     }
 
-    /// Stones, stirring, rain and damping mean nothing to noise water (it has no wave
-    /// equation); `c` calms it.
+    /// The ocean's wind keys: digits set the wind to that Beaufort number, `[` and `]` weaken
+    /// and strengthen it by 1 m/s, `c` calms the lake; `o`/`O` add and drop an octave, `>` and
+    /// `<` raise and lower the persistence, `n` switches value and gradient noise. Stones,
+    /// stirring and rain mean nothing to noise water (it has no wave equation).
     fn resolve(&self, action: Action) -> Vec<Event> {
         let p = self.lake.params();
-        let wind = |w: f64| vec![Event::Wind((w * 10.0).round() / 10.0)];
+        // The lake's wind always blows from the far shore, the north.
+        let wind = |w: f64| vec![Event::Wind([(w.clamp(0.0, MAX_LAKE_WIND_M_S) * 10.0).round() / 10.0, 0.0])];
         let noise = |octaves: u32, persistence: f64, kind: NoiseKind| {
             let persistence = (persistence.clamp(0.0, 1.0) * 100.0).round() / 100.0;
             vec![Event::Noise { octaves: octaves.clamp(1, MAX_OCTAVES as u32), persistence, kind }]
         };
         match action {
             Action::Clear => wind(0.0),
-            Action::Key('w') => wind((p.wind_m_s + WIND_STEP_M_S).min(MAX_LAKE_WIND_M_S)),
-            Action::Key('W') => wind((p.wind_m_s - WIND_STEP_M_S).max(0.0)),
+            Action::Key(c @ '0'..='9') => wind(beaufort_speed_m_s(c as u8 - b'0').unwrap_or(p.wind_m_s)),
+            Action::Damping(weaker) => wind(p.wind_m_s + if weaker { -WIND_STEP_M_S } else { WIND_STEP_M_S }),
             Action::Key('o') => noise(p.octaves + 1, p.persistence, p.noise),
             Action::Key('O') => noise(p.octaves.saturating_sub(1), p.persistence, p.noise),
-            Action::Key('.') => noise(p.octaves, p.persistence + PERSISTENCE_STEP, p.noise),
-            Action::Key(',') => noise(p.octaves, p.persistence - PERSISTENCE_STEP, p.noise),
+            Action::Key('>') => noise(p.octaves, p.persistence + PERSISTENCE_STEP, p.noise),
+            Action::Key('<') => noise(p.octaves, p.persistence - PERSISTENCE_STEP, p.noise),
             Action::Key('n') => {
                 let other = if p.noise == NoiseKind::Value { NoiseKind::Gradient } else { NoiseKind::Value };
                 noise(p.octaves, p.persistence, other)
@@ -182,7 +186,9 @@ impl Playable for LakeScene {
     fn apply(&mut self, event: &Event) {
         let p = self.lake.params();
         match *event {
-            Event::Wind(w) => self.set_params(LakeParams { wind_m_s: w.clamp(0.0, MAX_LAKE_WIND_M_S), ..p }),
+            Event::Wind([speed, _]) => {
+                self.set_params(LakeParams { wind_m_s: speed.clamp(0.0, MAX_LAKE_WIND_M_S), ..p });
+            }
             Event::Noise { octaves, persistence, kind } => {
                 self.set_params(LakeParams { octaves, persistence, noise: kind, ..p });
             }
@@ -209,11 +215,24 @@ impl Playable for LakeScene {
 
     fn help(&self) -> Vec<(&'static str, &'static str)> {
         vec![
-            ("w W", "more / less wind (1 m/s)"),
+            ("0 .. 9", "wind: Beaufort 0 to 9"),
+            ("[ ]", "less / more wind (1 m/s)"),
             ("c", "calm: no wind, a mirror"),
             ("o O", "more / fewer noise octaves"),
-            (". ,", "rougher / smoother (persistence)"),
+            ("> <", "rougher / smoother (persistence)"),
             ("n", "value / gradient noise"),
+        ]
+    }
+
+    fn takes_stones(&self) -> bool {
+        false
+    }
+
+    fn hints(&self) -> &'static [&'static str] {
+        &[
+            "0-9 Beaufort \u{b7} [ ] wind \u{b7} c calm \u{b7} o O octaves \u{b7} < > rough \u{b7} n noise \u{b7} p pause \u{b7} s shot \u{b7} ? help \u{b7} q quit",
+            "[ ] wind \u{b7} c calm \u{b7} ? help \u{b7} q quit",
+            "? help \u{b7} q quit",
         ]
     }
 }
@@ -245,32 +264,37 @@ mod tests {
     #[test]
     fn keys_change_the_wind_and_the_noise() {
         let mut s = scene(3.0);
-        let up = s.resolve(Action::Key('w'));
-        assert_eq!(up, vec![Event::Wind(4.0)]);
+        let up = s.resolve(Action::Damping(false));
+        assert_eq!(up, vec![Event::Wind([4.0, 0.0])]);
         s.apply(&up[0]);
         assert_eq!(s.lake().params().wind_m_s, 4.0);
-        assert_eq!(s.resolve(Action::Clear), vec![Event::Wind(0.0)]);
-        assert_eq!(s.resolve(Action::Key('W')), vec![Event::Wind(3.0)]);
+        assert_eq!(s.resolve(Action::Clear), vec![Event::Wind([0.0, 0.0])]);
+        assert_eq!(s.resolve(Action::Damping(true)), vec![Event::Wind([3.0, 0.0])]);
+        assert_eq!(s.resolve(Action::Key('5')), vec![Event::Wind([9.4, 0.0])], "Beaufort 5 is 9.35 m/s");
         let n = s.resolve(Action::Key('n'));
         assert_eq!(n, vec![Event::Noise { octaves: 5, persistence: 0.5, kind: NoiseKind::Gradient }]);
         s.apply(&n[0]);
         assert_eq!(s.lake().params().noise, NoiseKind::Gradient);
         s.apply(&s.resolve(Action::Key('O'))[0]);
-        s.apply(&s.resolve(Action::Key('.'))[0]);
+        s.apply(&s.resolve(Action::Key('>'))[0]);
         assert_eq!((s.lake().params().octaves, s.lake().params().persistence), (4, 0.55));
         assert!(s.resolve(Action::Stone { x: 1, y: 1, radius: 2, big: false }).is_empty());
         assert!(s.resolve(Action::ToggleRain).is_empty());
+        assert!(!s.takes_stones());
         let mut status = String::new();
         s.status(&mut status);
         assert_eq!(status, "wind 4 m/s \u{b7} 4 octaves \u{b7} persistence 0.55 \u{b7} gradient noise");
-        // Limits hold: no wind below 0, at most MAX_OCTAVES octaves.
+        // Limits hold: no wind below 0, at most MAX_OCTAVES octaves; an ocean's wind from
+        // another direction still sets the lake's speed.
         let mut calm = scene(0.0);
-        assert_eq!(calm.resolve(Action::Key('W')), vec![Event::Wind(0.0)]);
+        assert_eq!(calm.resolve(Action::Damping(true)), vec![Event::Wind([0.0, 0.0])]);
         for _ in 0..20 {
             let e = calm.resolve(Action::Key('o'));
             calm.apply(&e[0]);
         }
         assert_eq!(calm.lake().params().octaves, MAX_OCTAVES as u32);
+        calm.apply(&Event::Wind([50.0, 200.0]));
+        assert_eq!(calm.lake().params().wind_m_s, MAX_LAKE_WIND_M_S);
         calm.apply(&Event::Resize([30, 20]));
         assert_eq!(Playable::size(&calm), (30, 20));
     }

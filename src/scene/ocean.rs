@@ -5,7 +5,10 @@ use tiny_skia::Pixmap;
 use crate::output::heightmap::Heightmap;
 use crate::render::ocean::{OceanRenderer, OceanView};
 use crate::render::texture::SeaTexture;
+use crate::replay::Event;
+use crate::scene::playable::{Action, Playable};
 use crate::sim::ocean::{Sea, SeaParams};
+use crate::sim::sea_state;
 
 /// Everything about an ocean picture except its size and texture.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -23,6 +26,8 @@ pub struct OceanScene {
     renderer: OceanRenderer,
     texture: SeaTexture,
     time_s: f64,
+    /// The component phases of the last frame, reused.
+    phases: Vec<f32>,
 }
 
 /// The heightmap's east-west extent when none is given: 8 peak wavelengths (100 m for a calm).
@@ -36,7 +41,7 @@ impl OceanScene {
     /// Returns `None` when the (supersampled) size is zero or too large for a pixmap.
     pub fn new(settings: OceanSettings, width: u32, height: u32, texture: SeaTexture) -> Option<OceanScene> {
         let renderer = OceanRenderer::new(settings.view, width, height, texture.clone())?;
-        Some(OceanScene { sea: Sea::new(settings.sea), renderer, texture, time_s: 0.0 })
+        Some(OceanScene { sea: Sea::new(settings.sea), renderer, texture, time_s: 0.0, phases: Vec::new() })
     }
 
     /// The sea.
@@ -86,8 +91,9 @@ impl OceanScene {
 
     /// Draws the sea at the current time into `out` (the scene's size).
     pub fn render(&mut self, out: &mut Pixmap) {
-        let frame = self.sea.frame(self.time_s);
+        let frame = self.sea.frame_in(self.time_s, std::mem::take(&mut self.phases));
         self.renderer.render(&frame, out);
+        self.phases = frame.into_buffer();
     }
 
     /// A new picture of the current sea.
@@ -140,6 +146,106 @@ impl OceanScene {
     }
 }
 
+/// The player steps the sea 60 times a second, each step 1/60 s of physical time: the sea on
+/// screen moves in real time.
+pub const OCEAN_STEPS_PER_SECOND: f64 = 60.0;
+/// How far `,` and `.` turn the wind, degrees.
+pub const WIND_TURN_DEG: f64 = 15.0;
+
+impl OceanScene {
+    /// The wind after one Beaufort step down (`weaker`) or up from the current wind.
+    fn wind_step(&self, weaker: bool) -> f64 {
+        let b = sea_state::beaufort_number(self.sea.params().wind_m_s);
+        let next = if weaker { b.saturating_sub(1) } else { (b + 1).min(12) };
+        sea_state::beaufort_speed_m_s(next).unwrap_or(self.sea.params().wind_m_s)
+    }
+}
+
+impl Playable for OceanScene {
+    fn name(&self) -> &'static str {
+        "ocean"
+    }
+
+    fn steps_per_second(&self) -> f64 {
+        OCEAN_STEPS_PER_SECOND
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (self.width(), self.height())
+    }
+
+    fn step(&mut self) {
+        self.advance(1.0 / OCEAN_STEPS_PER_SECOND);
+    }
+
+    fn render(&mut self, out: &mut Pixmap) {
+        OceanScene::render(self, out);
+    }
+
+    /// Digits set the wind to that Beaufort number, `[` and `]` weaken and strengthen it by one,
+    /// `,` and `.` turn it; stones, rain and clearing mean nothing to the open sea.
+    fn resolve(&self, action: Action) -> Vec<Event> {
+        let params = self.sea.params();
+        let (speed, from) = match action {
+            Action::Key(c @ '0'..='9') => {
+                let b = c as u8 - b'0';
+                (sea_state::beaufort_speed_m_s(b).unwrap_or(params.wind_m_s), params.wind_from_deg)
+            }
+            Action::Damping(weaker) => (self.wind_step(weaker), params.wind_from_deg),
+            Action::Key(',') => (params.wind_m_s, (params.wind_from_deg - WIND_TURN_DEG).rem_euclid(360.0)),
+            Action::Key('.') => (params.wind_m_s, (params.wind_from_deg + WIND_TURN_DEG).rem_euclid(360.0)),
+            _ => return Vec::new(),
+        };
+        if (speed, from) == (params.wind_m_s, params.wind_from_deg) {
+            return Vec::new();
+        }
+        vec![Event::Wind([speed, from])]
+    }
+
+    fn apply(&mut self, event: &Event) {
+        match *event {
+            Event::Wind([speed, from]) => {
+                let params = self.sea.params();
+                self.set_sea(crate::sim::ocean::SeaParams { wind_m_s: speed, wind_from_deg: from, ..params });
+            }
+            Event::Resize([w, h]) => {
+                self.resize(w, h);
+            }
+            _ => {}
+        }
+    }
+
+    fn status(&self, out: &mut String) {
+        use std::fmt::Write;
+        out.clear();
+        let params = self.sea.params();
+        let _ = write!(
+            out,
+            "wind {:.1} m/s from {:.0}\u{b0} \u{b7} Beaufort {} \u{b7} Hs {:.1} m",
+            params.wind_m_s,
+            params.wind_from_deg,
+            sea_state::beaufort_number(params.wind_m_s),
+            self.sea.spectrum().significant_height_m()
+        );
+    }
+
+    fn help(&self) -> Vec<(&'static str, &'static str)> {
+        vec![("0 .. 9", "wind: Beaufort 0 to 9"), ("[ ]", "weaker / stronger wind"), (", .", "turn the wind 15\u{b0}")]
+    }
+
+    fn takes_stones(&self) -> bool {
+        false
+    }
+
+    fn hints(&self) -> &'static [&'static str] {
+        &[
+            "0-9 Beaufort \u{b7} [ ] wind \u{b7} , . turn \u{b7} p pause \u{b7} s shot \u{b7} tab scene \u{b7} ? help \u{b7} q quit",
+            "0-9 Beaufort \u{b7} ? help \u{b7} q quit",
+            "? help \u{b7} q quit",
+        ]
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -174,6 +280,28 @@ mod tests {
         assert_eq!(map.values[19 * 40 + 39], frame.height(390.0, -190.0));
         assert!((default_extent_m(s.sea()) - 8.0 * s.sea().spectrum().peak_wavelength_m().unwrap()).abs() < 1e-9);
         assert!(scene(0.0).heightmap(10.0, 3, 3).values.iter().all(|&v| v == 0.0));
+    }
+
+    #[test]
+    fn keys_change_the_wind_and_nothing_else() {
+        let mut s = scene(10.0);
+        assert!(s.resolve(Action::Stone { x: 3, y: 3, radius: 3, big: false }).is_empty());
+        assert!(s.resolve(Action::ToggleRain).is_empty());
+        let gale = s.resolve(Action::Key('8'));
+        assert_eq!(gale, vec![Event::Wind([18.95, 0.0])]);
+        s.apply(&gale[0]);
+        assert_eq!(s.sea().params().wind_m_s, 18.95);
+        assert_eq!(s.resolve(Action::Damping(true)), vec![Event::Wind([15.5, 0.0])]);
+        assert_eq!(s.resolve(Action::Damping(false)), vec![Event::Wind([22.6, 0.0])]);
+        assert_eq!(s.resolve(Action::Key(',')), vec![Event::Wind([18.95, 345.0])]);
+        assert_eq!(s.resolve(Action::Key('.')), vec![Event::Wind([18.95, 15.0])]);
+        assert!(s.resolve(Action::Key('8')).is_empty(), "already Beaufort 8");
+        let mut status = String::new();
+        s.status(&mut status);
+        assert!(status.contains("Beaufort 8"), "{status}");
+        let before = s.time_s();
+        Playable::step(&mut s);
+        assert!((s.time_s() - before - 1.0 / 60.0).abs() < 1e-12);
     }
 
     #[test]

@@ -71,4 +71,15 @@ pub trait Playable: Send {
 
     /// The scene's own keys for the help overlay, as (keys, what they do).
     fn help(&self) -> Vec<(&'static str, &'static str)>;
+
+    /// Whether stones (keys, clicks, drags) mean something here; the status line and the help
+    /// only mention them when they do.
+    fn takes_stones(&self) -> bool {
+        true
+    }
+
+    /// Key hints for the status line, longest first: the first that fits is shown.
+    fn hints(&self) -> &'static [&'static str] {
+        crate::term::ui::STONE_HINTS
+    }
 }

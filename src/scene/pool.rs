@@ -231,7 +231,7 @@ impl Playable for PoolScene {
             Event::Resize([w, h]) => {
                 self.resize(w, h);
             }
-            Event::Screenshot(_) | Event::End | Event::Wind(_) | Event::Noise { .. } => {}
+            Event::Screenshot(_) | Event::Wind(_) | Event::Noise { .. } | Event::End => {}
         }
     }
 

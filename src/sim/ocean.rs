@@ -296,8 +296,14 @@ impl Sea {
 
     /// The sea at `time_s` seconds, ready to sample.
     pub fn frame(&self, time_s: f64) -> SeaFrame<'_> {
-        let phase =
-            self.components.iter().map(|c| (c.phase_rad - c.omega * time_s).rem_euclid(2.0 * PI) as f32).collect();
+        self.frame_in(time_s, Vec::new())
+    }
+
+    /// [`Sea::frame`] reusing `buffer` (from [`SeaFrame::into_buffer`]), so that a stream of
+    /// frames allocates nothing.
+    pub fn frame_in(&self, time_s: f64, mut phase: Vec<f32>) -> SeaFrame<'_> {
+        phase.clear();
+        phase.extend(self.components.iter().map(|c| (c.phase_rad - c.omega * time_s).rem_euclid(2.0 * PI) as f32));
         let tail_offset = self.tail.as_ref().map_or([0.0; 2], |t| {
             let period = t.cell_m * t.field.size() as f64;
             [
@@ -315,6 +321,13 @@ pub struct SeaFrame<'a> {
     sea: &'a Sea,
     phase: Vec<f32>,
     tail_offset: [f32; 2],
+}
+
+impl SeaFrame<'_> {
+    /// Gives back the frame's buffer, for [`Sea::frame_in`].
+    pub fn into_buffer(self) -> Vec<f32> {
+        self.phase
+    }
 }
 
 /// cos(x) for any x, to about 1e-5: reduce to [-π, π] with an add-and-subtract round (no

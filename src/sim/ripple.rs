@@ -95,6 +95,10 @@ pub struct RipplePool {
     height: usize,
     current: Vec<i16>,
     previous: Vec<i16>,
+    /// Per row, a bound of the magnitudes in `current` / `previous` (see
+    /// [`super::stepper::RowMax`]): lets the step use 16-bit arithmetic where it is exact.
+    current_max: super::stepper::RowMax,
+    previous_max: super::stepper::RowMax,
     damping: Damping,
     steps: u64,
     scratch: super::stepper::Scratch,
@@ -109,6 +113,8 @@ impl RipplePool {
             height,
             current: vec![0; cells],
             previous: vec![0; cells],
+            current_max: vec![0; height],
+            previous_max: vec![0; height],
             damping,
             steps: 0,
             scratch: Default::default(),
@@ -154,6 +160,8 @@ impl RipplePool {
     pub fn clear(&mut self) {
         self.current.fill(0);
         self.previous.fill(0);
+        self.current_max.fill(0);
+        self.previous_max.fill(0);
     }
 
     /// Drops a stone into the current buffer, clipped to the interior (the wall stays zero).
@@ -184,6 +192,8 @@ impl RipplePool {
             }
             let row = y as usize * self.width;
             self.current[row + x0 as usize..=row + x1 as usize].fill(-stone.weight);
+            let bound = &mut self.current_max[y as usize];
+            *bound = (*bound).max(stone.weight.unsigned_abs());
         }
     }
 
@@ -197,8 +207,8 @@ impl RipplePool {
     /// [`RipplePool::step`] `steps` times, on any number of threads.
     pub fn advance(&mut self, steps: u64) {
         super::stepper::advance(
-            &mut self.current,
-            &mut self.previous,
+            (&mut self.current, &mut self.current_max),
+            (&mut self.previous, &mut self.previous_max),
             self.width,
             self.height,
             self.damping,
@@ -231,6 +241,7 @@ mod tests {
             }
         }
         std::mem::swap(&mut pool.current, &mut pool.previous);
+        pool.recompute_row_max();
         pool.steps += 1;
     }
 
@@ -262,6 +273,7 @@ mod tests {
                     assert_eq!(fast.heights(), slow.heights(), "{w}x{h} {damping:?} after {steps}");
                     assert_eq!(fast.previous_heights(), slow.previous_heights(), "{w}x{h} {damping:?}");
                     assert_eq!(fast.steps(), slow.steps());
+                    fast.assert_row_max_holds();
                 }
             }
         }
@@ -288,6 +300,7 @@ mod tests {
             let many = run(threads);
             assert_eq!(many.heights(), one.heights(), "{threads} threads");
             assert_eq!(many.previous_heights(), one.previous_heights(), "{threads} threads");
+            many.assert_row_max_holds();
         }
     }
 
@@ -295,7 +308,35 @@ mod tests {
         let mut pool = RipplePool::new(width, height, damping);
         pool.current.copy_from_slice(current);
         pool.previous.copy_from_slice(previous);
+        pool.recompute_row_max();
         pool
+    }
+
+    impl RipplePool {
+        /// After writing the buffers directly: the exact row maxima.
+        fn recompute_row_max(&mut self) {
+            let w = self.width;
+            let max_of = |cells: &[i16], row: usize| {
+                cells[row * w..(row + 1) * w].iter().map(|v| v.unsigned_abs()).max().unwrap_or(0)
+            };
+            for row in 0..self.height {
+                self.current_max[row] = max_of(&self.current, row);
+                self.previous_max[row] = max_of(&self.previous, row);
+            }
+        }
+
+        /// The row maxima bound every row (the invariant the 16-bit path relies on).
+        fn assert_row_max_holds(&self) {
+            let w = self.width;
+            for row in 0..self.height {
+                for (cells, bounds, name) in
+                    [(&self.current, &self.current_max, "current"), (&self.previous, &self.previous_max, "previous")]
+                {
+                    let actual = cells[row * w..(row + 1) * w].iter().map(|v| v.unsigned_abs()).max().unwrap_or(0);
+                    assert!(actual <= bounds[row], "{name} row {row}: |v| {actual} over its bound {}", bounds[row]);
+                }
+            }
+        }
     }
 
     #[test]
@@ -339,6 +380,7 @@ mod tests {
         // (-3 >> 1) = -2, not -1.
         let mut pool = RipplePool::new(5, 5, Damping::Off);
         pool.current[5 + 2] = -3;
+        pool.recompute_row_max();
         pool.step();
         assert_eq!(pool.heights()[2 * 5 + 2], -2);
     }
@@ -515,6 +557,7 @@ mod tests {
                         reference_step(&mut slow);
                     }
                     prop_assert_eq!(fast.heights(), slow.heights());
+                    fast.assert_row_max_holds();
                 }
                 for x in 0..w {
                     prop_assert_eq!(fast.heights()[x], 0);

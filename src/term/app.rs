@@ -289,7 +289,7 @@ impl Player {
             Input::Help => {
                 self.help = match self.help {
                     Some(_) => None,
-                    None => Some(ui::help_lines(&self.scene.help())),
+                    None => Some(ui::help_lines(&self.scene.help(), self.scene.takes_stones())),
                 }
             }
             Input::RandomStone => {
@@ -382,7 +382,7 @@ impl Player {
         self.scene = (self.make)(next, w, h)?;
         self.kind = next;
         if self.help.is_some() {
-            self.help = Some(ui::help_lines(&self.scene.help()));
+            self.help = Some(ui::help_lines(&self.scene.help(), self.scene.takes_stones()));
         }
         self.sim = SimClock::new(self.scene.steps_per_second(), Instant::now());
         Ok(())

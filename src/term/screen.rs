@@ -23,7 +23,7 @@ pub struct Overlay<'a> {
     pub fps: u32,
     /// Bytes sent per second.
     pub bytes_per_second: u64,
-    /// The stone radius in pixels.
+    /// The stone radius in pixels (shown when the scene takes stones).
     pub stone: u32,
     /// Whether the simulation is paused.
     pub paused: bool,
@@ -81,7 +81,8 @@ impl FrameBuilder {
             fps: overlay.fps,
             rate: &self.rate,
             detail: &self.detail,
-            stone: overlay.stone,
+            stone: scene.takes_stones().then_some(overlay.stone),
+            hints: scene.hints(),
             paused: overlay.paused,
             message: overlay.message,
         };

@@ -33,16 +33,18 @@ pub struct Status<'a> {
     pub rate: &'a str,
     /// The scene's own summary.
     pub detail: &'a str,
-    /// The stone radius in pixels.
-    pub stone: u32,
+    /// The stone radius in pixels, for scenes that take stones.
+    pub stone: Option<u32>,
+    /// Key hints, longest first: the first that fits is shown.
+    pub hints: &'a [&'static str],
     /// Paused.
     pub paused: bool,
     /// A passing message (screenshot saved...), shown instead of the key hints.
     pub message: Option<&'a str>,
 }
 
-/// The key hints, longest first: the first that fits is shown.
-const HINTS: [&str; 3] = [
+/// The key hints of scenes that take stones, longest first: the first that fits is shown.
+pub const STONE_HINTS: &[&str] = &[
     "space stone \u{b7} click drop \u{b7} drag stir \u{b7} arrows+enter aim \u{b7} r rain \u{b7} c clear \u{b7} p pause \u{b7} s shot \u{b7} ? help \u{b7} q quit",
     "space stone \u{b7} click drop \u{b7} ? help \u{b7} q quit",
     "? help \u{b7} q quit",
@@ -58,9 +60,12 @@ pub fn status_line(frame: &mut Frame, row: usize, status: &Status<'_>, mode: Col
     scratch.clear();
     let _ = write!(
         scratch,
-        " {}{paused} \u{b7} {} fps \u{b7} {} \u{b7} {} \u{b7} stone {} ",
-        status.scene, status.fps, status.rate, status.detail, status.stone
+        " {}{paused} \u{b7} {} fps \u{b7} {} \u{b7} {} ",
+        status.scene, status.fps, status.rate, status.detail
     );
+    if let Some(stone) = status.stone {
+        let _ = write!(scratch, "\u{b7} stone {stone} ");
+    }
     let cols = frame.cols();
     let left_len = scratch.chars().count();
     frame.text(0, row, scratch, fg, bg);
@@ -71,7 +76,7 @@ pub fn status_line(frame: &mut Frame, row: usize, status: &Status<'_>, mode: Col
         }
         None => {
             let room = cols.saturating_sub(left_len + 1);
-            if let Some(h) = HINTS.iter().find(|h| h.chars().count() <= room) {
+            if let Some(h) = status.hints.iter().find(|h| h.chars().count() <= room) {
                 let _ = write!(scratch, "{h} ");
             }
         }
@@ -106,17 +111,21 @@ pub fn aim_marker(frame: &mut Frame, x: u32, y: u32) {
     frame.set(col, row, Cell::Text { ch: '+', fg, bg: under });
 }
 
-/// Every key and mouse action the player knows, with `scene` keys added.
-pub fn help_lines(scene: &[(&'static str, &'static str)]) -> Vec<(&'static str, &'static str)> {
-    let mut lines = vec![
-        ("space", "a stone at a random spot"),
-        ("arrows hjkl", "move the aim"),
-        ("enter", "a stone at the aim"),
-        ("left click", "a stone where you click"),
-        ("drag", "stir the water"),
-        ("right click", "a big stone"),
-        ("+ -", "bigger / smaller stones"),
-    ];
+/// Every key and mouse action the player knows, with `scene` keys added; the stone keys and
+/// mouse actions only when the scene `takes_stones`.
+pub fn help_lines(scene: &[(&'static str, &'static str)], takes_stones: bool) -> Vec<(&'static str, &'static str)> {
+    let mut lines = Vec::new();
+    if takes_stones {
+        lines.extend_from_slice(&[
+            ("space", "a stone at a random spot"),
+            ("arrows hjkl", "move the aim"),
+            ("enter", "a stone at the aim"),
+            ("left click", "a stone where you click"),
+            ("drag", "stir the water"),
+            ("right click", "a big stone"),
+            ("+ -", "bigger / smaller stones"),
+        ]);
+    }
     lines.extend_from_slice(scene);
     lines.extend_from_slice(&[
         ("p", "pause / resume"),
@@ -196,7 +205,8 @@ mod tests {
             fps: 30,
             rate: "1.2 kB/s",
             detail: "rain 0.02 \u{b7} damping 5",
-            stone: 4,
+            stone: Some(4),
+            hints: STONE_HINTS,
             ..Status::default()
         }
     }
@@ -223,7 +233,8 @@ mod tests {
 
     #[test]
     fn help_lists_every_key_and_fits() {
-        let lines = help_lines(&[("r", "rain on/off")]);
+        let lines = help_lines(&[("r", "rain on/off")], true);
+        assert!(!help_lines(&[], false).iter().any(|(k, _)| *k == "space"), "no stones, no stone keys");
         let mut f = Frame::new(80, 30);
         help_overlay(&mut f, &lines, ColorMode::TrueColor);
         let all: String = (0..30).map(|y| row(&f, y)).collect();

@@ -38,32 +38,67 @@ fn updating() -> bool {
     std::env::var_os("UPDATE_GOLDEN").is_some_and(|v| !v.is_empty() && v != "0")
 }
 
-/// Compares a picture with `tests/golden/<name>.png`.
-pub fn check_png(name: &str, actual: &RgbaImage, tolerance: Tolerance) {
-    let path = reference_dir().join(format!("{name}.png"));
-    if updating() {
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        actual.save(&path).unwrap();
-        panic!("UPDATE_GOLDEN: wrote {}; look at it, then run the tests without UPDATE_GOLDEN", path.display());
-    }
-    let expected = load_reference(&path, |p| image::open(p).map(|i| i.to_rgba8()).map_err(|e| e.to_string()));
-    compare(name, &expected, actual, tolerance);
+/// A test's golden checks. In an update run (`UPDATE_GOLDEN=1`) every reference is written,
+/// and when the value is dropped at the end of the test it fails, listing them: a test with
+/// several references rewrites them all in one run, and an update run never passes.
+#[derive(Default)]
+pub struct Goldens {
+    updated: Vec<PathBuf>,
 }
 
-/// Compares half-block text with `tests/golden/<name>.ans`, by the pixels a terminal shows.
-/// Default-background halves decode as transparent black.
-pub fn check_ansi(name: &str, actual: &[u8], tolerance: Tolerance) {
-    let path = reference_dir().join(format!("{name}.ans"));
-    if updating() {
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        std::fs::write(&path, actual).unwrap();
-        panic!(
-            "UPDATE_GOLDEN: wrote {}; look at it (cat it), then run the tests without UPDATE_GOLDEN",
-            path.display()
-        );
+impl Goldens {
+    /// Checks for one test.
+    pub fn new() -> Goldens {
+        Goldens::default()
     }
-    let expected = load_reference(&path, |p| std::fs::read(p).map_err(|e| e.to_string()));
-    compare(name, &decode_ansi(&expected), &decode_ansi(actual), tolerance);
+
+    /// Compares a picture with `tests/golden/<name>.png`.
+    pub fn png(&mut self, name: &str, actual: &RgbaImage, tolerance: Tolerance) {
+        let path = reference_dir().join(format!("{name}.png"));
+        if updating() {
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            actual.save(&path).unwrap();
+            println!("UPDATE_GOLDEN: wrote {}", path.display());
+            self.updated.push(path);
+            return;
+        }
+        let expected = load_reference(&path, |p| image::open(p).map(|i| i.to_rgba8()).map_err(|e| e.to_string()));
+        compare(name, &expected, actual, tolerance);
+    }
+
+    /// Compares half-block text with `tests/golden/<name>.ans`, by the pixels a terminal
+    /// shows. Default-background halves decode as transparent black.
+    pub fn ansi(&mut self, name: &str, actual: &[u8], tolerance: Tolerance) {
+        let path = reference_dir().join(format!("{name}.ans"));
+        if updating() {
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(&path, actual).unwrap();
+            println!("UPDATE_GOLDEN: wrote {} (cat it to look at it)", path.display());
+            self.updated.push(path);
+            return;
+        }
+        let expected = load_reference(&path, |p| std::fs::read(p).map_err(|e| e.to_string()));
+        compare(name, &decode_ansi(&expected), &decode_ansi(actual), tolerance);
+    }
+}
+
+impl Drop for Goldens {
+    fn drop(&mut self) {
+        if !self.updated.is_empty() && !std::thread::panicking() {
+            let list: Vec<String> = self.updated.iter().map(|p| p.display().to_string()).collect();
+            panic!("UPDATE_GOLDEN: wrote {}; look at each, then run the tests without UPDATE_GOLDEN", list.join(", "));
+        }
+    }
+}
+
+/// Compares a picture with `tests/golden/<name>.png` (one reference; see [`Goldens`]).
+pub fn check_png(name: &str, actual: &RgbaImage, tolerance: Tolerance) {
+    Goldens::new().png(name, actual, tolerance);
+}
+
+/// Compares half-block text with `tests/golden/<name>.ans` (one reference; see [`Goldens`]).
+pub fn check_ansi(name: &str, actual: &[u8], tolerance: Tolerance) {
+    Goldens::new().ansi(name, actual, tolerance);
 }
 
 /// Decodes half-block text (as written by `tidepool --format ansi`) into pixels.

@@ -1,0 +1,133 @@
+//! Animations and caustics, rendered by the binary: GIF frames and timing, APNG and PNG
+//! sequences, replays turned into animations, and golden pictures of both.
+
+mod common;
+
+use common::golden::{self, Tolerance};
+use common::{read_png, run_in, scratch, stderr};
+
+/// Decodes a GIF into its frames as composited RGBA pictures, with their delays (1/100 s).
+fn gif_frames(bytes: &[u8]) -> (u32, u32, Vec<(image::RgbaImage, u16)>) {
+    let mut options = gif::DecodeOptions::new();
+    options.set_color_output(gif::ColorOutput::RGBA);
+    let mut decoder = options.read_info(std::io::Cursor::new(bytes)).unwrap();
+    let (w, h) = (u32::from(decoder.width()), u32::from(decoder.height()));
+    let mut screen = image::RgbaImage::new(w, h);
+    let mut frames = Vec::new();
+    while let Some(frame) = decoder.read_next_frame().unwrap() {
+        for y in 0..u32::from(frame.height) {
+            for x in 0..u32::from(frame.width) {
+                let i = ((y * u32::from(frame.width) + x) * 4) as usize;
+                let px = &frame.buffer[i..i + 4];
+                if px[3] != 0 {
+                    screen.put_pixel(
+                        x + u32::from(frame.left),
+                        y + u32::from(frame.top),
+                        image::Rgba([px[0], px[1], px[2], 255]),
+                    );
+                }
+            }
+        }
+        frames.push((screen.clone(), frame.delay));
+    }
+    (w, h, frames)
+}
+
+/// A GIF's frames match the PNGs of the same steps within the palette's tolerance.
+const GIF_TOLERANCE: Tolerance = Tolerance { channel: 48, max_fraction: 0.02 };
+
+#[test]
+fn a_gif_of_falling_stones() {
+    let dir = scratch("gif_stones");
+    let out =
+        run_in(&dir, &["render", "pool", "--size", "96x64", "--frames", "12", "--fps", "20", "--out", "drops.gif"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (w, h, frames) = gif_frames(&std::fs::read(dir.join("drops.gif")).unwrap());
+    assert_eq!((w, h, frames.len()), (96, 64, 12));
+    assert!(frames.iter().all(|(_, delay)| *delay == 5), "20 fps = 5 cs a frame");
+    let mut goldens = golden::Goldens::new();
+    goldens.png("anim_first_frame", &frames[0].0, GIF_TOLERANCE);
+    goldens.png("anim_last_frame", &frames[11].0, GIF_TOLERANCE);
+    // The last frame is the pool after 11 · 60 / 20 = 33 steps: the same as a still render.
+    let still = run_in(&dir, &["render", "pool", "--size", "96x64", "--steps", "33", "--out", "still.png"]);
+    assert!(still.status.success());
+    golden::compare("anim_last_vs_still", &read_png(&dir.join("still.png")), &frames[11].0, GIF_TOLERANCE);
+}
+
+#[test]
+fn apng_and_png_sequences_hold_every_frame() {
+    let dir = scratch("apng_sequence");
+    std::fs::create_dir(dir.join("frames")).unwrap();
+    let args = ["render", "pool", "--size", "40x30", "--frames", "5", "--fps", "60", "--rain", "1"];
+    for out in ["anim.png", "frames/f_{frame:03}.png"] {
+        let result = run_in(&dir, &[&args[..], &["--out", out]].concat());
+        assert!(result.status.success(), "{out}: {}", stderr(&result));
+    }
+    let decoder = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(dir.join("anim.png")).unwrap()));
+    let mut reader = decoder.read_info().unwrap();
+    assert_eq!(reader.info().animation_control().unwrap().num_frames, 5);
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    for k in 0..5 {
+        reader.next_frame(&mut buf).unwrap();
+        // The same frame as the sequence's PNG, to the byte.
+        let file = read_png(&dir.join(format!("frames/f_{k:03}.png")));
+        let rgb: Vec<u8> = file.pixels().flat_map(|p| [p[0], p[1], p[2]]).collect();
+        assert_eq!(&buf[..rgb.len()], &rgb[..], "frame {k}");
+    }
+    assert!(!dir.join("frames/f_005.png").exists());
+}
+
+#[test]
+fn animation_flags_are_checked() {
+    let dir = scratch("anim_flags");
+    let cases: &[(&[&str], &str)] = &[
+        (&["--frames", "3", "--out", "a.gif", "--fps", "60"], "--fps"),
+        (&["--frames", "3", "--out", "a.mp4"], "--out"),
+        (&["--frames", "3", "--out", "-"], "standard output"),
+        (&["--frames", "3", "--out", "a.gif", "--heightmap", "h.npy"], "--heightmap"),
+        (&["--frames", "3", "--out", "a.gif", "--format", "png"], "--format"),
+        (&["--frames", "0", "--out", "a.gif"], "--frames"),
+        (&["--frames", "3", "--out", "f_{frame:4}.png"], "--out"),
+    ];
+    for (args, needle) in cases {
+        let out = run_in(&dir, &[&["render", "pool", "--size", "20x20"], *args].concat());
+        assert_eq!(out.status.code(), Some(2), "{args:?}");
+        assert!(stderr(&out).contains(needle), "{args:?}: {}", stderr(&out));
+    }
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "nothing written");
+}
+
+#[test]
+fn the_ocean_animates_in_physical_time() {
+    let dir = scratch("ocean_gif");
+    let out = run_in(&dir, &["render", "ocean", "--size", "64x36", "--frames", "4", "--fps", "10", "--out", "sea.gif"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (_, _, frames) = gif_frames(&std::fs::read(dir.join("sea.gif")).unwrap());
+    assert_eq!(frames.len(), 4);
+    assert_ne!(frames[0].0, frames[3].0, "the sea moved");
+    // Frame 3 at 10 fps is 0.3 s of sea: the same as a still picture at --time 0.3.
+    let still = run_in(&dir, &["render", "ocean", "--size", "64x36", "--time", "0.3", "--ssaa", "2", "--out", "t.png"]);
+    assert!(still.status.success());
+    golden::compare("ocean_frame_vs_still", &read_png(&dir.join("t.png")), &frames[3].0, GIF_TOLERANCE);
+}
+
+#[test]
+fn caustics_throw_rings_of_light_on_the_floor() {
+    let dir = scratch("caustics");
+    let args = ["render", "pool", "--size", "160x120", "--stone", "80,60,5,200", "--steps", "40", "--sun", "90,50"];
+    for (out, extra) in [("lit.png", &[][..]), ("dark.png", &["--no-caustics"][..])] {
+        let result = run_in(&dir, &[&args[..], extra, &["--out", out]].concat());
+        assert!(result.status.success(), "{}", stderr(&result));
+    }
+    let lit = read_png(&dir.join("lit.png"));
+    golden::check_png("pool_caustics", &lit, Tolerance::default());
+    let dark = read_png(&dir.join("dark.png"));
+    // Brighter than the floor somewhere on a ring (the focused light), darker elsewhere.
+    let luma = |p: &image::Rgba<u8>| u32::from(p[0]) + u32::from(p[1]) + u32::from(p[2]);
+    let (mut brighter, mut darker) = (0, 0);
+    for (a, b) in lit.pixels().zip(dark.pixels()) {
+        brighter += usize::from(luma(a) > luma(b) + 60);
+        darker += usize::from(luma(a) + 30 < luma(b));
+    }
+    assert!(brighter > 100 && darker > 100, "brighter {brighter}, darker {darker}");
+}
