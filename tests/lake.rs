@@ -35,11 +35,12 @@ fn windy_lake_golden() {
 #[test]
 fn half_block_lake_goldens() {
     let dir = scratch("lake_ansi");
+    let mut goldens = golden::Goldens::new();
     for (name, wind) in [("lake_calm_small", "0"), ("lake_windy_small", "6")] {
         render(&dir, &["--wind", wind, "--time", "1", "--size", "80x48", "--out", "lake.ans"]);
         let text = std::fs::read(dir.join("lake.ans")).unwrap();
         assert_eq!(String::from_utf8_lossy(&text).lines().count(), 24, "two pixel rows per line");
-        golden::check_ansi(name, &text, Tolerance::default());
+        goldens.ansi(name, &text, Tolerance::default());
     }
     // Standard output gets the same text.
     let stdout = render(&dir, &["--wind", "6", "--time", "1", "--size", "80x48", "--out", "-"]);
