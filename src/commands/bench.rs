@@ -13,9 +13,11 @@ use crate::render::background;
 use crate::render::ocean::OceanView;
 use crate::render::pool::PoolLook;
 use crate::render::texture::SeaTexture;
+use crate::scene::lake::{LakeScene, LakeSettings};
 use crate::scene::ocean::{OceanScene, OceanSettings};
 use crate::scene::playable::Playable;
 use crate::scene::pool::{PoolScene, PoolSettings};
+use crate::sim::lake::LakeParams;
 use crate::sim::ocean::SeaParams;
 use crate::sim::ripple::{Damping, RipplePool, Stone};
 use crate::sim::stepper::Kernel;
@@ -60,6 +62,10 @@ fn other_scenes(w: u32, h: u32, ssaa: u32) -> Vec<(&'static str, Box<dyn Playabl
     };
     if let Some(scene) = OceanScene::new(ocean, w, h, SeaTexture::builtin()) {
         scenes.push(("ocean", Box::new(scene)));
+    }
+    let lake = LakeSettings { lake: LakeParams::default(), ssaa };
+    if let Some(scene) = LakeScene::new(lake, w, h) {
+        scenes.push(("lake", Box::new(scene)));
     }
     scenes
 }
