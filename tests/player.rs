@@ -232,7 +232,26 @@ fn the_ocean_plays_its_wind_keys_and_tab_switches_scenes() {
     p.send(b".");
     p.wait_for_status("from 345", WAIT);
     p.send(b"\t");
+    p.wait_for_status("octaves", WAIT);
+    p.send(b"\t");
     p.wait_for_status("damping", WAIT);
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+    assert_restored(&p);
+}
+
+#[test]
+fn the_lake_plays_its_wind_and_noise_keys() {
+    let mut p = Player::spawn(&temp_dir("lake"), 80, 20, &[ARGS, &["lake"]].concat(), &[]);
+    p.wait_for_status("wind 3 m/s", WAIT);
+    p.send(b"]");
+    p.wait_for_status("wind 4 m/s", WAIT);
+    p.send(b"c");
+    p.wait_for_status("wind 0 m/s", WAIT);
+    p.send(b"n");
+    p.wait_for_status("\u{b7} gradient", WAIT);
+    p.send(b"O");
+    p.wait_for_status("4 octaves", WAIT);
     p.send(b"q");
     assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
     assert_restored(&p);

@@ -19,6 +19,13 @@
 //!    faces and breaks the shore's reflection into pieces, and the unresolved ripples smear
 //!    the far reflection into vertical streaks (a window of rows of the mirror, ±√3·2σ·focal);
 //! 4. supersampled pictures are box-filtered down.
+//!
+//! The paper meshes its water as a unit grid of quads, one normal each. tidepool samples the
+//! noise on the shared mesh's lattice instead, which is laid out on the screen: its faces are
+//! a few pixels wide everywhere — centimetres near the camera, metres long near the far
+//! shore, where the footprint filter leaves out the octaves they cannot carry. A literal
+//! one-metre grid over this lake would be 250,000 quads, most far smaller than a pixel (and
+//! aliasing), while the ripples near the camera are shorter than a metre.
 
 use rayon::prelude::*;
 use tiny_skia::Pixmap;

@@ -23,36 +23,37 @@
 //!    edges come from supersampling ([`crate::render::supersample`]).
 //! 4. **Or deferred** ([`MeshRenderer::draw_ids`]): the same faces, but each pixel gets the
 //!    number of the face it shows ([`FaceIds`]) and [`MeshRenderer::facet`] gives that face's
-//!    [`Facet`], for a renderer that shades per pixel (the lake's mirror looks up its
-//!    reflection per pixel with the face's normal). The numbers are written by
-//!    [`crate::render::raster::fill_triangle_ids`], an exact integer fill with the same
-//!    coverage as tiny-skia's non-AA fill (pixel centres, watertight); tiny-skia would need the
-//!    ids as colours and allocates an edge list for every triangle, and the player's frames
-//!    must not allocate.
+//!    [`Facet`], for a renderer that shades per pixel. The numbers are written by
+//!    [`crate::render::raster::fill_triangle_ids`], an exact integer fill of the pixels whose
+//!    centres lie inside (as tiny-skia's non-AA fill does, watertight): tiny-skia would need
+//!    the numbers as colours and allocates an edge list for every triangle, and the player's
+//!    frames must not allocate.
 //!
-//! # Reusing it (the lake)
+//! # The two users
 //!
 //! ```text
-//! impl Surface for LakeFrame { fn sample(&self, x, y, footprint) -> SurfaceSample { .. } }
-//! struct SkyAndShore { sky: Sky, .. }   impl Environment for SkyAndShore { fn radiance(..) }
-//!
-//! let camera = Camera::new(pose, width * ssaa, height * ssaa);     // once per view
-//! let mut mesh = MeshRenderer::new();                               // keep between frames
-//! // each frame:
-//! sky.draw(&camera, far_water_colour, &mut big);                    // or your own background
-//! mesh.prepare(&camera, spacing_px * ssaa as f32);                  // no-op if nothing moved
-//! mesh.draw(&lake_frame, &Shading { environment: &sky_and_shore, light: sky.light(),
-//!                                   look: WaterLook { .. }, texture: &texture }, &mut big);
+//! // The ocean (crate::render::ocean): one colour per face.
+//! sky.draw(&camera, far_sea_colour, &mut big);
+//! mesh.prepare(&camera, spacing_px * ssaa as f32);              // no-op if nothing moved
+//! mesh.draw(&sea_frame, &Shading { environment: &sky, light: sky.light(), look, texture }, &mut big);
 //! supersample::downsample(&big, ssaa, Downsample::Box, &mut out);
+//!
+//! // The lake (crate::render::lake): face numbers, then a per-pixel mirror.
+//! mesh.prepare(&camera, spacing_px * ssaa as f32);
+//! mesh.draw_ids(&lake_frame, &mut ids);
+//! for each face i: mesh.facet(i), mesh.face_points(i), mesh.vertex_samples()  -> its shading
+//! for each pixel: its face's normal reflects the view ray -> a mirror lookup, Fresnel blend
 //! ```
 //!
 //! - [`Surface`] returns heights in metres plus foam cover and the slope variance the mesh
-//!   cannot show (0 for a smooth lake); its [`Footprint`] says what the mesh can carry.
-//! - [`Environment`] is what the water reflects: [`crate::render::sky::Sky`] alone for the
-//!   ocean; the lake answers with its shore for directions that hit the shore.
+//!   cannot show; its [`Footprint`] says what the mesh can carry.
+//! - [`Environment`] is what the ocean reflects ([`crate::render::sky::Sky`]): light by
+//!   direction alone, right for a sky at infinity. The lake's shore is 300 m from a 3 m eye,
+//!   where a lookup by direction would lift its reflection twice the eye height off the
+//!   waterline; the lake reflects through a mirror camera instead
+//!   ([`crate::render::mirror`]).
 //! - [`WaterLook`] holds the colours and strengths (body light, glint, foam, haze distance);
 //!   [`SeaTexture`] is any image tiled over the water in metres (`SeaTexture::from_pixmap`).
-//! - [`crate::render::ocean::OceanRenderer`] is the ocean's use of all this, in 60 lines.
 
 use rayon::prelude::*;
 use spade::{DelaunayTriangulation, Point2, Triangulation};

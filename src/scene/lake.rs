@@ -205,7 +205,7 @@ impl Playable for LakeScene {
         out.clear();
         let _ = write!(
             out,
-            "wind {:.0} m/s \u{b7} {} octaves \u{b7} persistence {:.2} \u{b7} {} noise",
+            "wind {} m/s \u{b7} {} octaves \u{b7} p {:.2} \u{b7} {}",
             p.wind_m_s,
             p.octaves,
             p.persistence,
@@ -283,7 +283,7 @@ mod tests {
         assert!(!s.takes_stones());
         let mut status = String::new();
         s.status(&mut status);
-        assert_eq!(status, "wind 4 m/s \u{b7} 4 octaves \u{b7} persistence 0.55 \u{b7} gradient noise");
+        assert_eq!(status, "wind 4 m/s \u{b7} 4 octaves \u{b7} p 0.55 \u{b7} gradient");
         // Limits hold: no wind below 0, at most MAX_OCTAVES octaves; an ocean's wind from
         // another direction still sets the lake's speed.
         let mut calm = scene(0.0);

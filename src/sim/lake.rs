@@ -4,8 +4,9 @@
 //! tidepool gives the sum a physical scale so that `--wind` means metres per second:
 //!
 //! - **Geometry.** The camera stands on the south shore at the origin; the far (north) shore
-//!   runs east-west [`FAR_SHORE_M`] metres away, and the lake reaches past both sides of the
-//!   view ([`LAKE_WIDTH_M`] east-west). Z = 0 is the still water plane; heights are metres.
+//!   runs east-west [`FAR_SHORE_M`] metres away, drawn over ±55° (870 m at the waterline,
+//!   see `crate::render::shore`); the east and west shores lie outside the view, so the water
+//!   has no edge but the far shore. Z = 0 is the still water plane; heights are metres.
 //! - **Wind.** It blows from the far shore towards the camera, over a fetch of
 //!   [`FAR_SHORE_M`]. The ripples' length is that of the fetch-limited JONSWAP sea (Hasselmann
 //!   et al. 1973): peak frequency `fp = 3.5·(g/U)·(gF/U²)^-0.33`, 0.77 m at 5 m/s. What a
@@ -36,8 +37,6 @@ use super::surface::{Footprint, Surface, SurfaceSample};
 
 /// The far shore's distance north of the camera's shore, m: the wind's fetch.
 pub const FAR_SHORE_M: f32 = 300.0;
-/// The lake's east-west extent, m (beyond the view on both sides).
-pub const LAKE_WIDTH_M: f32 = 1200.0;
 /// Below this wind speed the slopes fade in as (U / onset)², m/s.
 pub const RIPPLE_ONSET_M_S: f64 = 2.0;
 /// Standard gravity, m/s².
