@@ -72,6 +72,20 @@ fn same_flags_same_bytes_time_moves_the_water_and_flags_matter() {
     assert_eq!(picture("c1.png", &["--wind", "0", "--time", "0"]), picture("c2.png", &["--wind", "0", "--time", "9"]));
 }
 
+#[test]
+fn animations_move_the_water() {
+    let dir = scratch("lake_animation");
+    render(&dir, &["--wind", "5", "--frames", "3", "--fps", "10", "--size", "48x27", "--out", "f_{frame}.png"]);
+    let frames: Vec<Vec<u8>> = (0..3).map(|k| std::fs::read(dir.join(format!("f_{k}.png"))).unwrap()).collect();
+    assert!(frames[0] != frames[1] && frames[1] != frames[2], "each frame a tenth of a second on");
+    // The first frame is the picture at --time; animations take no heightmap.
+    render(&dir, &["--wind", "5", "--size", "48x27", "--ssaa", "2", "--out", "still.png"]);
+    assert_eq!(read_png(&dir.join("still.png")), read_png(&dir.join("f_0.png")));
+    let out = run_in(&dir, &["render", "lake", "--frames", "2", "--heightmap", "h.npy", "--out", "a.gif"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--heightmap"));
+}
+
 /// Reads a float32 NPY written by tidepool: (rows, columns, values).
 fn read_npy(bytes: &[u8]) -> (usize, usize, Vec<f32>) {
     assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");

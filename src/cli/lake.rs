@@ -15,7 +15,8 @@ Examples:
   tidepool render lake --wind 7 --time 2.5 --out windy.png
   tidepool render lake --noise gradient --octaves 7 --persistence 0.6 --out rough.png
   tidepool render lake --out - --size 160x96           # in this terminal
-  tidepool render lake --wind 5 --heightmap lake.npy --size 600x300";
+  tidepool render lake --wind 5 --heightmap lake.npy --size 600x300
+  tidepool render lake --wind 4 --frames 90 --fps 30 --size 480x270 --out breeze.gif";
 
 /// `--noise`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -96,6 +97,10 @@ pub struct RenderLake {
     /// count to standard error.
     #[arg(long)]
     pub stats: bool,
+
+    /// An animation instead of one picture (it starts at --time).
+    #[command(flatten)]
+    pub animation: super::AnimationArgs,
 }
 
 impl RenderLake {

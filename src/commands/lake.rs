@@ -31,6 +31,9 @@ pub fn settings(args: &RenderLake, ssaa: u32) -> LakeSettings {
 
 /// Runs `tidepool render lake`.
 pub fn render_lake(args: RenderLake) -> Result<()> {
+    if let Some(frames) = args.animation.frames {
+        return animate_lake(&args, frames);
+    }
     let plan = OutputPlan::new(&args.output_args(), "lake", std::io::stdout().is_terminal(), terminal_pixels())?;
     let ssaa = args.ssaa.unwrap_or_else(|| default_ssaa(plan.format));
     check_pixels(plan.size, ssaa).map_err(|e| Error::arg("--size", format!("{e} (or lower --ssaa)")))?;
@@ -54,6 +57,32 @@ pub fn render_lake(args: RenderLake) -> Result<()> {
     // The supersampled buffers are the largest allocations; free them before encoding.
     drop(scene);
     plan.write_timed(&picture, heights.as_ref(), HEIGHTMAP_PNG_SCALE, &mut stats)?;
+    if args.stats {
+        eprint!("{}", stats.report());
+    }
+    Ok(())
+}
+
+/// `tidepool render lake --frames N`: the lake from `--time` on, 1/30 s a step as in the player.
+fn animate_lake(args: &RenderLake, frames: u32) -> Result<()> {
+    use super::animate::{Animation, AnimationTarget, animate};
+    super::render::check_animation_flags(&args.output_args())?;
+    let target = AnimationTarget::from_out(args.out.as_deref(), "lake", args.animation.fps)?;
+    let size = args.size.unwrap_or(super::render::DEFAULT_PNG_SIZE);
+    let ssaa = args.ssaa.unwrap_or_else(|| default_ssaa(crate::cli::Format::Png));
+    check_pixels(size, ssaa).map_err(|e| Error::arg("--size", format!("{e} (or lower --ssaa)")))?;
+    let settings = settings(args, ssaa);
+    let time = args.time;
+    let mut make = || -> Result<Box<dyn crate::scene::playable::Playable>> {
+        let mut scene = LakeScene::new(settings, size.width, size.height).ok_or_else(|| {
+            Error::arg("--size", format!("cannot allocate a {size} picture; choose a smaller size or --ssaa"))
+        })?;
+        scene.set_time(time);
+        Ok(Box::new(scene))
+    };
+    let animation = Animation { frames, fps: args.animation.fps, start_step: 0, script: &[] };
+    let mut stats = Stats::default();
+    animate(&mut make, &animation, &target, &mut stats)?;
     if args.stats {
         eprint!("{}", stats.report());
     }
