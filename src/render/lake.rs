@@ -363,8 +363,8 @@ impl PixelPass<'_> {
     /// is shaded once, at the block's centre (the face's quantities are smooth, so the mean
     /// of its samples is the centre's); only blocks along face edges shade every sample —
     /// multisample anti-aliasing, in effect. At 1920x1080 with 2x2 samples three blocks in
-    /// four are whole: 2.0 million lookups instead of 4.6 million, 97 ms a frame instead of
-    /// 120. (Shading each face of an edge block once instead of each sample saved nothing
+    /// four are whole: 2.0 million lookups instead of 4.6 million, about 95 ms a frame instead
+    /// of 120. (Shading each face of an edge block once instead of each sample saved nothing
     /// measurable: the lookups' memory reads, not their arithmetic, set the pace.)
     fn blocks(&self, top: usize, ssaa: usize, waterline: usize, rows: &mut [u8], ids: &mut [u32]) {
         let width = ids.len() / ssaa.max(1);
