@@ -275,12 +275,14 @@ pub struct AnimationArgs {
 /// Flags every rendered scene takes.
 #[derive(Args, Debug, Clone)]
 pub struct OutputArgs {
-    /// Picture size in pixels, WIDTHxHEIGHT (each side 1..=16384, at most 64 megapixels).
-    /// [default: 640x360 for PNG; for text, the terminal's size when writing to it, else 80x48]
+    /// Picture size in pixels, WIDTHxHEIGHT (each side 1..=16384, at most 64 megapixels including
+    /// any supersampling). [default: 640x360 for PNG; for text, the terminal's size when writing
+    /// to it, else 80x48]
     #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]
     pub size: Option<Size>,
 
-    /// Seed for everything random (rain, phases); the same seed and flags give the same bytes.
+    /// Seed for everything random (rain, wave phases, noise, the shore); the same seed and flags
+    /// give the same bytes.
     #[arg(long, value_name = "N", default_value_t = 1, allow_negative_numbers = true)]
     pub seed: u64,
 
@@ -298,8 +300,8 @@ pub struct OutputArgs {
     #[arg(long, value_name = "FILE")]
     pub heightmap: Option<PathBuf>,
 
-    /// Print how long each stage took (simulation, picture, encoding, writing) to standard
-    /// error, with throughput.
+    /// Print how long each stage took (simulation or mesh, picture, encoding, writing) to
+    /// standard error, with throughput or triangle counts.
     #[arg(long)]
     pub stats: bool,
 }

@@ -1,10 +1,9 @@
 //! Flags of the lake: `tidepool render lake`.
 
-use std::path::PathBuf;
-
 use clap::{Args, ValueEnum};
 
-use super::{Format, OutputArgs, Size, parse_size};
+use super::OutputArgs;
+use super::ocean::number;
 use crate::scene::lake::MAX_LAKE_WIND_M_S;
 use crate::sim::noise::{MAX_OCTAVES, NoiseKind};
 
@@ -17,6 +16,10 @@ Examples:
   tidepool render lake --out - --size 160x96           # in this terminal
   tidepool render lake --wind 5 --heightmap lake.npy --size 600x300
   tidepool render lake --wind 4 --frames 90 --fps 30 --size 480x270 --out breeze.gif";
+
+const LAKE_HEIGHTMAP_HELP: &str = "Also write the water's height, sampled at the picture's size on square \
+cells over the lake from the far shore (row 0, 300 m north) to the near shore, centred on the camera: FILE.npy \
+(float32 metres) or FILE.png (16-bit grey, value = round(height*1000) + 32768, i.e. millimetres).";
 
 /// `--noise`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -39,6 +42,7 @@ impl From<NoiseArg> for NoiseKind {
 /// `tidepool render lake`.
 #[derive(Args, Debug)]
 #[command(after_help = LAKE_EXAMPLES)]
+#[command(mut_arg("heightmap", |arg| arg.help(LAKE_HEIGHTMAP_HELP)))]
 pub struct RenderLake {
     /// Wind speed at 10 m, m/s (0..=30): 0 is a mirror calm; the ripples' height and length
     /// follow the wind over the lake's 300 m fetch.
@@ -67,63 +71,13 @@ pub struct RenderLake {
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4))]
     pub ssaa: Option<u32>,
 
-    /// Picture size in pixels, WIDTHxHEIGHT (at most 64 megapixels including supersampling).
-    /// [default: 640x360 for PNG; for text, the terminal's size when writing to it, else 80x48]
-    #[arg(long, value_name = "WxH", value_parser = parse_size)]
-    pub size: Option<Size>,
-
-    /// Seed of the noise and of the shore's hills and trees; the same seed and flags give the
-    /// same bytes.
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub seed: u64,
-
-    /// Output file, or - for standard output. The format follows the extension: .png, or
-    /// .ans/.txt for half-block text. [default: lake.png, or lake.ans with --format ansi]
-    #[arg(long, value_name = "FILE|-")]
-    pub out: Option<PathBuf>,
-
-    /// Output format; overrides the extension. Standard output defaults to ansi.
-    #[arg(long, value_enum, value_name = "FORMAT")]
-    pub format: Option<Format>,
-
-    /// Also write the water's height, sampled at the picture's size on square cells over the
-    /// lake from the far shore (row 0, 300 m north) to the near shore, centred on the camera:
-    /// FILE.npy (float32 metres) or FILE.png (16-bit grey, value = round(height·1000) + 32768,
-    /// i.e. millimetres).
-    #[arg(long, value_name = "FILE")]
-    pub heightmap: Option<PathBuf>,
-
-    /// Print how long each stage took (picture, heightmap, encoding, writing) and the triangle
-    /// count to standard error.
-    #[arg(long)]
-    pub stats: bool,
+    /// Size, seed, output file and format, heightmap, stats.
+    #[command(flatten)]
+    pub output: OutputArgs,
 
     /// An animation instead of one picture (it starts at --time).
     #[command(flatten)]
     pub animation: super::AnimationArgs,
-}
-
-impl RenderLake {
-    /// The flags every scene shares, for [`crate::commands::render::OutputPlan`].
-    pub fn output_args(&self) -> OutputArgs {
-        OutputArgs {
-            size: self.size,
-            seed: self.seed,
-            out: self.out.clone(),
-            format: self.format,
-            heightmap: self.heightmap.clone(),
-            stats: self.stats,
-        }
-    }
-}
-
-fn number(text: &str, what: &str, example: &str) -> Result<f64, String> {
-    let v: f64 =
-        text.trim().parse().map_err(|_| format!("the {what} '{}' is not a number; e.g. {example}", text.trim()))?;
-    if !v.is_finite() {
-        return Err(format!("the {what} must be a finite number; e.g. {example}"));
-    }
-    Ok(v)
 }
 
 /// Parses the lake's wind, 0..=30 m/s.

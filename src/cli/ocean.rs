@@ -4,7 +4,7 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use super::{Format, OutputArgs, Size, parse_size};
+use super::OutputArgs;
 use crate::render::camera::CameraPose;
 use crate::sim::sea_state;
 
@@ -22,6 +22,10 @@ Examples:
   tidepool render ocean --beaufort 8 --direction 200 --size 1280x720 --out gale.png
   tidepool render ocean --out - --size 160x96        # in this terminal
   tidepool render ocean --wind 10 --heightmap sea.npy --size 512x512";
+
+const OCEAN_HEIGHTMAP_HELP: &str = "Also write the sea surface height on the --extent patch, sampled at the \
+picture's size: FILE.npy (float32 metres, numpy's format) or FILE.png (16-bit grey, value = round(height*100) + \
+32768, i.e. centimetres, clamped). Columns run east, row 0 is the north edge.";
 
 /// The wind: a speed or a Beaufort number.
 #[derive(Args, Debug, Clone)]
@@ -50,6 +54,7 @@ impl WindArgs {
 /// `tidepool render ocean`.
 #[derive(Args, Debug)]
 #[command(after_help = OCEAN_EXAMPLES)]
+#[command(mut_arg("heightmap", |arg| arg.help(OCEAN_HEIGHTMAP_HELP)))]
 pub struct RenderOcean {
     /// The wind.
     #[command(flatten)]
@@ -88,53 +93,13 @@ pub struct RenderOcean {
     #[arg(long, value_name = "METRES", value_parser = parse_extent)]
     pub extent: Option<f64>,
 
-    /// Picture size in pixels, WIDTHxHEIGHT (at most 64 megapixels including supersampling).
-    /// [default: 640x360 for PNG; for text, the terminal's size when writing to it, else 80x48]
-    #[arg(long, value_name = "WxH", value_parser = parse_size, allow_hyphen_values = true)]
-    pub size: Option<Size>,
-
-    /// Seed of the wave phases and the fine-scale fBm; the same seed and flags give the same bytes.
-    #[arg(long, value_name = "N", default_value_t = 1)]
-    pub seed: u64,
-
-    /// Output file, or - for standard output. The format follows the extension: .png, or
-    /// .ans/.txt for half-block text. [default: ocean.png, or ocean.ans with --format ansi]
-    #[arg(long, value_name = "FILE|-")]
-    pub out: Option<PathBuf>,
-
-    /// Output format; overrides the extension. Standard output defaults to ansi.
-    #[arg(long, value_enum, value_name = "FORMAT")]
-    pub format: Option<Format>,
-
-    /// Also write the sea surface height on the --extent patch, sampled at the picture's size:
-    /// FILE.npy (float32 metres, numpy's format) or FILE.png (16-bit grey, value =
-    /// round(height·100) + 32768, i.e. centimetres, clamped). Columns run east, row 0 is the
-    /// north edge.
-    #[arg(long, value_name = "FILE")]
-    pub heightmap: Option<PathBuf>,
-
-    /// Print how long each stage took (mesh, picture, heightmap, encoding, writing) and the
-    /// triangle count to standard error.
-    #[arg(long)]
-    pub stats: bool,
+    /// Size, seed, output file and format, heightmap, stats.
+    #[command(flatten)]
+    pub output: OutputArgs,
 
     /// An animation instead of one picture (it starts at --time).
     #[command(flatten)]
     pub animation: super::AnimationArgs,
-}
-
-impl RenderOcean {
-    /// The flags every scene shares, for [`crate::commands::render::OutputPlan`].
-    pub fn output_args(&self) -> OutputArgs {
-        OutputArgs {
-            size: self.size,
-            seed: self.seed,
-            out: self.out.clone(),
-            format: self.format,
-            heightmap: self.heightmap.clone(),
-            stats: self.stats,
-        }
-    }
 }
 
 /// `tidepool spectrum`.
@@ -153,7 +118,7 @@ pub struct SpectrumCommand {
     pub out: Option<PathBuf>,
 }
 
-fn number(text: &str, what: &str, example: &str) -> Result<f64, String> {
+pub(super) fn number(text: &str, what: &str, example: &str) -> Result<f64, String> {
     let v: f64 =
         text.trim().parse().map_err(|_| format!("the {what} '{}' is not a number; e.g. {example}", text.trim()))?;
     if !v.is_finite() {

@@ -20,7 +20,7 @@ pub fn settings(args: &RenderLake, ssaa: u32) -> LakeSettings {
     LakeSettings {
         lake: LakeParams {
             wind_m_s: args.wind,
-            seed: args.seed,
+            seed: args.output.seed,
             octaves: args.octaves,
             persistence: args.persistence,
             noise: args.noise.into(),
@@ -34,7 +34,7 @@ pub fn render_lake(args: RenderLake) -> Result<()> {
     if let Some(frames) = args.animation.frames {
         return animate_lake(&args, frames);
     }
-    let plan = OutputPlan::new(&args.output_args(), "lake", std::io::stdout().is_terminal(), terminal_pixels())?;
+    let plan = OutputPlan::new(&args.output, "lake", std::io::stdout().is_terminal(), terminal_pixels())?;
     let ssaa = args.ssaa.unwrap_or_else(|| default_ssaa(plan.format));
     check_pixels(plan.size, ssaa).map_err(|e| Error::arg("--size", format!("{e} (or lower --ssaa)")))?;
     let (width, height) = (plan.size.width, plan.size.height);
@@ -57,18 +57,16 @@ pub fn render_lake(args: RenderLake) -> Result<()> {
     // The supersampled buffers are the largest allocations; free them before encoding.
     drop(scene);
     plan.write_timed(&picture, heights.as_ref(), HEIGHTMAP_PNG_SCALE, &mut stats)?;
-    if args.stats {
-        eprint!("{}", stats.report());
-    }
+    stats.print_if(args.output.stats);
     Ok(())
 }
 
 /// `tidepool render lake --frames N`: the lake from `--time` on, 1/30 s a step as in the player.
 fn animate_lake(args: &RenderLake, frames: u32) -> Result<()> {
     use super::animate::{Animation, AnimationTarget, animate};
-    super::render::check_animation_flags(&args.output_args())?;
-    let target = AnimationTarget::from_out(args.out.as_deref(), "lake", args.animation.fps)?;
-    let size = args.size.unwrap_or(super::render::DEFAULT_PNG_SIZE);
+    super::render::check_animation_flags(&args.output)?;
+    let target = AnimationTarget::from_out(args.output.out.as_deref(), "lake", args.animation.fps)?;
+    let size = args.output.size.unwrap_or(super::render::DEFAULT_PNG_SIZE);
     let ssaa = args.ssaa.unwrap_or_else(|| default_ssaa(crate::cli::Format::Png));
     check_pixels(size, ssaa).map_err(|e| Error::arg("--size", format!("{e} (or lower --ssaa)")))?;
     let settings = settings(args, ssaa);
@@ -83,8 +81,6 @@ fn animate_lake(args: &RenderLake, frames: u32) -> Result<()> {
     let animation = Animation { frames, fps: args.animation.fps, start_step: 0, script: &[] };
     let mut stats = Stats::default();
     animate(&mut make, &animation, &target, &mut stats)?;
-    if args.stats {
-        eprint!("{}", stats.report());
-    }
+    stats.print_if(args.output.stats);
     Ok(())
 }

@@ -26,7 +26,7 @@ pub fn default_ssaa(format: Format) -> u32 {
 /// The validated settings of a `render ocean` command line.
 pub fn settings(args: &RenderOcean, format: Format) -> OceanSettings {
     OceanSettings {
-        sea: SeaParams { wind_m_s: args.wind.speed_m_s(), wind_from_deg: args.direction, seed: args.seed },
+        sea: SeaParams { wind_m_s: args.wind.speed_m_s(), wind_from_deg: args.direction, seed: args.output.seed },
         view: OceanView {
             camera: args.camera.unwrap_or(CameraPose::DEFAULT),
             sun_azimuth_deg: args.sun.0 as f32,
@@ -42,7 +42,7 @@ pub fn render_ocean(args: RenderOcean) -> Result<()> {
     if let Some(frames) = args.animation.frames {
         return animate_ocean(&args, frames);
     }
-    let plan = OutputPlan::new(&args.output_args(), "ocean", std::io::stdout().is_terminal(), terminal_pixels())?;
+    let plan = OutputPlan::new(&args.output, "ocean", std::io::stdout().is_terminal(), terminal_pixels())?;
     if args.extent.is_some() && plan.heightmap.is_none() {
         return Err(Error::arg(
             "--extent",
@@ -77,21 +77,19 @@ pub fn render_ocean(args: RenderOcean) -> Result<()> {
     // The supersampled buffer is the largest allocation; free it before encoding.
     drop(scene);
     plan.write_timed(&picture, heights.as_ref(), HEIGHTMAP_PNG_SCALE, &mut stats)?;
-    if args.stats {
-        eprint!("{}", stats.report());
-    }
+    stats.print_if(args.output.stats);
     Ok(())
 }
 
 /// `tidepool render ocean --frames N`: the sea from `--time` on, 1/60 s a step as in the player.
 fn animate_ocean(args: &RenderOcean, frames: u32) -> Result<()> {
     use super::animate::{Animation, AnimationTarget, animate};
-    super::render::check_animation_flags(&args.output_args())?;
+    super::render::check_animation_flags(&args.output)?;
     if args.extent.is_some() {
         return Err(Error::arg("--extent", "only sizes the --heightmap patch, which animations do not write"));
     }
-    let target = AnimationTarget::from_out(args.out.as_deref(), "ocean", args.animation.fps)?;
-    let size = args.size.unwrap_or(super::render::DEFAULT_PNG_SIZE);
+    let target = AnimationTarget::from_out(args.output.out.as_deref(), "ocean", args.animation.fps)?;
+    let size = args.output.size.unwrap_or(super::render::DEFAULT_PNG_SIZE);
     let settings = settings(args, crate::cli::Format::Png);
     check_pixels(size, settings.view.ssaa).map_err(|e| Error::arg("--size", format!("{e} (or lower --ssaa)")))?;
     let texture = match &args.texture {
@@ -109,8 +107,6 @@ fn animate_ocean(args: &RenderOcean, frames: u32) -> Result<()> {
     let animation = Animation { frames, fps: args.animation.fps, start_step: 0, script: &[] };
     let mut stats = Stats::default();
     animate(&mut make, &animation, &target, &mut stats)?;
-    if args.stats {
-        eprint!("{}", stats.report());
-    }
+    stats.print_if(args.output.stats);
     Ok(())
 }

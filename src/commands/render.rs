@@ -182,6 +182,13 @@ impl Stats {
         self.stages.push((stage, started.elapsed(), detail));
     }
 
+    /// Prints [`Stats::report`] to standard error when `--stats` asked for it.
+    pub fn print_if(&self, asked: bool) {
+        if asked {
+            eprint!("{}", self.report());
+        }
+    }
+
     /// The stages as aligned lines: name, milliseconds, detail.
     pub fn report(&self) -> String {
         let mut text = String::new();
@@ -321,9 +328,7 @@ fn render_pool(args: RenderPool) -> Result<()> {
     stats.record("render", started, format!("{width}x{height}"));
     let heights = plan.heightmap.is_some().then(|| scene.heightmap());
     plan.write_timed(&picture, heights.as_ref(), 1.0, &mut stats)?;
-    if args.output.stats {
-        eprint!("{}", stats.report());
-    }
+    stats.print_if(args.output.stats);
     Ok(())
 }
 
@@ -364,9 +369,7 @@ fn animate_pool(args: &RenderPool, frames: u32) -> Result<()> {
     let animation = Animation { frames, fps: args.animation.fps, start_step: args.steps.unwrap_or(0), script: &script };
     let mut stats = Stats::default();
     animate(&mut make, &animation, &target, &mut stats)?;
-    if args.output.stats {
-        eprint!("{}", stats.report());
-    }
+    stats.print_if(args.output.stats);
     Ok(())
 }
 
