@@ -124,7 +124,7 @@ pub struct PlayCommand {
 
     /// Seed for everything random (rain, random stones); the same seed and the same inputs
     /// give the same water.
-    #[arg(long, value_name = "N", default_value_t = 1)]
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]
     pub seed: u64,
 
     /// Display frames per second (1..=240); the simulation runs at its own fixed rate.
@@ -283,7 +283,7 @@ pub struct OutputArgs {
 
     /// Seed for everything random (rain, wave phases, noise, the shore); the same seed and flags
     /// give the same bytes.
-    #[arg(long, value_name = "N", default_value_t = 1, allow_negative_numbers = true)]
+    #[arg(long, value_name = "N", default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]
     pub seed: u64,
 
     /// Output file, or - for standard output. The format follows the extension: .png, or
@@ -409,6 +409,13 @@ pub enum Format {
     Png,
     /// Truecolor half-block text (`▀`), one text row per two pixel rows.
     Ansi,
+}
+
+/// Parses a seed: any whole number 0..=2^64-1.
+pub fn parse_seed(text: &str) -> Result<u64, String> {
+    text.trim()
+        .parse()
+        .map_err(|_| format!("the seed '{}' is not a whole number 0..={}; e.g. 42", text.trim(), u64::MAX))
 }
 
 /// Parses `WxH` and checks it against the size limits.
@@ -610,6 +617,10 @@ mod tests {
     fn replay_conflicts_with_what_it_fixes() {
         let parse = |args: &[&str]| Cli::try_parse_from(["tidepool", "render", "pool"].iter().chain(args));
         assert!(parse(&["--replay", "r.jsonl", "--out", "x.png", "--steps", "5"]).is_ok());
+        for bad in ["-1", "1.5", "", "18446744073709551616"] {
+            assert!(parse_seed(bad).unwrap_err().contains("whole number"), "{bad}");
+        }
+        assert_eq!(parse_seed(" 42 "), Ok(42));
         for flag in [&["--size", "10x10"][..], &["--seed", "3"], &["--stone", "1,2"], &["--damping", "4"]] {
             let err = parse(&[&["--replay", "r.jsonl"][..], flag].concat()).unwrap_err();
             assert_eq!(err.kind(), clap::error::ErrorKind::ArgumentConflict, "{flag:?}");
