@@ -29,7 +29,7 @@ pub enum Error {
         message: String,
     },
     /// Reading or writing a file failed.
-    #[error("{action} {path}: {source}")]
+    #[error("{action} {path}: {}", explain_io(action, source))]
     Io {
         /// What tidepool was doing: "cannot write", "cannot read"...
         action: &'static str,
@@ -72,6 +72,23 @@ impl Error {
     /// is how a reader says it has seen enough, not a failure.
     pub fn is_broken_pipe(&self) -> bool {
         matches!(self, Error::Stdout(e) if e.kind() == io::ErrorKind::BrokenPipe)
+    }
+}
+
+/// The operating system's reason, with what to do about it for the errors users meet.
+fn explain_io(action: &str, error: &io::Error) -> String {
+    use io::ErrorKind::*;
+    let writing = action.contains("write");
+    match error.kind() {
+        NotFound if writing => "the folder does not exist; create it or choose another path".into(),
+        NotFound => "no such file; check the path".into(),
+        PermissionDenied if writing => "permission denied; choose a folder you can write to".into(),
+        PermissionDenied => "permission denied; check the file's permissions".into(),
+        StorageFull => "no space left on the device; free some space or write somewhere else".into(),
+        ReadOnlyFilesystem => "the file system is read-only; write somewhere else".into(),
+        QuotaExceeded => "the disk quota is exhausted; free some space or write somewhere else".into(),
+        IsADirectory => "it is a directory; give a file name".into(),
+        _ => error.to_string(),
     }
 }
 

@@ -115,6 +115,8 @@ fn broken_and_hostile_images_are_refused_cleanly() {
     }
     std::fs::write(dir.join("scrambled.jpg"), &scrambled).unwrap();
     std::fs::write(dir.join("cut.jpg"), &jpeg[..jpeg.len() / 3]).unwrap();
+    // Cut inside the scan data: the decoder alone would fill the rest with grey.
+    std::fs::write(dir.join("half.jpg"), &jpeg[..jpeg.len() * 3 / 4]).unwrap();
     std::fs::write(dir.join("empty.png"), b"").unwrap();
     std::fs::write(dir.join("notes.png"), b"remember to buy milk\n").unwrap();
     std::fs::create_dir(dir.join("folder.png")).unwrap();
@@ -122,6 +124,7 @@ fn broken_and_hostile_images_are_refused_cleanly() {
         ("huge.png", "too large to decode"),
         ("scrambled.jpg", "decode"),
         ("cut.jpg", "decode"),
+        ("half.jpg", "cut short"),
         ("empty.png", "empty"),
         ("notes.png", "format could not be determined"),
         ("folder.png", "directory"),
@@ -158,7 +161,7 @@ fn outputs_that_cannot_be_written_keep_what_was_there() {
     // /dev/full stands in for a full disk: the error says so, exit 2.
     let full = run_in(&dir, &["render", "pool", "--size", "16x16", "--format", "png", "--out", "/dev/full"]);
     assert_eq!(full.status.code(), Some(2));
-    assert!(stderr(&full).contains("No space left on device"), "{}", stderr(&full));
+    assert!(stderr(&full).contains("no space left on the device; free some space"), "{}", stderr(&full));
 }
 
 /// CRC-32 as PNG chunks use it.

@@ -195,7 +195,7 @@ mod tests {
         let meta = std::fs::metadata("/dev/null").unwrap();
         assert!(!meta.is_file(), "/dev/null is still a device");
         let err = write_file(Path::new("/dev/full"), b"no room").unwrap_err().to_string();
-        assert!(err.contains("No space left"), "{err}");
+        assert!(err.contains("no space left on the device"), "{err}");
     }
 
     #[test]

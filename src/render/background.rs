@@ -46,6 +46,20 @@ pub fn load(flag: &'static str, path: &Path) -> Result<Pixmap> {
     decode(&bytes).map_err(fail)
 }
 
+/// Whether a JPEG's last scan is followed by its end-of-image marker (`FF D9`).
+///
+/// The JPEG decoder is lenient: a file cut short inside its scan data decodes, with the
+/// missing rows grey, and the user would get a pool on half a picture without a word. Inside
+/// entropy-coded data a `0xFF` byte is always followed by `0x00` or a restart marker, so after
+/// the last start-of-scan marker (`FF DA`) an `FF D9` appears exactly when that scan is
+/// complete. Files with no scan at all are left to the decoder, which refuses them.
+fn jpeg_is_complete(bytes: &[u8]) -> bool {
+    match bytes.windows(2).rposition(|w| w == [0xFF, 0xDA]) {
+        Some(sos) => bytes[sos..].windows(2).any(|w| w == [0xFF, 0xD9]),
+        None => true,
+    }
+}
+
 /// Decodes image bytes with size limits into an opaque premultiplied pixmap.
 pub fn decode(bytes: &[u8]) -> Result<Pixmap, String> {
     let mut reader = ImageReader::new(Cursor::new(bytes))
@@ -58,6 +72,9 @@ pub fn decode(bytes: &[u8]) -> Result<Pixmap, String> {
     reader.limits(limits);
     if reader.format().is_none() {
         return Err("not a PNG or JPEG image (the format could not be determined); give a PNG or JPEG file".into());
+    }
+    if reader.format() == Some(image::ImageFormat::Jpeg) && !jpeg_is_complete(bytes) {
+        return Err("the JPEG is cut short (its last scan has no end-of-image marker); the file is truncated, give a complete PNG or JPEG".into());
     }
     let image = reader.decode().map_err(|e| match e {
         image::ImageError::Limits(_) => format!(
@@ -126,6 +143,23 @@ mod tests {
             assert_eq!((fitted.width(), fitted.height()), (w, h));
             assert!(fitted.pixels().iter().all(|p| p.alpha() == 255));
         }
+    }
+
+    #[test]
+    fn jpegs_cut_inside_their_scan_are_refused() {
+        let mut jpeg = Vec::new();
+        image::RgbImage::from_fn(200, 150, |x, y| image::Rgb([x as u8, y as u8, 120]))
+            .write_to(&mut std::io::Cursor::new(&mut jpeg), image::ImageFormat::Jpeg)
+            .unwrap();
+        assert!(decode(&jpeg).is_ok());
+        for keep in [jpeg.len() / 2, jpeg.len() * 9 / 10, jpeg.len() - 2] {
+            let err = decode(&jpeg[..keep]).unwrap_err();
+            assert!(err.contains("cut short"), "{keep} of {} bytes: {err}", jpeg.len());
+        }
+        // Bytes after the end-of-image marker (some cameras append data) are fine.
+        let mut padded = jpeg.clone();
+        padded.extend_from_slice(&[0u8; 64]);
+        assert!(decode(&padded).is_ok());
     }
 
     #[test]
