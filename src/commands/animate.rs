@@ -250,7 +250,7 @@ impl std::io::Write for SharedFile {
 
 /// The open output of an animation.
 enum Sink {
-    Gif(Box<GifWriter<AtomicFile>>),
+    Gif(Box<GifWriter<AtomicFile>>, PathBuf),
     Apng(ApngWriter<SharedFile>, SharedFile, PathBuf),
     Sequence(FramePattern, usize),
 }
@@ -269,7 +269,7 @@ impl Sink {
                 let palette = palette.expect("a GIF's palette is learned first");
                 let writer = GifWriter::new(file, width, height, palette, animation.fps)
                     .map_err(|e| Error::io("cannot write", path, e))?;
-                Sink::Gif(Box::new(writer))
+                Sink::Gif(Box::new(writer), path.clone())
             }
             AnimationTarget::Apng(path) => {
                 let file = SharedFile::new(AtomicFile::create(path)?);
@@ -283,7 +283,7 @@ impl Sink {
 
     fn write(&mut self, k: u32, pixmap: &Pixmap) -> Result<()> {
         match self {
-            Sink::Gif(writer) => writer.write(pixmap).map_err(|e| Error::io("cannot write", "the GIF", e)),
+            Sink::Gif(writer, path) => writer.write(pixmap).map_err(|e| Error::io("cannot write", path.as_path(), e)),
             Sink::Apng(writer, _, path) => {
                 writer.write(pixmap).map_err(|e| Error::io("cannot write", path.as_path(), e))
             }
@@ -298,9 +298,8 @@ impl Sink {
     /// Closes the output: (what was written, bytes).
     fn finish(self) -> Result<(String, usize)> {
         match self {
-            Sink::Gif(writer) => {
-                let file = writer.finish().map_err(|e| Error::io("cannot write", "the GIF", e))?;
-                let path = file.path().to_owned();
+            Sink::Gif(writer, path) => {
+                let file = writer.finish().map_err(|e| Error::io("cannot write", &path, e))?;
                 file.commit()?;
                 Ok((path.display().to_string(), file_size(&path)))
             }
