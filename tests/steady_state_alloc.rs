@@ -103,7 +103,6 @@ fn player_frames(mut scene: Box<dyn tidepool::scene::playable::Playable>) -> usi
 
     let (cols, rows) = (160u16, 48u16);
     let (w, h) = tidepool::term::app::picture_size(cols, rows);
-    let name = scene.name();
     let mut pixmap = tiny_skia::Pixmap::new(w, h).unwrap();
     let mut builder = FrameBuilder::default();
     let mut shown = Shown::UNKNOWN;
