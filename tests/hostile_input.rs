@@ -103,6 +103,21 @@ fn broken_and_hostile_images_are_refused_cleanly() {
     huge.extend_from_slice(&ihdr);
     huge.extend_from_slice(&crc32(&ihdr).to_be_bytes());
     std::fs::write(dir.join("huge.png"), &huge).unwrap();
+    // A well-formed PNG (valid CRCs) whose palette is 10 bytes, not whole RGB entries: png
+    // 0.18.1 panics on it (found by fuzzing); tidepool checks the palette first.
+    let mut palette = b"\x89PNG\r\n\x1a\n".to_vec();
+    for (kind, data) in [
+        (&b"IHDR"[..], vec![0, 0, 0, 4, 0, 0, 0, 4, 8, 3, 0, 0, 0]),
+        (b"PLTE", (0..10).collect()),
+        (b"IDAT", vec![0x78, 0x9c, 0x63, 0x60, 0x00, 0x00, 0x00, 0x02, 0x00, 0x01]),
+        (b"IEND", vec![]),
+    ] {
+        let typed: Vec<u8> = kind.iter().chain(&data).copied().collect();
+        palette.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        palette.extend_from_slice(&typed);
+        palette.extend_from_slice(&crc32(&typed).to_be_bytes());
+    }
+    std::fs::write(dir.join("palette.png"), &palette).unwrap();
     // A JPEG with its entropy-coded data scrambled, and one cut short.
     let mut jpeg = Vec::new();
     image::RgbImage::from_fn(64, 64, |x, y| image::Rgb([x as u8 * 4, y as u8 * 4, 90]))
@@ -122,6 +137,7 @@ fn broken_and_hostile_images_are_refused_cleanly() {
     std::fs::create_dir(dir.join("folder.png")).unwrap();
     let cases = [
         ("huge.png", "too large to decode"),
+        ("palette.png", "palette is malformed"),
         ("scrambled.jpg", "decode"),
         ("cut.jpg", "decode"),
         ("half.jpg", "cut short"),

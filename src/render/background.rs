@@ -46,6 +46,51 @@ pub fn load(flag: &'static str, path: &Path) -> Result<Pixmap> {
     decode(&bytes).map_err(fail)
 }
 
+/// Runs `f`, turning a panic inside it into `None` without printing the panic message.
+///
+/// The decoders are large third-party code fed arbitrary bytes; fuzzing found a PNG that makes
+/// `png` 0.18.1 index out of bounds (see [`check_png_palette`]). A user's file must get an error
+/// message, never a crash, so a panic in a decoder is caught and reported as a damaged file.
+/// The panic hook stays installed; a thread-local flag silences it while `f` runs, so other
+/// threads' panics still print.
+fn without_panics<T>(f: impl FnOnce() -> T) -> Option<T> {
+    use std::cell::Cell;
+    use std::panic::{self, AssertUnwindSafe};
+    thread_local!(static QUIET: Cell<bool> = const { Cell::new(false) });
+    static INSTALL: std::sync::Once = std::sync::Once::new();
+    INSTALL.call_once(|| {
+        let previous = panic::take_hook();
+        panic::set_hook(Box::new(move |info| {
+            if !QUIET.with(Cell::get) {
+                previous(info);
+            }
+        }));
+    });
+    QUIET.with(|q| q.set(true));
+    let result = panic::catch_unwind(AssertUnwindSafe(f));
+    QUIET.with(|q| q.set(false));
+    result.ok()
+}
+
+/// Refuses a PNG whose palette (`PLTE`) is not 1 to 256 whole RGB entries.
+///
+/// The PNG specification requires it; `png` 0.18.1 does not check it and panics slicing a
+/// palette whose length is not a multiple of 3 (found by the `decode_image` fuzz target). The
+/// chunks are walked by their length fields only; anything else wrong is left to the decoder.
+fn check_png_palette(bytes: &[u8]) -> Result<(), String> {
+    let mut at = 8; // the signature
+    while let Some(header) = bytes.get(at..at + 8) {
+        let length = u32::from_be_bytes([header[0], header[1], header[2], header[3]]) as usize;
+        if &header[4..8] == b"PLTE" && (length == 0 || length > 768 || length % 3 != 0) {
+            return Err(format!(
+                "the PNG's palette is malformed ({length} bytes, not 1 to 256 RGB entries); the file is damaged, give a valid PNG or JPEG"
+            ));
+        }
+        at = at.saturating_add(12).saturating_add(length);
+    }
+    Ok(())
+}
+
 /// Whether a JPEG's last scan is followed by its end-of-image marker (`FF D9`).
 ///
 /// The JPEG decoder is lenient: a file cut short inside its scan data decodes, with the
@@ -76,7 +121,14 @@ pub fn decode(bytes: &[u8]) -> Result<Pixmap, String> {
     if reader.format() == Some(image::ImageFormat::Jpeg) && !jpeg_is_complete(bytes) {
         return Err("the JPEG is cut short (its last scan has no end-of-image marker); the file is truncated, give a complete PNG or JPEG".into());
     }
-    let image = reader.decode().map_err(|e| match e {
+    if reader.format() == Some(image::ImageFormat::Png) {
+        check_png_palette(bytes)?;
+    }
+    let decoded = without_panics(|| reader.decode()).ok_or_else(|| {
+        "cannot decode the image (the decoder gave up on its structure); the file is damaged, give a valid PNG or JPEG"
+            .to_string()
+    })?;
+    let image = decoded.map_err(|e| match e {
         image::ImageError::Limits(_) => format!(
             "the image is too large to decode (more than {MAX_IMAGE_SIDE} pixels a side or {} MB of pixels); scale it down",
             MAX_IMAGE_BYTES >> 20
@@ -160,6 +212,47 @@ mod tests {
         let mut padded = jpeg.clone();
         padded.extend_from_slice(&[0u8; 64]);
         assert!(decode(&padded).is_ok());
+    }
+
+    /// A minimal PNG: signature, IHDR (palette colour type), the given PLTE length, IEND.
+    fn png_with_palette_of(length: usize) -> Vec<u8> {
+        let mut png = b"\x89PNG\r\n\x1a\n".to_vec();
+        let mut chunk = |kind: &[u8], data: &[u8]| {
+            png.extend_from_slice(&(data.len() as u32).to_be_bytes());
+            png.extend_from_slice(kind);
+            png.extend_from_slice(data);
+            png.extend_from_slice(&[0; 4]); // CRC: the check comes first
+        };
+        chunk(b"IHDR", &[0, 0, 0, 4, 0, 0, 0, 4, 8, 3, 0, 0, 0]);
+        chunk(b"PLTE", &vec![7; length]);
+        chunk(b"IEND", &[]);
+        png
+    }
+
+    #[test]
+    fn malformed_png_palettes_are_refused_before_the_decoder() {
+        for length in [0, 4, 515, 771] {
+            let err = decode(&png_with_palette_of(length)).unwrap_err();
+            assert!(err.contains("palette is malformed"), "{length}: {err}");
+        }
+        assert_eq!(check_png_palette(&png_with_palette_of(6)), Ok(()));
+        assert_eq!(check_png_palette(&png_with_palette_of(768)), Ok(()));
+        // Truncated chunk headers and absurd lengths end the walk, they do not panic.
+        let png = png_with_palette_of(6);
+        for cut in 0..png.len() {
+            let _ = check_png_palette(&png[..cut]);
+        }
+        let mut huge = png.clone();
+        huge[33..37].copy_from_slice(&u32::MAX.to_be_bytes());
+        let _ = check_png_palette(&huge);
+    }
+
+    #[test]
+    fn a_panicking_decoder_is_an_error_not_a_crash() {
+        assert_eq!(without_panics(|| 7), Some(7));
+        assert_eq!(without_panics(|| -> u8 { panic!("inside a decoder") }), None);
+        // The hook still reports panics outside the guard (the flag was reset).
+        assert_eq!(without_panics(|| 8), Some(8));
     }
 
     #[test]
