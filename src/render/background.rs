@@ -81,7 +81,7 @@ fn check_png_palette(bytes: &[u8]) -> Result<(), String> {
     let mut at = 8; // the signature
     while let Some(header) = bytes.get(at..at + 8) {
         let length = u32::from_be_bytes([header[0], header[1], header[2], header[3]]) as usize;
-        if &header[4..8] == b"PLTE" && (length == 0 || length > 768 || length % 3 != 0) {
+        if &header[4..8] == b"PLTE" && (length == 0 || length > 768 || !length.is_multiple_of(3)) {
             return Err(format!(
                 "the PNG's palette is malformed ({length} bytes, not 1 to 256 RGB entries); the file is damaged, give a valid PNG or JPEG"
             ));
