@@ -36,6 +36,16 @@ pub fn lake_settings(seed: u64) -> LakeSettings {
     LakeSettings { lake: LakeParams { seed, ..LakeParams::default() }, ssaa: 1 }
 }
 
+/// What to tell a user whose terminal was guessed to have fewer than 16 million colours.
+///
+/// SSH does not forward `COLORTERM` and tmux hides it, so most terminals that could show true
+/// colour are guessed as 256-colour ones there, and the water loses its shades. Saying so in
+/// the status line's first seconds tells the user the one flag that fixes it.
+pub fn color_hint(choice: ColorChoice, mode: ColorMode) -> Option<String> {
+    (choice == ColorChoice::Auto && mode != ColorMode::TrueColor)
+        .then(|| format!("{} colours (no COLORTERM): try --color truecolor", mode.name()))
+}
+
 /// Runs the player.
 pub fn run(command: PlayCommand) -> Result<()> {
     if !std::io::stdout().is_terminal() {
@@ -100,6 +110,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
         encode: EncodeOptions { threshold, sync: !command.no_sync },
         seed: command.seed,
         record: command.record.clone().map(|path| (path, super::replay::pool_options(&command.pool, rain))),
+        greeting: color_hint(command.color, color),
     };
     app::run(command.scene, make, config)
 }
@@ -107,6 +118,14 @@ pub fn run(command: PlayCommand) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_guessed_palette_says_how_to_get_true_colour() {
+        assert!(color_hint(ColorChoice::Auto, ColorMode::Palette256).unwrap().contains("--color truecolor"));
+        assert!(color_hint(ColorChoice::Auto, ColorMode::Palette16).unwrap().starts_with("16 colours"));
+        assert_eq!(color_hint(ColorChoice::Auto, ColorMode::TrueColor), None);
+        assert_eq!(color_hint(ColorChoice::Palette256, ColorMode::Palette256), None, "asked for: no hint");
+    }
 
     #[test]
     fn threshold_is_exact_locally_and_3_over_ssh() {

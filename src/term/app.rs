@@ -37,6 +37,8 @@ pub const DEFAULT_STONE_RADIUS: u32 = 3;
 const AIM_VISIBLE: Duration = Duration::from_secs(4);
 /// How long a status message (screenshot saved) stays.
 const MESSAGE_VISIBLE: Duration = Duration::from_secs(4);
+/// How long [`PlayerConfig::greeting`] stays.
+const GREETING_VISIBLE: Duration = Duration::from_secs(10);
 /// Random stones use their own generator, seeded from `--seed` xor this, so that pressing
 /// `space` does not change the rain.
 const STONE_SEED_MIX: u64 = 0x5354_4f4e_4553_0001;
@@ -62,6 +64,8 @@ pub struct PlayerConfig {
     pub seed: u64,
     /// Where to record the session, with the scene's pixel-changing options.
     pub record: Option<(PathBuf, serde_json::Map<String, serde_json::Value>)>,
+    /// A message for the status line's first seconds (e.g. how to get true colour).
+    pub greeting: Option<String>,
 }
 
 /// The picture size in pixels for a terminal of `cols x rows` (one row for the status line).
@@ -123,6 +127,7 @@ pub fn run(first: PlayScene, mut make: SceneFactory, config: PlayerConfig) -> Re
         })
     });
     let now = Instant::now();
+    let message = config.greeting.clone().map(|m| (m, now + GREETING_VISIBLE));
     let mut player = Player {
         kind: first,
         sim: SimClock::new(scene.steps_per_second(), now),
@@ -136,7 +141,7 @@ pub fn run(first: PlayScene, mut make: SceneFactory, config: PlayerConfig) -> Re
         help: None,
         aim: ((w / 2) as i32, ((h / 2) & !1) as i32),
         aim_until: None,
-        message: None,
+        message,
         drag: None,
         radius: DEFAULT_STONE_RADIUS,
     };
