@@ -124,6 +124,11 @@ pub struct Animation<'a> {
 }
 
 impl Animation<'_> {
+    /// An animation without scripted events, from the scene's own start.
+    pub fn plain(frames: u32, fps: u32) -> Animation<'static> {
+        Animation { frames, fps, start_step: 0, script: &[] }
+    }
+
     /// The simulation step of frame `k`.
     pub fn frame_step(&self, k: u32, steps_per_second: f64) -> u64 {
         self.start_step + (f64::from(k) * steps_per_second / f64::from(self.fps)).floor() as u64

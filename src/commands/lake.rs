@@ -49,16 +49,8 @@ pub fn render_lake(args: RenderLake) -> Result<()> {
     let picture = scene.snapshot();
     let triangles = scene.renderer().triangle_count();
     stats.record("render", started, format!("{width}x{height}, ssaa {ssaa}, {triangles} triangles"));
-    let started = Instant::now();
-    let heights = plan.heightmap.is_some().then(|| scene.heightmap(width as usize, height as usize));
-    if heights.is_some() {
-        stats.record("sample", started, format!("heightmap {width}x{height}"));
-    }
-    // The supersampled buffers are the largest allocations; free them before encoding.
-    drop(scene);
-    plan.write_timed(&picture, heights.as_ref(), HEIGHTMAP_PNG_SCALE, &mut stats)?;
-    stats.print_if(args.output.stats);
-    Ok(())
+    let sample = |scene: &LakeScene, w, h| scene.heightmap(w, h);
+    plan.sample_and_write(scene, &picture, sample, HEIGHTMAP_PNG_SCALE, stats, args.output.stats)
 }
 
 /// `tidepool render lake --frames N`: the lake from `--time` on, 1/30 s a step as in the player.
@@ -78,9 +70,8 @@ fn animate_lake(args: &RenderLake, frames: u32) -> Result<()> {
         scene.set_time(time);
         Ok(Box::new(scene))
     };
-    let animation = Animation { frames, fps: args.animation.fps, start_step: 0, script: &[] };
     let mut stats = Stats::default();
-    animate(&mut make, &animation, &target, &mut stats)?;
+    animate(&mut make, &Animation::plain(frames, args.animation.fps), &target, &mut stats)?;
     stats.print_if(args.output.stats);
     Ok(())
 }

@@ -66,19 +66,10 @@ pub fn render_ocean(args: RenderOcean) -> Result<()> {
     let ssaa = scene.renderer().view().ssaa;
     let triangles = scene.renderer().triangle_count();
     stats.record("render", started, format!("{width}x{height}, ssaa {ssaa}, {triangles} triangles"));
-    let started = Instant::now();
-    let heights = plan.heightmap.is_some().then(|| {
-        let extent = args.extent.unwrap_or_else(|| default_extent_m(scene.sea()));
-        scene.heightmap(extent, width as usize, height as usize)
-    });
-    if heights.is_some() {
-        stats.record("sample", started, format!("heightmap {width}x{height}"));
-    }
-    // The supersampled buffer is the largest allocation; free it before encoding.
-    drop(scene);
-    plan.write_timed(&picture, heights.as_ref(), HEIGHTMAP_PNG_SCALE, &mut stats)?;
-    stats.print_if(args.output.stats);
-    Ok(())
+    let extent = args.extent;
+    let sample =
+        |scene: &OceanScene, w, h| scene.heightmap(extent.unwrap_or_else(|| default_extent_m(scene.sea())), w, h);
+    plan.sample_and_write(scene, &picture, sample, HEIGHTMAP_PNG_SCALE, stats, args.output.stats)
 }
 
 /// `tidepool render ocean --frames N`: the sea from `--time` on, 1/60 s a step as in the player.
@@ -104,9 +95,8 @@ fn animate_ocean(args: &RenderOcean, frames: u32) -> Result<()> {
         scene.set_time(time);
         Ok(Box::new(scene))
     };
-    let animation = Animation { frames, fps: args.animation.fps, start_step: 0, script: &[] };
     let mut stats = Stats::default();
-    animate(&mut make, &animation, &target, &mut stats)?;
+    animate(&mut make, &Animation::plain(frames, args.animation.fps), &target, &mut stats)?;
     stats.print_if(args.output.stats);
     Ok(())
 }

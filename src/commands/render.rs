@@ -124,13 +124,32 @@ impl OutputPlan {
         Ok(OutputPlan { target, format, size, heightmap })
     }
 
-    /// Encodes and writes the picture, then the heightmap (heights in the scene's unit;
-    /// `png_scale` converts them to PNG levels).
-    pub fn write(&self, picture: &Pixmap, heights: Option<&Heightmap>, png_scale: f32) -> Result<()> {
-        self.write_timed(picture, heights, png_scale, &mut Stats::default())
+    /// Samples the heightmap (when `--heightmap` asked for one) from `scene`, frees the scene
+    /// (its buffers are the largest allocation) before encoding, writes everything and prints
+    /// the stats when asked. The tail every rendered scene shares.
+    pub fn sample_and_write<S>(
+        &self,
+        scene: S,
+        picture: &Pixmap,
+        sample: impl FnOnce(&S, usize, usize) -> Heightmap,
+        png_scale: f32,
+        mut stats: Stats,
+        print_stats: bool,
+    ) -> Result<()> {
+        let (width, height) = (self.size.width as usize, self.size.height as usize);
+        let started = Instant::now();
+        let heights = self.heightmap.is_some().then(|| sample(&scene, width, height));
+        if heights.is_some() {
+            stats.record("sample", started, format!("heightmap {width}x{height}"));
+        }
+        drop(scene);
+        self.write_timed(picture, heights.as_ref(), png_scale, &mut stats)?;
+        stats.print_if(print_stats);
+        Ok(())
     }
 
-    /// [`OutputPlan::write`], recording how long encoding and writing took.
+    /// Encodes and writes the picture, then the heightmap (heights in the scene's unit;
+    /// `png_scale` converts them to PNG levels), recording how long each took.
     pub fn write_timed(
         &self,
         picture: &Pixmap,
@@ -326,10 +345,7 @@ fn render_pool(args: RenderPool) -> Result<()> {
     let started = Instant::now();
     let picture = scene.snapshot();
     stats.record("render", started, format!("{width}x{height}"));
-    let heights = plan.heightmap.is_some().then(|| scene.heightmap());
-    plan.write_timed(&picture, heights.as_ref(), 1.0, &mut stats)?;
-    stats.print_if(args.output.stats);
-    Ok(())
+    plan.sample_and_write(scene, &picture, |scene, _, _| scene.heightmap(), 1.0, stats, args.output.stats)
 }
 
 /// Refuses flags that mean nothing for an animation.

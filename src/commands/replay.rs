@@ -139,8 +139,9 @@ pub fn render(args: &RenderPool, path: &Path) -> Result<()> {
     let mut plan = OutputPlan::new(&args.output, "pool", std::io::stdout().is_terminal(), terminal_pixels())?;
     let mut scene = simulate(path, &replay, args.steps)?;
     plan.size = Size { width: scene.width(), height: scene.height() };
-    let heights = plan.heightmap.is_some().then(|| scene.heightmap());
-    plan.write(&scene.snapshot(), heights.as_ref(), 1.0)
+    let picture = scene.snapshot();
+    let stats = super::render::Stats::default();
+    plan.sample_and_write(scene, &picture, |scene, _, _| scene.heightmap(), 1.0, stats, args.output.stats)
 }
 
 /// `tidepool render pool --replay FILE --frames N`: the session as an animation, from step 0
