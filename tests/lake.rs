@@ -5,7 +5,7 @@
 mod common;
 
 use common::golden::{self, Tolerance};
-use common::{read_png, run_in, scratch, stderr};
+use common::{read_npy, read_png, run_in, scratch, stderr};
 use tidepool::sim::lake::{Lake, LakeParams};
 
 fn render(dir: &std::path::Path, args: &[&str]) -> Vec<u8> {
@@ -84,17 +84,6 @@ fn animations_move_the_water() {
     let out = run_in(&dir, &["render", "lake", "--frames", "2", "--heightmap", "h.npy", "--out", "a.gif"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("--heightmap"));
-}
-
-/// Reads a float32 NPY written by tidepool: (rows, columns, values).
-fn read_npy(bytes: &[u8]) -> (usize, usize, Vec<f32>) {
-    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
-    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
-    let shape = header.split("'shape': (").nth(1).unwrap().split(')').next().unwrap();
-    let dims: Vec<usize> = shape.split(',').filter_map(|d| d.trim().parse().ok()).collect();
-    let values = bytes[10 + header_len..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
-    (dims[0], dims[1], values)
 }
 
 #[test]

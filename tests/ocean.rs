@@ -4,7 +4,7 @@
 mod common;
 
 use common::golden::{self, Tolerance};
-use common::{read_png, run, run_in, scratch, stderr};
+use common::{read_npy, read_png, run, run_in, scratch, stderr};
 
 fn sea_golden(beaufort: &str, direction: &str) {
     let dir = scratch(&format!("ocean_golden_b{beaufort}"));
@@ -53,17 +53,6 @@ fn same_flags_same_bytes_and_time_moves_the_sea() {
     let out =
         run_in(&dir, &["render", "ocean", "--size", "32x18", "--time", "-5", "--direction", "-90", "--out", "n.png"]);
     assert!(out.status.success(), "{}", stderr(&out));
-}
-
-/// Reads a float32 NPY written by tidepool: (rows, columns, values).
-fn read_npy(bytes: &[u8]) -> (usize, usize, Vec<f32>) {
-    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
-    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
-    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
-    let shape = header.split("'shape': (").nth(1).unwrap().split(')').next().unwrap();
-    let dims: Vec<usize> = shape.split(',').filter_map(|d| d.trim().parse().ok()).collect();
-    let values = bytes[10 + header_len..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
-    (dims[0], dims[1], values)
 }
 
 #[test]

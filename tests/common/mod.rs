@@ -49,3 +49,14 @@ pub fn target_dir() -> PathBuf {
 pub fn read_png(path: &Path) -> image::RgbaImage {
     image::open(path).unwrap_or_else(|e| panic!("{} is not a readable image: {e}", path.display())).to_rgba8()
 }
+
+/// Reads a float32 NPY written by tidepool: (rows, columns, values).
+pub fn read_npy(bytes: &[u8]) -> (usize, usize, Vec<f32>) {
+    assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+    let shape = header.split("'shape': (").nth(1).unwrap().split(')').next().unwrap();
+    let dims: Vec<usize> = shape.split(',').filter_map(|d| d.trim().parse().ok()).collect();
+    let values = bytes[10 + header_len..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
+    (dims[0], dims[1], values)
+}
