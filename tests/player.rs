@@ -223,38 +223,34 @@ fn max_bps_caps_the_output_rate() {
     assert!(window >= 3 * 20_000 / 4, "busy water still uses the budget: {window} bytes in 3 s");
 }
 
-#[test]
-fn the_ocean_plays_its_wind_keys_and_tab_switches_scenes() {
-    let mut p = Player::spawn(&temp_dir("ocean"), 80, 20, &[ARGS, &["ocean"]].concat(), &[]);
-    p.wait_for_status("Beaufort 5", WAIT);
-    p.send(b"8");
-    p.wait_for_status("Beaufort 8", WAIT);
-    p.send(b".");
-    p.wait_for_status("from 345", WAIT);
-    p.send(b"\t");
-    p.wait_for_status("octaves", WAIT);
-    p.send(b"\t");
-    p.wait_for_status("damping", WAIT);
+/// Opens `scene`, waits for `first` in the status line, then sends each key and waits for its
+/// status text; quits with `q` and checks the terminal was restored.
+fn play_keys(scene: &str, first: &str, keys: &[(&[u8], &str)]) {
+    let mut p = Player::spawn(&temp_dir(scene), 80, 20, &[ARGS, &[scene]].concat(), &[]);
+    p.wait_for_status(first, WAIT);
+    for (key, status) in keys {
+        p.send(key);
+        p.wait_for_status(status, WAIT);
+    }
     p.send(b"q");
     assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
     assert_restored(&p);
 }
 
 #[test]
+fn the_ocean_plays_its_wind_keys_and_tab_switches_scenes() {
+    play_keys(
+        "ocean",
+        "Beaufort 5",
+        &[(b"8", "Beaufort 8"), (b".", "from 345"), (b"\t", "octaves"), (b"\t", "damping")],
+    );
+}
+
+#[test]
 fn the_lake_plays_its_wind_and_noise_keys() {
-    let mut p = Player::spawn(&temp_dir("lake"), 80, 20, &[ARGS, &["lake"]].concat(), &[]);
-    p.wait_for_status("wind 3 m/s", WAIT);
-    p.send(b"]");
-    p.wait_for_status("wind 4 m/s", WAIT);
-    p.send(b"c");
-    p.wait_for_status("wind 0 m/s", WAIT);
-    p.send(b"n");
-    p.wait_for_status("\u{b7} gradient", WAIT);
-    p.send(b"O");
-    p.wait_for_status("4 octaves", WAIT);
-    p.send(b"q");
-    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
-    assert_restored(&p);
+    let keys: [(&[u8], &str); 4] =
+        [(b"]", "wind 4 m/s"), (b"c", "wind 0 m/s"), (b"n", "\u{b7} gradient"), (b"O", "4 octaves")];
+    play_keys("lake", "wind 3 m/s", &keys);
 }
 
 #[test]

@@ -165,8 +165,21 @@ impl Run<'_> {
 }
 
 /// Renders the animation of scenes made by `make` (called once, twice for a GIF: a first pass
-/// learns the palette from sample frames) to `target`.
+/// learns the palette from sample frames) to `target`; prints the stage timings when
+/// `print_stats` (`--stats`).
 pub fn animate(
+    make: &mut dyn FnMut() -> Result<Box<dyn Playable>>,
+    animation: &Animation<'_>,
+    target: &AnimationTarget,
+    print_stats: bool,
+) -> Result<()> {
+    let mut stats = Stats::default();
+    render_animation(make, animation, target, &mut stats)?;
+    stats.print_if(print_stats);
+    Ok(())
+}
+
+fn render_animation(
     make: &mut dyn FnMut() -> Result<Box<dyn Playable>>,
     animation: &Animation<'_>,
     target: &AnimationTarget,

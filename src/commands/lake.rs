@@ -40,9 +40,8 @@ pub fn render_lake(args: RenderLake) -> Result<()> {
     let (width, height) = (plan.size.width, plan.size.height);
     let mut stats = Stats::default();
     let started = Instant::now();
-    let mut scene = LakeScene::new(settings(&args, ssaa), width, height).ok_or_else(|| {
-        Error::arg("--size", format!("cannot allocate a {width}x{height} picture; choose a smaller size or --ssaa"))
-    })?;
+    let mut scene = LakeScene::new(settings(&args, ssaa), width, height)
+        .ok_or_else(|| super::render::too_large(plan.size, " or --ssaa"))?;
     scene.set_time(args.time);
     stats.record("setup", started, "sky, shore and mirror".into());
     let started = Instant::now();
@@ -64,14 +63,10 @@ fn animate_lake(args: &RenderLake, frames: u32) -> Result<()> {
     let settings = settings(args, ssaa);
     let time = args.time;
     let mut make = || -> Result<Box<dyn crate::scene::playable::Playable>> {
-        let mut scene = LakeScene::new(settings, size.width, size.height).ok_or_else(|| {
-            Error::arg("--size", format!("cannot allocate a {size} picture; choose a smaller size or --ssaa"))
-        })?;
+        let mut scene = LakeScene::new(settings, size.width, size.height)
+            .ok_or_else(|| super::render::too_large(size, " or --ssaa"))?;
         scene.set_time(time);
         Ok(Box::new(scene))
     };
-    let mut stats = Stats::default();
-    animate(&mut make, &Animation::plain(frames, args.animation.fps), &target, &mut stats)?;
-    stats.print_if(args.output.stats);
-    Ok(())
+    animate(&mut make, &Animation::plain(frames, args.animation.fps), &target, args.output.stats)
 }

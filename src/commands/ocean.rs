@@ -56,9 +56,8 @@ pub fn render_ocean(args: RenderOcean) -> Result<()> {
         None => SeaTexture::builtin(),
     };
     let (width, height) = (plan.size.width, plan.size.height);
-    let mut scene = OceanScene::new(settings, width, height, texture).ok_or_else(|| {
-        Error::arg("--size", format!("cannot allocate a {width}x{height} picture; choose a smaller size or --ssaa"))
-    })?;
+    let mut scene = OceanScene::new(settings, width, height, texture)
+        .ok_or_else(|| super::render::too_large(plan.size, " or --ssaa"))?;
     scene.set_time(args.time);
     let mut stats = Stats::default();
     let started = Instant::now();
@@ -89,14 +88,10 @@ fn animate_ocean(args: &RenderOcean, frames: u32) -> Result<()> {
     };
     let time = args.time;
     let mut make = || -> Result<Box<dyn crate::scene::playable::Playable>> {
-        let mut scene = OceanScene::new(settings, size.width, size.height, texture.clone()).ok_or_else(|| {
-            Error::arg("--size", format!("cannot allocate a {size} picture; choose a smaller size or --ssaa"))
-        })?;
+        let mut scene = OceanScene::new(settings, size.width, size.height, texture.clone())
+            .ok_or_else(|| super::render::too_large(size, " or --ssaa"))?;
         scene.set_time(time);
         Ok(Box::new(scene))
     };
-    let mut stats = Stats::default();
-    animate(&mut make, &Animation::plain(frames, args.animation.fps), &target, &mut stats)?;
-    stats.print_if(args.output.stats);
-    Ok(())
+    animate(&mut make, &Animation::plain(frames, args.animation.fps), &target, args.output.stats)
 }

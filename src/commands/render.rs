@@ -308,9 +308,7 @@ fn render_pool(args: RenderPool) -> Result<()> {
     let floor = args.pool.floor()?;
     let settings = args.pool.settings(args.output.seed, 0.0);
     let Size { width, height } = plan.size;
-    let mut scene = PoolScene::new(width, height, floor, settings).ok_or_else(|| {
-        Error::arg("--size", format!("cannot allocate a {width}x{height} picture; choose a smaller size"))
-    })?;
+    let mut scene = PoolScene::new(width, height, floor, settings).ok_or_else(|| too_large(plan.size, ""))?;
     let mut script = if args.stones.is_empty() {
         default_stones(plan.size)
     } else {
@@ -348,6 +346,12 @@ fn render_pool(args: RenderPool) -> Result<()> {
     plan.sample_and_write(scene, &picture, |scene, _, _| scene.heightmap(), 1.0, stats, args.output.stats)
 }
 
+/// The error when a picture of `size` cannot be allocated; `also` names another way out
+/// (such as " or --ssaa").
+pub fn too_large(size: Size, also: &str) -> Error {
+    Error::arg("--size", format!("cannot allocate a {size} picture; choose a smaller size{also}"))
+}
+
 /// Refuses flags that mean nothing for an animation.
 pub fn check_animation_flags(output: &OutputArgs) -> Result<()> {
     if output.format.is_some() {
@@ -380,13 +384,10 @@ fn animate_pool(args: &RenderPool, frames: u32) -> Result<()> {
     let mut make = || -> Result<Box<dyn crate::scene::playable::Playable>> {
         PoolScene::new(size.width, size.height, floor.clone(), settings)
             .map(|scene| Box::new(scene) as Box<dyn crate::scene::playable::Playable>)
-            .ok_or_else(|| Error::arg("--size", format!("cannot allocate a {size} picture; choose a smaller size")))
+            .ok_or_else(|| too_large(size, ""))
     };
     let animation = Animation { frames, fps: args.animation.fps, start_step: args.steps.unwrap_or(0), script: &script };
-    let mut stats = Stats::default();
-    animate(&mut make, &animation, &target, &mut stats)?;
-    stats.print_if(args.output.stats);
-    Ok(())
+    animate(&mut make, &animation, &target, args.output.stats)
 }
 
 #[cfg(test)]

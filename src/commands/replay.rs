@@ -170,8 +170,5 @@ fn animate(args: &RenderPool, path: &Path, replay: &Replay, frames: u32) -> Resu
         })
     };
     let animation = Animation { frames, fps: args.animation.fps, start_step: args.steps.unwrap_or(0), script: &script };
-    let mut stats = super::render::Stats::default();
-    super::animate::animate(&mut make, &animation, &target, &mut stats)?;
-    stats.print_if(args.output.stats);
-    Ok(())
+    super::animate::animate(&mut make, &animation, &target, args.output.stats)
 }
