@@ -20,7 +20,7 @@ use crate::scene::pool::{PoolScene, PoolSettings};
 use crate::sim::lake::LakeParams;
 use crate::sim::ocean::SeaParams;
 use crate::sim::ripple::{Damping, RipplePool, Stone};
-use crate::sim::stepper::Kernel;
+use crate::simd::Simd;
 
 /// One measured workload.
 struct Row {
@@ -80,7 +80,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     let threads = rayon::current_num_threads();
     println!(
         "tidepool bench: {threads} threads, SIMD kernel {:?}, {:.1} s per workload",
-        Kernel::detect(),
+        Simd::detect(),
         budget.as_secs_f64()
     );
     let mut rows = Vec::new();

@@ -12,7 +12,7 @@
 use tiny_skia::Pixmap;
 
 use super::camera::Camera;
-use super::shade::{Rgb, SrgbTable, mix, srgb_decode};
+use super::light::{Rgb, SrgbTable, mix, srgb_decode};
 use super::sky::{Environment, Sky, pixel, sky_grid_px};
 use super::vec3::normalize;
 use crate::sim::noise::{Fractal, NoiseKind};

@@ -32,10 +32,11 @@ use tiny_skia::Pixmap;
 
 use super::camera::{Camera, CameraPose};
 use super::clouds::Clouds;
+use super::light::{Light, Rgb, SrgbTable, mix};
 use super::mesh::{FaceIds, MeshRenderer};
 use super::mirror::Mirror;
 use super::ocean::mesh_spacing_px;
-use super::shade::{Facet, Light, Rgb, SrgbTable, WaterLook, fresnel, glint, mix};
+use super::shade::{Facet, WaterLook, fresnel, glint};
 use super::shore::Shore;
 use super::sky::{Environment, Sky};
 use super::supersample::{Downsample, downsample};

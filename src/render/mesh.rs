@@ -60,8 +60,9 @@ use spade::{DelaunayTriangulation, Point2, Triangulation};
 use tiny_skia::{BlendMode, Paint, Pixmap, PixmapMut};
 
 use super::camera::Camera;
+use super::light::{Light, to_srgb8};
 use super::raster::{TriangleFiller, fill_triangle_ids};
-use super::shade::{Facet, Light, WaterLook, shade_facet, to_srgb8};
+use super::shade::{Facet, WaterLook, shade_facet};
 use super::sky::Environment;
 use super::texture::SeaTexture;
 use super::vec3::{Vec3, cross, length, normalize, scale, sub};

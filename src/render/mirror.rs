@@ -18,7 +18,7 @@
 use tiny_skia::Pixmap;
 
 use super::camera::Camera;
-use super::shade::{Rgb, srgb_decode};
+use super::light::{Rgb, srgb_decode};
 
 /// Linear light is kept as this many levels per unit.
 const LEVELS: f32 = 65535.0;

@@ -10,6 +10,7 @@ pub mod camera;
 pub mod caustics;
 pub mod clouds;
 pub mod lake;
+pub mod light;
 pub mod mesh;
 pub mod mirror;
 pub mod ocean;

@@ -128,7 +128,7 @@ impl OceanRenderer {
     /// The colour of the sea at the horizon straight ahead: a level facet seen at a grazing
     /// angle with all of the Cox–Munk roughness unresolved. It fills the sliver between the
     /// farthest mesh row and the horizon.
-    fn far_sea(&self, wind_m_s: f64) -> super::shade::Rgb {
+    fn far_sea(&self, wind_m_s: f64) -> super::light::Rgb {
         let f = self.camera.forward();
         let level = super::vec3::normalize([f[0], f[1], 0.0]);
         let distance_m = self.camera.horizon_distance_m();

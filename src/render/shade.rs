@@ -18,50 +18,18 @@
 //! facets and a broad glitter path towards the horizon, as on a real sea. Colours are linear
 //! RGB floats; [`to_srgb8`] tone-maps and encodes them once per triangle.
 
+use super::light::{Light, Rgb, mix};
 use super::sky::Environment;
 use super::vec3::{Vec3, dot, normalize, reflect};
 
-/// A linear RGB colour (1.0 = white paper in full light; highlights go above 1).
-pub type Rgb = [f32; 3];
-
 /// Water's reflectance at normal incidence (refractive index 1.33).
 pub const WATER_F0: f32 = 0.02;
-
-/// Colour `a` mixed towards `b` by `t` (0 = a, 1 = b).
-#[inline(always)]
-pub fn mix(a: Rgb, b: Rgb, t: f32) -> Rgb {
-    [a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t]
-}
 
 /// Schlick's Fresnel reflectance for a cosine of incidence `cos`.
 #[inline(always)]
 pub fn fresnel(cos: f32) -> f32 {
     let m = (1.0 - cos.clamp(0.0, 1.0)).powi(5);
     WATER_F0 + (1.0 - WATER_F0) * m
-}
-
-/// The sRGB encoding of a linear value in 0..=1.
-#[inline(always)]
-pub fn srgb_encode(v: f32) -> f32 {
-    let v = v.clamp(0.0, 1.0);
-    if v <= 0.003_130_8 { 12.92 * v } else { 1.055 * v.powf(1.0 / 2.4) - 0.055 }
-}
-
-/// The linear value of an sRGB level 0..=255.
-pub fn srgb_decode(level: u8) -> f32 {
-    let v = f32::from(level) / 255.0;
-    if v <= 0.040_45 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
-}
-
-/// Linear colour to 8-bit sRGB: values up to 0.8 pass unchanged, brighter ones roll off
-/// smoothly towards 1 (so a glint saturates to white without a hard edge).
-#[inline(always)]
-pub fn to_srgb8(c: Rgb) -> [u8; 3] {
-    let tone = |v: f32| {
-        let v = v.max(0.0);
-        if v <= 0.8 { v } else { 0.8 + 0.2 * (1.0 - (-(v - 0.8) / 0.2).exp()) }
-    };
-    c.map(|v| (srgb_encode(tone(v)) * 255.0 + 0.5) as u8)
 }
 
 /// How water is lit and coloured.
@@ -111,17 +79,6 @@ pub struct Facet {
     pub slope_variance: f32,
     /// Mean height of the facet above the still water level, m (the lake colours by it).
     pub height_m: f32,
-}
-
-/// The light falling on the water.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Light {
-    /// Unit direction towards the sun.
-    pub sun_dir: Vec3,
-    /// The sun's colour (times [`WaterLook::sun_irradiance`] for the glint).
-    pub sun: Rgb,
-    /// The average sky light on a level surface.
-    pub sky: Rgb,
 }
 
 /// The sun's glint on a facet with unit normal `n` seen from the unit direction `v` (towards
@@ -180,31 +137,6 @@ pub fn shade_facet<E: Environment + ?Sized>(look: &WaterLook, light: &Light, env
     mix(colour, env.radiance(away), haze)
 }
 
-/// [`to_srgb8`] for one channel through a table, for per-pixel work: 16,384 steps per unit of linear light up to 4
-/// (fine enough that the darkest water has no bands: one step is under 0.1 of an 8-bit level).
-pub struct SrgbTable {
-    levels: Vec<u8>,
-}
-
-impl SrgbTable {
-    const STEPS: f32 = 16_384.0;
-
-    /// The table, built on first use.
-    pub fn shared() -> &'static SrgbTable {
-        static TABLE: std::sync::OnceLock<SrgbTable> = std::sync::OnceLock::new();
-        TABLE.get_or_init(|| SrgbTable {
-            levels: (0..65_536).map(|i| to_srgb8([(i as f32 + 0.5) / Self::STEPS, 0.0, 0.0])[0]).collect(),
-        })
-    }
-
-    /// The 8-bit sRGB level of a linear value (NaN and negatives give 0).
-    #[inline(always)]
-    pub fn encode(&self, v: f32) -> u8 {
-        // `as usize` sends NaN and negatives to 0.
-        self.levels[((v * Self::STEPS) as usize).min(self.levels.len() - 1)]
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -227,19 +159,6 @@ mod tests {
         assert!((fresnel(1.0) - WATER_F0).abs() < 1e-6);
         assert!((fresnel(0.0) - 1.0).abs() < 1e-6);
         assert!(fresnel(0.2) > fresnel(0.6));
-    }
-
-    #[test]
-    fn tone_mapping_is_monotonic_and_saturates() {
-        assert_eq!(to_srgb8([0.0, 0.5, 100.0]), [0, 188, 255]);
-        assert!(to_srgb8([1.0; 3])[0] > 240);
-        let mut last = 0;
-        for i in 0..200 {
-            let v = to_srgb8([i as f32 / 50.0; 3])[0];
-            assert!(v >= last);
-            last = v;
-        }
-        assert_eq!(srgb_encode(srgb_decode(128)), 128.0 / 255.0);
     }
 
     #[test]
@@ -273,16 +192,5 @@ mod tests {
         let far = shade_facet(&look, &light, &sky, &f);
         let horizon = sky.radiance(normalize([0.0, 0.5, 0.0]));
         assert!((0..3).all(|i| (far[i] - horizon[i]).abs() < 1e-3));
-    }
-
-    #[test]
-    fn the_table_matches_to_srgb8() {
-        let t = SrgbTable::shared();
-        for v in [0.0f32, 0.0004, 0.01, 0.2, 0.79, 0.81, 1.5, 3.9, 10.0] {
-            let want = to_srgb8([v, 0.0, 0.0])[0];
-            assert!(t.encode(v).abs_diff(want) <= 1, "{v}: {} vs {want}", t.encode(v));
-        }
-        assert_eq!(t.encode(f32::NAN), 0);
-        assert_eq!(t.encode(-1.0), 0);
     }
 }

@@ -17,7 +17,7 @@ use tiny_skia::{
 };
 
 use super::camera::Camera;
-use super::shade::{Rgb, mix, to_srgb8};
+use super::light::{Rgb, mix, to_srgb8};
 use super::sky::{Environment, Sky};
 use super::vec3::{Vec3, dot, normalize};
 use crate::sim::noise::{Fractal, NoiseKind, fold_seed, lattice_value};

@@ -13,7 +13,7 @@
 use tiny_skia::{Pixmap, PremultipliedColorU8};
 
 use super::camera::Camera;
-use super::shade::{Light, Rgb, mix, to_srgb8};
+use super::light::{Light, Rgb, mix, to_srgb8};
 use super::vec3::{Vec3, dot};
 
 /// Spacing of the sky's evaluation grid, px: a 135th of the picture height, within 4..=16

@@ -8,5 +8,4 @@ pub mod rain;
 pub mod ripple;
 pub mod sea_state;
 pub mod spectrum;
-pub mod stepper;
 pub mod surface;

@@ -21,6 +21,8 @@
 //! - The outermost ring of cells is a fixed zero wall (the papers' 1-D loop reads across row
 //!   ends instead; that defect is not reproduced). Stones are clipped to the interior.
 
+mod stepper;
+
 /// How fast waves lose energy: `v -= v >> shift` after every step.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Damping {
@@ -96,12 +98,12 @@ pub struct RipplePool {
     current: Vec<i16>,
     previous: Vec<i16>,
     /// Per row, a bound of the magnitudes in `current` / `previous` (see
-    /// [`super::stepper::RowMax`]): lets the step use 16-bit arithmetic where it is exact.
-    current_max: super::stepper::RowMax,
-    previous_max: super::stepper::RowMax,
+    /// [`stepper::RowMax`]): lets the step use 16-bit arithmetic where it is exact.
+    current_max: stepper::RowMax,
+    previous_max: stepper::RowMax,
     damping: Damping,
     steps: u64,
-    scratch: super::stepper::Scratch,
+    scratch: stepper::Scratch,
 }
 
 impl RipplePool {
@@ -206,7 +208,7 @@ impl RipplePool {
     /// blocking and all cores; see [`super::stepper`]). The result is bit-identical to calling
     /// [`RipplePool::step`] `steps` times, on any number of threads.
     pub fn advance(&mut self, steps: u64) {
-        super::stepper::advance(
+        stepper::advance(
             (&mut self.current, &mut self.current_max),
             (&mut self.previous, &mut self.previous_max),
             self.width,

@@ -28,7 +28,7 @@
 //! Everything is safe Rust except the `unsafe` calls of the `#[target_feature]` entry points,
 //! which are guarded by run-time feature detection.
 
-use super::ripple::Damping;
+use super::Damping;
 use crate::simd::Simd;
 
 /// The most steps computed in one wavefront sweep. With `k` steps about `k + 2` rows of each
