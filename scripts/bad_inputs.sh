@@ -30,7 +30,7 @@ png = b'\x89PNG\r\n\x1a\n' + chunk(b'IHDR', struct.pack('>IIBBBBB', 100000, 1000
 open('huge.png','wb').write(png)
 PY
 cp ok.png keep.png; before=$(sha256sum keep.png)
-printf '{"tidepool_replay":1,"version":"0.1.0","scene":"pool","seed":1,"size":[64,48],"options":{"damping":"5"}}\n{"step":3,"stone":[10,10,3,48]}\n{"step":9,"en' > trunc.jsonl
+printf '{"tidepool_replay":1,"version":"0.1.0","scene":"pool","seed":1,"size":[64,48],"options":{"background":null,"caustics":true,"damping":"5","depth":24.0,"rain":0.0,"refraction":"auto","shading":true,"sun":"315,60"}}\n{"step":3,"stone":[10,10,3,48]}\n{"step":9,"en' > trunc.jsonl
 printf 'hello\n' > garbage.jsonl
 printf '{"tidepool_replay":2,"version":"0.9.0","scene":"pool","seed":1,"size":[64,48],"options":{}}\n{"step":9,"end":true}\n' > future.jsonl
 

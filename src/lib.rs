@@ -1,26 +1,65 @@
 //! tidepool: water you can play with in any terminal, simulated and drawn on the CPU.
 //!
-//! Data flows one way: **simulation -> renderer -> pixels -> output**.
-//! - [`sim`]: simulations (the ripple pool, rain, the wind-driven sea); no drawing, no I/O.
-//! - [`render`]: simulation state -> `tiny_skia::Pixmap`.
-//! - [`output`]: pixels -> PNG, half-block text, heightmaps; atomic file writes.
-//! - [`scene`]: a simulation together with its renderer, driven alike by the headless
-//!   renderer and the terminal player.
-//! - [`term`]: the interactive terminal player; [`replay`]: recorded sessions.
-//! - [`cli`] and [`commands`]: the command line.
+//! Three scenes — a ripple pool, a wind-driven sea and a lake mirroring its shore — behind one
+//! contract, [`Scene`]: advance it, apply [`Event`]s, render it into a `tiny_skia::Pixmap`.
+//! Data flows one way: **simulation -> renderer -> pixels -> output** ([`encode`],
+//! [`terminal`]); nothing flows back except user input, which becomes events.
+//!
+//! ```
+//! use tidepool::{PoolScene, PoolSettings, Scene, Stone};
+//!
+//! let mut pool = PoolScene::new(64, 48, PoolSettings::default()).expect("a small pool");
+//! let still = pool.snapshot()?;
+//! pool.drop_stone(Stone::new(32, 24, 6, 128)?);
+//! pool.advance(20);
+//! let rippled = pool.snapshot()?;
+//! assert_ne!(still.pixel(32, 20), rippled.pixel(32, 20), "the ring has moved the floor");
+//! let png: Vec<u8> = tidepool::encode::png(&rippled);
+//! assert!(png.starts_with(b"\x89PNG"));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+//!
+//! Features: `cli` (default: the `tidepool` binary), `player` (the interactive terminal player,
+//! [`player`]), `animation` (GIF and animated PNG writers in [`encode`]).
 #![warn(missing_docs)]
 
-pub mod cli;
-pub mod commands;
-pub mod error;
-pub mod output;
-pub mod progress;
-pub mod render;
-pub mod replay;
-pub mod scene;
-pub mod signals;
-pub mod sim;
-pub mod simd;
-pub mod term;
+mod error;
+mod numbers;
+mod output;
+mod render;
+mod scene;
+mod sim;
+mod simd;
+mod size;
+mod storage;
+#[cfg(feature = "player")]
+mod term;
 
-pub use error::{Error, Result};
+pub mod encode;
+#[cfg(feature = "player")]
+pub mod player;
+pub mod replay;
+pub mod sea;
+pub mod terminal;
+pub mod values;
+
+pub use error::{Error, Result, ValueError};
+pub use output::heightmap::Heightmap;
+pub use render::background::{load as load_image, pool_floor};
+pub use render::camera::CameraPose;
+pub use render::caustics::CausticsLook;
+pub use render::ocean::OceanView;
+pub use render::pool::{PoolLook, Refraction, Sun};
+pub use render::supersample::Downsample;
+pub use render::texture::SeaTexture;
+pub use scene::lake::{LakeScene, LakeSettings};
+pub use scene::ocean::{OceanScene, OceanSettings};
+pub use scene::pool::{PoolScene, PoolSettings};
+pub use scene::{Action, Controls, Event, Playable, Scene, SceneKind, SceneSpec, Script};
+pub use sim::lake::LakeParams;
+pub use sim::noise::NoiseKind;
+pub use sim::ocean::SeaParams;
+pub use sim::ripple::{Damping, RipplePool, Stone};
+pub use simd::Simd;
+pub use size::Size;
+pub use storage::Storage;

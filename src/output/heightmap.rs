@@ -12,6 +12,9 @@ pub struct Heightmap {
     pub height: usize,
     /// `width * height` values in the scene's unit (pool: raw amplitude; ocean/lake: metres).
     pub values: Vec<f32>,
+    /// 16-bit PNG levels per unit (pool: 1, the raw amplitude; ocean: 100, centimetres; lake:
+    /// 1000, millimetres).
+    pub png_levels_per_unit: f32,
 }
 
 /// Encodes NPY format 1.0: `{'descr': '<f4', 'fortran_order': False, 'shape': (H, W), }`,
@@ -34,9 +37,10 @@ pub fn encode_npy(map: &Heightmap) -> Vec<u8> {
     out
 }
 
-/// Encodes a 16-bit greyscale PNG where a pixel is `round(value · scale) + 32768`, clamped to
-/// 0..=65535 (pool: scale 1, the raw amplitude; ocean and lake: scale 100, centimetres).
-pub fn encode_png16(map: &Heightmap, scale: f32) -> Vec<u8> {
+/// Encodes a 16-bit greyscale PNG where a pixel is `round(value · png_levels_per_unit) + 32768`,
+/// clamped to 0..=65535.
+pub fn encode_png16(map: &Heightmap) -> Vec<u8> {
+    let scale = map.png_levels_per_unit;
     let mut samples = Vec::with_capacity(map.values.len() * 2);
     for &v in &map.values {
         let level = ((v * scale).round() + 32768.0).clamp(0.0, 65535.0) as u16;
@@ -55,7 +59,12 @@ mod tests {
     use super::*;
 
     fn sample() -> Heightmap {
-        Heightmap { width: 3, height: 2, values: vec![0.0, 1.5, -2.0, 100.0, -32768.0, 40000.0] }
+        Heightmap {
+            width: 3,
+            height: 2,
+            values: vec![0.0, 1.5, -2.0, 100.0, -32768.0, 40000.0],
+            png_levels_per_unit: 1.0,
+        }
     }
 
     #[test]
@@ -74,11 +83,11 @@ mod tests {
 
     #[test]
     fn png16_offsets_scales_and_clamps() {
-        let png = encode_png16(&sample(), 1.0);
+        let png = encode_png16(&sample());
         let decoded = image::load_from_memory(&png).unwrap();
         let grey = decoded.as_luma16().expect("16-bit grey").as_raw().clone();
         assert_eq!(grey, vec![32768, 32770, 32766, 32868, 0, 65535]);
-        let cm = encode_png16(&Heightmap { width: 1, height: 1, values: vec![0.123] }, 100.0);
+        let cm = encode_png16(&Heightmap { width: 1, height: 1, values: vec![0.123], png_levels_per_unit: 100.0 });
         assert_eq!(image::load_from_memory(&cm).unwrap().as_luma16().unwrap().as_raw(), &vec![32780]);
     }
 }

@@ -1,13 +1,15 @@
 //! Outputs: pixels (and heights) in, bytes out. Nothing here knows what it draws.
 
+#[cfg(feature = "animation")]
 pub mod apng;
-pub mod atomic;
 pub mod color;
 pub mod cursor;
 pub mod diff;
 pub mod frame;
+#[cfg(feature = "animation")]
 pub mod gif;
 pub mod halfblock;
 pub mod heightmap;
 pub mod png;
+pub mod units;
 pub mod vt;

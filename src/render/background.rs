@@ -24,13 +24,13 @@ pub fn pool_floor() -> Pixmap {
     decode(POOL_FLOOR_PNG).expect("the built-in pool floor is a valid PNG")
 }
 
-/// Reads and decodes a PNG or JPEG file named by `flag` into an opaque pixmap.
+/// Reads and decodes a PNG or JPEG file into an opaque pixmap.
 ///
 /// Any format `image` was built with works, in any bit depth or colour type (16-bit, grey,
 /// palette; an animated PNG gives its first frame). Transparent pixels are flattened onto black.
 /// Every failure is a one-line [`Error::Image`] that names the file and what to do.
-pub fn load(flag: &'static str, path: &Path) -> Result<Pixmap> {
-    let fail = |message: String| Error::Image { flag, path: path.to_owned(), message };
+pub fn load(path: &Path) -> Result<Pixmap> {
+    let fail = |problem: String| Error::Image { path: path.to_owned(), problem };
     if path.is_dir() {
         return Err(fail("is a directory; give a PNG or JPEG file".into()));
     }

@@ -15,6 +15,7 @@
 //! stencils cancel it exactly (the papers' refraction offsets have the same property). The
 //! result is a multiplier per cell (1 = flat water) in 8.8 fixed point.
 
+use crate::error::ValueError;
 use crate::simd::Simd;
 
 /// Amplitude units per pixel of surface height: a weight-64 stone makes a dent one pixel deep.
@@ -22,18 +23,49 @@ pub const AMPLITUDE_PER_PIXEL: f32 = 64.0;
 /// Water's refractive index.
 pub const WATER_INDEX: f32 = 1.33;
 
-/// How the caustics look.
+/// How the caustics look: the water's depth in pixels (deeper water focuses the light into
+/// sharper, stronger lines), `0..=`[`CausticsLook::MAX_DEPTH_PX`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CausticsLook {
-    /// Water depth in pixels: deeper water focuses the light into sharper, stronger lines.
-    pub depth_px: f32,
+    depth_px: f32,
     /// How much of the floor's light is sunlight that takes part (the rest is ambient).
-    pub strength: f32,
+    strength: f32,
 }
 
 impl Default for CausticsLook {
     fn default() -> Self {
         CausticsLook { depth_px: 24.0, strength: 0.8 }
+    }
+}
+
+impl CausticsLook {
+    /// The deepest water, in pixels.
+    pub const MAX_DEPTH_PX: f32 = 10_000.0;
+
+    /// Caustics through water `depth_px` pixels deep.
+    pub fn with_depth(depth_px: f32) -> Result<CausticsLook, ValueError> {
+        Self::checked(depth_px, &depth_px.to_string())
+    }
+
+    fn checked(depth_px: f32, shown: &str) -> Result<CausticsLook, ValueError> {
+        if !depth_px.is_finite() || !(0.0..=Self::MAX_DEPTH_PX).contains(&depth_px) {
+            return Err(ValueError::new("depth", format!("'{shown}' must be between 0 and 10000 pixels")));
+        }
+        Ok(CausticsLook { depth_px, ..CausticsLook::default() })
+    }
+
+    /// Parses a depth in pixels.
+    pub fn parse_depth(text: &str) -> Result<CausticsLook, ValueError> {
+        let v: f32 = text
+            .trim()
+            .parse()
+            .map_err(|_| ValueError::new("depth", format!("'{text}' is not a number of pixels; e.g. 48")))?;
+        Self::checked(v, text)
+    }
+
+    /// The water's depth, px.
+    pub fn depth_px(&self) -> f32 {
+        self.depth_px
     }
 }
 

@@ -154,16 +154,19 @@ impl MeshTopology {
         MeshTopology { camera: *camera, spacing_px, ground, footprints, triangles }
     }
 
+    #[cfg(test)]
     /// The camera it was built for.
     pub fn camera(&self) -> &Camera {
         &self.camera
     }
 
+    #[cfg(test)]
     /// Sample points (east, north metres).
     pub fn points(&self) -> &[[f32; 2]] {
         &self.ground
     }
 
+    #[cfg(test)]
     /// Each point's footprint.
     pub fn footprints(&self) -> &[Footprint] {
         &self.footprints
@@ -391,16 +394,19 @@ impl FaceIds {
         FaceIds { width, height, ids: vec![0; width * height] }
     }
 
+    #[cfg(test)]
     /// Columns.
     pub fn width(&self) -> usize {
         self.width
     }
 
+    #[cfg(test)]
     /// Rows.
     pub fn height(&self) -> usize {
         self.height
     }
 
+    #[cfg(test)]
     /// The numbers, row-major.
     pub fn ids(&self) -> &[u32] {
         &self.ids
@@ -411,6 +417,7 @@ impl FaceIds {
         &mut self.ids
     }
 
+    #[cfg(test)]
     /// Sets every number to 0.
     pub fn clear(&mut self) {
         self.ids.fill(0);

@@ -74,16 +74,19 @@ impl Mirror {
         Some(Mirror { width, rows, pad_x: pad_x as usize, first_row: first as f32 - pad_y as f32, sums })
     }
 
+    #[cfg(test)]
     /// Columns kept (the picture's plus the padding).
     pub fn width(&self) -> usize {
         self.width
     }
 
+    #[cfg(test)]
     /// Rows kept.
     pub fn rows(&self) -> usize {
         self.rows
     }
 
+    #[cfg(test)]
     /// The picture row where the kept rows begin.
     pub fn first_row(&self) -> f32 {
         self.first_row

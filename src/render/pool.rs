@@ -4,7 +4,7 @@
 //! `(x + xoff·F, y + yoff·F)` with `xoff = h[x-1] - h[x+1]` and `yoff = h[y-1] - h[y+1]`,
 //! clamped to the picture. F = 1 is the papers' factor; it is right for the papers' 640x480
 //! window, but the amplitudes do not shrink with the picture, so at terminal size the same
-//! offsets scramble the floor. [`Refraction::Auto`] therefore scales F with the picture's
+//! offsets scramble the floor. [`Refraction::AUTO`] therefore scales F with the picture's
 //! smaller side (see [`Refraction::factor`]). Fractional offsets are filtered bilinearly.
 //!
 //! Light, beyond the papers: the floor is lit by caustics ([`super::caustics`]), shifted away
@@ -14,42 +14,93 @@
 //! Displacement and filtering are integer arithmetic in 8.8 fixed point; the light is `f32`.
 //! Either way the picture is the same on every run.
 
+use std::str::FromStr;
+
 use tiny_skia::Pixmap;
 
 use super::caustics::{self, AMPLITUDE_PER_PIXEL, CausticsLook, WATER_INDEX};
+use crate::error::ValueError;
 use crate::sim::ripple::RipplePool;
 use crate::simd::Simd;
 
-/// How strongly the surface slope displaces the background.
+/// How strongly the surface slope displaces the background: a fixed factor (1.0 is the papers'
+/// displacement, 0 shows the floor undistorted) or [`Refraction::AUTO`], which scales with the
+/// picture. Fixed factors are finite and within [`Refraction::MAX_FACTOR`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Refraction {
-    /// Scale with the picture: `min(width, height) / 720`, between 0.15 and 1.
-    Auto,
-    /// A fixed factor; 1.0 is the papers' displacement, 0 shows the floor undistorted.
-    Factor(f32),
+pub struct Refraction {
+    /// The fixed factor, or `None` for automatic.
+    fixed: Option<f32>,
 }
 
 impl Refraction {
-    /// The side (in pixels) at which `Auto` gives the papers' factor of 1.
+    /// Scale with the picture: `min(width, height) / 720`, between 0.15 and 1.
+    pub const AUTO: Refraction = Refraction { fixed: None };
+    /// The side (in pixels) at which `AUTO` gives the papers' factor of 1.
     pub const AUTO_REFERENCE_SIDE: f32 = 720.0;
+    /// The largest fixed factor.
+    pub const MAX_FACTOR: f32 = 100.0;
+
+    /// A fixed factor, `0..=`[`Refraction::MAX_FACTOR`].
+    pub fn fixed(factor: f32) -> Result<Refraction, ValueError> {
+        Self::checked(factor, &factor.to_string())
+    }
+
+    fn checked(factor: f32, shown: &str) -> Result<Refraction, ValueError> {
+        if !factor.is_finite() || !(0.0..=Self::MAX_FACTOR).contains(&factor) {
+            return Err(ValueError::new(
+                "refraction",
+                format!("'{shown}' must be between 0 and 100 (1.0 is the papers' factor), or 'auto'"),
+            ));
+        }
+        Ok(Refraction { fixed: Some(factor) })
+    }
+
+    /// The fixed factor, or `None` for automatic.
+    pub fn fixed_factor(self) -> Option<f32> {
+        self.fixed
+    }
 
     /// The factor used for a `width x height` picture.
     pub fn factor(self, width: u32, height: u32) -> f32 {
-        match self {
-            Refraction::Factor(f) => f,
-            Refraction::Auto => (width.min(height) as f32 / Self::AUTO_REFERENCE_SIDE).clamp(0.15, 1.0),
+        match self.fixed {
+            Some(f) => f,
+            None => (width.min(height) as f32 / Self::AUTO_REFERENCE_SIDE).clamp(0.15, 1.0),
         }
     }
 }
 
+impl std::fmt::Display for Refraction {
+    /// `auto` or the factor: the form [`Refraction::from_str`] reads back.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.fixed {
+            None => f.write_str("auto"),
+            Some(v) => write!(f, "{v}"),
+        }
+    }
+}
+
+impl FromStr for Refraction {
+    type Err = ValueError;
+
+    /// Parses a factor (finite, `0..=100`) or `auto`.
+    fn from_str(text: &str) -> Result<Refraction, ValueError> {
+        let text = text.trim();
+        if text.eq_ignore_ascii_case("auto") {
+            return Ok(Refraction::AUTO);
+        }
+        let v: f32 = text
+            .parse()
+            .map_err(|_| ValueError::new("refraction", format!("'{text}' is neither a number nor 'auto'")))?;
+        Self::checked(v, text)
+    }
+}
+
 /// Where the sun is: azimuth clockwise from north (the top of the picture), elevation above
-/// the horizon, both in degrees.
+/// the horizon, both in degrees. The azimuth is kept in `0..360`, the elevation in `0..=90`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Sun {
-    /// Degrees clockwise from north (0 = top of the picture, 90 = right).
-    pub azimuth_deg: f32,
-    /// Degrees above the horizon, 0..=90.
-    pub elevation_deg: f32,
+    azimuth_deg: f32,
+    elevation_deg: f32,
 }
 
 impl Default for Sun {
@@ -60,10 +111,68 @@ impl Default for Sun {
 }
 
 impl Sun {
+    /// A sun at any finite azimuth (wrapped to `0..360`) and an elevation in `0..=90` degrees.
+    pub fn new(azimuth_deg: f32, elevation_deg: f32) -> Result<Sun, ValueError> {
+        let hint = SUN_HINT;
+        if !azimuth_deg.is_finite() {
+            return Err(ValueError::new("sun", format!("the azimuth must be finite; {hint}")));
+        }
+        if !elevation_deg.is_finite() {
+            return Err(ValueError::new("sun", format!("the elevation must be finite; {hint}")));
+        }
+        if !(0.0..=90.0).contains(&elevation_deg) {
+            return Err(ValueError::new(
+                "sun",
+                format!("the elevation {elevation_deg} is outside 0..=90 degrees; {hint}"),
+            ));
+        }
+        Ok(Sun { azimuth_deg: azimuth_deg.rem_euclid(360.0), elevation_deg })
+    }
+
+    /// Degrees clockwise from north (0 = top of the picture, 90 = right).
+    pub fn azimuth_deg(self) -> f32 {
+        self.azimuth_deg
+    }
+
+    /// Degrees above the horizon.
+    pub fn elevation_deg(self) -> f32 {
+        self.elevation_deg
+    }
+
     /// The unit vector towards the sun in picture coordinates (x right, y down, z up).
     pub fn direction(self) -> [f32; 3] {
         let (az, el) = (self.azimuth_deg.to_radians(), self.elevation_deg.to_radians());
         [az.sin() * el.cos(), -az.cos() * el.cos(), el.sin()]
+    }
+}
+
+const SUN_HINT: &str = "write it as AZIMUTH,ELEVATION in degrees, e.g. 315,60";
+
+impl std::fmt::Display for Sun {
+    /// `AZIMUTH,ELEVATION`: the form [`Sun::from_str`] reads back.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{},{}", self.azimuth_deg, self.elevation_deg)
+    }
+}
+
+impl FromStr for Sun {
+    type Err = ValueError;
+
+    /// Parses `AZIMUTH,ELEVATION` in degrees.
+    fn from_str(text: &str) -> Result<Sun, ValueError> {
+        let hint = SUN_HINT;
+        let (az, el) =
+            text.split_once(',').ok_or_else(|| ValueError::new("sun", format!("expected two numbers; {hint}")))?;
+        let number = |s: &str, name: &str| -> Result<f32, ValueError> {
+            s.trim()
+                .parse()
+                .map_err(|_| ValueError::new("sun", format!("the {name} '{}' is not a number; {hint}", s.trim())))
+        };
+        let azimuth = number(az, "azimuth")?;
+        if !azimuth.is_finite() {
+            return Err(ValueError::new("sun", format!("the azimuth must be finite; {hint}")));
+        }
+        Sun::new(azimuth, number(el, "elevation")?)
     }
 }
 
@@ -83,7 +192,7 @@ pub struct PoolLook {
 impl Default for PoolLook {
     fn default() -> Self {
         PoolLook {
-            refraction: Refraction::Auto,
+            refraction: Refraction::AUTO,
             shading: true,
             caustics: Some(CausticsLook::default()),
             sun: Sun::default(),
@@ -200,7 +309,7 @@ impl PoolRenderer {
         let light_shift = match look.caustics {
             Some(c) => {
                 let sin_refracted = (horizontal / WATER_INDEX).min(1.0);
-                let run = c.depth_px * sin_refracted / (1.0 - sin_refracted * sin_refracted).sqrt();
+                let run = c.depth_px() * sin_refracted / (1.0 - sin_refracted * sin_refracted).sqrt();
                 ((-sun[0] / horizontal * run).round() as i32, (-sun[1] / horizontal * run).round() as i32)
             }
             None => (0, 0),
@@ -240,6 +349,7 @@ impl PoolRenderer {
         self.look
     }
 
+    #[cfg(test)]
     /// The background it refracts.
     pub fn background(&self) -> &Pixmap {
         &self.background
@@ -587,8 +697,12 @@ mod tests {
     #[test]
     fn offsets_follow_the_papers_formula() {
         let bg = striped_background(30, 30);
-        let look =
-            PoolLook { refraction: Refraction::Factor(1.0), shading: false, caustics: None, ..PoolLook::default() };
+        let look = PoolLook {
+            refraction: Refraction::fixed(1.0).unwrap(),
+            shading: false,
+            caustics: None,
+            ..PoolLook::default()
+        };
         let mut renderer = PoolRenderer::new(bg, look);
         let mut pool = RipplePool::new(30, 30, Damping::Off);
         // A single deep cell at (10, 10): its neighbours see a slope of ±5.
@@ -613,8 +727,12 @@ mod tests {
     #[test]
     fn offsets_clamp_at_the_edges() {
         let bg = striped_background(8, 8);
-        let look =
-            PoolLook { refraction: Refraction::Factor(10.0), shading: false, caustics: None, ..PoolLook::default() };
+        let look = PoolLook {
+            refraction: Refraction::fixed(10.0).unwrap(),
+            shading: false,
+            caustics: None,
+            ..PoolLook::default()
+        };
         let mut renderer = PoolRenderer::new(bg, look);
         let mut pool = RipplePool::new(8, 8, Damping::Off);
         pool.drop_stone(Stone { x: 3, y: 3, radius: 1, weight: 100 });
@@ -640,7 +758,7 @@ mod tests {
         assert_eq!(renderer.light_surface(grey, -30000, -30000).to_ne_bytes()[3], 255, "alpha untouched");
         let west = Shader(PoolRenderer::new(
             striped_background(4, 4),
-            PoolLook { sun: Sun { azimuth_deg: 270.0, elevation_deg: 45.0 }, ..PoolLook::default() },
+            PoolLook { sun: Sun::new(270.0, 45.0).unwrap(), ..PoolLook::default() },
         ));
         assert!(red(west.light_surface(grey, -10, 0)) > 100);
         assert_eq!(red(west.light_surface(grey, 0, -10)), 100, "a slope across the light is not shaded");
@@ -664,7 +782,7 @@ mod tests {
     #[test]
     fn the_glint_pre_test_never_misses_a_glint() {
         for (az, el) in [(315.0, 60.0), (90.0, 20.0), (0.0, 85.0), (200.0, 45.0), (10.0, 5.0)] {
-            let look = PoolLook { sun: Sun { azimuth_deg: az, elevation_deg: el }, ..PoolLook::default() };
+            let look = PoolLook { sun: Sun::new(az, el).unwrap(), ..PoolLook::default() };
             let renderer = PoolRenderer::new(striped_background(4, 4), look);
             let (mut glints, mut candidates) = (0, 0);
             for across in (-3000..=3000).step_by(7) {
@@ -702,7 +820,7 @@ mod tests {
 
     #[test]
     fn the_sun_shifts_the_caustics_away_from_it() {
-        let look = PoolLook { sun: Sun { azimuth_deg: 90.0, elevation_deg: 45.0 }, ..PoolLook::default() };
+        let look = PoolLook { sun: Sun::new(90.0, 45.0).unwrap(), ..PoolLook::default() };
         let renderer = PoolRenderer::new(striped_background(4, 4), look);
         // Sun in the east: light travels west (negative x), by depth · tan(asin(cos 45° / 1.33))
         // = 24 · 0.628 ≈ 15 pixels.
@@ -717,7 +835,7 @@ mod tests {
         for look in [
             PoolLook::default(),
             PoolLook {
-                refraction: Refraction::Factor(1.0),
+                refraction: Refraction::fixed(1.0).unwrap(),
                 sun: Sun { azimuth_deg: 100.0, elevation_deg: 30.0 },
                 ..PoolLook::default()
             },
@@ -776,9 +894,9 @@ mod tests {
 
     #[test]
     fn auto_refraction_scales_with_size() {
-        assert_eq!(Refraction::Auto.factor(1920, 1080), 1.0);
-        assert!((Refraction::Auto.factor(640, 360) - 0.5).abs() < 1e-6);
-        assert_eq!(Refraction::Auto.factor(160, 94), 0.15);
-        assert_eq!(Refraction::Factor(2.5).factor(10, 10), 2.5);
+        assert_eq!(Refraction::AUTO.factor(1920, 1080), 1.0);
+        assert!((Refraction::AUTO.factor(640, 360) - 0.5).abs() < 1e-6);
+        assert_eq!(Refraction::AUTO.factor(160, 94), 0.15);
+        assert_eq!(Refraction::fixed(2.5).unwrap().factor(10, 10), 2.5);
     }
 }

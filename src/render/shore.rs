@@ -148,6 +148,7 @@ impl Shore {
         Shore { shapes, distance_m }
     }
 
+    #[cfg(test)]
     /// The waterline's distance north, m.
     pub fn distance_m(&self) -> f32 {
         self.distance_m

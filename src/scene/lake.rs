@@ -2,16 +2,17 @@
 
 use tiny_skia::Pixmap;
 
+use super::{Action, Controls, Event, Scene, SceneKind};
+use crate::error::{Error, Result};
 use crate::output::heightmap::Heightmap;
 use crate::render::lake::LakeRenderer;
-use crate::replay::Event;
-use crate::scene::playable::{Action, Playable};
 use crate::sim::lake::{FAR_SHORE_M, Lake, LakeParams};
 use crate::sim::noise::{MAX_OCTAVES, NoiseKind};
 use crate::sim::sea_state::beaufort_speed_m_s;
+use crate::sim::wind::MAX_LAKE_WIND_M_S;
 
-/// The strongest wind the lake takes, m/s (a storm; beyond it a lake is all spray).
-pub const MAX_LAKE_WIND_M_S: f64 = 30.0;
+/// Heightmap PNG levels per metre: millimetres (lake ripples are millimetres to centimetres).
+pub const HEIGHTMAP_PNG_LEVELS_PER_M: f32 = 1000.0;
 /// How much `[` and `]` change the wind in the player, m/s.
 pub const WIND_STEP_M_S: f64 = 1.0;
 /// How much `>` and `<` change the persistence in the player.
@@ -26,6 +27,15 @@ pub struct LakeSettings {
     pub lake: LakeParams,
     /// Supersampling per axis, 1..=4.
     pub ssaa: u32,
+    /// The lake's time at step 0, s.
+    pub start_time_s: f64,
+}
+
+impl Default for LakeSettings {
+    /// The default breeze and noise, no supersampling, time 0.
+    fn default() -> Self {
+        LakeSettings { lake: LakeParams::default(), ssaa: 1, start_time_s: 0.0 }
+    }
 }
 
 /// A lake, its clock (seconds) and its renderer.
@@ -38,12 +48,12 @@ pub struct LakeScene {
 }
 
 impl LakeScene {
-    /// A scene at time 0 drawing `width x height` pictures.
+    /// A scene at its start time drawing `width x height` pictures.
     ///
     /// Returns `None` when the (supersampled) size is zero or too large for a pixmap.
     pub fn new(settings: LakeSettings, width: u32, height: u32) -> Option<LakeScene> {
         let renderer = LakeRenderer::new(width, height, settings.ssaa, settings.lake.seed)?;
-        Some(LakeScene { lake: Lake::new(settings.lake), renderer, ssaa: settings.ssaa, time_s: 0.0 })
+        Some(LakeScene { lake: Lake::new(settings.lake), renderer, ssaa: settings.ssaa, time_s: settings.start_time_s })
     }
 
     /// The lake.
@@ -92,13 +102,6 @@ impl LakeScene {
         self.renderer.render(&frame, out);
     }
 
-    /// A new picture of the lake now.
-    pub fn snapshot(&mut self) -> Pixmap {
-        let mut out = Pixmap::new(self.width(), self.height()).expect("the scene's size is a valid pixmap size");
-        self.render(&mut out);
-        out
-    }
-
     /// Starts drawing at a new size (same lake and clock).
     ///
     /// Returns `false` (and changes nothing) when the size is zero or too large.
@@ -129,13 +132,17 @@ impl LakeScene {
                 *v = frame.height((west + (col as f64 + 0.5) * cell) as f32, y as f32);
             }
         });
-        Heightmap { width, height, values }
+        Heightmap { width, height, values, png_levels_per_unit: HEIGHTMAP_PNG_LEVELS_PER_M }
     }
 }
 
-impl Playable for LakeScene {
-    fn name(&self) -> &'static str {
-        "lake"
+impl Scene for LakeScene {
+    fn kind(&self) -> SceneKind {
+        SceneKind::Lake
+    }
+
+    fn size(&self) -> (u32, u32) {
+        (self.width(), self.height())
     }
 
     /// One step is 1/30 s of lake time: the water moves in real time.
@@ -143,18 +150,49 @@ impl Playable for LakeScene {
         1.0 / PLAYER_STEP_S
     }
 
-    fn size(&self) -> (u32, u32) {
-        (self.width(), self.height())
-    }
-
-    fn step(&mut self) {
-        self.advance(PLAYER_STEP_S);
+    fn advance(&mut self, steps: u64) {
+        for _ in 0..steps {
+            LakeScene::advance(self, PLAYER_STEP_S);
+        }
     }
 
     fn render(&mut self, out: &mut Pixmap) {
         LakeScene::render(self, out);
     }
 
+    fn apply(&mut self, event: &Event) {
+        let p = self.lake.params();
+        match *event {
+            Event::Wind([speed, _]) => {
+                self.set_params(LakeParams { wind_m_s: speed.clamp(0.0, MAX_LAKE_WIND_M_S), ..p });
+            }
+            Event::Noise { octaves, persistence, kind } => {
+                self.set_params(LakeParams { octaves, persistence, noise: kind, ..p });
+            }
+            Event::Resize([w, h]) => {
+                LakeScene::resize(self, w, h);
+            }
+            _ => {}
+        }
+    }
+
+    fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        match LakeScene::resize(self, width, height) {
+            true => Ok(()),
+            false => Err(Error::TooLarge { what: "lake", width, height }),
+        }
+    }
+
+    fn describe(&self) -> String {
+        format!("ssaa {}, {} triangles", self.ssaa, self.renderer.triangle_count())
+    }
+
+    fn heightmap(&self, width: usize, height: usize) -> Heightmap {
+        LakeScene::heightmap(self, width, height)
+    }
+}
+
+impl Controls for LakeScene {
     /// The ocean's wind keys: digits set the wind to that Beaufort number, `[` and `]` weaken
     /// and strengthen it by 1 m/s, `c` calms the lake; `o`/`O` add and drop an octave, `>` and
     /// `<` raise and lower the persistence, `n` switches value and gradient noise. Stones,
@@ -180,22 +218,6 @@ impl Playable for LakeScene {
                 noise(p.octaves, p.persistence, other)
             }
             _ => Vec::new(),
-        }
-    }
-
-    fn apply(&mut self, event: &Event) {
-        let p = self.lake.params();
-        match *event {
-            Event::Wind([speed, _]) => {
-                self.set_params(LakeParams { wind_m_s: speed.clamp(0.0, MAX_LAKE_WIND_M_S), ..p });
-            }
-            Event::Noise { octaves, persistence, kind } => {
-                self.set_params(LakeParams { octaves, persistence, noise: kind, ..p });
-            }
-            Event::Resize([w, h]) => {
-                self.resize(w, h);
-            }
-            _ => {}
         }
     }
 
@@ -242,23 +264,24 @@ mod tests {
     use super::*;
 
     fn scene(wind: f64) -> LakeScene {
-        let settings = LakeSettings { lake: LakeParams { wind_m_s: wind, ..LakeParams::default() }, ssaa: 1 };
+        let settings =
+            LakeSettings { lake: LakeParams { wind_m_s: wind, ..LakeParams::default() }, ..LakeSettings::default() };
         LakeScene::new(settings, 64, 40).unwrap()
     }
 
     #[test]
     fn time_moves_the_water_and_calm_stays_still() {
         let mut s = scene(5.0);
-        let a = s.snapshot();
-        Playable::step(&mut s);
+        let a = s.snapshot().unwrap();
+        Scene::advance(&mut s, 1);
         assert!((s.time_s() - PLAYER_STEP_S).abs() < 1e-12);
-        assert!(a.data() != s.snapshot().data());
+        assert!(a.data() != s.snapshot().unwrap().data());
         s.set_time(0.0);
-        assert!(a.data() == s.snapshot().data(), "the same time, the same picture");
+        assert!(a.data() == s.snapshot().unwrap().data(), "the same time, the same picture");
         let mut calm = scene(0.0);
-        let still = calm.snapshot();
-        calm.advance(3.0);
-        assert!(still.data() == calm.snapshot().data(), "a calm lake does not move");
+        let still = calm.snapshot().unwrap();
+        LakeScene::advance(&mut calm, 3.0);
+        assert!(still.data() == calm.snapshot().unwrap().data(), "a calm lake does not move");
     }
 
     #[test]
@@ -296,19 +319,19 @@ mod tests {
         calm.apply(&Event::Wind([50.0, 200.0]));
         assert_eq!(calm.lake().params().wind_m_s, MAX_LAKE_WIND_M_S);
         calm.apply(&Event::Resize([30, 20]));
-        assert_eq!(Playable::size(&calm), (30, 20));
+        assert_eq!(Scene::size(&calm), (30, 20));
     }
 
     #[test]
     fn heightmaps_cover_the_lake() {
         let s = scene(6.0);
-        let map = s.heightmap(40, 20);
+        let map = LakeScene::heightmap(&s, 40, 20);
         assert_eq!((map.width, map.height, map.values.len()), (40, 20, 800));
         // Cells of 15 m: row 0 is the far shore, column 0 the west edge.
         let frame = s.lake().frame(0.0);
         assert_eq!(map.values[0], frame.height(-292.5, 292.5));
         assert_eq!(map.values[19 * 40 + 39], frame.height(292.5, 7.5));
         assert!(map.values.iter().all(|v| v.abs() < 0.2));
-        assert!(scene(0.0).heightmap(4, 4).values.iter().all(|&v| v == 0.0));
+        assert!(LakeScene::heightmap(&scene(0.0), 4, 4).values.iter().all(|&v| v == 0.0));
     }
 }

@@ -2,21 +2,45 @@
 
 use tiny_skia::Pixmap;
 
+use super::{Action, Controls, Event, Scene, SceneKind};
+use crate::error::{Error, Result};
 use crate::output::heightmap::Heightmap;
 use crate::render::ocean::{OceanRenderer, OceanView};
 use crate::render::texture::SeaTexture;
-use crate::replay::Event;
-use crate::scene::playable::{Action, Playable};
 use crate::sim::ocean::{Sea, SeaParams};
 use crate::sim::sea_state;
+use crate::sim::wind::{DEFAULT_SEA_WIND_M_S, DEFAULT_WIND_FROM_DEG};
 
-/// Everything about an ocean picture except its size and texture.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Heightmap PNG levels per metre: centimetres.
+pub const HEIGHTMAP_PNG_LEVELS_PER_M: f32 = 100.0;
+
+/// Everything about an ocean picture except its size.
+#[derive(Clone, Debug)]
 pub struct OceanSettings {
     /// Wind and seed.
     pub sea: SeaParams,
     /// Camera, sun and supersampling.
     pub view: OceanView,
+    /// The picture stretched over the sea.
+    pub texture: SeaTexture,
+    /// The sea's time at step 0, s.
+    pub start_time_s: f64,
+    /// East-west size of the heightmap patch, m (`None`: 8 peak wavelengths).
+    pub heightmap_extent_m: Option<f64>,
+}
+
+impl Default for OceanSettings {
+    /// A 10 m/s wind from 330°, seed 1, the default view without supersampling, the built-in
+    /// texture, time 0.
+    fn default() -> Self {
+        OceanSettings {
+            sea: SeaParams { wind_m_s: DEFAULT_SEA_WIND_M_S, wind_from_deg: DEFAULT_WIND_FROM_DEG, seed: 1 },
+            view: OceanView::default(),
+            texture: SeaTexture::builtin(),
+            start_time_s: 0.0,
+            heightmap_extent_m: None,
+        }
+    }
 }
 
 /// A sea, its clock (physical seconds) and its renderer.
@@ -28,6 +52,8 @@ pub struct OceanScene {
     time_s: f64,
     /// The component phases of the last frame, reused.
     phases: Vec<f32>,
+    /// The heightmap patch's east-west size, m.
+    extent_m: Option<f64>,
 }
 
 /// The heightmap's east-west extent when none is given: 8 peak wavelengths (100 m for a calm).
@@ -36,12 +62,19 @@ pub fn default_extent_m(sea: &Sea) -> f64 {
 }
 
 impl OceanScene {
-    /// A scene at time 0 drawing `width x height` pictures.
+    /// A scene at its start time drawing `width x height` pictures.
     ///
     /// Returns `None` when the (supersampled) size is zero or too large for a pixmap.
-    pub fn new(settings: OceanSettings, width: u32, height: u32, texture: SeaTexture) -> Option<OceanScene> {
-        let renderer = OceanRenderer::new(settings.view, width, height, texture.clone())?;
-        Some(OceanScene { sea: Sea::new(settings.sea), renderer, texture, time_s: 0.0, phases: Vec::new() })
+    pub fn new(settings: OceanSettings, width: u32, height: u32) -> Option<OceanScene> {
+        let renderer = OceanRenderer::new(settings.view, width, height, settings.texture.clone())?;
+        Some(OceanScene {
+            sea: Sea::new(settings.sea),
+            renderer,
+            texture: settings.texture,
+            time_s: settings.start_time_s,
+            phases: Vec::new(),
+            extent_m: settings.heightmap_extent_m,
+        })
     }
 
     /// The sea.
@@ -96,13 +129,6 @@ impl OceanScene {
         self.phases = frame.into_buffer();
     }
 
-    /// A new picture of the current sea.
-    pub fn snapshot(&mut self) -> Pixmap {
-        let mut out = Pixmap::new(self.width(), self.height()).expect("the scene's size is a valid pixmap size");
-        self.render(&mut out);
-        out
-    }
-
     /// Starts drawing at a new size (same sea, clock and camera).
     ///
     /// Returns `false` (and changes nothing) when the size is zero or too large.
@@ -142,7 +168,7 @@ impl OceanScene {
                 });
             }
         });
-        Heightmap { width, height, values }
+        Heightmap { width, height, values, png_levels_per_unit: HEIGHTMAP_PNG_LEVELS_PER_M }
     }
 }
 
@@ -161,27 +187,63 @@ impl OceanScene {
     }
 }
 
-impl Playable for OceanScene {
-    fn name(&self) -> &'static str {
-        "ocean"
-    }
-
-    fn steps_per_second(&self) -> f64 {
-        OCEAN_STEPS_PER_SECOND
+impl Scene for OceanScene {
+    fn kind(&self) -> SceneKind {
+        SceneKind::Ocean
     }
 
     fn size(&self) -> (u32, u32) {
         (self.width(), self.height())
     }
 
-    fn step(&mut self) {
-        self.advance(1.0 / OCEAN_STEPS_PER_SECOND);
+    fn steps_per_second(&self) -> f64 {
+        OCEAN_STEPS_PER_SECOND
+    }
+
+    /// Each step is 1/60 s of the sea's time.
+    fn advance(&mut self, steps: u64) {
+        for _ in 0..steps {
+            OceanScene::advance(self, 1.0 / OCEAN_STEPS_PER_SECOND);
+        }
     }
 
     fn render(&mut self, out: &mut Pixmap) {
         OceanScene::render(self, out);
     }
 
+    fn apply(&mut self, event: &Event) {
+        match *event {
+            Event::Wind([speed, from]) => {
+                let params = self.sea.params();
+                self.set_sea(SeaParams { wind_m_s: speed, wind_from_deg: from, ..params });
+            }
+            Event::Resize([w, h]) => {
+                OceanScene::resize(self, w, h);
+            }
+            _ => {}
+        }
+    }
+
+    fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        match OceanScene::resize(self, width, height) {
+            true => Ok(()),
+            false => Err(Error::TooLarge { what: "sea", width, height }),
+        }
+    }
+
+    /// The patch is `heightmap_extent_m` wide (default 8 peak wavelengths); see
+    /// [`OceanScene::heightmap`].
+    fn describe(&self) -> String {
+        format!("ssaa {}, {} triangles", self.renderer.view().ssaa, self.renderer.triangle_count())
+    }
+
+    fn heightmap(&self, width: usize, height: usize) -> Heightmap {
+        let extent = self.extent_m.unwrap_or_else(|| default_extent_m(&self.sea));
+        OceanScene::heightmap(self, extent, width, height)
+    }
+}
+
+impl Controls for OceanScene {
     /// Digits set the wind to that Beaufort number, `[` and `]` weaken and strengthen it by one,
     /// `,` and `.` turn it; stones, rain and clearing mean nothing to the open sea.
     fn resolve(&self, action: Action) -> Vec<Event> {
@@ -200,19 +262,6 @@ impl Playable for OceanScene {
             return Vec::new();
         }
         vec![Event::Wind([speed, from])]
-    }
-
-    fn apply(&mut self, event: &Event) {
-        match *event {
-            Event::Wind([speed, from]) => {
-                let params = self.sea.params();
-                self.set_sea(crate::sim::ocean::SeaParams { wind_m_s: speed, wind_from_deg: from, ..params });
-            }
-            Event::Resize([w, h]) => {
-                self.resize(w, h);
-            }
-            _ => {}
-        }
     }
 
     fn status(&self, out: &mut String) {
@@ -253,33 +302,33 @@ mod tests {
     fn scene(wind: f64) -> OceanScene {
         let settings = OceanSettings {
             sea: SeaParams { wind_m_s: wind, wind_from_deg: 0.0, seed: 5 },
-            view: OceanView::default(),
+            ..OceanSettings::default()
         };
-        OceanScene::new(settings, 64, 36, SeaTexture::builtin()).unwrap()
+        OceanScene::new(settings, 64, 36).unwrap()
     }
 
     #[test]
     fn time_moves_the_sea() {
         let mut s = scene(8.0);
-        let a = s.snapshot();
-        s.advance(1.5);
+        let a = s.snapshot().unwrap();
+        OceanScene::advance(&mut s, 1.5);
         assert_eq!(s.time_s(), 1.5);
-        assert_ne!(a.data(), s.snapshot().data());
+        assert_ne!(a.data(), s.snapshot().unwrap().data());
         s.set_time(0.0);
-        assert_eq!(a.data(), s.snapshot().data(), "the same time gives the same picture");
+        assert_eq!(a.data(), s.snapshot().unwrap().data(), "the same time gives the same picture");
     }
 
     #[test]
     fn heightmaps_are_oriented_and_sized() {
         let s = scene(10.0);
-        let map = s.heightmap(800.0, 40, 20);
+        let map = OceanScene::heightmap(&s, 800.0, 40, 20);
         assert_eq!((map.width, map.height, map.values.len()), (40, 20, 800));
         let frame = s.sea().frame(0.0);
         // Row 0 is north, column 0 is west: cell (0, 0) is centred at (-390, 190).
         assert_eq!(map.values[0], frame.height(-390.0, 190.0));
         assert_eq!(map.values[19 * 40 + 39], frame.height(390.0, -190.0));
         assert!((default_extent_m(s.sea()) - 8.0 * s.sea().spectrum().peak_wavelength_m().unwrap()).abs() < 1e-9);
-        assert!(scene(0.0).heightmap(10.0, 3, 3).values.iter().all(|&v| v == 0.0));
+        assert!(OceanScene::heightmap(&scene(0.0), 10.0, 3, 3).values.iter().all(|&v| v == 0.0));
     }
 
     #[test]
@@ -300,16 +349,16 @@ mod tests {
         s.status(&mut status);
         assert!(status.contains("Beaufort 8"), "{status}");
         let before = s.time_s();
-        Playable::step(&mut s);
+        Scene::advance(&mut s, 1);
         assert!((s.time_s() - before - 1.0 / 60.0).abs() < 1e-12);
     }
 
     #[test]
     fn resize_keeps_the_sea() {
         let mut s = scene(6.0);
-        assert!(s.resize(32, 20));
+        assert!(OceanScene::resize(&mut s, 32, 20));
         assert_eq!((s.width(), s.height()), (32, 20));
-        assert_eq!(s.snapshot().width(), 32);
-        assert!(!s.resize(0, 5));
+        assert_eq!(s.snapshot().unwrap().width(), 32);
+        assert!(Scene::resize(&mut s, 0, 5).is_err());
     }
 }

@@ -2,25 +2,40 @@
 
 use tiny_skia::Pixmap;
 
+use super::{Action, Controls, Event, Scene, SceneKind};
+use crate::error::{Error, Result};
 use crate::output::heightmap::Heightmap;
 use crate::render::background;
 use crate::render::pool::{PoolLook, PoolRenderer};
-use crate::replay::Event;
-use crate::scene::playable::{Action, Playable};
 use crate::sim::rain::Rain;
 use crate::sim::ripple::{Damping, RipplePool, Stone};
 
-/// Everything about a pool except its size and floor image.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Everything about a pool except its size.
+#[derive(Clone, Debug, PartialEq)]
 pub struct PoolSettings {
     /// Damping of the water.
     pub damping: Damping,
-    /// Raindrops per step on average.
+    /// Raindrops per step on average (0 for none; see [`crate::sim::rain::check_rate`]).
     pub rain_rate: f64,
     /// Seed of the rain.
     pub seed: u64,
     /// How the water is drawn.
     pub look: PoolLook,
+    /// The floor seen through the water, scaled to cover the picture.
+    pub floor: Pixmap,
+}
+
+impl Default for PoolSettings {
+    /// The papers' damping, no rain, seed 1, the default look over the built-in tiled floor.
+    fn default() -> Self {
+        PoolSettings {
+            damping: Damping::PAPERS,
+            rain_rate: 0.0,
+            seed: 1,
+            look: PoolLook::default(),
+            floor: background::pool_floor(),
+        }
+    }
 }
 
 /// A ripple pool with its rain and floor, one simulation cell per pixel.
@@ -48,18 +63,20 @@ pub const BIG_STONE_FACTOR: u32 = 2;
 const STIR_SPACING: f32 = 2.0;
 /// The weight of the small stones of a stir.
 const STIR_WEIGHT: i16 = 32;
+/// The papers' pool runs at 60 steps a second: waves cross a 160-pixel terminal in ~4 s.
+pub const POOL_STEPS_PER_SECOND: f64 = 60.0;
 
 impl PoolScene {
-    /// A still pool of `width x height` pixels over `floor` (scaled to cover the picture).
+    /// A still pool of `width x height` pixels.
     ///
     /// Returns `None` when the size is zero or too large for a pixmap.
-    pub fn new(width: u32, height: u32, floor: Pixmap, settings: PoolSettings) -> Option<PoolScene> {
-        let fitted = background::cover(&floor, width, height)?;
+    pub fn new(width: u32, height: u32, settings: PoolSettings) -> Option<PoolScene> {
+        let fitted = background::cover(&settings.floor, width, height)?;
         Some(PoolScene {
             pool: RipplePool::new(width as usize, height as usize, settings.damping),
             rain: Rain::new(settings.rain_rate, settings.seed),
             renderer: PoolRenderer::new(fitted, settings.look),
-            floor,
+            floor: settings.floor,
             drops: Vec::new(),
             rain_when_on: if settings.rain_rate > 0.0 { settings.rain_rate } else { DEFAULT_TOGGLE_RAIN },
         })
@@ -80,31 +97,16 @@ impl PoolScene {
         &self.pool
     }
 
-    /// The water, for changes such as damping or clearing.
-    pub fn pool_mut(&mut self) -> &mut RipplePool {
-        &mut self.pool
-    }
-
-    /// The rain.
-    pub fn rain_mut(&mut self) -> &mut Rain {
-        &mut self.rain
-    }
-
     /// Drops a stone now.
     pub fn drop_stone(&mut self, stone: Stone) {
         self.pool.drop_stone(stone);
     }
 
-    /// One simulation step: this step's raindrops land, then the water moves.
-    pub fn step(&mut self) {
-        self.advance(1);
-    }
-
-    /// `steps` simulation steps, identical to calling [`PoolScene::step`] that many times.
+    /// `steps` simulation steps: each step's raindrops land, then the water moves.
     ///
-    /// The rain is drawn step by step (so the random stream is the same), and the calm runs
-    /// between raindrops go to [`RipplePool::advance`] in one piece, which computes them many
-    /// times faster than single steps.
+    /// The rain is drawn step by step (so the random stream is the same as single steps), and
+    /// the calm runs between raindrops go to [`RipplePool::advance`] in one piece, which
+    /// computes them many times faster than single steps.
     pub fn advance(&mut self, steps: u64) {
         let (width, height) = (self.pool.width(), self.pool.height());
         let mut calm = 0;
@@ -130,13 +132,6 @@ impl PoolScene {
         self.renderer.render(&self.pool, out);
     }
 
-    /// A new pixmap of the scene's size holding the current picture.
-    pub fn snapshot(&mut self) -> Pixmap {
-        let mut out = Pixmap::new(self.width(), self.height()).expect("the scene's size is a valid pixmap size");
-        self.render(&mut out);
-        out
-    }
-
     /// Starts over at a new size: still water, the floor refitted, the rain continuing.
     ///
     /// Returns `false` (and changes nothing) when the size is zero or too large.
@@ -150,71 +145,36 @@ impl PoolScene {
         true
     }
 
-    /// The current amplitudes as a heightmap (raw amplitude units).
+    /// The current amplitudes as a heightmap (raw amplitude units, one PNG level each).
     pub fn heightmap(&self) -> Heightmap {
         Heightmap {
             width: self.pool.width(),
             height: self.pool.height(),
             values: self.pool.heights().iter().map(|&v| f32::from(v)).collect(),
+            png_levels_per_unit: 1.0,
         }
     }
 }
 
-impl Playable for PoolScene {
-    fn name(&self) -> &'static str {
-        "pool"
-    }
-
-    /// The papers' pool runs at 60 steps a second: waves cross a 160-pixel terminal in ~4 s.
-    fn steps_per_second(&self) -> f64 {
-        60.0
+impl Scene for PoolScene {
+    fn kind(&self) -> SceneKind {
+        SceneKind::Pool
     }
 
     fn size(&self) -> (u32, u32) {
         (self.width(), self.height())
     }
 
-    fn step(&mut self) {
-        PoolScene::step(self);
+    fn steps_per_second(&self) -> f64 {
+        POOL_STEPS_PER_SECOND
+    }
+
+    fn advance(&mut self, steps: u64) {
+        PoolScene::advance(self, steps);
     }
 
     fn render(&mut self, out: &mut Pixmap) {
         PoolScene::render(self, out);
-    }
-
-    fn resolve(&self, action: Action) -> Vec<Event> {
-        match action {
-            Action::Stone { x, y, radius, big } => {
-                let (radius, weight) = if big {
-                    (radius * BIG_STONE_FACTOR, PLAYER_STONE_WEIGHT.saturating_mul(2))
-                } else {
-                    (radius, PLAYER_STONE_WEIGHT)
-                };
-                vec![Event::Stone(Stone { x, y, radius: radius.max(1), weight })]
-            }
-            Action::Stir { from, to } => {
-                let (dx, dy) = ((to.0 - from.0) as f32, (to.1 - from.1) as f32);
-                let n = ((dx.hypot(dy) / STIR_SPACING).ceil() as i32).clamp(1, 512);
-                (1..=n)
-                    .map(|i| {
-                        let t = i as f32 / n as f32;
-                        let x = from.0 + (dx * t).round() as i32;
-                        let y = from.1 + (dy * t).round() as i32;
-                        Event::Stone(Stone { x, y, radius: 2, weight: STIR_WEIGHT })
-                    })
-                    .collect()
-            }
-            Action::ToggleRain => {
-                let rate = if self.rain.rate() > 0.0 { 0.0 } else { self.rain_when_on };
-                vec![Event::Rain(rate)]
-            }
-            Action::Clear => vec![Event::Clear],
-            Action::Damping(stronger) => {
-                let d = self.pool.damping();
-                vec![Event::Damping(if stronger { d.stronger() } else { d.weaker() })]
-            }
-            Action::Key(_) => Vec::new(),
-        }
     }
 
     fn apply(&mut self, event: &Event) {
@@ -229,9 +189,58 @@ impl Playable for PoolScene {
             Event::Damping(d) => self.pool.set_damping(d),
             Event::Clear => self.pool.clear(),
             Event::Resize([w, h]) => {
-                self.resize(w, h);
+                PoolScene::resize(self, w, h);
             }
             Event::Screenshot(_) | Event::Wind(_) | Event::Noise { .. } | Event::End => {}
+        }
+    }
+
+    fn resize(&mut self, width: u32, height: u32) -> Result<()> {
+        match PoolScene::resize(self, width, height) {
+            true => Ok(()),
+            false => Err(Error::TooLarge { what: "pool", width, height }),
+        }
+    }
+
+    /// The pool's own cells, whatever size is asked for.
+    fn heightmap(&self, _width: usize, _height: usize) -> Heightmap {
+        PoolScene::heightmap(self)
+    }
+}
+
+impl Controls for PoolScene {
+    fn resolve(&self, action: Action) -> Vec<Event> {
+        match action {
+            Action::Stone { x, y, radius, big } => {
+                let (radius, weight) = if big {
+                    (radius * BIG_STONE_FACTOR, PLAYER_STONE_WEIGHT.saturating_mul(2))
+                } else {
+                    (radius, PLAYER_STONE_WEIGHT)
+                };
+                vec![Event::Stone(Stone::clamped(x, y, radius, weight))]
+            }
+            Action::Stir { from, to } => {
+                let (dx, dy) = ((to.0 - from.0) as f32, (to.1 - from.1) as f32);
+                let n = ((dx.hypot(dy) / STIR_SPACING).ceil() as i32).clamp(1, 512);
+                (1..=n)
+                    .map(|i| {
+                        let t = i as f32 / n as f32;
+                        let x = from.0 + (dx * t).round() as i32;
+                        let y = from.1 + (dy * t).round() as i32;
+                        Event::Stone(Stone::clamped(x, y, 2, STIR_WEIGHT))
+                    })
+                    .collect()
+            }
+            Action::ToggleRain => {
+                let rate = if self.rain.rate() > 0.0 { 0.0 } else { self.rain_when_on };
+                vec![Event::Rain(rate)]
+            }
+            Action::Clear => vec![Event::Clear],
+            Action::Damping(stronger) => {
+                let d = self.pool.damping();
+                vec![Event::Damping(if stronger { d.stronger() } else { d.weaker() })]
+            }
+            Action::Key(_) => Vec::new(),
         }
     }
 
@@ -255,29 +264,29 @@ mod tests {
     use super::*;
 
     fn settings(rain_rate: f64) -> PoolSettings {
-        PoolSettings { damping: Damping::PAPERS, rain_rate, seed: 7, look: PoolLook::default() }
+        PoolSettings { rain_rate, seed: 7, ..PoolSettings::default() }
     }
 
     #[test]
     fn rain_moves_the_water_deterministically() {
         let run = || {
-            let mut scene = PoolScene::new(64, 48, background::pool_floor(), settings(0.5)).unwrap();
+            let mut scene = PoolScene::new(64, 48, settings(0.5)).unwrap();
             for _ in 0..40 {
-                scene.step();
+                scene.advance(1);
             }
-            scene.snapshot().data().to_vec()
+            scene.snapshot().unwrap().data().to_vec()
         };
-        let still = PoolScene::new(64, 48, background::pool_floor(), settings(0.0)).unwrap().snapshot();
+        let still = PoolScene::new(64, 48, settings(0.0)).unwrap().snapshot().unwrap();
         assert_eq!(run(), run());
         assert_ne!(run(), still.data());
     }
 
     #[test]
     fn advance_equals_single_steps() {
-        let mut stepped = PoolScene::new(80, 60, background::pool_floor(), settings(0.3)).unwrap();
+        let mut stepped = PoolScene::new(80, 60, settings(0.3)).unwrap();
         let mut advanced = stepped.clone();
         for _ in 0..77 {
-            stepped.step();
+            stepped.advance(1);
         }
         advanced.advance(77);
         assert_eq!(stepped.pool().heights(), advanced.pool().heights());
@@ -287,36 +296,36 @@ mod tests {
 
     #[test]
     fn resize_reallocates() {
-        let mut scene = PoolScene::new(64, 48, background::pool_floor(), settings(0.0)).unwrap();
+        let mut scene = PoolScene::new(64, 48, settings(0.0)).unwrap();
         scene.drop_stone(Stone { x: 10, y: 10, radius: 4, weight: 64 });
-        assert!(scene.resize(30, 20));
+        assert!(PoolScene::resize(&mut scene, 30, 20));
         assert_eq!((scene.width(), scene.height()), (30, 20));
         assert!(scene.pool().heights().iter().all(|&v| v == 0));
-        assert_eq!(scene.snapshot().width(), 30);
-        assert!(!scene.resize(0, 10));
+        assert_eq!(scene.snapshot().unwrap().width(), 30);
+        assert!(Scene::resize(&mut scene, 0, 10).is_err());
         assert_eq!(scene.width(), 30);
     }
 
     #[test]
     fn actions_resolve_to_events_that_apply() {
-        let mut scene = PoolScene::new(40, 30, background::pool_floor(), settings(0.0)).unwrap();
+        let mut scene = PoolScene::new(40, 30, settings(0.0)).unwrap();
         let events = scene.resolve(Action::Stone { x: 10, y: 12, radius: 3, big: true });
-        assert_eq!(events, vec![Event::Stone(Stone { x: 10, y: 12, radius: 6, weight: 96 })]);
+        assert_eq!(events, vec![Event::Stone(Stone::new(10, 12, 6, 96).unwrap())]);
         scene.apply(&events[0]);
         assert!(scene.pool().heights()[12 * 40 + 10] < 0);
         let stir = scene.resolve(Action::Stir { from: (5, 5), to: (15, 5) });
         assert_eq!(stir.len(), 5);
-        assert_eq!(stir[4], Event::Stone(Stone { x: 15, y: 5, radius: 2, weight: STIR_WEIGHT }));
+        assert_eq!(stir[4], Event::Stone(Stone::clamped(15, 5, 2, STIR_WEIGHT)));
         let rain = scene.resolve(Action::ToggleRain);
         assert_eq!(rain, vec![Event::Rain(DEFAULT_TOGGLE_RAIN)]);
         scene.apply(&rain[0]);
         assert_eq!(scene.resolve(Action::ToggleRain), vec![Event::Rain(0.0)]);
         let damping = scene.resolve(Action::Damping(true));
-        assert_eq!(damping, vec![Event::Damping(Damping::Shift(4))]);
+        assert_eq!(damping, vec![Event::Damping(Damping::from_shift(4).unwrap())]);
         scene.apply(&Event::Clear);
         assert!(scene.pool().heights().iter().all(|&v| v == 0));
         scene.apply(&Event::Resize([20, 10]));
-        assert_eq!(Playable::size(&scene), (20, 10));
+        assert_eq!(Scene::size(&scene), (20, 10));
         assert!(scene.resolve(Action::Key('w')).is_empty());
         let mut status = String::new();
         scene.status(&mut status);
@@ -325,7 +334,7 @@ mod tests {
 
     #[test]
     fn heightmap_mirrors_the_amplitudes() {
-        let mut scene = PoolScene::new(10, 8, background::pool_floor(), settings(0.0)).unwrap();
+        let mut scene = PoolScene::new(10, 8, settings(0.0)).unwrap();
         scene.drop_stone(Stone { x: 4, y: 3, radius: 1, weight: 99 });
         let map = scene.heightmap();
         assert_eq!((map.width, map.height), (10, 8));

@@ -34,6 +34,7 @@ use std::f32::consts::PI;
 use super::noise::{Fractal, MAX_OCTAVES, NoiseFrame, NoiseKind, WaterNoise};
 use super::ocean::upper_normal_quantile;
 use super::surface::{Footprint, Surface, SurfaceSample};
+use crate::error::ValueError;
 
 /// The far shore's distance north of the camera's shore, m: the wind's fetch.
 pub const FAR_SHORE_M: f32 = 300.0;
@@ -166,6 +167,41 @@ impl Default for LakeParams {
     fn default() -> Self {
         LakeParams { wind_m_s: 3.0, seed: 1, octaves: 5, persistence: 0.5, noise: NoiseKind::Value }
     }
+}
+
+/// Parses an octave count, `1..=`[`MAX_OCTAVES`].
+pub fn parse_octaves(text: &str) -> Result<u32, ValueError> {
+    let v: i64 = text.trim().parse().map_err(|_| {
+        ValueError::new("octaves", format!("the octave count '{}' is not a whole number; e.g. 5", text.trim()))
+    })?;
+    check_octaves(v)
+}
+
+/// Checks an octave count.
+pub fn check_octaves(v: i64) -> Result<u32, ValueError> {
+    if !(1..=MAX_OCTAVES as i64).contains(&v) {
+        return Err(ValueError::new(
+            "octaves",
+            format!("the octave count {v} is outside 1..={MAX_OCTAVES}; 5 is the default"),
+        ));
+    }
+    Ok(v as u32)
+}
+
+/// Parses a persistence, `0..=1`.
+pub fn parse_persistence(text: &str) -> Result<f64, ValueError> {
+    check_persistence(crate::numbers::finite(text, "persistence", "0.5")?)
+}
+
+/// Checks a persistence.
+pub fn check_persistence(v: f64) -> Result<f64, ValueError> {
+    if !(0.0..=1.0).contains(&v) {
+        return Err(ValueError::new(
+            "persistence",
+            format!("the persistence {v} is outside 0..=1; 0.5 halves each octave (the default), higher is rougher"),
+        ));
+    }
+    Ok(v)
 }
 
 /// The mean square slope (both axes together) of the lake's surface under `u` m/s of wind:
@@ -364,6 +400,21 @@ impl Surface for LakeFrame {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn octaves_and_persistence_are_checked() {
+        assert_eq!(parse_octaves("1"), Ok(1));
+        assert_eq!(parse_octaves("12"), Ok(12));
+        for bad in ["0", "13", "-2", "2.5", "x"] {
+            assert!(parse_octaves(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_persistence("0"), Ok(0.0));
+        assert_eq!(parse_persistence("1"), Ok(1.0));
+        for bad in ["-0.1", "1.01", "NaN", "half"] {
+            assert!(parse_persistence(bad).is_err(), "{bad}");
+        }
+        assert!(parse_persistence("2").unwrap_err().to_string().contains("rougher"));
+    }
 
     #[test]
     fn the_wind_sets_slopes_and_wavelength() {

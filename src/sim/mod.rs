@@ -9,3 +9,4 @@ pub mod ripple;
 pub mod sea_state;
 pub mod spectrum;
 pub mod surface;
+pub mod wind;

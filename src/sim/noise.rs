@@ -53,6 +53,28 @@ impl NoiseKind {
     }
 }
 
+impl std::fmt::Display for NoiseKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for NoiseKind {
+    type Err = crate::error::ValueError;
+
+    /// `value` or `gradient`.
+    fn from_str(text: &str) -> Result<NoiseKind, Self::Err> {
+        match text {
+            "value" => Ok(NoiseKind::Value),
+            "gradient" => Ok(NoiseKind::Gradient),
+            other => Err(crate::error::ValueError::new(
+                "noise kind",
+                format!("unknown kind \"{other}\"; use \"value\" or \"gradient\""),
+            )),
+        }
+    }
+}
+
 const VALUE_VARIANCE: f32 = 0.0396;
 const VALUE_SLOPE_VARIANCE: f32 = 0.0353;
 const GRADIENT_VARIANCE: f32 = 0.0901;
@@ -91,6 +113,7 @@ pub fn lattice_value(seed: u32, x: i32, y: i32, z: i32) -> f32 {
     1.0 - hash(seed, x, y, z) as f32 / 1_073_741_824.0
 }
 
+#[cfg(test)]
 /// The paper's smoothing of a lattice value: corners/16 + sides/8 + centre/4 over the 3x3
 /// neighbourhood (the weights sum to 1, so the result stays in [-1, 1]).
 pub fn smoothed_value(seed: u32, x: i32, y: i32, z: i32) -> f32 {
@@ -108,6 +131,7 @@ pub fn cosine_weight(t: f32) -> f32 {
 
 /// Cosine interpolation from `a` (t = 0) to `b` (t = 1).
 #[inline(always)]
+#[cfg(test)]
 pub fn cosine_interpolate(a: f32, b: f32, t: f32) -> f32 {
     lerp(a, b, cosine_weight(t))
 }
@@ -210,7 +234,7 @@ fn noise_at(kind: NoiseKind, seed: u32, c: Cell, z: i32, ft: f32, keep_variance:
 }
 
 /// The noise at (x, y) lattice units and time `t` (in time slices): in [-1, 1], continuous,
-/// equal to [`smoothed_value`] at lattice points of whole time slices (value noise) or 0
+/// equal to `smoothed_value` at lattice points of whole time slices (value noise) or 0
 /// there (gradient noise).
 pub fn noise(kind: NoiseKind, seed: u32, x: f32, y: f32, t: f32) -> f32 {
     let z = t.floor();

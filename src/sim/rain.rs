@@ -4,6 +4,35 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::ripple::Stone;
+use crate::error::ValueError;
+
+/// The heaviest rain tidepool accepts, drops per step (beyond it the pool boils).
+pub const MAX_RATE: f64 = 10_000.0;
+
+/// Parses a rain rate: a finite number of drops per step, `0..=`[`MAX_RATE`].
+pub fn parse_rate(text: &str) -> Result<f64, ValueError> {
+    let v: f64 =
+        text.trim().parse().map_err(|_| ValueError::new("rain", format!("'{text}' is not a number; e.g. 0.05")))?;
+    check(v, text)
+}
+
+/// Checks a rain rate read as a number (from a replay).
+pub fn check_rate(v: f64) -> Result<f64, ValueError> {
+    check(v, &v.to_string())
+}
+
+fn check(v: f64, shown: &str) -> Result<f64, ValueError> {
+    if !v.is_finite() || v < 0.0 {
+        return Err(ValueError::new(
+            "rain",
+            format!("'{shown}' must be a finite number >= 0 (drops per step), e.g. 0.05"),
+        ));
+    }
+    if v > MAX_RATE {
+        return Err(ValueError::new("rain", format!("{v} drops per step would boil the pool; use at most {MAX_RATE}")));
+    }
+    Ok(v)
+}
 
 /// A deterministic source of raindrops (the papers' radius 2, weight 64).
 ///
@@ -57,6 +86,19 @@ fn sanitize(rate: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn rates_are_checked() {
+        assert_eq!(parse_rate("0.02"), Ok(0.02));
+        for bad in ["-1", "NaN", "inf", "x", "1e9"] {
+            assert!(parse_rate(bad).is_err(), "{bad}");
+        }
+        assert_eq!(
+            parse_rate("1e9").unwrap_err().to_string(),
+            "1000000000 drops per step would boil the pool; use at most 10000"
+        );
+        assert!(check_rate(f64::NAN).is_err() && check_rate(0.0).is_ok());
+    }
 
     fn count(rate: f64, steps: usize, seed: u64) -> (usize, Vec<Stone>) {
         let mut rain = Rain::new(rate, seed);

@@ -15,80 +15,18 @@
 //!   move a value towards zero) cannot leave the range again.
 //! - `>>` on a negative number rounds towards minus infinity, so both the `>> 1` of the spread
 //!   and the damping are biased downwards. Damped, a disturbed pool still returns to all-zero;
-//!   **undamped (`Damping::Off`) the mean level drifts slowly negative** after a disturbance,
+//!   **undamped ([`Damping::OFF`]) the mean level drifts slowly negative** after a disturbance,
 //!   because every odd neighbour sum loses half a unit. That is the papers' arithmetic, kept on
 //!   purpose so that tidepool matches them bit for bit.
 //! - The outermost ring of cells is a fixed zero wall (the papers' 1-D loop reads across row
 //!   ends instead; that defect is not reproduced). Stones are clipped to the interior.
 
+mod damping;
 mod stepper;
+mod stone;
 
-/// How fast waves lose energy: `v -= v >> shift` after every step.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum Damping {
-    /// No damping: waves ring until the walls' rounding eats them.
-    Off,
-    /// Lose `1 / 2^shift` of the amplitude per step; `shift` is in `1..=15` (papers: 5).
-    Shift(u8),
-}
-
-impl Damping {
-    /// The papers' damping, 1/32 per step.
-    pub const PAPERS: Damping = Damping::Shift(5);
-    /// The largest shift; `v >> 16` would be 0 or -1 for every `i16`, i.e. no damping at all.
-    pub const MAX_SHIFT: u8 = 15;
-
-    /// A damping from a shift, or `None` when the shift is outside `1..=15` (0 would zero the
-    /// pool every step; use [`Damping::Off`] for no damping).
-    pub fn shift(shift: u8) -> Option<Damping> {
-        (1..=Self::MAX_SHIFT).contains(&shift).then_some(Damping::Shift(shift))
-    }
-
-    /// One step weaker (larger shift), saturating at `Off`.
-    pub fn weaker(self) -> Damping {
-        match self {
-            Damping::Shift(s) if s < Self::MAX_SHIFT => Damping::Shift(s + 1),
-            _ => Damping::Off,
-        }
-    }
-
-    /// One step stronger (smaller shift), saturating at shift 1.
-    pub fn stronger(self) -> Damping {
-        match self {
-            Damping::Off => Damping::Shift(Self::MAX_SHIFT),
-            Damping::Shift(s) => Damping::Shift(s.saturating_sub(1).max(1)),
-        }
-    }
-}
-
-impl std::fmt::Display for Damping {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            Damping::Off => f.write_str("off"),
-            Damping::Shift(s) => write!(f, "{s}"),
-        }
-    }
-}
-
-/// A stone (or raindrop): every cell with `dx² + dy² < radius²` is set to `-weight`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Stone {
-    /// Centre column in cells; may lie outside the pool (the circle is clipped).
-    pub x: i32,
-    /// Centre row in cells, 0 at the top.
-    pub y: i32,
-    /// Radius in cells, at least 1.
-    pub radius: u32,
-    /// Depth of the dent, `1..=32767` (papers: 32..128 looks right).
-    pub weight: i16,
-}
-
-impl Stone {
-    /// The papers' raindrop: radius 2, weight 64.
-    pub fn raindrop(x: i32, y: i32) -> Stone {
-        Stone { x, y, radius: 2, weight: 64 }
-    }
-}
+pub use damping::Damping;
+pub use stone::Stone;
 
 /// The ripple pool's state: the current and previous amplitude of every cell.
 #[derive(Clone, Debug)]
@@ -235,7 +173,7 @@ mod tests {
                     let c = &pool.current;
                     let sum = i32::from(c[i - 1]) + i32::from(c[i + 1]) + i32::from(c[i - w]) + i32::from(c[i + w]);
                     let mut v = ((sum >> 1) - i32::from(pool.previous[i])).clamp(-32768, 32767);
-                    if let Damping::Shift(s) = pool.damping {
+                    if let Some(s) = pool.damping.shift() {
                         v -= v >> s;
                     }
                     pool.previous[i] = v as i16;
@@ -264,7 +202,9 @@ mod tests {
     #[test]
     fn fast_paths_match_the_plain_rule_bit_for_bit() {
         for (w, h) in [(3, 3), (4, 7), (17, 5), (33, 40), (64, 64), (130, 97), (300, 520)] {
-            for damping in [Damping::Off, Damping::Shift(1), Damping::PAPERS, Damping::Shift(15)] {
+            for damping in
+                [Damping::OFF, Damping::from_shift(1).unwrap(), Damping::PAPERS, Damping::from_shift(15).unwrap()]
+            {
                 let mut fast = rough_pool(w, h, damping, (w * h) as u64);
                 let mut slow = fast.clone();
                 for steps in [1u64, 2, 3, 16, 17, 40] {
@@ -358,7 +298,7 @@ mod tests {
             0, 0, -5, 0,
             0, 0, 0, 0,
         ];
-        let mut pool = pool_with(4, 4, &cur, &prev, Damping::Off);
+        let mut pool = pool_with(4, 4, &cur, &prev, Damping::OFF);
         pool.step();
         // (1,1): N0+S-7+W0+E3 = -4 >> 1 = -2; -2 - 2 = -4
         // (2,1): N0+S0+W10+E0 = 10 >> 1 = 5; 5 - 0 = 5
@@ -380,7 +320,7 @@ mod tests {
     fn odd_sums_round_towards_minus_infinity() {
         // Centre (2, 2) of a 5x5 pool whose only disturbance is its northern neighbour:
         // (-3 >> 1) = -2, not -1.
-        let mut pool = RipplePool::new(5, 5, Damping::Off);
+        let mut pool = RipplePool::new(5, 5, Damping::OFF);
         pool.current[5 + 2] = -3;
         pool.recompute_row_max();
         pool.step();
@@ -394,11 +334,11 @@ mod tests {
         cur[2 * 5 + 1] = 200;
         cur[2 * 5 + 3] = 200;
         let prev = [0i16; 25];
-        let mut pool = pool_with(5, 5, &cur, &prev, Damping::Shift(5));
+        let mut pool = pool_with(5, 5, &cur, &prev, Damping::PAPERS);
         pool.step();
         // spread: 400 >> 1 = 200; damping: 200 - (200 >> 5) = 200 - 6 = 194
         assert_eq!(pool.heights()[12], 194);
-        let mut negative = pool_with(5, 5, &cur.map(|v| -v), &prev, Damping::Shift(5));
+        let mut negative = pool_with(5, 5, &cur.map(|v| -v), &prev, Damping::PAPERS);
         negative.step();
         // -200 - (-200 >> 5) = -200 - (-7) = -193: the papers' asymmetric rounding.
         assert_eq!(negative.heights()[12], -193);
@@ -406,7 +346,7 @@ mod tests {
 
     #[test]
     fn damping_off_keeps_energy_in_a_closed_pool() {
-        let mut off = RipplePool::new(64, 64, Damping::Off);
+        let mut off = RipplePool::new(64, 64, Damping::OFF);
         let mut damped = RipplePool::new(64, 64, Damping::PAPERS);
         for pool in [&mut off, &mut damped] {
             pool.drop_stone(Stone { x: 32, y: 32, radius: 4, weight: 100 });
@@ -471,7 +411,7 @@ mod tests {
 
     #[test]
     fn walls_stay_zero() {
-        let mut pool = RipplePool::new(30, 20, Damping::Off);
+        let mut pool = RipplePool::new(30, 20, Damping::OFF);
         pool.drop_stone(Stone { x: 1, y: 1, radius: 6, weight: 32767 });
         for _ in 0..200 {
             pool.step();
@@ -490,7 +430,7 @@ mod tests {
     #[test]
     fn piled_stones_saturate_instead_of_wrapping() {
         // Runs in the dev profile with overflow checks: any wrap would panic here.
-        let mut pool = RipplePool::new(40, 40, Damping::Off);
+        let mut pool = RipplePool::new(40, 40, Damping::OFF);
         for round in 0..50 {
             pool.drop_stone(Stone { x: 20, y: 20, radius: 6, weight: 32767 });
             pool.drop_stone(Stone { x: 20 + round % 3, y: 19, radius: 9, weight: 32767 });
@@ -512,23 +452,12 @@ mod tests {
         }
     }
 
-    #[test]
-    fn damping_steps_saturate() {
-        assert_eq!(Damping::Shift(1).stronger(), Damping::Shift(1));
-        assert_eq!(Damping::Shift(15).weaker(), Damping::Off);
-        assert_eq!(Damping::Off.weaker(), Damping::Off);
-        assert_eq!(Damping::Off.stronger(), Damping::Shift(15));
-        assert_eq!(Damping::shift(0), None);
-        assert_eq!(Damping::shift(16), None);
-        assert_eq!(Damping::shift(5), Some(Damping::PAPERS));
-    }
-
     mod properties {
         use super::*;
         use proptest::prelude::*;
 
         fn damping() -> impl Strategy<Value = Damping> {
-            prop_oneof![Just(Damping::Off), (1u8..=15).prop_map(Damping::Shift)]
+            prop_oneof![Just(Damping::OFF), (1u8..=15).prop_map(|s| Damping::from_shift(s).unwrap())]
         }
 
         fn stone(w: usize, h: usize) -> impl Strategy<Value = Stone> {

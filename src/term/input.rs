@@ -1,22 +1,34 @@
-//! Terminal events -> the player's inputs, with motion coalesced.
+//! Bytes from the terminal -> the player's inputs.
 //!
-//! Only key presses count (some platforms also report releases). The mouse is reported for
-//! button presses and drags only (mode 1002, see [`crate::term::guard::ENTER`]), not for every
-//! motion, so a moving mouse sends nothing; a drag still produces an event per cell crossed,
-//! which [`coalesce`] reduces to the latest position per batch (the stir interpolates the
-//! path), as it does for bursts of resize events.
+//! The player reads the terminal's bytes itself instead of through crossterm's event reader, so
+//! it runs the same over a local terminal and an SSH channel, and so it can tell the
+//! terminal's *replies* (device attributes, cursor position reports, kitty graphics answers,
+//! mode reports) from key presses: crossterm turns `ESC _` into Alt-`_` and the rest of an APC
+//! reply into keys, so a late kitty reply's digits would set the ocean's Beaufort number.
+//! Here every reply is recognised and dropped, except cursor position reports, which the
+//! player uses to measure the link's round trip.
 //!
-//! A click means the upper pixel of the clicked cell. SGR-pixels reporting (mode 1016) is not
-//! turned on: crossterm reports its pixel coordinates as if they were cells, nothing tells the
-//! two apart without a mode query crossterm cannot parse, and tmux does not pass it through; a
-//! half-cell of precision is not worth a click landing in the wrong place.
+//! What is understood: printable characters (UTF-8), Enter, Tab and Shift-Tab, Ctrl-C, Esc,
+//! the arrow keys (`CSI A..D` and `SS3 A..D`), and mouse reports in SGR form (`CSI < b;x;y M/m`,
+//! mode 1006) and the legacy X10 form (`CSI M b x y`). Everything else (function keys,
+//! modified keys, Alt combinations, unknown sequences) is ignored. A lone `ESC` is the Escape key
+//! only once no more bytes follow within [`ESC_WAIT`]; until then it may start a sequence.
+//!
+//! Mouse motion is reported for button presses and drags only (mode 1002), not for every
+//! motion; [`coalesce`] reduces a burst of drags to the latest position (the stir interpolates
+//! the path).
 
-use crossterm::event::{Event, KeyCode, KeyEvent, KeyEventKind, KeyModifiers, MouseButton, MouseEvent, MouseEventKind};
+use std::time::{Duration, Instant};
 
-/// What the user asked for.
+/// How long a lone `ESC` waits for the rest of a sequence before it counts as the Escape key.
+pub const ESC_WAIT: Duration = Duration::from_millis(40);
+/// The longest sequence kept while waiting for its end; longer ones are dropped as garbage.
+pub const MAX_SEQUENCE: usize = 8192;
+
+/// What the user asked for (or the terminal said).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Input {
-    /// Leave (`q`, `Esc`, `Ctrl-C`).
+    /// Leave (`q`, `Ctrl-C`).
     Quit,
     /// `Esc`: closes the help if it is open, else quits.
     Escape,
@@ -46,81 +58,278 @@ pub enum Input {
     Other(char),
     /// A mouse button went down in cell (column, row); `big` for the right button.
     Press {
-        /// Column.
+        /// Column, from 0.
         col: u16,
-        /// Row.
+        /// Row, from 0.
         row: u16,
         /// Right button.
         big: bool,
     },
     /// The left button was dragged to cell (column, row).
     Drag {
-        /// Column.
+        /// Column, from 0.
         col: u16,
-        /// Row.
+        /// Row, from 0.
         row: u16,
     },
     /// The mouse button was released.
     Release,
     /// The terminal is now (columns, rows).
     Resize(u16, u16),
+    /// The terminal answered a cursor position request (`CSI 6n`): row and column, from 1.
+    CursorReport(u16, u16),
 }
 
-/// The input a terminal event means, if any.
-pub fn map_event(event: Event) -> Option<Input> {
-    match event {
-        Event::Key(key) => map_key(key),
-        Event::Mouse(mouse) => map_mouse(mouse),
-        Event::Resize(cols, rows) => Some(Input::Resize(cols, rows)),
-        _ => None,
+/// An incremental parser: feed it bytes as they arrive, get inputs out.
+#[derive(Clone, Debug, Default)]
+pub struct InputParser {
+    pending: Vec<u8>,
+    /// When the oldest pending byte arrived.
+    since: Option<Instant>,
+}
+
+/// What the start of the buffer holds.
+enum Parsed {
+    /// A complete item of this many bytes, meaning this input (or nothing).
+    Item(usize, Option<Input>),
+    /// The start of a sequence whose end has not arrived.
+    Incomplete,
+}
+
+impl InputParser {
+    /// A parser with nothing pending.
+    pub fn new() -> InputParser {
+        InputParser::default()
+    }
+
+    /// Parses `bytes` that arrived at `now`, appending the inputs to `out`.
+    pub fn feed(&mut self, bytes: &[u8], now: Instant, out: &mut Vec<Input>) {
+        if bytes.is_empty() {
+            return;
+        }
+        if self.pending.is_empty() {
+            self.since = Some(now);
+        }
+        self.pending.extend_from_slice(bytes);
+        self.drain(out, false);
+        if self.pending.is_empty() {
+            self.since = None;
+        } else if self.pending.len() > MAX_SEQUENCE {
+            // A sequence that never ends (or a flood of garbage): drop it, keep reading.
+            self.pending.clear();
+            self.since = None;
+        }
+    }
+
+    /// Resolves what is pending once no more bytes have come for [`ESC_WAIT`]: a lone `ESC` is
+    /// the Escape key, an unfinished sequence is dropped.
+    pub fn flush_stale(&mut self, now: Instant, out: &mut Vec<Input>) {
+        if self.since.is_some_and(|t| now.saturating_duration_since(t) >= ESC_WAIT) {
+            self.drain(out, true);
+            self.pending.clear();
+            self.since = None;
+        }
+    }
+
+    /// When [`InputParser::flush_stale`] should next be called (`None`: nothing pending).
+    pub fn deadline(&self) -> Option<Instant> {
+        self.since.map(|t| t + ESC_WAIT)
+    }
+
+    fn drain(&mut self, out: &mut Vec<Input>, stale: bool) {
+        let mut at = 0;
+        while at < self.pending.len() {
+            match parse_one(&self.pending[at..], stale) {
+                Parsed::Item(len, input) => {
+                    out.extend(input);
+                    at += len.max(1);
+                }
+                Parsed::Incomplete => break,
+            }
+        }
+        self.pending.drain(..at);
     }
 }
 
-fn map_key(key: KeyEvent) -> Option<Input> {
-    if key.kind != KeyEventKind::Press {
-        return None;
-    }
-    if key.modifiers.contains(KeyModifiers::CONTROL) {
-        return matches!(key.code, KeyCode::Char('c' | 'C')).then_some(Input::Quit);
-    }
-    Some(match key.code {
-        KeyCode::Esc => Input::Escape,
-        KeyCode::Enter => Input::DropAtAim,
-        KeyCode::Tab | KeyCode::BackTab => Input::NextScene,
-        KeyCode::Left => Input::Aim(-1, 0),
-        KeyCode::Right => Input::Aim(1, 0),
-        KeyCode::Up => Input::Aim(0, -1),
-        KeyCode::Down => Input::Aim(0, 1),
-        KeyCode::Char(c) => match c {
-            'q' | 'Q' => Input::Quit,
-            ' ' => Input::RandomStone,
-            'h' => Input::Aim(-1, 0),
-            'l' => Input::Aim(1, 0),
-            'k' => Input::Aim(0, -1),
-            'j' => Input::Aim(0, 1),
-            'r' => Input::ToggleRain,
-            'c' => Input::Clear,
-            '+' | '=' => Input::StoneSize(true),
-            '-' | '_' => Input::StoneSize(false),
-            '[' => Input::Damping(true),
-            ']' => Input::Damping(false),
-            'p' => Input::Pause,
-            's' => Input::Screenshot,
-            '?' => Input::Help,
-            other => Input::Other(other),
+const ESC: u8 = 0x1b;
+
+/// Parses the item at the start of `b`. With `stale`, an incomplete sequence is taken as what
+/// it is so far: a lone ESC is the Escape key, anything longer is dropped.
+fn parse_one(b: &[u8], stale: bool) -> Parsed {
+    let incomplete = |len: usize, lone_escape: bool| {
+        if !stale {
+            Parsed::Incomplete
+        } else if lone_escape {
+            Parsed::Item(1, Some(Input::Escape))
+        } else {
+            Parsed::Item(len, None)
+        }
+    };
+    match b[0] {
+        ESC => match b.get(1) {
+            None => incomplete(1, true),
+            Some(b'[') => parse_csi(b, stale),
+            Some(b'O') => match b.get(2) {
+                None => incomplete(2, false),
+                Some(&c) => Parsed::Item(3, arrow(c)),
+            },
+            // APC (`ESC _`, kitty graphics replies), DCS (`ESC P`), OSC (`ESC ]`), SOS, PM:
+            // strings up to ST (`ESC \`) or, for OSC, BEL. Replies, never keys.
+            Some(b'_' | b'P' | b']' | b'X' | b'^') => match string_end(b) {
+                Some(len) => Parsed::Item(len, None),
+                None => incomplete(b.len(), false),
+            },
+            // ESC ESC: the first is a lone Escape key pressed twice, or Alt-Esc.
+            Some(&ESC) => Parsed::Item(1, Some(Input::Escape)),
+            // Alt plus a key (or a stray ESC): ignored, with the byte after it.
+            Some(&c) => Parsed::Item((1 + utf8_len(Some(c))).min(b.len()), None),
         },
-        _ => return None,
+        0x03 => Parsed::Item(1, Some(Input::Quit)),
+        b'\r' | b'\n' => Parsed::Item(1, Some(Input::DropAtAim)),
+        b'\t' => Parsed::Item(1, Some(Input::NextScene)),
+        c if c < 0x20 || c == 0x7f => Parsed::Item(1, None),
+        c if c < 0x80 => Parsed::Item(1, Some(key(c as char))),
+        c => {
+            let len = utf8_len(Some(c));
+            if b.len() < len {
+                return incomplete(b.len(), false);
+            }
+            match std::str::from_utf8(&b[..len]).ok().and_then(|s| s.chars().next()) {
+                Some(ch) => Parsed::Item(len, Some(Input::Other(ch))),
+                None => Parsed::Item(1, None),
+            }
+        }
+    }
+}
+
+/// The length of a UTF-8 sequence from its first byte (1 for anything invalid).
+fn utf8_len(first: Option<u8>) -> usize {
+    match first {
+        Some(0xC2..=0xDF) => 2,
+        Some(0xE0..=0xEF) => 3,
+        Some(0xF0..=0xF4) => 4,
+        _ => 1,
+    }
+}
+
+/// The length of an ESC-introduced string up to and including its terminator, if it is there.
+fn string_end(b: &[u8]) -> Option<usize> {
+    let osc = b[1] == b']';
+    (2..b.len()).find_map(|i| match b[i] {
+        0x07 if osc => Some(i + 1),
+        ESC if b.get(i + 1) == Some(&b'\\') => Some(i + 2),
+        _ => None,
     })
 }
 
-fn map_mouse(mouse: MouseEvent) -> Option<Input> {
-    let (col, row) = (mouse.column, mouse.row);
-    match mouse.kind {
-        MouseEventKind::Down(MouseButton::Left) => Some(Input::Press { col, row, big: false }),
-        MouseEventKind::Down(MouseButton::Right) => Some(Input::Press { col, row, big: true }),
-        MouseEventKind::Drag(MouseButton::Left) => Some(Input::Drag { col, row }),
-        MouseEventKind::Up(_) => Some(Input::Release),
+fn arrow(c: u8) -> Option<Input> {
+    match c {
+        b'A' => Some(Input::Aim(0, -1)),
+        b'B' => Some(Input::Aim(0, 1)),
+        b'C' => Some(Input::Aim(1, 0)),
+        b'D' => Some(Input::Aim(-1, 0)),
         _ => None,
+    }
+}
+
+/// `ESC [` parameters, intermediates, final byte.
+fn parse_csi(b: &[u8], stale: bool) -> Parsed {
+    // The legacy X10 mouse report: `ESC [ M` and three raw bytes.
+    if b.get(2) == Some(&b'M') {
+        return match b.get(3..6) {
+            Some(&[cb, cx, cy]) => Parsed::Item(6, x10_mouse(u32::from(cb.wrapping_sub(32)), cx, cy)),
+            _ if stale => Parsed::Item(b.len(), None),
+            _ => Parsed::Incomplete,
+        };
+    }
+    let Some(end) = (2..b.len()).find(|&i| (0x40..=0x7e).contains(&b[i])) else {
+        return if stale { Parsed::Item(b.len(), None) } else { Parsed::Incomplete };
+    };
+    let body = &b[2..end];
+    let final_byte = b[end];
+    let len = end + 1;
+    // A byte that cannot be in a sequence ends it as garbage.
+    if body.iter().any(|&c| !(0x20..=0x3f).contains(&c)) {
+        return Parsed::Item(len, None);
+    }
+    let input = match (body.first(), final_byte) {
+        (None, b'A'..=b'D') => arrow(final_byte),
+        (None, b'Z') => Some(Input::NextScene),
+        (Some(b'<'), b'M' | b'm') => sgr_mouse(&body[1..], final_byte == b'M'),
+        (Some(b'0'..=b'9'), b'R') => {
+            let mut numbers = params(body);
+            match (numbers.next(), numbers.next(), numbers.next()) {
+                (Some(Some(row)), Some(Some(col)), None) => Some(Input::CursorReport(row, col)),
+                _ => None,
+            }
+        }
+        // Device attributes, mode reports, window reports, graphics attributes, unknown keys.
+        _ => None,
+    };
+    Parsed::Item(len, input)
+}
+
+/// The numbers of a `;`-separated parameter list (`None` for an empty or oversized one).
+fn params(body: &[u8]) -> impl Iterator<Item = Option<u16>> + '_ {
+    body.split(|&c| c == b';').map(|p| std::str::from_utf8(p).ok()?.parse::<u16>().ok())
+}
+
+fn sgr_mouse(body: &[u8], pressed: bool) -> Option<Input> {
+    let mut numbers = params(body);
+    let (Some(Some(cb)), Some(Some(x)), Some(Some(y)), None) =
+        (numbers.next(), numbers.next(), numbers.next(), numbers.next())
+    else {
+        return None;
+    };
+    if !pressed {
+        return Some(Input::Release);
+    }
+    let (col, row) = (x.saturating_sub(1), y.saturating_sub(1));
+    button(u32::from(cb), col, row)
+}
+
+/// An X10 report: button byte and 1-based coordinates offset by 32.
+fn x10_mouse(cb: u32, cx: u8, cy: u8) -> Option<Input> {
+    let (col, row) = (u16::from(cx.saturating_sub(33)), u16::from(cy.saturating_sub(33)));
+    if cb & 3 == 3 && cb & 32 == 0 {
+        return Some(Input::Release);
+    }
+    button(cb, col, row)
+}
+
+/// Button code (low bits: 0 left, 1 middle, 2 right; +32 motion; +64 wheel) at a cell.
+fn button(cb: u32, col: u16, row: u16) -> Option<Input> {
+    if cb & 64 != 0 {
+        return None; // the wheel
+    }
+    let motion = cb & 32 != 0;
+    match (cb & 3, motion) {
+        (0, false) => Some(Input::Press { col, row, big: false }),
+        (2, false) => Some(Input::Press { col, row, big: true }),
+        (0, true) => Some(Input::Drag { col, row }),
+        _ => None,
+    }
+}
+
+/// The input a plain character means.
+fn key(c: char) -> Input {
+    match c {
+        'q' | 'Q' => Input::Quit,
+        ' ' => Input::RandomStone,
+        'h' => Input::Aim(-1, 0),
+        'l' => Input::Aim(1, 0),
+        'k' => Input::Aim(0, -1),
+        'j' => Input::Aim(0, 1),
+        'r' => Input::ToggleRain,
+        'c' => Input::Clear,
+        '+' | '=' => Input::StoneSize(true),
+        '-' | '_' => Input::StoneSize(false),
+        '[' => Input::Damping(true),
+        ']' => Input::Damping(false),
+        'p' => Input::Pause,
+        's' => Input::Screenshot,
+        '?' => Input::Help,
+        other => Input::Other(other),
     }
 }
 
@@ -139,50 +348,4 @@ pub fn coalesce(inputs: impl IntoIterator<Item = Input>) -> Vec<Input> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crossterm::event::KeyEventState;
-
-    fn key(code: KeyCode, modifiers: KeyModifiers) -> Event {
-        Event::Key(KeyEvent { code, modifiers, kind: KeyEventKind::Press, state: KeyEventState::NONE })
-    }
-
-    #[test]
-    fn keys() {
-        let k = |c| map_event(key(KeyCode::Char(c), KeyModifiers::NONE));
-        assert_eq!(k('q'), Some(Input::Quit));
-        assert_eq!(k(' '), Some(Input::RandomStone));
-        assert_eq!(k('j'), Some(Input::Aim(0, 1)));
-        assert_eq!(k('['), Some(Input::Damping(true)));
-        assert_eq!(k('w'), Some(Input::Other('w')));
-        assert_eq!(map_event(key(KeyCode::Char('c'), KeyModifiers::CONTROL)), Some(Input::Quit));
-        assert_eq!(map_event(key(KeyCode::Char('x'), KeyModifiers::CONTROL)), None);
-        assert_eq!(map_event(key(KeyCode::Esc, KeyModifiers::NONE)), Some(Input::Escape));
-        assert_eq!(map_event(key(KeyCode::Left, KeyModifiers::NONE)), Some(Input::Aim(-1, 0)));
-        let release = KeyEvent {
-            code: KeyCode::Char('q'),
-            modifiers: KeyModifiers::NONE,
-            kind: KeyEventKind::Release,
-            state: KeyEventState::NONE,
-        };
-        assert_eq!(map_event(Event::Key(release)), None);
-    }
-
-    #[test]
-    fn mouse() {
-        let m = |kind| map_event(Event::Mouse(MouseEvent { kind, column: 3, row: 4, modifiers: KeyModifiers::NONE }));
-        assert_eq!(m(MouseEventKind::Down(MouseButton::Left)), Some(Input::Press { col: 3, row: 4, big: false }));
-        assert_eq!(m(MouseEventKind::Down(MouseButton::Right)), Some(Input::Press { col: 3, row: 4, big: true }));
-        assert_eq!(m(MouseEventKind::Drag(MouseButton::Left)), Some(Input::Drag { col: 3, row: 4 }));
-        assert_eq!(m(MouseEventKind::Moved), None);
-    }
-
-    #[test]
-    fn drags_and_resizes_coalesce() {
-        let drag = |col| Input::Drag { col, row: 1 };
-        let inputs = [drag(1), drag(2), drag(3), Input::Clear, drag(4), Input::Resize(5, 5), Input::Resize(9, 9)];
-        assert_eq!(coalesce(inputs), vec![drag(3), Input::Clear, drag(4), Input::Resize(9, 9)]);
-        // A flood of drags is one input.
-        assert_eq!(coalesce((0..10_000).map(|i| drag(i as u16))).len(), 1);
-    }
-}
+mod tests;

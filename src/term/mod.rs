@@ -1,12 +1,12 @@
-//! The interactive terminal player: terminal setup and restore ([`guard`]), input
-//! ([`input`]), time ([`pacing`]), the frame writer ([`writer`]), overlays ([`ui`]) and the
-//! loop that ties them to a scene ([`app`]). The bytes themselves come from the pure encoder in
-//! [`crate::output::diff`].
+//! The interactive terminal player: the loop that ties a scene to a terminal ([`player`]),
+//! input bytes to inputs ([`input`]), time ([`pacing`]), the frame writer ([`writer`]), what is
+//! drawn over the picture ([`ui`], [`screen`]), and this process's own terminal ([`tty`]). The
+//! bytes themselves come from the pure encoder in [`crate::output::diff`].
 
-pub mod app;
-pub mod guard;
 pub mod input;
 pub mod pacing;
+pub mod player;
 pub mod screen;
+pub mod tty;
 pub mod ui;
 pub mod writer;

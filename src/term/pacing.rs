@@ -136,27 +136,6 @@ impl Meter {
     }
 }
 
-/// A byte rate for people: `850 B/s`, `12.3 kB/s`, `1.20 MB/s`.
-pub fn human_rate(bytes_per_second: u64) -> String {
-    let mut text = String::new();
-    write_human_rate(&mut text, bytes_per_second);
-    text
-}
-
-/// [`human_rate`] into a reused buffer (cleared first).
-pub fn write_human_rate(out: &mut String, bytes_per_second: u64) {
-    use std::fmt::Write;
-    out.clear();
-    let b = bytes_per_second as f64;
-    let _ = if b < 1000.0 {
-        write!(out, "{bytes_per_second} B/s")
-    } else if b < 1e6 {
-        write!(out, "{:.1} kB/s", b / 1e3)
-    } else {
-        write!(out, "{:.2} MB/s", b / 1e6)
-    };
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -216,8 +195,5 @@ mod tests {
         }
         assert!(m.frame(t0 + ms(1000), 100));
         assert_eq!((m.fps, m.bytes_per_second), (30, 3000));
-        assert_eq!(human_rate(850), "850 B/s");
-        assert_eq!(human_rate(12_345), "12.3 kB/s");
-        assert_eq!(human_rate(1_200_000), "1.20 MB/s");
     }
 }

@@ -4,11 +4,11 @@
 
 use tiny_skia::Pixmap;
 
+use super::ui::{self, MIN_SIZE, Status};
 use crate::output::color::ColorMode;
 use crate::output::frame::Frame;
-use crate::scene::playable::Playable;
-use crate::term::pacing::write_human_rate;
-use crate::term::ui::{self, MIN_SIZE, Status};
+use crate::output::units::write_human_rate;
+use crate::scene::Playable;
 
 /// What goes over the picture this frame.
 #[derive(Clone, Copy, Debug, Default)]
@@ -77,7 +77,7 @@ impl FrameBuilder {
         write_human_rate(&mut self.rate, overlay.bytes_per_second);
         scene.status(&mut self.detail);
         let status = Status {
-            scene: scene.name(),
+            scene: scene.kind().name(),
             fps: overlay.fps,
             rate: &self.rate,
             detail: &self.detail,

@@ -43,13 +43,6 @@ pub struct Status<'a> {
     pub message: Option<&'a str>,
 }
 
-/// The key hints of scenes that take stones, longest first: the first that fits is shown.
-pub const STONE_HINTS: &[&str] = &[
-    "space stone \u{b7} click drop \u{b7} drag stir \u{b7} arrows+enter aim \u{b7} r rain \u{b7} c clear \u{b7} p pause \u{b7} s shot \u{b7} ? help \u{b7} q quit",
-    "space stone \u{b7} click drop \u{b7} ? help \u{b7} q quit",
-    "? help \u{b7} q quit",
-];
-
 /// Draws the status line into row `row`; `scratch` is a reusable buffer (no allocation once it
 /// has grown to a line's length).
 pub fn status_line(frame: &mut Frame, row: usize, status: &Status<'_>, mode: ColorMode, scratch: &mut String) {
@@ -206,7 +199,7 @@ mod tests {
             rate: "1.2 kB/s",
             detail: "rain 0.02 \u{b7} damping 5",
             stone: Some(4),
-            hints: STONE_HINTS,
+            hints: &["space stone \u{b7} ? help \u{b7} q quit", "? help \u{b7} q quit"],
             ..Status::default()
         }
     }

@@ -22,7 +22,7 @@ pub struct FrameWriter {
 
 impl FrameWriter {
     /// Starts a writer thread that writes each frame with `write` (one call per frame).
-    pub fn spawn(write: impl Fn(&[u8]) -> io::Result<()> + Send + 'static) -> io::Result<FrameWriter> {
+    pub fn spawn(mut write: impl FnMut(&[u8]) -> io::Result<()> + Send + 'static) -> io::Result<FrameWriter> {
         let (frames, inbox) = mpsc::sync_channel::<Vec<u8>>(1);
         let (error_tx, errors) = mpsc::channel();
         // Bounded, so handing buffers back never allocates (an unbounded channel allocates a

@@ -280,11 +280,11 @@ impl Band<'_> {
 #[inline(always)]
 fn row_kernel(rows: [&[i16]; 3], inputs: u16, old: u16, out: &mut [i16], damping: Damping) -> u16 {
     let narrow = inputs < NARROW_INPUT && old < NARROW_OLD;
-    match (damping, narrow) {
-        (Damping::Off, true) => narrow_row::<false>(rows, out, 0),
-        (Damping::Off, false) => wide_row::<false>(rows, out, 0),
-        (Damping::Shift(shift), true) => narrow_row::<true>(rows, out, u32::from(shift)),
-        (Damping::Shift(shift), false) => wide_row::<true>(rows, out, u32::from(shift)),
+    match (damping.shift(), narrow) {
+        (None, true) => narrow_row::<false>(rows, out, 0),
+        (None, false) => wide_row::<false>(rows, out, 0),
+        (Some(shift), true) => narrow_row::<true>(rows, out, u32::from(shift)),
+        (Some(shift), false) => wide_row::<true>(rows, out, u32::from(shift)),
     }
 }
 

@@ -1,0 +1,222 @@
+//! Flags of the ocean: `tidepool render ocean` and `tidepool spectrum`.
+
+use std::path::PathBuf;
+
+use clap::Args;
+
+use tidepool::CameraPose;
+use tidepool::sea::{DEFAULT_SEA_WIND_M_S, beaufort_speed_m_s};
+
+use super::OutputArgs;
+
+const OCEAN_EXAMPLES: &str = "\
+Examples:
+  tidepool render ocean                              # ocean.png, 640x360, a 10 m/s breeze
+  tidepool render ocean --beaufort 8 --direction 200 --size 1280x720 --out gale.png
+  tidepool render ocean --out - --size 160x96        # in this terminal
+  tidepool render ocean --wind 10 --heightmap sea.npy --size 512x512";
+
+const OCEAN_HEIGHTMAP_HELP: &str = "Also write the sea surface height on the --extent patch, sampled at the \
+picture's size: FILE.npy (float32 metres, numpy's format) or FILE.png (16-bit grey, value = round(height*100) + \
+32768, i.e. centimetres, clamped). Columns run east, row 0 is the north edge.";
+
+/// The wind: a speed or a Beaufort number.
+#[derive(Args, Debug, Clone)]
+pub struct WindArgs {
+    /// Wind speed at 10 m, m/s (0..=60; 0 is a flat calm). [default: 10]
+    #[arg(long, value_name = "M/S", value_parser = parse_wind, conflicts_with = "beaufort", allow_negative_numbers = true)]
+    pub wind: Option<f64>,
+
+    /// Wind as a Beaufort number 0..=12 (0.15, 0.9, 2.45, 4.4, 6.7, 9.35, 12.3, 15.5, 18.95,
+    /// 22.6, 26.45, 30.55, 35 m/s).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u8).range(0..=12))]
+    pub beaufort: Option<u8>,
+}
+
+impl WindArgs {
+    /// The wind speed, m/s.
+    pub fn speed_m_s(&self) -> f64 {
+        match (self.wind, self.beaufort) {
+            (Some(w), _) => w,
+            (None, Some(b)) => beaufort_speed_m_s(b).unwrap_or(DEFAULT_SEA_WIND_M_S),
+            (None, None) => DEFAULT_SEA_WIND_M_S,
+        }
+    }
+}
+
+/// `tidepool render ocean`.
+#[derive(Args, Debug)]
+#[command(after_help = OCEAN_EXAMPLES)]
+#[command(mut_arg("heightmap", |arg| arg.help(OCEAN_HEIGHTMAP_HELP)))]
+pub struct RenderOcean {
+    /// The wind.
+    #[command(flatten)]
+    pub wind: WindArgs,
+
+    /// Where the wind comes FROM, degrees clockwise from north (meteorological convention);
+    /// the waves travel downwind.
+    #[arg(long, value_name = "DEG", default_value = "330", value_parser = parse_degrees, allow_hyphen_values = true)]
+    pub direction: f64,
+
+    /// The sun: azimuth (degrees clockwise from north) and elevation (0..=90 degrees).
+    #[arg(long, value_name = "AZ,EL", default_value = "15,22", value_parser = parse_sun, allow_hyphen_values = true)]
+    pub sun: (f64, f64),
+
+    /// The camera: height above the sea in metres (0.5..=10000), tilt below the horizontal in
+    /// degrees (-45..=89), horizontal field of view in degrees (5..=150) and heading in
+    /// degrees clockwise from north. [default: 25,8,70,0]
+    #[arg(long, value_name = "H,PITCH,HFOV[,HEADING]", value_parser = parse_camera, allow_hyphen_values = true)]
+    pub camera: Option<CameraPose>,
+
+    /// Physical time in seconds: the sea at t and t + 1 is one second apart.
+    #[arg(long, value_name = "SECONDS", default_value_t = 0.0, value_parser = parse_time, allow_hyphen_values = true)]
+    pub time: f64,
+
+    /// A PNG or JPEG stretched over the sea, one copy every 48 m. [default: the built-in one]
+    #[arg(long, value_name = "FILE")]
+    pub texture: Option<PathBuf>,
+
+    /// Supersampling: render N times larger in each direction and average down (1..=4).
+    /// [default: 2 for PNG, 1 for text]
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=4))]
+    pub ssaa: Option<u32>,
+
+    /// East-west size of the --heightmap patch in metres (it spans extent·H/W north-south,
+    /// centred under the camera). [default: 8 peak wavelengths]
+    #[arg(long, value_name = "METRES", value_parser = parse_extent)]
+    pub extent: Option<f64>,
+
+    /// Size, seed, output file and format, heightmap, stats.
+    #[command(flatten)]
+    pub output: OutputArgs,
+
+    /// An animation instead of one picture (it starts at --time).
+    #[command(flatten)]
+    pub animation: super::AnimationArgs,
+}
+
+/// `tidepool spectrum`.
+#[derive(Args, Debug)]
+pub struct SpectrumCommand {
+    /// The wind.
+    #[command(flatten)]
+    pub wind: WindArgs,
+
+    /// Print JSON instead of `name: value unit` lines.
+    #[arg(long)]
+    pub json: bool,
+
+    /// Also plot E(f) and the spreading D(theta) at the peak into this PNG file.
+    #[arg(long, value_name = "FILE.png")]
+    pub out: Option<PathBuf>,
+}
+
+fn number(text: &str, what: &'static str, example: &str) -> Result<f64, String> {
+    tidepool::values::parse_number(text, what, example).map_err(|e| e.to_string())
+}
+
+fn in_range(v: f64, lo: f64, hi: f64, what: &str, unit: &str) -> Result<f64, String> {
+    if v < lo || v > hi {
+        return Err(format!("the {what} {v} is outside {lo}..={hi} {unit}"));
+    }
+    Ok(v)
+}
+
+/// Parses a wind speed 0..=60 m/s.
+pub fn parse_wind(text: &str) -> Result<f64, String> {
+    tidepool::values::parse_sea_wind(text).map_err(|e| e.to_string())
+}
+
+/// Parses an angle in degrees, wrapped into 0..360.
+pub fn parse_degrees(text: &str) -> Result<f64, String> {
+    Ok(number(text, "direction", "270 (a west wind)")?.rem_euclid(360.0))
+}
+
+/// Parses `AZ,EL`.
+pub fn parse_sun(text: &str) -> Result<(f64, f64), String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    let [az, el] = parts.as_slice() else {
+        return Err("expected AZIMUTH,ELEVATION in degrees, e.g. 15,22".into());
+    };
+    let az = number(az, "sun azimuth", "15,22")?.rem_euclid(360.0);
+    let el = number(el, "sun elevation", "15,22")?;
+    let el = in_range(el, 0.0, 90.0, "sun elevation", "degrees (the sun must be above the horizon)")?;
+    Ok((az, el))
+}
+
+/// Parses `H,PITCH,HFOV[,HEADING]`.
+pub fn parse_camera(text: &str) -> Result<CameraPose, String> {
+    let parts: Vec<&str> = text.split(',').collect();
+    if !(3..=4).contains(&parts.len()) {
+        return Err("expected HEIGHT_M,PITCH_DEG_DOWN,HFOV_DEG[,HEADING_DEG], e.g. 25,8,70 or 25,8,70,180".into());
+    }
+    let ex = "25,8,70,180";
+    let height = in_range(number(parts[0], "camera height", ex)?, 0.5, 10_000.0, "camera height", "m")?;
+    let pitch = in_range(number(parts[1], "camera pitch", ex)?, -45.0, 89.0, "camera pitch", "degrees down")?;
+    let hfov = in_range(number(parts[2], "field of view", ex)?, 5.0, 150.0, "field of view", "degrees")?;
+    let heading = match parts.get(3) {
+        Some(h) => number(h, "camera heading", ex)?.rem_euclid(360.0),
+        None => CameraPose::DEFAULT.heading_deg,
+    };
+    Ok(CameraPose {
+        height_m: height,
+        pitch_down_deg: pitch,
+        hfov_deg: hfov,
+        heading_deg: heading,
+        ..CameraPose::DEFAULT
+    })
+}
+
+/// Parses a time in seconds (|t| <= 1e7, about four months).
+pub fn parse_time(text: &str) -> Result<f64, String> {
+    let v = number(text, "time", "12.5")?;
+    in_range(v, -1e7, 1e7, "time", "seconds")
+}
+
+/// Parses a heightmap extent, 0.01..=1e6 m.
+pub fn parse_extent(text: &str) -> Result<f64, String> {
+    let v = number(text, "extent", "800")?;
+    in_range(v, 0.01, 1e6, "extent", "metres")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn winds() {
+        assert_eq!(parse_wind("0"), Ok(0.0));
+        assert_eq!(parse_wind(" 60 "), Ok(60.0));
+        for bad in ["-1", "60.5", "nan", "inf", "fast"] {
+            assert!(parse_wind(bad).is_err(), "{bad}");
+        }
+        let w = WindArgs { wind: None, beaufort: Some(8) };
+        assert_eq!(w.speed_m_s(), 18.95);
+        assert_eq!(WindArgs { wind: None, beaufort: None }.speed_m_s(), DEFAULT_SEA_WIND_M_S);
+    }
+
+    #[test]
+    fn angles_sun_and_camera() {
+        assert_eq!(parse_degrees("-90"), Ok(270.0));
+        assert_eq!(parse_degrees("720"), Ok(0.0));
+        assert_eq!(parse_sun("370,10"), Ok((10.0, 10.0)));
+        for bad in ["10", "10,-5", "10,91", "a,b", "1,2,3"] {
+            assert!(parse_sun(bad).is_err(), "{bad}");
+        }
+        let c = parse_camera("40,10,60").unwrap();
+        assert_eq!((c.height_m, c.pitch_down_deg, c.hfov_deg, c.heading_deg), (40.0, 10.0, 60.0, 0.0));
+        assert_eq!(parse_camera("40,10,60,-90").unwrap().heading_deg, 270.0);
+        for bad in ["0,10,60", "40,90,60", "40,10,170", "40,10", "40,10,60,1,2", "x,1,2"] {
+            assert!(parse_camera(bad).is_err(), "{bad}");
+        }
+        assert!(parse_camera("0,10,60").unwrap_err().contains("camera height"));
+    }
+
+    #[test]
+    fn times_and_extents() {
+        assert_eq!(parse_time("-3.5"), Ok(-3.5));
+        assert!(parse_time("1e9").is_err());
+        assert!(parse_extent("0").is_err());
+        assert_eq!(parse_extent("800"), Ok(800.0));
+    }
+}

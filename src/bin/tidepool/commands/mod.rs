@@ -1,0 +1,42 @@
+//! The subcommands: validated flags in, files and terminal output out.
+//!
+//! Each command is a leaf; they share the output plan ([`output`]), the stage timings
+//! ([`stats`]), still pictures ([`still`]) and animations ([`animate`]), and never import each
+//! other except through those.
+
+pub mod animate;
+pub mod bench;
+pub mod docs;
+pub mod lake;
+pub mod ocean;
+pub mod output;
+pub mod play;
+pub mod pool;
+pub mod replay;
+pub mod spectrum;
+pub mod stats;
+pub mod still;
+
+use crate::cli::{Cli, Command, RenderScene};
+use crate::error::Result;
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> Result<()> {
+    crate::signals::install();
+    match cli.command {
+        Some(Command::Render(render)) => match render.scene {
+            RenderScene::Pool(args) => pool::render(args),
+            RenderScene::Ocean(args) => ocean::render(args),
+            RenderScene::Lake(args) => lake::render(args),
+        },
+        Some(Command::Spectrum(args)) => spectrum::run(args),
+        Some(Command::Bench(args)) => bench::run(args),
+        Some(Command::Completions(args)) => docs::completions(args),
+        Some(Command::Man(args)) => docs::man(args),
+        Some(Command::Play(play)) => play::run(play),
+        None => match <Cli as clap::Parser>::try_parse_from(["tidepool", "play"]) {
+            Ok(Cli { command: Some(Command::Play(play)) }) => play::run(play),
+            _ => unreachable!("`tidepool play` with no flags always parses"),
+        },
+    }
+}

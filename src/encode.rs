@@ -1,0 +1,13 @@
+//! Pixels and heights to bytes: PNG, half-block text and heightmaps, and with the `animation`
+//! feature animated GIF and PNG. Every encoder returns bytes (or writes to any `Write`); where
+//! the bytes go is the caller's choice.
+
+#[cfg(feature = "animation")]
+pub use crate::output::apng::ApngWriter;
+#[cfg(feature = "animation")]
+pub use crate::output::gif::{GifPalette, GifWriter};
+pub use crate::output::halfblock::encode as halfblock;
+pub use crate::output::heightmap::{encode_npy as npy, encode_png16 as png16};
+pub use crate::output::png::encode as png;
+pub use crate::output::units::human_bytes;
+pub use crate::render::background::decode as decode_image;

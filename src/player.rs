@@ -1,0 +1,8 @@
+//! The interactive player (feature `player`): a scene full-screen in a terminal, keys and the
+//! mouse dropping stones. [`play`] runs it in this process's terminal; [`run`] runs the same
+//! loop over any input and output, such as an SSH channel.
+
+pub use crate::term::player::{
+    DEFAULT_STONE_RADIUS, PlayerConfig, STONE_RADII, TEST_PANIC_VAR, TerminalInput, picture_size, run,
+};
+pub use crate::term::tty::{ENTER, RESTORE, play, restore};

@@ -1,0 +1,124 @@
+use std::sync::Mutex;
+
+use super::*;
+use crate::sim::noise::NoiseKind;
+use crate::sim::ripple::Stone;
+use crate::storage::Storage;
+
+fn header() -> Header {
+    let options = PoolOptions::of(&PoolSettings::default(), None);
+    Header { format: FORMAT, version: "0.1.0".into(), scene: SceneKind::Pool, seed: 7, size: [20, 10], options }
+}
+
+fn text(entries: &[Entry]) -> String {
+    let mut t = header_line(&header()) + "\n";
+    for e in entries {
+        t += &(event_line(e) + "\n");
+    }
+    t
+}
+
+fn err(text: &str) -> String {
+    parse(Path::new("r.jsonl"), text).unwrap_err().to_string()
+}
+
+#[test]
+fn round_trip() {
+    let entries = vec![
+        Entry { step: 0, event: Event::Stone(Stone::new(-3, 4, 5, 160).unwrap()) },
+        Entry { step: 3, event: Event::Rain(0.25) },
+        Entry { step: 3, event: Event::Damping(Damping::OFF) },
+        Entry { step: 4, event: Event::Clear },
+        Entry { step: 9, event: Event::Resize([30, 12]) },
+        Entry { step: 9, event: Event::Screenshot("a b.png".into()) },
+        Entry { step: 10, event: Event::Wind([4.5, 0.0]) },
+        Entry { step: 11, event: Event::Noise { octaves: 6, persistence: 0.55, kind: NoiseKind::Gradient } },
+        Entry { step: 12, event: Event::End },
+    ];
+    let replay = parse(Path::new("r"), &text(&entries)).unwrap();
+    assert_eq!(replay, Replay { header: header(), entries });
+    assert_eq!(replay.end_step(), 12);
+}
+
+#[test]
+fn a_file_written_by_0_1_0_reads_back() {
+    // The first two lines of a replay recorded by tidepool 0.1.0 (keys in alphabetical order).
+    let old = r#"{"options":{"background":null,"caustics":true,"damping":"4","depth":24.0,"rain":0.05,"refraction":"auto","shading":true,"sun":"315,60"},"scene":"pool","seed":7,"size":[100,58],"tidepool_replay":1,"version":"0.1.0"}
+{"step":88,"stone":[8,18,3,48]}
+{"rain":0.0,"step":209}
+{"damping":"5","step":233}
+{"clear":true,"step":519}
+{"end":true,"step":598}
+"#;
+    let replay = parse(Path::new("old"), old).unwrap();
+    assert_eq!(replay.header.options.damping, "4".parse().unwrap());
+    assert_eq!(replay.header.options.sun, Sun::default());
+    assert_eq!(replay.entries[0].event, Event::Stone(Stone::new(8, 18, 3, 48).unwrap()));
+    assert_eq!(replay.entries.len(), 5);
+}
+
+#[test]
+fn errors_name_the_line() {
+    let end = Entry { step: 5, event: Event::End };
+    let good = text(&[Entry { step: 1, event: Event::Clear }, end.clone()]);
+    let truncated = &good[..good.len() - 10];
+    assert!(err(truncated).starts_with("r.jsonl, line 3: the line is cut short"), "{}", err(truncated));
+    let lines: Vec<&str> = good.lines().collect();
+    let missing_end = format!("{}\n{}\n", lines[0], lines[1]);
+    assert!(err(&missing_end).contains("line 3: the replay stops without"), "{}", err(&missing_end));
+    assert!(err("").contains("line 1: the file is empty"));
+    assert!(err("{\"a\":1}").contains("line 1: not a tidepool replay"));
+    let newer = good.replacen("\"tidepool_replay\":1", "\"tidepool_replay\":2", 1);
+    assert!(err(&newer).contains("line 1: replay format 2 (recorded by 0.1.0) is newer"), "{}", err(&newer));
+    let bad_event = good.replacen("\"clear\":true", "\"splash\":true", 1);
+    assert!(err(&bad_event).contains("line 2: unknown event \"splash\""));
+    let bad_stone = good.replacen("\"clear\":true", "\"stone\":[1,2,0,3]", 1);
+    assert!(err(&bad_stone).contains("line 2: bad stone: the radius 0"), "{}", err(&bad_stone));
+    let bad_noise =
+        good.replacen("\"clear\":true", "\"noise\":{\"octaves\":0,\"persistence\":0.5,\"kind\":\"value\"}", 1);
+    assert!(err(&bad_noise).contains("line 2: bad noise: the octave count 0"), "{}", err(&bad_noise));
+    let backwards = good.replacen("\"step\":5", "\"step\":0", 1);
+    assert!(err(&backwards).contains("line 3: step 0 comes after step 1"));
+    let after_end = good.clone() + &event_line(&end) + "\n";
+    assert!(err(&after_end).contains("line 4: text after the end line"));
+    let no_size = good.replacen("\"size\":[20,10]", "\"size\":[0,10]", 1);
+    assert!(err(&no_size).contains("line 1: \"size\""), "{}", err(&no_size));
+    let wrong_type = good.replacen("\"clear\":true", "\"stone\":\"here\"", 1);
+    assert!(err(&wrong_type).contains("line 2: \"stone\": invalid type"), "{}", err(&wrong_type));
+}
+
+#[derive(Default)]
+struct Memory(Mutex<Vec<(PathBuf, Vec<u8>)>>);
+
+impl Storage for Memory {
+    fn save(&self, path: &Path, bytes: &[u8]) -> Result<()> {
+        self.0.lock().unwrap().push((path.to_owned(), bytes.to_vec()));
+        Ok(())
+    }
+}
+
+#[test]
+fn recorder_saves_once_when_finished() {
+    let storage = std::sync::Arc::new(Memory::default());
+    let mut rec = Recorder::new(Path::new("s.jsonl"), &header(), storage.clone());
+    rec.record(2, Event::Clear);
+    assert!(storage.0.lock().unwrap().is_empty(), "nothing is saved before the end");
+    rec.finish(7).unwrap();
+    rec.finish(9).unwrap();
+    drop(rec);
+    let saved = storage.0.lock().unwrap();
+    assert_eq!(saved.len(), 1, "saved once");
+    let replay = parse(&saved[0].0, std::str::from_utf8(&saved[0].1).unwrap()).unwrap();
+    assert_eq!(replay.entries, vec![Entry { step: 2, event: Event::Clear }, Entry { step: 7, event: Event::End }]);
+}
+
+#[test]
+fn a_dropped_recorder_still_saves() {
+    let storage = std::sync::Arc::new(Memory::default());
+    let mut rec = Recorder::new(Path::new("s.jsonl"), &header(), storage.clone());
+    rec.advance(40);
+    drop(rec);
+    let saved = storage.0.lock().unwrap();
+    let replay = parse(&saved[0].0, std::str::from_utf8(&saved[0].1).unwrap()).unwrap();
+    assert_eq!(replay.end_step(), 40);
+}

@@ -1,0 +1,62 @@
+//! Wind speeds: the limits of the sea's and the lake's winds, checked where they enter.
+
+use crate::error::ValueError;
+
+/// The strongest wind the sea takes, m/s.
+pub const MAX_SEA_WIND_M_S: f64 = 60.0;
+/// The sea's wind when none is given, m/s (Beaufort 5, Hs 2.46 m).
+pub const DEFAULT_SEA_WIND_M_S: f64 = 10.0;
+/// Where the sea's default wind comes from, degrees clockwise from north (north-north-west: the
+/// waves run towards the camera's right, across the default view).
+pub const DEFAULT_WIND_FROM_DEG: f64 = 330.0;
+/// The strongest wind the lake takes, m/s (a storm; beyond it a lake is all spray).
+pub const MAX_LAKE_WIND_M_S: f64 = 30.0;
+
+/// Parses the sea's wind speed, `0..=`[`MAX_SEA_WIND_M_S`] m/s.
+pub fn parse_sea_wind(text: &str) -> Result<f64, ValueError> {
+    check_sea_wind(crate::numbers::finite(text, "wind speed", "10")?)
+}
+
+/// Checks the sea's wind speed.
+pub fn check_sea_wind(v: f64) -> Result<f64, ValueError> {
+    if !(0.0..=MAX_SEA_WIND_M_S).contains(&v) {
+        return Err(ValueError::new(
+            "wind speed",
+            format!("the wind speed {v} is outside 0..={MAX_SEA_WIND_M_S} m/s (use --beaufort 0..=12 for named winds)"),
+        ));
+    }
+    Ok(v)
+}
+
+/// Parses the lake's wind speed, `0..=`[`MAX_LAKE_WIND_M_S`] m/s.
+pub fn parse_lake_wind(text: &str) -> Result<f64, ValueError> {
+    let v = crate::numbers::finite(text, "wind speed", "3")?;
+    if !(0.0..=MAX_LAKE_WIND_M_S).contains(&v) {
+        return Err(ValueError::new(
+            "wind speed",
+            format!(
+                "the wind speed {v} is outside 0..={MAX_LAKE_WIND_M_S} m/s; use 0 for a mirror calm, 3 for a breeze, 10 for a strong wind"
+            ),
+        ));
+    }
+    Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn winds() {
+        assert_eq!(parse_sea_wind("0"), Ok(0.0));
+        assert_eq!(parse_sea_wind(" 60 "), Ok(60.0));
+        for bad in ["-1", "60.5", "nan", "inf", "fast"] {
+            assert!(parse_sea_wind(bad).is_err(), "{bad}");
+        }
+        assert_eq!(parse_lake_wind(" 30 "), Ok(30.0));
+        for bad in ["-1", "30.5", "nan", "inf", "calm", ""] {
+            assert!(parse_lake_wind(bad).is_err(), "{bad}");
+        }
+        assert!(parse_lake_wind("31").unwrap_err().to_string().contains("0..=30 m/s"));
+    }
+}
