@@ -13,25 +13,21 @@
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
-use tidepool::output::color::{Color, ColorMode};
-use tidepool::output::diff::{EncodeOptions, Shown, encode_into};
-use tidepool::output::frame::Frame;
-use tidepool::render::background;
-use tidepool::render::pool::PoolLook;
-use tidepool::scene::pool::{PoolScene, PoolSettings};
-use tidepool::sim::ripple::{Damping, Stone};
+use tidepool::terminal::{Color, ColorMode, EncodeOptions, Frame, Shown, encode_into};
+use tidepool::{Damping, PoolScene, PoolSettings, Scene, Stone};
 use tiny_skia::Pixmap;
 
 const COLS: usize = 160;
 const ROWS: usize = 48;
 
 fn scene() -> PoolScene {
-    let settings = PoolSettings { damping: Damping::Shift(4), rain_rate: 0.02, seed: 1, look: PoolLook::default() };
-    let mut scene = PoolScene::new(COLS as u32, 2 * (ROWS as u32 - 1), background::pool_floor(), settings).unwrap();
+    let damping = Damping::from_shift(4).unwrap();
+    let settings = PoolSettings { damping, rain_rate: 0.02, seed: 1, ..PoolSettings::default() };
+    let mut scene = PoolScene::new(COLS as u32, 2 * (ROWS as u32 - 1), settings).unwrap();
     for (i, (x, y)) in [(30, 20), (120, 70), (80, 45)].into_iter().enumerate() {
-        scene.drop_stone(Stone { x, y, radius: 3, weight: 64 });
+        scene.drop_stone(Stone::clamped(x, y, 3, 64));
         for _ in 0..20 * (i + 1) {
-            scene.step();
+            Scene::advance(&mut scene, 1);
         }
     }
     scene
@@ -49,8 +45,8 @@ fn encoder(c: &mut Criterion) {
     let mut scene = scene();
     let mut pixmap = Pixmap::new(scene.width(), scene.height()).unwrap();
     let a = frame(&mut scene, &mut pixmap);
-    scene.step();
-    scene.step();
+    Scene::advance(&mut scene, 1);
+    Scene::advance(&mut scene, 1);
     let b = frame(&mut scene, &mut pixmap);
     let options = EncodeOptions::default();
     let mut shown_a = Shown::UNKNOWN;
@@ -86,10 +82,10 @@ fn encoder(c: &mut Criterion) {
         bench.iter(|| {
             n += 1;
             if n.is_multiple_of(30) {
-                scene.drop_stone(Stone { x: (n * 37 % 160) as i32, y: (n * 17 % 94) as i32, radius: 3, weight: 64 });
+                scene.drop_stone(Stone::clamped((n * 37 % 160) as i32, (n * 17 % 94) as i32, 3, 64));
             }
-            scene.step();
-            scene.step();
+            Scene::advance(&mut scene, 1);
+            Scene::advance(&mut scene, 1);
             let f = frame(&mut scene, &mut pixmap);
             out.clear();
             encode_into(&mut shown, &f, options, &mut out);

@@ -6,11 +6,11 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use tiny_skia::Pixmap;
 
-use tidepool::scene::lake::{LakeScene, LakeSettings};
-use tidepool::sim::lake::LakeParams;
+use tidepool::{LakeParams, LakeScene, LakeSettings, Scene};
 
 fn scene(width: u32, height: u32, ssaa: u32) -> LakeScene {
-    let settings = LakeSettings { lake: LakeParams { wind_m_s: 3.0, ..LakeParams::default() }, ssaa };
+    let settings =
+        LakeSettings { lake: LakeParams { wind_m_s: 3.0, ..LakeParams::default() }, ssaa, ..LakeSettings::default() };
     LakeScene::new(settings, width, height).expect("valid size")
 }
 
@@ -21,7 +21,7 @@ fn render_lake(c: &mut Criterion) {
         let mut s = scene(w, h, ssaa);
         let mut out = Pixmap::new(w, h).unwrap();
         s.render(&mut out);
-        eprintln!("render/lake/{name}: {} triangles", s.renderer().triangle_count());
+        eprintln!("render/lake/{name}: {}", s.describe());
         group.bench_function(name, |b| {
             b.iter(|| {
                 s.advance(1.0 / 30.0);

@@ -6,17 +6,11 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use tiny_skia::Pixmap;
 
-use tidepool::render::ocean::OceanView;
-use tidepool::render::texture::SeaTexture;
-use tidepool::scene::ocean::{OceanScene, OceanSettings};
-use tidepool::sim::ocean::SeaParams;
+use tidepool::{OceanScene, OceanSettings, OceanView, Scene};
 
 fn scene(width: u32, height: u32, ssaa: u32) -> OceanScene {
-    let settings = OceanSettings {
-        sea: SeaParams { wind_m_s: 10.0, wind_from_deg: 330.0, seed: 1 },
-        view: OceanView { ssaa, ..OceanView::default() },
-    };
-    OceanScene::new(settings, width, height, SeaTexture::builtin()).expect("valid size")
+    let settings = OceanSettings { view: OceanView { ssaa, ..OceanView::default() }, ..OceanSettings::default() };
+    OceanScene::new(settings, width, height).expect("valid size")
 }
 
 fn render_ocean(c: &mut Criterion) {
@@ -26,7 +20,7 @@ fn render_ocean(c: &mut Criterion) {
         let mut s = scene(w, h, ssaa);
         let mut out = Pixmap::new(w, h).unwrap();
         s.render(&mut out);
-        eprintln!("render/ocean/{name}: {} triangles", s.renderer().triangle_count());
+        eprintln!("render/ocean/{name}: {}", s.describe());
         group.bench_function(name, |b| {
             b.iter(|| {
                 s.advance(1.0 / 30.0);

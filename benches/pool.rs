@@ -7,10 +7,7 @@
 //! Run: `cargo bench --bench pool` (add `-- sim/` to run one group).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
-use tidepool::render::background;
-use tidepool::render::pool::{PoolLook, PoolRenderer};
-use tidepool::sim::rain::Rain;
-use tidepool::sim::ripple::{Damping, RipplePool, Stone};
+use tidepool::{Damping, Event, PoolLook, PoolScene, PoolSettings, RipplePool, Scene, Stone};
 use tiny_skia::Pixmap;
 
 /// The papers' loop, transliterated: index arithmetic, an i32 sum, shifts, store, swap.
@@ -45,7 +42,7 @@ fn rough_pool(side: usize) -> RipplePool {
     for k in 0..64 {
         let x = (k * 7919 % side) as i32;
         let y = (k * 104729 % side) as i32;
-        pool.drop_stone(Stone { x, y, radius: 6, weight: 200 });
+        pool.drop_stone(Stone::clamped(x, y, 6, 200));
     }
     pool.advance(20);
     pool
@@ -89,37 +86,33 @@ fn ripple_step(c: &mut Criterion) {
 fn render_pool(c: &mut Criterion) {
     let mut group = c.benchmark_group("render/pool");
     group.sample_size(20);
-    let floor = background::pool_floor();
     for (w, h) in [(160u32, 96u32), (1920, 1080)] {
         // Lively water: heavy rain (one papers' raindrop per 100,000 pixels per step) for 200
         // steps leaves rings over the whole picture, the busy case for refraction and light.
-        let mut rain = Rain::new(f64::from(w * h) / 100_000.0, 7);
-        let mut pool = RipplePool::new(w as usize, h as usize, Damping::PAPERS);
-        let mut drops = Vec::new();
-        for _ in 0..200 {
-            drops.clear();
-            rain.drops(w as usize, h as usize, &mut drops);
-            for &drop in &drops {
-                pool.drop_stone(drop);
-            }
-            pool.step();
-        }
-        let mut renderer = PoolRenderer::new(background::cover(&floor, w, h).unwrap(), PoolLook::default());
+        // Each look gets its own scene with the same seed, so the same water.
+        let lively = |look| {
+            let rain_rate = f64::from(w * h) / 100_000.0;
+            let mut scene = PoolScene::new(w, h, PoolSettings { rain_rate, seed: 7, look, ..PoolSettings::default() })
+                .expect("a benchmark-sized pool");
+            scene.advance(200);
+            scene.apply(&Event::Rain(0.0));
+            scene
+        };
         let mut out = Pixmap::new(w, h).unwrap();
+        let mut full = lively(PoolLook::default());
         group.throughput(Throughput::Elements(u64::from(w * h)));
         group.bench_function(BenchmarkId::new("refract_shade", format!("{w}x{h}")), |b| {
-            b.iter(|| renderer.render(&pool, &mut out))
+            b.iter(|| full.render(&mut out))
         });
         // The same without caustics and without light, to see what each costs.
         let bare = PoolLook { caustics: None, ..PoolLook::default() };
-        let mut no_caustics = PoolRenderer::new(background::cover(&floor, w, h).unwrap(), bare);
+        let mut no_caustics = lively(bare);
         group.bench_function(BenchmarkId::new("refract_shade_no_caustics", format!("{w}x{h}")), |b| {
-            b.iter(|| no_caustics.render(&pool, &mut out))
+            b.iter(|| no_caustics.render(&mut out))
         });
-        let mut refract_only =
-            PoolRenderer::new(background::cover(&floor, w, h).unwrap(), PoolLook { shading: false, ..bare });
+        let mut refract_only = lively(PoolLook { shading: false, ..bare });
         group.bench_function(BenchmarkId::new("refract_only", format!("{w}x{h}")), |b| {
-            b.iter(|| refract_only.render(&pool, &mut out))
+            b.iter(|| refract_only.render(&mut out))
         });
         // A frame of the interactive loop: a raindrop, a step, the picture. The drops keep
         // the water moving so the filtered (fractional-offset) path is what gets measured.
@@ -127,9 +120,9 @@ fn render_pool(c: &mut Criterion) {
         group.bench_function(BenchmarkId::new("step_and_render", format!("{w}x{h}")), |b| {
             b.iter(|| {
                 k = k.wrapping_add(1);
-                pool.drop_stone(Stone { x: (k * 7919 % w) as i32, y: (k * 104729 % h) as i32, radius: 3, weight: 128 });
-                pool.step();
-                renderer.render(&pool, &mut out)
+                full.drop_stone(Stone::clamped((k * 7919 % w) as i32, (k * 104729 % h) as i32, 3, 128));
+                Scene::advance(&mut full, 1);
+                full.render(&mut out)
             })
         });
     }
@@ -139,8 +132,9 @@ fn render_pool(c: &mut Criterion) {
 fn output_png(c: &mut Criterion) {
     let mut group = c.benchmark_group("output/png");
     group.sample_size(10);
-    let floor = background::cover(&background::pool_floor(), 1920, 1080).unwrap();
-    group.bench_function("encode_1920x1080", |b| b.iter(|| tidepool::output::png::encode(&floor)));
+    let mut pool = PoolScene::new(1920, 1080, PoolSettings::default()).unwrap();
+    let floor = pool.snapshot().unwrap();
+    group.bench_function("encode_1920x1080", |b| b.iter(|| tidepool::encode::png(&floor)));
     group.finish();
 }
 

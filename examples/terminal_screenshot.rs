@@ -5,7 +5,7 @@
 //! Usage: `cargo run --release --example terminal_screenshot CAPTURE.ans OUT.png COLS ROWS`
 
 use font8x8::UnicodeFonts;
-use tidepool::output::vt::Screen;
+use tidepool::terminal::Screen;
 use tiny_skia::{Pixmap, PremultipliedColorU8};
 
 const CELL_W: u32 = 8;
@@ -68,6 +68,6 @@ fn main() {
             }
         }
     }
-    std::fs::write(out, tidepool::output::png::encode(&pixmap)).expect("a writable output");
+    std::fs::write(out, tidepool::encode::png(&pixmap)).expect("a writable output");
     println!("{out}: {cols}x{rows} cells");
 }

@@ -54,7 +54,7 @@ pub use render::supersample::Downsample;
 pub use render::texture::SeaTexture;
 pub use scene::lake::{LakeScene, LakeSettings};
 pub use scene::ocean::{OceanScene, OceanSettings};
-pub use scene::pool::{PoolScene, PoolSettings};
+pub use scene::pool::{PoolScene, PoolSettings, showcase as pool_showcase};
 pub use scene::{Action, Controls, Event, Playable, Scene, SceneKind, SceneSpec, Script};
 pub use sim::lake::LakeParams;
 pub use sim::noise::NoiseKind;

@@ -3,10 +3,13 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
+use tidepool::{PoolScene, PoolSettings, Scene};
 
 fuzz_target!(|data: &[u8]| {
-    if let Ok(pixmap) = tidepool::render::background::decode(data) {
-        // A decoded image must be usable: fit it to a small pool as the renderer does.
-        let _ = tidepool::render::background::cover(&pixmap, 7, 5);
+    if let Ok(floor) = tidepool::encode::decode_image(data) {
+        // A decoded image must be usable: a small pool on it, as the renderer fits it.
+        if let Some(mut pool) = PoolScene::new(7, 5, PoolSettings { floor, ..PoolSettings::default() }) {
+            let _ = pool.snapshot();
+        }
     }
 });

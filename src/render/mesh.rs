@@ -155,12 +155,6 @@ impl MeshTopology {
     }
 
     #[cfg(test)]
-    /// The camera it was built for.
-    pub fn camera(&self) -> &Camera {
-        &self.camera
-    }
-
-    #[cfg(test)]
     /// Sample points (east, north metres).
     pub fn points(&self) -> &[[f32; 2]] {
         &self.ground
@@ -395,18 +389,6 @@ impl FaceIds {
     }
 
     #[cfg(test)]
-    /// Columns.
-    pub fn width(&self) -> usize {
-        self.width
-    }
-
-    #[cfg(test)]
-    /// Rows.
-    pub fn height(&self) -> usize {
-        self.height
-    }
-
-    #[cfg(test)]
     /// The numbers, row-major.
     pub fn ids(&self) -> &[u32] {
         &self.ids
@@ -415,12 +397,6 @@ impl FaceIds {
     /// The numbers, to read and reset.
     pub fn ids_mut(&mut self) -> &mut [u32] {
         &mut self.ids
-    }
-
-    #[cfg(test)]
-    /// Sets every number to 0.
-    pub fn clear(&mut self) {
-        self.ids.fill(0);
     }
 }
 

@@ -86,12 +86,6 @@ impl Mirror {
         self.rows
     }
 
-    #[cfg(test)]
-    /// The picture row where the kept rows begin.
-    pub fn first_row(&self) -> f32 {
-        self.first_row
-    }
-
     /// The mean linear colour of the mirror in the column under picture x (continuous pixel
     /// coordinates: pixel (0, 0) spans 0..1) over rows `y - half_height ..= y + half_height`.
     /// Points outside the kept image use its nearest column and its first or last row; a

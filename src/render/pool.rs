@@ -349,12 +349,6 @@ impl PoolRenderer {
         self.look
     }
 
-    #[cfg(test)]
-    /// The background it refracts.
-    pub fn background(&self) -> &Pixmap {
-        &self.background
-    }
-
     /// Draws `pool` into `out`. Both must have the background's size. Large pictures are drawn
     /// in row bands on all cores; every pixel is computed the same way whatever the split.
     ///
@@ -704,7 +698,7 @@ mod tests {
             ..PoolLook::default()
         };
         let mut renderer = PoolRenderer::new(bg, look);
-        let mut pool = RipplePool::new(30, 30, Damping::Off);
+        let mut pool = RipplePool::new(30, 30, Damping::OFF);
         // A single deep cell at (10, 10): its neighbours see a slope of ±5.
         pool.drop_stone(Stone { x: 10, y: 10, radius: 1, weight: 5 });
         let mut out = Pixmap::new(30, 30).unwrap();
@@ -734,7 +728,7 @@ mod tests {
             ..PoolLook::default()
         };
         let mut renderer = PoolRenderer::new(bg, look);
-        let mut pool = RipplePool::new(8, 8, Damping::Off);
+        let mut pool = RipplePool::new(8, 8, Damping::OFF);
         pool.drop_stone(Stone { x: 3, y: 3, radius: 1, weight: 100 });
         let mut out = Pixmap::new(8, 8).unwrap();
         renderer.render(&pool, &mut out);

@@ -148,12 +148,6 @@ impl Shore {
         Shore { shapes, distance_m }
     }
 
-    #[cfg(test)]
-    /// The waterline's distance north, m.
-    pub fn distance_m(&self) -> f32 {
-        self.distance_m
-    }
-
     /// Draws the shore as `camera` sees it into `out` (the camera's size), anti-aliased, over
     /// whatever is there.
     pub fn draw(&self, camera: &Camera, out: &mut Pixmap) {

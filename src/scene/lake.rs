@@ -116,7 +116,7 @@ impl LakeScene {
     }
 
     /// The full surface height (m) on a `width x height` grid of square cells covering the
-    /// lake from the far shore (row 0) to the camera's shore ([`FAR_SHORE_M`] north-south,
+    /// lake from the far shore (row 0) to the camera's shore (300 m north-south,
     /// `FAR_SHORE_M·width/height` east-west, centred on the camera), at cell centres; columns
     /// run east.
     pub fn heightmap(&self, width: usize, height: usize) -> Heightmap {

@@ -158,7 +158,7 @@ impl SceneSpec {
         Ok(match self {
             SceneSpec::Pool(s) => Box::new(pool::PoolScene::new(width, height, s.clone()).ok_or_else(too_large)?),
             SceneSpec::Ocean(s) => Box::new(ocean::OceanScene::new(s.clone(), width, height).ok_or_else(too_large)?),
-            SceneSpec::Lake(s) => Box::new(lake::LakeScene::new(s.clone(), width, height).ok_or_else(too_large)?),
+            SceneSpec::Lake(s) => Box::new(lake::LakeScene::new(*s, width, height).ok_or_else(too_large)?),
         })
     }
 }

@@ -154,12 +154,19 @@ pub struct LakeParams {
     pub wind_m_s: f64,
     /// Seed of the noise.
     pub seed: u64,
-    /// Noise octaves, 1..=[`MAX_OCTAVES`].
+    /// Noise octaves, 1..=12.
     pub octaves: u32,
     /// Amplitude ratio between successive octaves.
     pub persistence: f64,
     /// Value or gradient lattice noise.
     pub noise: NoiseKind,
+}
+
+impl LakeParams {
+    /// The significant wave height (4 standard deviations of the surface) this wind raises, m.
+    pub fn significant_height_m(&self) -> f64 {
+        Lake::new(*self).significant_height_m()
+    }
 }
 
 impl Default for LakeParams {
@@ -169,7 +176,7 @@ impl Default for LakeParams {
     }
 }
 
-/// Parses an octave count, `1..=`[`MAX_OCTAVES`].
+/// Parses an octave count, `1..=12`.
 pub fn parse_octaves(text: &str) -> Result<u32, ValueError> {
     let v: i64 = text.trim().parse().map_err(|_| {
         ValueError::new("octaves", format!("the octave count '{}' is not a whole number; e.g. 5", text.trim()))

@@ -9,7 +9,7 @@ use crate::error::ValueError;
 /// The heaviest rain tidepool accepts, drops per step (beyond it the pool boils).
 pub const MAX_RATE: f64 = 10_000.0;
 
-/// Parses a rain rate: a finite number of drops per step, `0..=`[`MAX_RATE`].
+/// Parses a rain rate: a finite number of drops per step, `0..=10000`.
 pub fn parse_rate(text: &str) -> Result<f64, ValueError> {
     let v: f64 =
         text.trim().parse().map_err(|_| ValueError::new("rain", format!("'{text}' is not a number; e.g. 0.05")))?;

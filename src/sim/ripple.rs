@@ -143,7 +143,7 @@ impl RipplePool {
     }
 
     /// Advances the water by `steps` steps, as fast as this machine allows (SIMD, temporal
-    /// blocking and all cores; see [`super::stepper`]). The result is bit-identical to calling
+    /// blocking and all cores; see `stepper.rs`). The result is bit-identical to calling
     /// [`RipplePool::step`] `steps` times, on any number of threads.
     pub fn advance(&mut self, steps: u64) {
         stepper::advance(

@@ -86,6 +86,9 @@ pub struct InputParser {
     pending: Vec<u8>,
     /// When the oldest pending byte arrived.
     since: Option<Instant>,
+    /// Inside a string sequence (APC, DCS, OSC) longer than [`MAX_SEQUENCE`]: its bytes are
+    /// dropped until its terminator, or until the terminal falls silent for [`ESC_WAIT`].
+    skipping: bool,
 }
 
 /// What the start of the buffer holds.
@@ -107,6 +110,20 @@ impl InputParser {
         if bytes.is_empty() {
             return;
         }
+        let mut bytes = bytes;
+        if self.skipping {
+            // The rest of an overlong string: drop up to its terminator.
+            match bytes.iter().position(|&b| b == 0x07 || b == b'\\') {
+                Some(end) => {
+                    bytes = &bytes[end + 1..];
+                    self.skipping = false;
+                }
+                None => {
+                    self.since = Some(now);
+                    return;
+                }
+            }
+        }
         if self.pending.is_empty() {
             self.since = Some(now);
         }
@@ -115,9 +132,11 @@ impl InputParser {
         if self.pending.is_empty() {
             self.since = None;
         } else if self.pending.len() > MAX_SEQUENCE {
-            // A sequence that never ends (or a flood of garbage): drop it, keep reading.
+            // A sequence that never ends (or a flood of garbage): drop what is kept and, if it
+            // is a string, the rest of it as it comes.
+            self.skipping = matches!(self.pending.get(1), Some(b'_' | b'P' | b']' | b'X' | b'^'));
             self.pending.clear();
-            self.since = None;
+            self.since = Some(now);
         }
     }
 
@@ -128,6 +147,7 @@ impl InputParser {
             self.drain(out, true);
             self.pending.clear();
             self.since = None;
+            self.skipping = false;
         }
     }
 

@@ -202,6 +202,8 @@ impl Player {
         let mut bytes_in = Vec::new();
         let mut inputs = Vec::new();
         let mut builder = FrameBuilder::default();
+        // A buffer kept back from a frame that had nothing to send, so it is not lost.
+        let mut unused: Option<Vec<u8>> = None;
         let read_error = |source| Error::Terminal { action: "cannot read the terminal", source };
         loop {
             if self.config.quit.load(Ordering::SeqCst) {
@@ -261,11 +263,13 @@ impl Player {
                 })?;
             }
             let frame = self.frame(&mut builder, &mut pixmap, &meter, now);
-            let mut bytes = writer.buffer();
+            let mut bytes = unused.take().unwrap_or_else(|| writer.buffer());
             encode_into(&mut shown, frame, self.config.encode, &mut bytes);
             let len = bytes.len();
             if len > 0 {
                 writer.send(bytes);
+            } else {
+                unused = Some(bytes);
             }
             meter.frame(now, len);
             pacer.sent(now, len);

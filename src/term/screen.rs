@@ -29,6 +29,11 @@ pub struct Overlay<'a> {
     pub paused: bool,
 }
 
+/// Bytes reserved for the formatted byte rate.
+const RATE_ROOM: usize = 16;
+/// Bytes reserved for the scene's status summary.
+const DETAIL_ROOM: usize = 128;
+
 /// Whether a `cols x rows` terminal is big enough for the picture and the status line.
 pub fn big_enough((cols, rows): (u16, u16)) -> bool {
     cols >= MIN_SIZE.0 && rows >= MIN_SIZE.1
@@ -62,6 +67,11 @@ impl FrameBuilder {
     ) -> &Frame {
         let (cols, rows) = (usize::from(term.0), usize::from(term.1));
         self.frame.reset(cols, rows);
+        // Room for the longest texts once (they grow as the figures do: `0 B/s` becomes
+        // `1.23 MB/s`), so steady frames never reallocate them.
+        self.rate.reserve(RATE_ROOM);
+        self.detail.reserve(DETAIL_ROOM);
+        self.line.reserve(4 * cols);
         if !big_enough(term) {
             ui::too_small(&mut self.frame);
             return &self.frame;

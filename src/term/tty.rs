@@ -129,8 +129,8 @@ impl Write for TtyOut {
 }
 
 /// Restores the terminal if the player has it (safe to call from any thread, any number of
-/// times, from a signal-handling thread too; only the first call after
-/// [`TerminalGuard::enter`] does anything).
+/// times, from a signal-handling thread too; only the first call after the player took the
+/// terminal does anything).
 pub fn restore() {
     if !ACTIVE.swap(false, Ordering::SeqCst) {
         return;

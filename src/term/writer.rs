@@ -5,75 +5,116 @@
 //! the frames it would have drawn are dropped. Because a frame is only encoded when the writer
 //! is idle, every frame is a diff against what was really sent, and input latency stays one
 //! frame even when the link is slower than the frame rate.
+//!
+//! The hand-over is one slot under a mutex with a condition variable, and written buffers come
+//! back for reuse, so a steady stream of frames allocates nothing (a channel would allocate
+//! when a thread blocks on it).
 
 use std::io;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::mpsc::{self, Receiver, SyncSender};
+use std::sync::{Arc, Condvar, Mutex, MutexGuard};
 
-/// The writer thread's handle.
+/// What the two threads share.
+#[derive(Debug, Default)]
+struct Slot {
+    /// The frame to write next.
+    frame: Option<Vec<u8>>,
+    /// Written buffers, for reuse (at most two exist).
+    spare: Vec<Vec<u8>>,
+    /// A frame is waiting or being written.
+    busy: bool,
+    /// The error that stopped the writer.
+    error: Option<io::Error>,
+    /// The handle was dropped: the thread ends.
+    closed: bool,
+}
+
+/// The writer thread's handle; dropping it ends the thread after the frame in hand.
 #[derive(Debug)]
 pub struct FrameWriter {
-    frames: SyncSender<Vec<u8>>,
-    busy: Arc<AtomicBool>,
-    errors: Receiver<io::Error>,
-    spare: Receiver<Vec<u8>>,
+    shared: Arc<(Mutex<Slot>, Condvar)>,
+}
+
+fn lock(shared: &(Mutex<Slot>, Condvar)) -> MutexGuard<'_, Slot> {
+    shared.0.lock().unwrap_or_else(|p| p.into_inner())
 }
 
 impl FrameWriter {
     /// Starts a writer thread that writes each frame with `write` (one call per frame).
     pub fn spawn(mut write: impl FnMut(&[u8]) -> io::Result<()> + Send + 'static) -> io::Result<FrameWriter> {
-        let (frames, inbox) = mpsc::sync_channel::<Vec<u8>>(1);
-        let (error_tx, errors) = mpsc::channel();
-        // Bounded, so handing buffers back never allocates (an unbounded channel allocates a
-        // block every few dozen messages); at most two frames are ever in flight.
-        let (spare_tx, spare) = mpsc::sync_channel(2);
-        let busy = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&busy);
+        let slot = Slot { spare: Vec::with_capacity(2), ..Slot::default() };
+        let shared = Arc::new((Mutex::new(slot), Condvar::new()));
+        let theirs = Arc::clone(&shared);
         std::thread::Builder::new().name("tidepool-writer".into()).spawn(move || {
-            for mut frame in inbox {
+            loop {
+                let mut frame = {
+                    let mut slot = lock(&theirs);
+                    loop {
+                        if let Some(frame) = slot.frame.take() {
+                            break frame;
+                        }
+                        if slot.closed {
+                            return;
+                        }
+                        slot = theirs.1.wait(slot).unwrap_or_else(|p| p.into_inner());
+                    }
+                };
                 let result = write(&frame);
                 frame.clear();
-                let _ = spare_tx.try_send(frame);
-                flag.store(false, Ordering::SeqCst);
+                let mut slot = lock(&theirs);
+                if slot.spare.len() < slot.spare.capacity() {
+                    slot.spare.push(frame);
+                }
+                slot.busy = false;
                 if let Err(e) = result {
-                    let _ = error_tx.send(e);
+                    slot.error = Some(e);
                     return;
                 }
             }
         })?;
-        Ok(FrameWriter { frames, busy, errors, spare })
+        Ok(FrameWriter { shared })
     }
 
     /// Whether the last frame has been written, so a new one can be sent.
     pub fn idle(&self) -> bool {
-        !self.busy.load(Ordering::SeqCst)
+        !lock(&self.shared).busy
     }
 
     /// Hands a frame to the thread. Call only when [`FrameWriter::idle`]; a frame sent while
-    /// busy waits for the one before (it is never dropped: it is a diff).
+    /// busy replaces nothing: it waits for the one before (it is never dropped: it is a diff).
     pub fn send(&self, frame: Vec<u8>) {
-        self.busy.store(true, Ordering::SeqCst);
-        if self.frames.send(frame).is_err() {
-            self.busy.store(false, Ordering::SeqCst);
+        let mut slot = lock(&self.shared);
+        if slot.error.is_some() {
+            return;
         }
+        while slot.frame.is_some() {
+            slot = self.shared.1.wait(slot).unwrap_or_else(|p| p.into_inner());
+        }
+        slot.frame = Some(frame);
+        slot.busy = true;
+        self.shared.1.notify_all();
     }
 
     /// A buffer to encode the next frame into, reusing a written frame's allocation.
     pub fn buffer(&self) -> Vec<u8> {
-        self.spare.try_recv().unwrap_or_default()
+        lock(&self.shared).spare.pop().unwrap_or_default()
     }
 
     /// The error that stopped the thread, if any.
     pub fn error(&self) -> Option<io::Error> {
-        self.errors.try_recv().ok()
+        lock(&self.shared).error.take()
+    }
+}
+
+impl Drop for FrameWriter {
+    fn drop(&mut self) {
+        lock(&self.shared).closed = true;
+        self.shared.1.notify_all();
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::sync::Mutex;
     use std::time::{Duration, Instant};
 
     fn wait_idle(w: &FrameWriter) {
@@ -104,13 +145,16 @@ mod tests {
 
     #[test]
     fn a_slow_write_keeps_the_writer_busy() {
-        let w = FrameWriter::spawn(|_| {
-            std::thread::sleep(Duration::from_millis(150));
+        let (tx, rx) = std::sync::mpsc::channel::<()>();
+        let rx = Mutex::new(rx);
+        let w = FrameWriter::spawn(move |_| {
+            let _ = rx.lock().unwrap().recv();
             Ok(())
         })
         .unwrap();
         w.send(vec![1]);
         assert!(!w.idle(), "busy while writing: the caller drops frames instead of queueing");
+        tx.send(()).unwrap();
         wait_idle(&w);
     }
 
@@ -119,11 +163,6 @@ mod tests {
         let w = FrameWriter::spawn(|_| Err(io::Error::other("gone"))).unwrap();
         w.send(vec![1]);
         wait_idle(&w);
-        let deadline = Instant::now() + Duration::from_secs(5);
-        let mut error = None;
-        while error.is_none() && Instant::now() < deadline {
-            error = w.error();
-        }
-        assert_eq!(error.unwrap().to_string(), "gone");
+        assert_eq!(w.error().unwrap().to_string(), "gone");
     }
 }

@@ -1,12 +1,10 @@
 //! Whatever file a user points tidepool at: odd but valid images work, broken or hostile ones
 //! get a one-line error, exit status 2, and nothing is written.
 
-mod common;
-
 use std::io::Cursor;
 use std::path::Path;
 
-use common::{run_in, scratch, stderr};
+use crate::common::{run_in, scratch, stderr};
 
 /// Renders a tiny pool on `background` and returns (exit code, stderr).
 fn render_on(dir: &Path, background: &str) -> (Option<i32>, String) {

@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests: running the binary and the golden-image harness.
-#![allow(dead_code)] // each test binary uses its own subset
 
 pub mod golden;
+pub mod pty;
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -1,14 +1,12 @@
 //! Runs the `tidepool` binary in a real pseudo-terminal and collects everything it writes.
 
-#![allow(dead_code)] // each test binary uses a different part
-
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use portable_pty::{Child, CommandBuilder, ExitStatus, MasterPty, PtySize, native_pty_system};
-use tidepool::output::vt::Screen;
+use tidepool::terminal::Screen;
 
 /// A player running in a pty.
 pub struct Player {

@@ -1,6 +1,6 @@
 //! The long run (ignored by default; about a minute in the dev profile):
 //!
-//!     cargo test --test soak -- --ignored --nocapture
+//!     cargo test --test integration soak -- --ignored --nocapture
 //!
 //! A million steps of the player's pool in the dev profile (overflow checks on), driven by a
 //! scripted input stream: heavy rain, a stone every step, drags, rain toggles, damping changes
@@ -10,14 +10,8 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tidepool::output::color::ColorMode;
-use tidepool::output::diff::{EncodeOptions, Shown, encode_into};
-use tidepool::render::background;
-use tidepool::render::pool::PoolLook;
-use tidepool::scene::playable::{Action, Playable};
-use tidepool::scene::pool::{PoolScene, PoolSettings};
-use tidepool::sim::ripple::Damping;
-use tidepool::term::screen::{FrameBuilder, Overlay};
+use tidepool::terminal::{ColorMode, EncodeOptions, Frame, Shown, encode_into};
+use tidepool::{Action, Controls, Damping, Event, PoolScene, PoolSettings, Scene};
 
 /// Resident memory of this process in KiB (Linux), for the "memory stays flat" check.
 fn resident_kib() -> u64 {
@@ -27,15 +21,16 @@ fn resident_kib() -> u64 {
 }
 
 #[test]
-#[ignore = "a million steps: cargo test --test soak -- --ignored --nocapture"]
+#[ignore = "a million steps: cargo test --test integration soak -- --ignored --nocapture"]
 fn a_million_steps_of_heavy_weather() {
     const STEPS: u64 = 1_000_000;
     let started = std::time::Instant::now();
-    let settings = PoolSettings { damping: Damping::Shift(4), rain_rate: 2.0, seed: 11, look: PoolLook::default() };
+    let damping = Damping::from_shift(4).unwrap();
+    let settings = PoolSettings { damping, rain_rate: 2.0, seed: 11, ..PoolSettings::default() };
     let (mut w, mut h) = (160u32, 94u32);
-    let mut scene = PoolScene::new(w, h, background::pool_floor(), settings).unwrap();
+    let mut scene = PoolScene::new(w, h, settings).unwrap();
     let mut rng = ChaCha8Rng::seed_from_u64(99);
-    let mut builder = FrameBuilder::default();
+    let mut frame = Frame::new(0, 0);
     let mut pixmap = tiny_skia::Pixmap::new(w, h).unwrap();
     let mut shown = Shown::UNKNOWN;
     let mut bytes = Vec::new();
@@ -67,18 +62,17 @@ fn a_million_steps_of_heavy_weather() {
         if step % 250_003 == 250_000 {
             // A resize, as the terminal would send.
             (w, h) = if w == 160 { (97, 61) } else { (160, 94) };
-            scene.apply(&tidepool::replay::Event::Resize([w, h]));
+            scene.apply(&Event::Resize([w, h]));
             pixmap = tiny_skia::Pixmap::new(w, h).unwrap();
             shown = Shown::UNKNOWN;
         }
-        Playable::step(&mut scene);
+        Scene::advance(&mut scene, 1);
         if step % 97 == 0 {
-            let cols = w as u16;
-            let rows = (h / 2 + 1) as u16;
-            let overlay = Overlay { fps: 30, bytes_per_second: 1_000, stone: 3, ..Overlay::default() };
-            let frame = builder.build((cols, rows), &mut scene, &mut pixmap, ColorMode::TrueColor, &overlay);
+            frame.reset(w as usize, (h / 2 + 1) as usize);
+            scene.render(&mut pixmap);
+            frame.draw_pixels(&pixmap, ColorMode::TrueColor);
             bytes.clear();
-            encode_into(&mut shown, frame, EncodeOptions::default(), &mut bytes);
+            encode_into(&mut shown, &frame, EncodeOptions::default(), &mut bytes);
         }
         if step % 100_000 == 99_999 {
             let heights = scene.pool().heights();

@@ -3,14 +3,12 @@
 //! stone a second, counted over 8 s after a 4 s warm-up, against the naive full redraw of
 //! 40 bytes a cell. Ignored by default (it takes 12 s and wants an optimized build):
 //!
-//!     cargo test --release --test bytes_per_frame -- --ignored --nocapture
-
-mod pty_support;
+//!     cargo test --release --test integration bytes_per_frame -- --ignored --nocapture
 
 use std::time::{Duration, Instant};
 
-use pty_support::{Player, temp_dir};
-use tidepool::output::diff::{SYNC_BEGIN, SYNC_END};
+use crate::common::pty::{Player, temp_dir};
+use tidepool::terminal::{SYNC_BEGIN, SYNC_END};
 
 const COLS: u16 = 160;
 const ROWS: u16 = 48;

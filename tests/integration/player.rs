@@ -2,13 +2,11 @@
 //! clicks drop stones where expected (decoded from the half-block output with the terminal
 //! model), still water sends only the status line, and a recorded session replays exactly.
 
-mod pty_support;
-
 use std::time::Duration;
 
-use pty_support::{Player, cooked, find, rfind, temp_dir};
-use tidepool::output::diff::{SYNC_BEGIN, SYNC_END};
-use tidepool::term::guard::{ENTER, RESTORE};
+use crate::common::pty::{Player, cooked, find, rfind, temp_dir};
+use tidepool::player::{ENTER, RESTORE};
+use tidepool::terminal::{SYNC_BEGIN, SYNC_END};
 
 const WAIT: Duration = Duration::from_secs(20);
 const ARGS: &[&str] = &["play", "--color", "truecolor", "--color-threshold", "0"];
@@ -59,7 +57,7 @@ fn sigterm_and_sighup_restore() {
 #[test]
 fn a_panic_restores_before_its_message() {
     let dir = temp_dir("panic");
-    let mut p = Player::spawn(&dir, 40, 12, ARGS, &[(tidepool::term::app::TEST_PANIC_VAR, "1")]);
+    let mut p = Player::spawn(&dir, 40, 12, ARGS, &[(tidepool::player::TEST_PANIC_VAR, "1")]);
     let status = p.wait_exit(WAIT);
     assert_eq!(status.exit_code(), 101);
     let out = p.output();
@@ -117,13 +115,18 @@ fn still_water_sends_only_the_status_line() {
     assert!(window.len() < 4 * 40 * 40, "{} bytes in 2.5 s of still water", window.len());
 }
 
+/// The straight colour of pixel (x, y).
+fn pixel_rgb(pixmap: &tiny_skia::Pixmap, x: usize, y: usize) -> [u8; 3] {
+    let c = pixmap.pixel(x as u32, y as u32).unwrap().demultiply();
+    [c.red(), c.green(), c.blue()]
+}
+
 /// Keys and clicks drop stones where expected; what the terminal shows (decoded with the
 /// terminal model) is the replay of the recorded session; the screenshot is bit-identical to
 /// `render pool --replay` at its step; a resize redraws the whole window at the new size.
 #[test]
 fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
-    use tidepool::replay::Event;
-    use tidepool::sim::ripple::Stone;
+    use tidepool::{Event, Stone};
 
     let mut p = started("drive", &["--rain", "0", "--record", "session.jsonl"], &[]);
     p.send(b"p");
@@ -151,9 +154,9 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     let stones: Vec<Stone> =
         replay.entries.iter().filter_map(|e| if let Event::Stone(s) = e.event { Some(s) } else { None }).collect();
     assert_eq!(stones.len(), 4, "{:?}", replay.entries);
-    assert_eq!(stones[1], Stone { x: 9, y: 4, radius: 3, weight: 48 }, "left click: the cell's upper pixel");
-    assert_eq!(stones[2], Stone { x: 29, y: 14, radius: 6, weight: 96 }, "right click: a big stone");
-    assert_eq!(stones[3], Stone { x: 26, y: 8, radius: 3, weight: 48 }, "aim: centre (20, 10) + 3 columns, 1 row up");
+    assert_eq!(stones[1], Stone::new(9, 4, 3, 48).unwrap(), "left click: the cell's upper pixel");
+    assert_eq!(stones[2], Stone::new(29, 14, 6, 96).unwrap(), "right click: a big stone");
+    assert_eq!(stones[3], Stone::new(26, 8, 3, 48).unwrap(), "aim: centre (20, 10) + 3 columns, 1 row up");
     let step = replay.entries[0].step;
     assert!(replay.entries.iter().all(|e| e.step == step), "paused: every event at one step");
     let shot = replay
@@ -164,13 +167,14 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     assert!(replay.entries.iter().any(|e| e.event == Event::Resize([30, 18])));
 
     // The picture on screen before the resize is the replay at the screenshot.
-    let mut scene = tidepool::commands::replay::simulate(&path, &replay, Some(step)).unwrap();
-    let expected = scene.snapshot();
+    let spec = replay.spec(tidepool::pool_floor());
+    let mut scene = replay.simulate(&spec, Some(step), &mut |_| {}).unwrap();
+    let expected = scene.snapshot().unwrap();
     let mut compared = 0;
     for y in 0..22 {
         for x in 0..40 {
             if let Some(rgb) = shown.pixel(x, y) {
-                assert_eq!(rgb, tidepool::output::halfblock::pixel_rgb(&expected, x as u32, y as u32), "({x}, {y})");
+                assert_eq!(rgb, pixel_rgb(&expected, x, y), "({x}, {y})");
                 compared += 1;
             }
         }
@@ -190,14 +194,14 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     assert_eq!(std::fs::read(p.dir.join(&shot)).unwrap(), std::fs::read(&rendered).unwrap(), "bit-identical");
 
     // After the resize the window shows the 30x18 pool of the replay's end.
-    let mut resized = tidepool::output::vt::Screen::new(30, 10);
+    let mut resized = tidepool::terminal::Screen::new(30, 10);
     resized.lf_returns = false;
     resized.feed(&p.output()[before_resize..rfind(&p.output(), RESTORE).unwrap()]);
-    let end = tidepool::commands::replay::simulate(&path, &replay, None).unwrap().snapshot();
+    let end = replay.simulate(&spec, None, &mut |_| {}).unwrap().snapshot().unwrap();
     assert_eq!((end.width(), end.height()), (30, 18));
     for y in 0..18 {
         for x in 0..30 {
-            let want = tidepool::output::halfblock::pixel_rgb(&end, x as u32, y as u32);
+            let want = pixel_rgb(&end, x, y);
             if (x, y / 2) == (26, 4) {
                 assert_eq!(resized.cell(x, y / 2).ch, '+', "the aim marker is still shown");
                 continue;

@@ -1,8 +1,6 @@
 //! The command line as a user meets it: exit statuses, messages, files written or left alone.
 
-mod common;
-
-use common::{run, run_in, scratch, stderr, tidepool};
+use crate::common::{run, run_in, scratch, stderr, tidepool};
 
 #[test]
 fn help_and_version_exit_zero_and_explain_the_flags() {

@@ -1,0 +1,18 @@
+//! tidepool's integration tests, one binary made of modules (as tiny-skia's
+//! `tests/integration/main.rs`): pictures rendered in-process against golden images, the
+//! command line run as a user runs it, the player in a real pseudo-terminal, replays.
+//! The counting-allocator test stays a binary of its own (`tests/steady_state_alloc.rs`): it
+//! installs a global allocator.
+
+mod animation;
+mod bytes_per_frame;
+mod cli;
+mod common;
+mod goldens;
+mod hostile_input;
+mod lake;
+mod ocean;
+mod player;
+mod pool;
+mod replay;
+mod soak;
