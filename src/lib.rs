@@ -20,7 +20,8 @@
 //! ```
 //!
 //! Features: `cli` (default: the `tidepool` binary), `player` (the interactive terminal player,
-//! [`player`]), `animation` (GIF and animated PNG writers in [`encode`]).
+//! `player`), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
+//! that draws any scene, `widget`).
 #![warn(missing_docs)]
 
 mod error;
@@ -42,6 +43,8 @@ pub mod replay;
 pub mod sea;
 pub mod terminal;
 pub mod values;
+#[cfg(feature = "ratatui")]
+pub mod widget;
 
 pub use error::{Error, Result, ValueError};
 pub use output::heightmap::Heightmap;

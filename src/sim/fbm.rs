@@ -6,7 +6,7 @@
 //! kept as given, and each refinement sets the new points to the mean of their four lattice
 //! neighbours (wrapping around the edges) plus a Gaussian displacement whose standard deviation
 //! shrinks by `2^(-H/2)` every half step (diamond, then square), i.e. by `2^-H` per octave.
-//! With H = 1 this is the k⁻⁴ 2-D spectrum of the Pierson–Moskowitz tail (ALGORITHMS.md §3).
+//! With H = 1 this is the k⁻⁴ 2-D spectrum of the Pierson–Moskowitz tail (`docs/ALGORITHMS.md` §3.3).
 //!
 //! Because coarse lattice values are never changed by finer steps, the field cut off at any
 //! octave is simply the bilinear interpolation of the lattice at that stride: [`Fbm::sample`]

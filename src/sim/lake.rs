@@ -1,4 +1,4 @@
-//! The lake: Perlin-noise water (ALGORITHMS.md §2) whose height and ripple size follow the wind.
+//! The lake: Perlin-noise water (`docs/ALGORITHMS.md` §2) whose height and ripple size follow the wind.
 //!
 //! The paper sums octaves of lattice noise for the height field Z(x, y, t) and stops there;
 //! tidepool gives the sum a physical scale so that `--wind` means metres per second:

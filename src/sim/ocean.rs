@@ -1,5 +1,5 @@
 //! The wind-driven sea: a Pierson–Moskowitz surface as travelling sines plus a diamond-square
-//! fBm tail (ALGORITHMS.md section 3, "how tidepool makes the parts agree").
+//! fBm tail (`docs/ALGORITHMS.md` §3.3, "How tidepool makes the parts agree").
 //!
 //! # The sines
 //! [`FREQUENCY_BINS`] geometric frequency bins from [`BAND_LOW`]·fm to [`CUTOFF`]·fm times

@@ -1,4 +1,4 @@
-//! The integer ripple pool of the papers (digest: ALGORITHMS.md section 1).
+//! The integer ripple pool of the papers (`docs/ALGORITHMS.md` §1).
 //!
 //! Two `i16` amplitude buffers; every step replaces the older one with
 //! `((N + S + E + W) >> 1) - previous`, then damps it by `v -= v >> shift`, and swaps them.

@@ -1,5 +1,5 @@
-//! The Pierson–Moskowitz wave spectrum with Mitsuyasu directional spreading (digest:
-//! ALGORITHMS.md section 3).
+//! The Pierson–Moskowitz wave spectrum with Mitsuyasu directional spreading
+//! (`docs/ALGORITHMS.md` §3.1).
 //!
 //! ```text
 //! E(f)        = alpha·g² / ((2π)⁴ f⁵) · exp(-5/4 · (fm/f)⁴),  fm = 0.13·g/U,  alpha = 0.0081
