@@ -19,6 +19,7 @@ use tidepool::{Event, SceneSpec, Script, Size};
 
 use super::output::size_error;
 use super::stats::Stats;
+use crate::cli::OutputArgs;
 use crate::error::{Error, Result};
 use crate::files::{self, AtomicFile};
 use crate::progress::Progress;
@@ -206,6 +207,20 @@ fn render_animation(
         started,
         format!("{} frames of {width}x{height} at {fps} fps, {what}, {}", animation.frames, human_bytes(bytes as u64)),
     );
+    Ok(())
+}
+
+/// Refuses flags that mean nothing for an animation.
+pub fn check_animation_flags(output: &OutputArgs) -> Result<()> {
+    if output.format.is_some() {
+        return Err(Error::arg(
+            "--format",
+            "an animation takes its format from --out (.gif, .png or a {frame} pattern)",
+        ));
+    }
+    if output.heightmap.is_some() {
+        return Err(Error::arg("--heightmap", "is written for single pictures; drop --frames or --heightmap"));
+    }
     Ok(())
 }
 

@@ -6,8 +6,7 @@ use std::io::IsTerminal;
 use tidepool::{LakeParams, LakeSettings, SceneSpec};
 
 use super::animate::{Animation, AnimationTarget, animate};
-use super::ocean::default_ssaa;
-use super::output::{DEFAULT_PNG_SIZE, OutputPlan, terminal_pixels};
+use super::output::{DEFAULT_PNG_SIZE, OutputPlan, default_ssaa, terminal_pixels};
 use super::still::{self, Still};
 use crate::cli::Format;
 use crate::cli::lake::RenderLake;
@@ -44,7 +43,7 @@ pub fn render(args: RenderLake) -> Result<()> {
 
 /// `tidepool render lake --frames N`: the lake from `--time` on, 1/30 s a step as in the player.
 fn animate_lake(args: &RenderLake, frames: u32) -> Result<()> {
-    super::pool::check_animation_flags(&args.output)?;
+    super::animate::check_animation_flags(&args.output)?;
     let target = AnimationTarget::from_out(args.output.out.as_deref(), "lake", args.animation.fps)?;
     let size = args.output.size.unwrap_or(DEFAULT_PNG_SIZE);
     let ssaa = args.ssaa.unwrap_or_else(|| default_ssaa(Format::Png));

@@ -25,7 +25,10 @@ pub fn run(cli: Cli) -> Result<()> {
     crate::signals::install();
     match cli.command {
         Some(Command::Render(render)) => match render.scene {
-            RenderScene::Pool(args) => pool::render(args),
+            RenderScene::Pool(args) => match args.replay.clone() {
+                Some(path) => replay::render(&args, &path),
+                None => pool::render(args),
+            },
             RenderScene::Ocean(args) => ocean::render(args),
             RenderScene::Lake(args) => lake::render(args),
         },

@@ -7,16 +7,11 @@ use tidepool::sea::SEA_TEXTURE_TILE_M;
 use tidepool::{CameraPose, Downsample, OceanSettings, OceanView, SceneSpec, SeaParams, SeaTexture};
 
 use super::animate::{Animation, AnimationTarget, animate};
-use super::output::{DEFAULT_PNG_SIZE, OutputPlan, terminal_pixels};
+use super::output::{DEFAULT_PNG_SIZE, OutputPlan, default_ssaa, terminal_pixels};
 use super::still::{self, Still};
 use crate::cli::Format;
 use crate::cli::ocean::RenderOcean;
 use crate::error::{Error, Result};
-
-/// The supersampling used when `--ssaa` is not given: 2 for PNG, 1 for text.
-pub fn default_ssaa(format: Format) -> u32 {
-    if format == Format::Png { 2 } else { 1 }
-}
 
 /// The validated settings of a `render ocean` command line.
 fn settings(args: &RenderOcean, format: Format) -> Result<OceanSettings> {
@@ -63,7 +58,7 @@ pub fn render(args: RenderOcean) -> Result<()> {
 
 /// `tidepool render ocean --frames N`: the sea from `--time` on, 1/60 s a step as in the player.
 fn animate_ocean(args: &RenderOcean, frames: u32) -> Result<()> {
-    super::pool::check_animation_flags(&args.output)?;
+    super::animate::check_animation_flags(&args.output)?;
     if args.extent.is_some() {
         return Err(Error::arg("--extent", "only sizes the --heightmap patch, which animations do not write"));
     }

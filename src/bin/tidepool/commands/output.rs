@@ -149,6 +149,11 @@ impl OutputPlan {
     }
 }
 
+/// The supersampling used when `--ssaa` is not given: 2 for PNG, 1 for text.
+pub fn default_ssaa(format: Format) -> u32 {
+    if format == Format::Png { 2 } else { 1 }
+}
+
 /// The format an output file name implies, if any.
 fn format_of(path: &Path) -> Option<Format> {
     let ext = path.extension()?.to_str()?.to_ascii_lowercase();

@@ -8,14 +8,11 @@ use tidepool::{Event, SceneSpec, Size};
 use super::animate::{Animation, AnimationTarget, animate};
 use super::output::{DEFAULT_PNG_SIZE, OutputPlan, terminal_pixels};
 use super::still::{self, Still};
-use crate::cli::{OutputArgs, RenderPool};
-use crate::error::{Error, Result};
+use crate::cli::RenderPool;
+use crate::error::Result;
 
 /// Runs `tidepool render pool`.
 pub fn render(args: RenderPool) -> Result<()> {
-    if let Some(path) = &args.replay {
-        return super::replay::render(&args, path);
-    }
     if let Some(frames) = args.animation.frames {
         return animate_pool(&args, frames);
     }
@@ -42,24 +39,10 @@ fn default_pool_steps(size: Size) -> u64 {
     tidepool::pool_showcase(size.width(), size.height()).1
 }
 
-/// Refuses flags that mean nothing for an animation.
-pub fn check_animation_flags(output: &OutputArgs) -> Result<()> {
-    if output.format.is_some() {
-        return Err(Error::arg(
-            "--format",
-            "an animation takes its format from --out (.gif, .png or a {frame} pattern)",
-        ));
-    }
-    if output.heightmap.is_some() {
-        return Err(Error::arg("--heightmap", "is written for single pictures; drop --frames or --heightmap"));
-    }
-    Ok(())
-}
-
 /// `tidepool render pool --frames N`: the stones (given or default) land at their steps, the
 /// first frame after `--steps` steps (default 0, so the stones are seen falling).
 fn animate_pool(args: &RenderPool, frames: u32) -> Result<()> {
-    check_animation_flags(&args.output)?;
+    super::animate::check_animation_flags(&args.output)?;
     let target = AnimationTarget::from_out(args.output.out.as_deref(), "pool", args.animation.fps)?;
     let size = args.output.size.unwrap_or(DEFAULT_PNG_SIZE);
     let spec = SceneSpec::Pool(args.pool.settings(args.output.seed, 0.0)?);

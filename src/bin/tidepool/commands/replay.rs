@@ -64,7 +64,7 @@ fn spec(replay: &Replay) -> Result<SceneSpec> {
 /// `tidepool render pool --replay FILE --frames N`: the session as an animation, from step 0
 /// (or `--steps`), each event at its step.
 fn animate_replay(args: &RenderPool, replay: &Replay, spec: &SceneSpec, frames: u32) -> Result<()> {
-    super::pool::check_animation_flags(&args.output)?;
+    super::animate::check_animation_flags(&args.output)?;
     let target = AnimationTarget::from_out(args.output.out.as_deref(), "pool", args.animation.fps)?;
     let [w, h] = replay.header.size;
     let script = replay.script();
