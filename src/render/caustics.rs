@@ -16,7 +16,7 @@
 //! result is a multiplier per cell (1 = flat water) in 8.8 fixed point.
 
 use crate::error::ValueError;
-use crate::simd::Simd;
+use crate::simd::{Simd, Tier};
 
 /// Amplitude units per pixel of surface height: a weight-64 stone makes a dent one pixel deep.
 pub const AMPLITUDE_PER_PIXEL: f32 = 64.0;
@@ -113,7 +113,7 @@ impl LightMap {
     /// turn into glitter (the filter removes the checkerboard exactly and keeps ripples of
     /// eight cells and more). The three passes (along rows, along columns, the Jacobian) run
     /// fused over a few cached rows, so only the heights and the result cross main memory.
-    pub fn compute(&mut self, heights: &[i16], width: usize, height: usize, look: CausticsLook) {
+    pub fn compute(&mut self, heights: &[i16], width: usize, height: usize, look: CausticsLook, simd: Simd) {
         self.shift = u32::from(width * height >= HALF_RESOLUTION_FROM);
         let step = 1usize << self.shift;
         (self.width, self.height) = (width.div_ceil(step), height.div_ceil(step));
@@ -133,15 +133,15 @@ impl LightMap {
         let rows_per_task = if parallel { ((1 << 15) / width / step).max(16) } else { rows };
         let tasks = rows.div_ceil(rows_per_task);
         self.windows.resize_with(tasks, Window::default);
-        let simd = Simd::detect();
         let run = |(task, (chunk, window)): (usize, (&mut [u8], &mut Window))| {
             let task = Task { field: &field, first_row: task * rows_per_task, k, strength: look.strength };
-            match simd {
-                // SAFETY: the variants are only returned after run-time detection of the feature.
+            match simd.tier() {
+                // SAFETY: a `Simd` of this tier exists only when run-time detection found the
+                // feature (see `crate::simd`).
                 #[cfg(target_arch = "x86_64")]
-                Simd::Avx512 => unsafe { task.run_avx512(window, chunk) },
+                Tier::Avx512 => unsafe { task.run_avx512(window, chunk) },
                 #[cfg(target_arch = "x86_64")]
-                Simd::Avx2 => unsafe { task.run_avx2(window, chunk) },
+                Tier::Avx2 => unsafe { task.run_avx2(window, chunk) },
                 _ => task.run(window, chunk),
             }
         };
@@ -334,12 +334,12 @@ mod tests {
     fn flat_water_lights_the_floor_evenly() {
         let heights = vec![0i16; 30 * 20];
         let mut light = LightMap::default();
-        light.compute(&heights, 30, 20, CausticsLook::default());
+        light.compute(&heights, 30, 20, CausticsLook::default(), Simd::detect());
         assert_eq!(light.gains.len(), 600);
         assert!(light.gains.iter().all(|&l| l == UNIT_GAIN));
         // A tilted plane does not focus light either.
         let tilted: Vec<i16> = (0..600).map(|i| (i % 30) as i16 * 10).collect();
-        light.compute(&tilted, 30, 20, CausticsLook::default());
+        light.compute(&tilted, 30, 20, CausticsLook::default(), Simd::detect());
         assert!(light.gains.iter().enumerate().all(|(i, &l)| (i % 30) < 3 || (i % 30) > 26 || l == UNIT_GAIN));
     }
 
@@ -355,7 +355,7 @@ mod tests {
             }
         }
         let mut light = LightMap::default();
-        light.compute(&heights, w, h, CausticsLook::default());
+        light.compute(&heights, w, h, CausticsLook::default(), Simd::detect());
         let at = |x: usize| light.gain(x, 5);
         assert!(at(10) > UNIT_GAIN, "under the crest: {}", at(10));
         assert!(at(30) < UNIT_GAIN, "under the trough: {}", at(30));
@@ -367,7 +367,7 @@ mod tests {
         let (w, h) = (16, 16);
         let heights: Vec<i16> = (0..w * h).map(|i| if (i % w + i / w) % 2 == 0 { 50 } else { -50 }).collect();
         let mut light = LightMap::default();
-        light.compute(&heights, w, h, CausticsLook { depth_px: 200.0, strength: 1.0 });
+        light.compute(&heights, w, h, CausticsLook { depth_px: 200.0, strength: 1.0 }, Simd::detect());
         for y in 3..h - 3 {
             for x in 3..w - 3 {
                 assert_eq!(light.gain(x, y), UNIT_GAIN, "({x}, {y})");
@@ -380,11 +380,11 @@ mod tests {
         let (w, h) = (512, 300);
         let heights: Vec<i16> = (0..w * h).map(|i| (((i * 7919) % 401) as i16 - 200) / 3).collect();
         let mut parallel = LightMap::default();
-        parallel.compute(&heights, w, h, CausticsLook::default());
+        parallel.compute(&heights, w, h, CausticsLook::default(), Simd::detect());
         // The top rows on their own (64 rows are below the parallel threshold).
         let rows = 64;
         let mut serial = LightMap::default();
-        serial.compute(&heights[..w * rows], w, rows, CausticsLook::default());
+        serial.compute(&heights[..w * rows], w, rows, CausticsLook::default(), Simd::detect());
         for y in 0..rows - 3 {
             assert_eq!(parallel.gains[y * w..(y + 1) * w], serial.gains[y * w..(y + 1) * w], "row {y}");
         }
@@ -402,10 +402,10 @@ mod tests {
             })
             .collect();
         let mut half = LightMap::default();
-        half.compute(&heights, w, h, CausticsLook::default());
+        half.compute(&heights, w, h, CausticsLook::default(), Simd::detect());
         assert_eq!((half.shift, half.width, half.height), (1, 512, 300));
         let mut full = LightMap::default();
-        full.compute(&heights[..w * 400], w, 400, CausticsLook::default()); // under the threshold
+        full.compute(&heights[..w * 400], w, 400, CausticsLook::default(), Simd::detect()); // under the threshold
         assert_eq!(full.shift, 0);
         let (mut both_bright, mut bright) = (0, 0);
         for y in (0..400).step_by(2) {

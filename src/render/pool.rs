@@ -22,7 +22,7 @@ pub use look::{PoolLook, Refraction, Sun};
 
 use super::caustics::{self, AMPLITUDE_PER_PIXEL, WATER_INDEX};
 use crate::sim::ripple::RipplePool;
-use crate::simd::Simd;
+use crate::simd::{Simd, Tier};
 
 /// Brightness change per unit of the two-cell slope stencil along the sun, in colour steps.
 const SHADE_PER_SLOPE: f32 = 1.77;
@@ -51,6 +51,8 @@ pub struct PoolRenderer {
     /// Where the refracted sunlight lands relative to the cell it crossed, in whole pixels.
     light_shift: (i32, i32),
     lighting: Lighting,
+    /// The instruction set the rows and the caustics run with.
+    simd: Simd,
 }
 
 /// The sun's light, prepared once per renderer.
@@ -165,7 +167,13 @@ impl PoolRenderer {
             light: caustics::LightMap::default(),
             light_shift,
             lighting,
+            simd: Simd::detect(),
         }
+    }
+
+    /// Draws with another instruction set this CPU runs (every one gives the same picture).
+    pub fn set_simd(&mut self, simd: Simd) {
+        self.simd = simd;
     }
 
     /// The look this renderer was made with.
@@ -184,7 +192,7 @@ impl PoolRenderer {
         assert_eq!((out.width() as usize, out.height() as usize), (w, h), "output size differs");
         let heights = pool.heights();
         if let Some(look) = self.look.caustics {
-            self.light.compute(heights, w, h, look);
+            self.light.compute(heights, w, h, look, self.simd);
         }
         let this = &*self;
         let bytes = out.data_mut();
@@ -203,12 +211,13 @@ impl PoolRenderer {
     /// Draws the rows starting at `first_row` into `out` (whole rows of RGBA bytes), with the
     /// widest instruction set this CPU has (see [`crate::simd`]).
     fn render_rows(&self, heights: &[i16], first_row: usize, out: &mut [u8]) {
-        match Simd::detect() {
-            // SAFETY: the variants are only returned after run-time detection of the feature.
+        match self.simd.tier() {
+            // SAFETY: a `Simd` of this tier exists only when run-time detection found the
+            // feature (see `crate::simd`).
             #[cfg(target_arch = "x86_64")]
-            Simd::Avx512 => unsafe { self.render_rows_avx512(heights, first_row, out) },
+            Tier::Avx512 => unsafe { self.render_rows_avx512(heights, first_row, out) },
             #[cfg(target_arch = "x86_64")]
-            Simd::Avx2 => unsafe { self.render_rows_avx2(heights, first_row, out) },
+            Tier::Avx2 => unsafe { self.render_rows_avx2(heights, first_row, out) },
             _ => self.render_rows_with(heights, first_row, out),
         }
     }

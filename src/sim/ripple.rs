@@ -28,6 +28,8 @@ mod stone;
 pub use damping::Damping;
 pub use stone::Stone;
 
+use crate::simd::Simd;
+
 /// The ripple pool's state: the current and previous amplitude of every cell.
 #[derive(Clone, Debug)]
 pub struct RipplePool {
@@ -42,6 +44,8 @@ pub struct RipplePool {
     damping: Damping,
     steps: u64,
     scratch: stepper::Scratch,
+    /// The instruction set the step runs with.
+    simd: Simd,
 }
 
 impl RipplePool {
@@ -58,6 +62,7 @@ impl RipplePool {
             damping,
             steps: 0,
             scratch: Default::default(),
+            simd: Simd::detect(),
         }
     }
 
@@ -94,6 +99,12 @@ impl RipplePool {
     /// Changes the damping from the next step on.
     pub fn set_damping(&mut self, damping: Damping) {
         self.damping = damping;
+    }
+
+    /// Runs the step with another instruction set this CPU runs (every one gives the same
+    /// water; the default is [`Simd::detect`]).
+    pub fn set_simd(&mut self, simd: Simd) {
+        self.simd = simd;
     }
 
     /// Stills the water (the step counter keeps counting).
@@ -154,6 +165,7 @@ impl RipplePool {
             self.damping,
             steps,
             &mut self.scratch,
+            self.simd,
         );
         self.steps += steps;
     }
@@ -199,21 +211,30 @@ mod tests {
         pool
     }
 
+    /// Every instruction set this CPU runs (portable, SSE4.1, AVX2, AVX-512), each against the
+    /// plain scalar rule, in one process: `Simd::detect` alone would test only the widest.
     #[test]
-    fn fast_paths_match_the_plain_rule_bit_for_bit() {
+    fn fast_paths_match_the_plain_rule_bit_for_bit_on_every_simd_tier() {
+        for simd in Simd::supported() {
+            fast_paths_match_the_plain_rule(simd);
+        }
+    }
+
+    fn fast_paths_match_the_plain_rule(simd: Simd) {
         for (w, h) in [(3, 3), (4, 7), (17, 5), (33, 40), (64, 64), (130, 97), (300, 520)] {
             for damping in
                 [Damping::OFF, Damping::from_shift(1).unwrap(), Damping::PAPERS, Damping::from_shift(15).unwrap()]
             {
                 let mut fast = rough_pool(w, h, damping, (w * h) as u64);
+                fast.set_simd(simd);
                 let mut slow = fast.clone();
                 for steps in [1u64, 2, 3, 16, 17, 40] {
                     fast.advance(steps);
                     for _ in 0..steps {
                         reference_step(&mut slow);
                     }
-                    assert_eq!(fast.heights(), slow.heights(), "{w}x{h} {damping:?} after {steps}");
-                    assert_eq!(fast.previous_heights(), slow.previous_heights(), "{w}x{h} {damping:?}");
+                    assert_eq!(fast.heights(), slow.heights(), "{simd} {w}x{h} {damping:?} after {steps}");
+                    assert_eq!(fast.previous_heights(), slow.previous_heights(), "{simd} {w}x{h} {damping:?}");
                     assert_eq!(fast.steps(), slow.steps());
                     fast.assert_row_max_holds();
                 }

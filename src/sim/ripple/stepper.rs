@@ -29,7 +29,7 @@
 //! which are guarded by run-time feature detection.
 
 use super::Damping;
-use crate::simd::Simd;
+use crate::simd::{Simd, Tier};
 
 /// The most steps computed in one wavefront sweep. With `k` steps about `k + 2` rows of each
 /// buffer are live per band, e.g. 144 KB for a 2048-wide pool at k = 16: it fits in L2.
@@ -67,6 +67,7 @@ pub fn advance(
     damping: Damping,
     steps: u64,
     scratch: &mut Scratch,
+    simd: Simd,
 ) {
     if width < 3 || height < 3 {
         // No interior: both buffers stay all zero; only the parity of the swap matters.
@@ -82,7 +83,7 @@ pub fn advance(
     let mut remaining = steps;
     while remaining > 0 {
         let block = remaining.min(MAX_BLOCK_STEPS as u64) as usize;
-        let plan = Plan { width, rows: height - 2, bands, block, damping, kernel: Kernel::detect() };
+        let plan = Plan { width, rows: height - 2, bands, block, damping, kernel: simd };
         plan.run((current, current_max), (previous, previous_max), scratch);
         if block % 2 == 1 {
             std::mem::swap(current, previous);
@@ -331,7 +332,7 @@ fn narrow_row<const DAMPED: bool>([up, mid, down]: [&[i16]; 3], out: &mut [i16],
 }
 
 /// The kernels, compiled once per instruction set (see [`crate::simd`]).
-pub type Kernel = Simd;
+type Kernel = Simd;
 
 /// Dispatch of the sweep and row kernels to their compiled variants.
 trait Kernels {
@@ -341,28 +342,29 @@ trait Kernels {
 
 impl Kernels for Simd {
     fn sweep(self, band: &mut Band<'_>, block: usize, damping: Damping) {
-        match self {
-            Kernel::Portable => band.sweep(block, damping),
-            // SAFETY: these variants are only constructed after run-time detection of the feature.
+        match self.tier() {
+            Tier::Portable => band.sweep(block, damping),
+            // SAFETY: a `Simd` of this tier exists only when run-time detection found the
+            // feature (see `crate::simd`).
             #[cfg(target_arch = "x86_64")]
-            Kernel::Sse41 => unsafe { sweep_sse41(band, block, damping) },
+            Tier::Sse41 => unsafe { sweep_sse41(band, block, damping) },
             #[cfg(target_arch = "x86_64")]
-            Kernel::Avx2 => unsafe { sweep_avx2(band, block, damping) },
+            Tier::Avx2 => unsafe { sweep_avx2(band, block, damping) },
             #[cfg(target_arch = "x86_64")]
-            Kernel::Avx512 => unsafe { sweep_avx512(band, block, damping) },
+            Tier::Avx512 => unsafe { sweep_avx512(band, block, damping) },
         }
     }
 
     fn row(self, rows: [&[i16]; 3], inputs: u16, old: u16, out: &mut [i16], damping: Damping) -> u16 {
-        match self {
-            Kernel::Portable => row_kernel(rows, inputs, old, out, damping),
+        match self.tier() {
+            Tier::Portable => row_kernel(rows, inputs, old, out, damping),
             // SAFETY: as above.
             #[cfg(target_arch = "x86_64")]
-            Kernel::Sse41 => unsafe { row_sse41(rows, inputs, old, out, damping) },
+            Tier::Sse41 => unsafe { row_sse41(rows, inputs, old, out, damping) },
             #[cfg(target_arch = "x86_64")]
-            Kernel::Avx2 => unsafe { row_avx2(rows, inputs, old, out, damping) },
+            Tier::Avx2 => unsafe { row_avx2(rows, inputs, old, out, damping) },
             #[cfg(target_arch = "x86_64")]
-            Kernel::Avx512 => unsafe { row_avx512(rows, inputs, old, out, damping) },
+            Tier::Avx512 => unsafe { row_avx512(rows, inputs, old, out, damping) },
         }
     }
 }

@@ -63,7 +63,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
     let budget = Duration::from_secs_f64(args.seconds.max(0.05));
     let threads = rayon::current_num_threads();
     println!(
-        "tidepool bench: {threads} threads, SIMD kernel {:?}, {:.1} s per workload",
+        "tidepool bench: {threads} threads, SIMD kernel {}, {:.1} s per workload",
         Simd::detect(),
         budget.as_secs_f64()
     );
