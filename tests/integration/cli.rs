@@ -209,17 +209,28 @@ fn failed_writes_keep_the_existing_file() {
 
 #[test]
 fn ctrl_c_exits_130_and_leaves_no_file() {
+    /// Kills the render if the test fails before it ends (it would run for hours).
+    struct KillOnDrop(std::process::Child);
+    impl Drop for KillOnDrop {
+        fn drop(&mut self) {
+            let _ = self.0.kill();
+            let _ = self.0.wait();
+        }
+    }
     let dir = scratch("ctrl_c");
-    let mut child = tidepool()
+    let child = tidepool()
         .current_dir(&dir)
         .args(["render", "pool", "--size", "512x512", "--steps", "100000000", "--out", "never.png"])
         .spawn()
         .unwrap();
-    std::thread::sleep(std::time::Duration::from_millis(300));
-    // SAFETY-free: send SIGINT through the kill command, as a terminal's Ctrl-C would.
-    let killed = std::process::Command::new("kill").args(["-INT", &child.id().to_string()]).status().unwrap();
+    let mut child = KillOnDrop(child);
+    // Ready when the process catches SIGINT (its handler is installed): before that, the
+    // default action would kill it with another status.
+    crate::common::wait_until_catches(child.0.id(), 2);
+    // Send SIGINT through the kill command, as a terminal's Ctrl-C would.
+    let killed = std::process::Command::new("kill").args(["-INT", &child.0.id().to_string()]).status().unwrap();
     assert!(killed.success());
-    let status = child.wait().unwrap();
+    let status = child.0.wait().unwrap();
     assert_eq!(status.code(), Some(130));
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 0, "no file, no temporary file");
 }

@@ -60,3 +60,22 @@ pub fn read_npy(bytes: &[u8]) -> (usize, usize, Vec<f32>) {
     let values = bytes[10 + header_len..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect();
     (dims[0], dims[1], values)
 }
+
+/// Waits until process `pid` catches `signal` (its bit in the `SigCgt` mask of
+/// `/proc/PID/status`): the readiness signal that its handler is installed.
+pub fn wait_until_catches(pid: u32, signal: u32) {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    loop {
+        let status = std::fs::read_to_string(format!("/proc/{pid}/status")).unwrap_or_default();
+        let caught = status
+            .lines()
+            .find_map(|l| l.strip_prefix("SigCgt:"))
+            .and_then(|mask| u64::from_str_radix(mask.trim(), 16).ok())
+            .is_some_and(|mask| mask & (1 << (signal - 1)) != 0);
+        if caught {
+            return;
+        }
+        assert!(std::time::Instant::now() < deadline, "process {pid} never caught signal {signal}");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+}

@@ -2,6 +2,7 @@
 
 use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
@@ -14,6 +15,8 @@ pub struct Player {
     pub master: Box<dyn MasterPty + Send>,
     writer: Box<dyn Write + Send>,
     output: Arc<Mutex<Vec<u8>>>,
+    /// The reader saw the end of the output (every end of the pty closed: the player exited).
+    drained: Arc<AtomicBool>,
     pub dir: PathBuf,
     pub cols: u16,
     pub rows: u16,
@@ -48,6 +51,8 @@ impl Player {
         let writer = pair.master.take_writer().unwrap();
         let output = Arc::new(Mutex::new(Vec::new()));
         let sink = Arc::clone(&output);
+        let drained = Arc::new(AtomicBool::new(false));
+        let done = Arc::clone(&drained);
         std::thread::spawn(move || {
             let mut buf = [0u8; 65536];
             while let Ok(n) = reader.read(&mut buf) {
@@ -56,8 +61,9 @@ impl Player {
                 }
                 sink.lock().unwrap().extend_from_slice(&buf[..n]);
             }
+            done.store(true, Ordering::SeqCst);
         });
-        Player { child, master: pair.master, writer, output, dir: dir.to_owned(), cols, rows }
+        Player { child, master: pair.master, writer, output, drained, dir: dir.to_owned(), cols, rows }
     }
 
     /// Types bytes into the terminal.
@@ -97,6 +103,19 @@ impl Player {
         s
     }
 
+    /// Waits until `ready` holds for the screen the output draws (polled; `what` names it in the
+    /// failure). A readiness signal, never an assertion on time: the bound is only for a hang.
+    pub fn wait_until(&self, what: &str, timeout: Duration, ready: impl Fn(&Screen) -> bool) {
+        let deadline = Instant::now() + timeout;
+        loop {
+            if ready(&self.screen()) {
+                return;
+            }
+            assert!(Instant::now() < deadline, "never {what} within {timeout:?}");
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
     /// Waits until the screen's last row contains `text`.
     pub fn wait_for_status(&self, text: &str, timeout: Duration) {
         let deadline = Instant::now() + timeout;
@@ -115,8 +134,12 @@ impl Player {
         let deadline = Instant::now() + timeout;
         loop {
             if let Some(status) = self.child.try_wait().unwrap() {
-                // Let the reader drain what is left.
-                std::thread::sleep(Duration::from_millis(100));
+                // The reader sees the end once the process and its pty ends are gone; the
+                // last bytes are collected by then. (Only a grandchild holding the pty would
+                // keep it open; then give up waiting at the deadline.)
+                while !self.drained.load(Ordering::SeqCst) && Instant::now() < deadline {
+                    std::thread::sleep(Duration::from_millis(5));
+                }
                 return status;
             }
             if Instant::now() > deadline {
