@@ -91,14 +91,22 @@ fn the_heightmap_of_a_10_m_s_sea_has_its_significant_height() {
     let want = 0.2413 * 100.0 / 9.81;
     // One patch of 8 x 8 peak wavelengths holds few independent waves: allow 20 %.
     assert!((hs / want - 1.0).abs() < 0.2, "Hs {hs:.3} m vs {want:.3} m");
-    // The PNG form is centimetres around 32768.
-    let out = run_in(&dir, &["render", "ocean", "--size", "64x32", "--heightmap", "h.png", "--extent", "500"]);
-    assert!(out.status.success(), "{}", stderr(&out));
+    // The PNG form is the same heights in centimetres around 32768: exactly the .npy of a run
+    // with the same flags, rounded.
+    let args = ["render", "ocean", "--size", "64x32", "--extent", "500", "--out", "o.png"];
+    for map in ["h.png", "h2.npy"] {
+        let out = run_in(&dir, &[&args[..], &["--heightmap", map]].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
     let png = image::open(dir.join("h.png")).unwrap();
     let grey = png.as_luma16().expect("16-bit grey");
     assert_eq!(grey.dimensions(), (64, 32));
-    assert!(grey.pixels().all(|p| (32768 - 800..32768 + 800).contains(&p.0[0])), "within ±8 m");
-    assert!(grey.pixels().any(|p| p.0[0] != 32768));
+    let (_, _, metres) = read_npy(&std::fs::read(dir.join("h2.npy")).unwrap());
+    for (p, m) in grey.pixels().zip(&metres) {
+        let want = ((m * 100.0).round() + 32768.0).clamp(0.0, 65535.0) as u16;
+        assert_eq!(p.0[0], want, "{m} m");
+    }
+    assert!(grey.pixels().any(|p| p.0[0] != 32768), "the sea is not flat");
 }
 
 #[test]
