@@ -303,9 +303,12 @@ mod tests {
                         assert_eq!(screen.pixel(x, 2 * y), top.rgb(), "top of ({x}, {y})");
                         assert_eq!(screen.pixel(x, 2 * y + 1), bottom.rgb(), "bottom of ({x}, {y})");
                     }
-                    Cell::Text { ch, bg, .. } => {
+                    Cell::Text { ch, fg, bg } => {
                         let c = screen.cell(x, y);
                         assert_eq!((c.ch, c.bg), (ch, bg.rgb()), "text at ({x}, {y})");
+                        if ch != ' ' {
+                            assert_eq!(c.fg, fg.rgb(), "the colour of {ch:?} at ({x}, {y})");
+                        }
                     }
                 }
             }
@@ -316,7 +319,7 @@ mod tests {
     fn a_sequence_of_frames_round_trips_through_the_terminal_model() {
         for mode in [ColorMode::TrueColor, ColorMode::Palette256, ColorMode::Palette16] {
             let (cols, rows) = (23, 9);
-            let mut screen = model(cols, rows + 1);
+            let mut screen = model(cols, rows);
             let mut shown = Shown::UNKNOWN;
             for t in 0..6u32 {
                 // Moving blobs over a gradient, with flat areas, so every glyph choice occurs.
@@ -488,7 +491,7 @@ mod tests {
                 }),
                 sync in any::<bool>(),
             ) {
-                let mut screen = model(cols, rows + 1);
+                let mut screen = model(cols, rows);
                 let mut shown = Shown::UNKNOWN;
                 for frame in &frames {
                     let (bytes, next) = encode(&shown, frame, EncodeOptions { threshold: 0, sync });
