@@ -33,16 +33,28 @@ cp ok.png keep.png; before=$(sha256sum keep.png)
 printf '{"tidepool_replay":1,"version":"0.1.0","scene":"pool","seed":1,"size":[64,48],"options":{"background":null,"caustics":true,"damping":"5","depth":24.0,"rain":0.0,"refraction":"auto","shading":true,"sun":"315,60"}}\n{"step":3,"stone":[10,10,3,48]}\n{"step":9,"en' > trunc.jsonl
 printf 'hello\n' > garbage.jsonl
 printf '{"tidepool_replay":2,"version":"0.9.0","scene":"pool","seed":1,"size":[64,48],"options":{}}\n{"step":9,"end":true}\n' > future.jsonl
+options='"options":{"background":null,"caustics":true,"damping":"5","depth":24.0,"rain":0.0,"refraction":"auto","shading":true,"sun":"315,60"}'
+printf '{"tidepool_replay":1,"scene":"pool","seed":1,"size":[60000,60000],%s}\n{"step":9,"end":true}\n' "$options" > huge.jsonl
+printf '{"tidepool_replay":1,"scene":"pool","seed":1,"size":[64,48],%s}\n{"step":18446744073709551615,"end":true}\n' "$options" > forever.jsonl
+python3 - "$options" <<'PY'
+import sys
+with open('crowded.jsonl', 'w') as f:
+    f.write('{"tidepool_replay":1,"scene":"pool","seed":1,"size":[64,48],%s}\n' % sys.argv[1])
+    f.writelines('{"step":%d,"clear":true}\n' % i for i in range(1_000_001))
+    f.write('{"step":1000001,"end":true}\n')
+PY
 
 row() {  # row "description" command...
-  local out code
+  local out code start end
   out=$("${@:2}" 2>&1 >/dev/null | head -1); code=${PIPESTATUS[0]}
+  start=$(date +%s.%N)
   "${@:2}" >/dev/null 2>/dev/null; code=$?
-  printf '| %s | `%s` | %s | %s |\n' "$1" "$(echo "${@:2}" | sed "s|$T|tidepool|")" "${out//|/\\|}" "$code"
+  end=$(date +%s.%N)
+  printf '| %s | `%s` | %s | %s | %.2f |\n' "$1" "$(echo "${@:2}" | sed "s|$T|tidepool|")" "${out//|/\\|}" "$code" "$(awk "BEGIN { print $end - $start }")"
 }
 {
-echo '| input | command | what tidepool printed (first line) | exit |'
-echo '|---|---|---|---|'
+echo '| input | command | what tidepool printed (first line) | exit | seconds |'
+echo '|---|---|---|---|---|'
 row "missing background" $T render pool --background missing.png --out o.png
 row "a directory" $T render pool --background adir --out o.png
 row "zero bytes" $T render pool --background empty.png --out o.png
@@ -93,6 +105,9 @@ row "replay truncated" $T render pool --replay trunc.jsonl --out o.png
 row "replay garbage" $T render pool --replay garbage.jsonl --out o.png
 row "replay from another version" $T render pool --replay future.jsonl --out o.png
 row "replay with --size" $T render pool --replay trunc.jsonl --size 10x10
+row "replay of 60000x60000 pixels" $T render pool --replay huge.jsonl --out o.png
+row "replay ending at step 2^64-1" $T render pool --replay forever.jsonl --out o.png
+row "replay of 1,000,002 events" $T render pool --replay crowded.jsonl --out o.png
 row "player, stdout not a terminal" $T play
 row "unknown scene" $T play river
 row "ocean --extent without --heightmap" $T render ocean --extent 100

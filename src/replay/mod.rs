@@ -345,7 +345,16 @@ fn check_size(name: &str, value: &Value, limits: &Limits) -> Result<(), String> 
     let pair = value.as_array().filter(|a| a.len() == 2).ok_or_else(shape)?;
     let side = |v: &Value| v.as_i64().ok_or_else(shape);
     let (w, h) = (side(&pair[0])?, side(&pair[1])?);
-    let size = Size::new(w, h).map_err(|e| format!("\"{name}\" is {w}x{h}: {e}"))?;
+    if w < 1 || h < 1 {
+        return Err(shape());
+    }
+    let size = Size::new(w, h).map_err(|_| {
+        format!(
+            "\"{name}\" is {w}x{h}, over the picture limits ({} pixels a side, {} megapixels); the file is damaged or not a tidepool replay",
+            crate::size::MAX_SIDE,
+            crate::size::MAX_PIXELS >> 20
+        )
+    })?;
     if size.pixels() > limits.max_pixels {
         return Err(format!(
             "\"{name}\" is {size}, over the limit of {} pixels for a replay; the file is damaged or not a tidepool replay",
