@@ -5,4 +5,5 @@
 pub use crate::term::player::{
     DEFAULT_STONE_RADIUS, PlayerConfig, STONE_RADII, TEST_PANIC_VAR, TerminalInput, picture_size, run,
 };
+pub use crate::term::screen::{FrameBuilder, Overlay};
 pub use crate::term::tty::{ENTER, RESTORE, play, restore};
