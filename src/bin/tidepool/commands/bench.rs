@@ -140,7 +140,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
         let mut sent = 0usize;
         let median = median_time(budget, || {
             k = k.wrapping_add(1);
-            if k % 30 == 0 {
+            if k.is_multiple_of(30) {
                 // A stone a second, as a player drops them.
                 let (x, y) = ((k * 7919 % w) as i32, (k * 104729 % h) as i32);
                 scene.apply(&tidepool::Event::Stone(Stone::clamped(x, y, 3, 48)));
