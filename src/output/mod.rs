@@ -7,6 +7,7 @@ pub mod cursor;
 pub mod diff;
 pub mod frame;
 pub mod gif;
+pub mod graphics;
 pub mod halfblock;
 pub mod heightmap;
 pub mod png;
