@@ -19,7 +19,7 @@
 pub mod kitty;
 pub mod kitty_decode;
 pub mod kitty_placeholder;
-// pub mod sixel;
+pub mod sixel;
 pub mod tmux;
 
 use tiny_skia::Pixmap;
