@@ -14,8 +14,8 @@
 //! How the player is meant to drive these is in `INTEGRATION-graphics.md` at the repository's
 //! root; detection lives in [`crate::term::probe`].
 
-// pub mod geometry;
-// pub mod iterm2;
+pub mod geometry;
+pub mod iterm2;
 pub mod kitty;
 pub mod kitty_decode;
 pub mod kitty_placeholder;
