@@ -7,6 +7,8 @@ pub mod app;
 pub mod guard;
 pub mod input;
 pub mod pacing;
+pub mod probe;
+pub mod replies;
 pub mod screen;
 pub mod ui;
 pub mod writer;
