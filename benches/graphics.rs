@@ -3,14 +3,17 @@
 //! - `graphics/render_pool_1280x752`: the pool scene rendering one frame (the baseline every
 //!   protocol pays before encoding);
 //! - `graphics/sixel_full_1280x750`: dither + encode a whole sixel picture (a start, a resize);
+//! - `graphics/sixel_dither_1280x750`: the dither alone (part of both sixel figures);
 //! - `graphics/sixel_next_1280x750`: the next frame after two simulation steps (dither, find the
 //!   changed cells, encode them);
 //! - `graphics/kitty_direct_1280x752`: zlib level 1 + base64 chunks of a whole frame;
+//! - `graphics/kitty_direct_640x376`: the same at half the resolution (the terminal scales it
+//!   to the same cells): what a remote or busy player falls back to;
 //! - `graphics/kitty_tempfile_1280x752`: a whole frame through a file in /dev/shm (raw RGB);
 //! - `graphics/iterm2_png_1280x752`: PNG + base64 of a whole frame;
 //! - `graphics/rgb_1280x752`: the pixmap -> RGB copy kitty needs first.
 //!
-//! The bytes each frame takes are printed before the timings.
+//! The bytes each frame takes, and zlib levels 1 and 6 compared, are printed before the timings.
 //!
 //!     cargo bench --bench graphics
 //!
@@ -91,6 +94,20 @@ fn graphics(c: &mut Criterion) {
     it.encode(&ka, &mut out);
     println!("iterm2 {kw}x{kh}: whole frame {} bytes", out.len());
 
+    {
+        for level in [1, 6] {
+            let mut best = std::time::Duration::MAX;
+            let mut size = 0;
+            for _ in 0..5 {
+                let t = std::time::Instant::now();
+                let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::new(level));
+                std::io::Write::write_all(&mut z, &kb_rgb).unwrap();
+                size = z.finish().unwrap().len();
+                best = best.min(t.elapsed());
+            }
+            println!("zlib level {level} of {} RGB bytes: {size} bytes, best of 5 {best:?}", kb_rgb.len());
+        }
+    }
     let mut group = c.benchmark_group("graphics");
     group.sample_size(20);
     group.bench_function("render_pool_1280x752", |b| {
@@ -113,6 +130,11 @@ fn graphics(c: &mut Criterion) {
             enc.encode(black_box(&sa), sw, sh, &mut out)
         })
     });
+    group.bench_function("sixel_dither_1280x750", |b| {
+        let enc = SixelEncoder::new(palette.clone(), (0, 0), Some(CELL_PX));
+        let mut idx = Vec::new();
+        b.iter(|| enc.dither_into(black_box(&sa), sw, sh, &mut idx))
+    });
     group.bench_function("sixel_next_1280x750", |b| {
         let mut enc = SixelEncoder::new(palette.clone(), (0, 0), Some(CELL_PX));
         let mut flip = false;
@@ -128,6 +150,20 @@ fn graphics(c: &mut Criterion) {
             out.clear();
             enc.invalidate();
             enc.encode(black_box(&kb_rgb), kw, kh, &mut out).unwrap()
+        })
+    });
+    let half = (kw / 2, kh / 2);
+    let (small, _) = frames(half.0, half.1);
+    let small = rgb(&small);
+    out.clear();
+    KittyEncoder::new(KittyOptions::new(kitty.cells)).encode(&small, half.0, half.1, &mut out).unwrap();
+    println!("kitty direct {}x{}: whole frame {} bytes", half.0, half.1, out.len());
+    group.bench_function("kitty_direct_640x376", |b| {
+        let mut enc = KittyEncoder::new(KittyOptions::new(kitty.cells));
+        b.iter(|| {
+            out.clear();
+            enc.invalidate();
+            enc.encode(black_box(&small), half.0, half.1, &mut out).unwrap()
         })
     });
     group.bench_function("kitty_tempfile_1280x752", |b| {
@@ -156,7 +192,7 @@ fn graphics(c: &mut Criterion) {
 /// The file a `t=t` command names (its payload is the base64 path).
 fn temp_path(command: &[u8]) -> std::path::PathBuf {
     use base64::Engine;
-    let start = command.iter().position(|&b| b == b';').unwrap() + 1;
+    let start = command.windows(4).position(|w| w == b"t=t;").unwrap() + 4;
     let end = command.len() - 2;
     let path = base64::engine::general_purpose::STANDARD.decode(&command[start..end]).unwrap();
     std::path::PathBuf::from(String::from_utf8(path).unwrap())

@@ -55,13 +55,17 @@ impl GraphicsMode {
 /// Appends the pixmap's pixels as straight (un-premultiplied) RGB, 3 bytes a pixel, row-major.
 /// Alpha is dropped: the player's pictures are opaque.
 pub fn push_rgb(pixmap: &Pixmap, out: &mut Vec<u8>) {
-    out.reserve(pixmap.pixels().len() * 3);
-    for p in pixmap.pixels() {
-        if p.alpha() == 255 {
-            out.extend_from_slice(&[p.red(), p.green(), p.blue()]);
+    let start = out.len();
+    out.resize(start + pixmap.pixels().len() * 3, 0);
+    // Premultiplied and straight colour agree where alpha is 255 (every pixel of a rendered
+    // scene): copy those bytes as they are, and demultiply only the others.
+    for (p, to) in pixmap.data().chunks_exact(4).zip(out[start..].chunks_exact_mut(3)) {
+        if p[3] == 255 {
+            to.copy_from_slice(&p[..3]);
         } else {
-            let c = p.demultiply();
-            out.extend_from_slice(&[c.red(), c.green(), c.blue()]);
+            let c = tiny_skia::PremultipliedColorU8::from_rgba(p[0], p[1], p[2], p[3])
+                .map_or(tiny_skia::ColorU8::from_rgba(0, 0, 0, 0), |c| c.demultiply());
+            to.copy_from_slice(&[c.red(), c.green(), c.blue()]);
         }
     }
 }

@@ -22,8 +22,9 @@
 //! leaves pixels no colour covers as they are. The picture is cut into bands of six rows; in
 //! each band every colour used gets one pass (`#n`, then its sixels from its first to its last
 //! column, `$` back to the band's start), runs of four or more equal sixels are `!n`. Colours
-//! and columns are collected per band in one pass over the band's pixels, so the cost grows with
-//! the pixels, not with pixels x colours.
+//! and columns are collected per band in one pass over the band's pixels (each column's at most
+//! six registers and their bits, appended to each register's list), so the cost grows with the
+//! pixels, not with pixels x colours, and nothing of palette x width size is touched.
 //!
 //! **Changed rectangles.** Only the text rows and columns whose dithered pixels changed are sent,
 //! as a smaller sixel image placed at the top-left cell of that block (a sixel image is drawn
@@ -180,9 +181,9 @@ pub struct SixelEncoder {
     /// register per pixel).
     current: Vec<u8>,
     shown: Option<(u32, u32, Vec<u8>)>,
-    /// Per band: for each register, the columns it covers (ascending) and their sixel bits.
-    columns: Vec<Vec<u16>>,
-    bits: Vec<u8>,
+    /// Per band: for each register, the columns it covers (ascending) with their sixel bits,
+    /// as `column << 8 | bits`; and the registers used.
+    columns: Vec<Vec<u32>>,
     used: Vec<u8>,
 }
 
@@ -200,7 +201,6 @@ impl SixelEncoder {
             current: Vec::new(),
             shown: None,
             columns: vec![Vec::new(); n],
-            bits: Vec::new(),
             used: Vec::new(),
         }
     }
@@ -277,22 +277,33 @@ impl SixelEncoder {
             out.extend_from_slice(format!("#{i};2;{r};{g};{b}").as_bytes());
         }
         let (w, stride) = (w as usize, stride as usize);
-        self.bits.clear();
-        self.bits.resize(w * self.palette.len(), 0);
         for band in (0..h as usize).step_by(6) {
             self.used.clear();
+            let rows: Vec<&[u8]> = (0..6.min(h as usize - band))
+                .map(|dy| {
+                    let start = (y0 as usize + band + dy) * stride + x0 as usize;
+                    &pixels[start..start + w]
+                })
+                .collect();
             for x in 0..w {
-                for dy in 0..6.min(h as usize - band) {
-                    let c = pixels[(y0 as usize + band + dy) * stride + x0 as usize + x];
-                    let cell = &mut self.bits[usize::from(c) * w + x];
-                    if *cell == 0 {
-                        let cols = &mut self.columns[usize::from(c)];
-                        if cols.is_empty() {
-                            self.used.push(c);
+                // The (at most six) registers of this column and their sixel bits.
+                let (mut regs, mut bits, mut n) = ([0u8; 6], [0u8; 6], 0);
+                for (dy, row) in rows.iter().enumerate() {
+                    let c = row[x];
+                    match regs[..n].iter().position(|&r| r == c) {
+                        Some(k) => bits[k] |= 1 << dy,
+                        None => {
+                            (regs[n], bits[n]) = (c, 1 << dy);
+                            n += 1;
                         }
-                        cols.push(x as u16);
                     }
-                    *cell |= 1 << dy;
+                }
+                for k in 0..n {
+                    let cols = &mut self.columns[usize::from(regs[k])];
+                    if cols.is_empty() {
+                        self.used.push(regs[k]);
+                    }
+                    cols.push((x as u32) << 8 | u32::from(bits[k]));
                 }
             }
             self.used.sort_unstable();
@@ -302,9 +313,8 @@ impl SixelEncoder {
                 }
                 out.push(b'#');
                 push_decimal(out, usize::from(c));
-                let bits = &mut self.bits[usize::from(c) * w..(usize::from(c) + 1) * w];
                 let cols = &mut self.columns[usize::from(c)];
-                push_colour_pass(out, bits, cols);
+                push_colour_pass(out, cols);
                 cols.clear();
             }
             out.push(b'-');
@@ -313,23 +323,19 @@ impl SixelEncoder {
     }
 }
 
-/// Appends one colour's pass over a band: empty sixels (`?`) up to each covered column, runs of
-/// equal sixels as `!n`. Clears the bits it used.
-fn push_colour_pass(out: &mut Vec<u8>, bits: &mut [u8], cols: &[u16]) {
+/// Appends one colour's pass over a band from its covered columns (`column << 8 | sixel bits`,
+/// ascending): empty sixels (`?`) up to each covered column, runs of equal sixels as `!n`.
+fn push_colour_pass(out: &mut Vec<u8>, cols: &[u32]) {
     let mut next = 0usize; // the column the pass has reached
     let mut i = 0;
     while i < cols.len() {
-        let x = usize::from(cols[i]);
+        let (x, sixel) = ((cols[i] >> 8) as usize, cols[i] as u8);
         push_run(out, b'?', x - next);
-        let sixel = bits[x];
         let mut run = 1;
-        while i + run < cols.len() && usize::from(cols[i + run]) == x + run && bits[x + run] == sixel {
+        while i + run < cols.len() && cols[i + run] == cols[i] + ((run as u32) << 8) {
             run += 1;
         }
         push_run(out, 63 + sixel, run);
-        for b in &mut bits[x..x + run] {
-            *b = 0;
-        }
         next = x + run;
         i += run;
     }
