@@ -125,7 +125,7 @@ fn changed_rect_finds_the_exact_box() {
     let mut b = a.clone();
     b[(3 * 5 + 4) * 3 + 1] = 1; // (4, 3)
     assert_eq!(changed_rect(&a, &b, w, h), Some((4, 3, 1, 1)));
-    b[(1 * 5 + 0) * 3] = 1; // (0, 1)
+    b[5 * 3] = 1; // (0, 1)
     assert_eq!(changed_rect(&a, &b, w, h), Some((0, 1, 5, 3)));
 }
 
