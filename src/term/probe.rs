@@ -11,6 +11,9 @@
 //! - a root-frame edit of a scratch image (then deleted): an `OK` means changed rectangles can
 //!   be sent as frame edits (kitty); terminals without the animation part answer with an error
 //!   or not at all;
+//! - a virtual placement (`a=p,U=1`) of another scratch image (then deleted): an `OK` means
+//!   Unicode placeholders work (kitty 0.28+); kitty 0.26 (Debian 12's) rejects the unknown key
+//!   without a word, checked under Xvfb, while it answers `OK` to the same put without `U=1`;
 //! - XTSMGRAPHICS: colour registers (`CSI ? 1 ; 1 ; 0 S`) and the largest sixel image
 //!   (`CSI ? 2 ; 1 ; 0 S`);
 //! - `CSI 16 t` (cell size) and `CSI 14 t` (text area size), for when TIOCGWINSZ has no pixels;
@@ -57,10 +60,15 @@ pub const KITTY_QUERY_ID: u32 = 31;
 pub const KITTY_FILE_QUERY_ID: u32 = kitty::IMAGE_ID + 1;
 /// The id of the scratch image the frame-edit test edits (deleted at once).
 pub const KITTY_EDIT_PROBE_ID: u32 = kitty::IMAGE_ID + 2;
+/// The id of the scratch image the Unicode-placeholder test places virtually (deleted at once).
+pub const KITTY_PLACEHOLDER_PROBE_ID: u32 = kitty::IMAGE_ID + 3;
 /// The most bytes the probe keeps (replies and leftover keys) before it gives up.
 pub const MAX_PROBE_BYTES: usize = 64 * 1024;
 /// What the status line says in tmux when passthrough is off.
 pub const TMUX_HINT: &str = "tmux hides pictures: `set -g allow-passthrough on` for kitty graphics";
+/// What the status line says in tmux when the outer terminal speaks kitty graphics but has no
+/// Unicode placeholders, which images inside tmux need.
+pub const PLACEHOLDER_HINT: &str = "pictures inside tmux need kitty 0.28+ (Unicode placeholders)";
 /// A 1x1 black RGB pixel, base64.
 const ONE_PIXEL: &str = "AAAA";
 
@@ -162,6 +170,8 @@ pub struct GraphicsSupport {
     pub kitty_temp_file: bool,
     /// kitty root-frame edits work (changed rectangles).
     pub kitty_frame_edits: bool,
+    /// kitty Unicode placeholders work (needed inside tmux).
+    pub kitty_placeholders: bool,
     /// Sixel (DA1 attribute 4).
     pub sixel: Option<SixelSupport>,
     /// iTerm2 inline images.
@@ -185,10 +195,11 @@ pub fn queries(options: &ProbeOptions) -> Vec<u8> {
     if let Some(path) = options.kitty_file.as_deref().filter(|_| !options.env.ssh) {
         kitty_queries.extend_from_slice(file_query(path).as_bytes());
     }
-    let edit = KITTY_EDIT_PROBE_ID;
+    let (edit, virt) = (KITTY_EDIT_PROBE_ID, KITTY_PLACEHOLDER_PROBE_ID);
     kitty_queries.extend_from_slice(
         format!(
-            "\x1b_Ga=t,i={edit},s=1,v=1,f=24,q=1;{ONE_PIXEL}\x1b\\\x1b_Ga=f,r=1,i={edit},s=1,v=1,f=24,X=1;{ONE_PIXEL}\x1b\\\x1b_Ga=d,d=I,i={edit},q=2\x1b\\"
+            "\x1b_Ga=t,i={edit},s=1,v=1,f=24,q=1;{ONE_PIXEL}\x1b\\\x1b_Ga=f,r=1,i={edit},s=1,v=1,f=24,X=1;{ONE_PIXEL}\x1b\\\x1b_Ga=d,d=I,i={edit},q=2\x1b\\\
+             \x1b_Ga=t,i={virt},s=1,v=1,f=24,q=1;{ONE_PIXEL}\x1b\\\x1b_Ga=p,U=1,i={virt},c=1,r=1\x1b\\\x1b_Ga=d,d=I,i={virt},q=2\x1b\\"
         )
         .as_bytes(),
     );
@@ -322,6 +333,7 @@ impl Probe {
                     KITTY_QUERY_ID => support.kitty = true,
                     KITTY_FILE_QUERY_ID => support.kitty_temp_file = true,
                     KITTY_EDIT_PROBE_ID => support.kitty_frame_edits = true,
+                    KITTY_PLACEHOLDER_PROBE_ID => support.kitty_placeholders = true,
                     _ => {}
                 },
                 Reply::PrimaryAttributes(attrs) => {
@@ -440,8 +452,8 @@ pub fn should_probe(stdin_is_tty: bool, stdout_is_tty: bool) -> bool {
 
 /// The mode for `request` given what the probe found (`None`: no probe was made). `auto`
 /// prefers kitty (exact colours, scaled by the terminal, changed rectangles), then sixel, then
-/// iTerm2 (a whole PNG every frame), then cells. Inside tmux kitty needs passthrough and uses
-/// placeholders, sixel is used only when tmux draws it itself, and iTerm2 is not used (its
+/// iTerm2 (a whole PNG every frame), then cells. Inside tmux kitty needs passthrough and
+/// Unicode placeholders (the probe tests both), sixel is used only when tmux draws it itself, and iTerm2 is not used (its
 /// images are not placed through tmux). A forced mode is used as asked, wrapped for tmux when
 /// inside it.
 pub fn choose(request: GraphicsRequest, support: Option<&GraphicsSupport>) -> GraphicsChoice {
@@ -466,14 +478,15 @@ pub fn choose(request: GraphicsRequest, support: Option<&GraphicsSupport>) -> Gr
             GraphicsChoice { mode, tmux_wrap: false, kitty_placeholders: false, hint: None }
         }
         GraphicsRequest::Auto if !s.answered => cells(None),
-        GraphicsRequest::Auto if s.kitty && (!s.tmux || s.tmux_passthrough) => kitty,
+        GraphicsRequest::Auto if s.kitty && (!s.tmux || s.kitty_placeholders) => kitty,
         GraphicsRequest::Auto if s.sixel.is_some() => {
             GraphicsChoice { mode: GraphicsMode::Sixel, tmux_wrap: false, kitty_placeholders: false, hint: None }
         }
         GraphicsRequest::Auto if s.iterm2 && !s.tmux => {
             GraphicsChoice { mode: GraphicsMode::Iterm2, tmux_wrap: false, kitty_placeholders: false, hint: None }
         }
-        GraphicsRequest::Auto => cells((s.tmux && !s.tmux_passthrough).then_some(TMUX_HINT)),
+        GraphicsRequest::Auto if s.tmux && !s.tmux_passthrough => cells(Some(TMUX_HINT)),
+        GraphicsRequest::Auto => cells((s.tmux && s.kitty).then_some(PLACEHOLDER_HINT)),
     }
 }
 

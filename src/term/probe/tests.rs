@@ -161,15 +161,37 @@ fn keys_typed_during_the_probe_are_kept() {
 #[test]
 fn tmux_with_passthrough_gets_kitty_through_placeholders() {
     let mut outer = KITTY_OK.to_vec();
+    outer.extend_from_slice(format!("\x1b_Gi={KITTY_PLACEHOLDER_PROBE_ID};OK\x1b\\").as_bytes());
     outer.extend_from_slice(b"\x1b[6;16;8t\x1b[?62;22;52c");
     let run = FakeTerminal::new(&[(1, b"\x1b[?2026;2$y\x1b[?1;2c"), (20, &outer)]).run(&options(true));
     let s = &run.outcome.support;
-    assert!(s.answered && s.tmux && s.tmux_passthrough && s.kitty, "{s:?}");
+    assert!(s.answered && s.tmux && s.tmux_passthrough && s.kitty && s.kitty_placeholders, "{s:?}");
     assert_eq!((s.sixel, s.cell_px, s.sgr_pixels_mouse), (None, Some((8, 16)), false));
     assert_eq!(run.took, 20 * MS, "done at the outer terminal's DA1");
     assert_eq!(
         choose(GraphicsRequest::Auto, Some(s)),
         GraphicsChoice { mode: GraphicsMode::Kitty, tmux_wrap: true, kitty_placeholders: true, hint: None }
+    );
+    // kitty without placeholders (0.26, silent on `U=1`): cells and a hint, even with
+    // passthrough.
+    let run_old = FakeTerminal::new(&[(1, b"\x1b[?1;2c"), (20, b"\x1b_Gi=31;OK\x1b\\\x1b[?62;c")]).run(&options(true));
+    let old = &run_old.outcome.support;
+    assert!(old.kitty && old.tmux_passthrough && !old.kitty_placeholders);
+    assert_eq!(
+        choose(GraphicsRequest::Auto, Some(old)),
+        GraphicsChoice {
+            mode: GraphicsMode::Cells,
+            tmux_wrap: false,
+            kitty_placeholders: false,
+            hint: Some(PLACEHOLDER_HINT)
+        }
+    );
+    // Passthrough shown by the outer terminal's DA1 alone (xterm in tmux): no hint, cells.
+    let xterm = FakeTerminal::new(&[(1, b"\x1b[?1;2c"), (5, XTERM_DA1)]).run(&options(true)).outcome.support;
+    assert!(xterm.tmux_passthrough && !xterm.kitty && xterm.sixel.is_none(), "tmux's own DA1 decides sixel");
+    assert_eq!(
+        choose(GraphicsRequest::Auto, Some(&xterm)),
+        GraphicsChoice { mode: GraphicsMode::Cells, tmux_wrap: false, kitty_placeholders: false, hint: None }
     );
     // What went out: tmux's own queries plain, DA1 among them before anything wrapped; the
     // kitty query wrapped.
@@ -266,8 +288,9 @@ fn queries_end_with_da1_and_carry_every_question() {
     // The frame-edit test edits and deletes its scratch image.
     let state = kitty_decode::decode(&q).unwrap();
     let actions: Vec<&str> = state.commands.iter().map(|k| k.get(&'a').map_or("t", String::as_str)).collect();
-    assert_eq!(actions, ["q", "t", "f", "d"]);
-    assert!(state.images.is_empty() || !state.images.contains_key(&KITTY_EDIT_PROBE_ID));
+    assert_eq!(actions, ["q", "t", "f", "d", "t", "p", "d"]);
+    assert!(state.images.is_empty(), "the scratch images are deleted");
+    assert!(state.commands[5].get(&'U').is_some_and(|u| u == "1") && !state.commands[5].contains_key(&'q'), "answered");
 }
 
 #[test]
