@@ -8,7 +8,7 @@
 //! `graphics_demo.txt`), draws the picture over every row but the last (the status line says
 //! which mode), waits half of `SECONDS` (default 4), paints a red square into the picture and
 //! sends only that change (a kitty frame edit or a sixel cell block where the terminal allows),
-//! writes the picture it meant to show to `REPORT.png`, waits the other half and restores the
+//! writes the picture the terminal should show to `REPORT.png` (for sixel the dithered one), waits the other half and restores the
 //! terminal (kitty's image deleted). The reply reader is a thread reading stdin into a channel,
 //! so the deadline needs no `poll`.
 
@@ -19,7 +19,7 @@ use std::time::{Duration, Instant};
 use tidepool::output::graphics::geometry::{SCALED_CAP, layout};
 use tidepool::output::graphics::iterm2::Iterm2Encoder;
 use tidepool::output::graphics::kitty::{self, KittyEncoder, KittyOptions, Medium};
-use tidepool::output::graphics::sixel::{SixelEncoder, SixelPalette};
+use tidepool::output::graphics::sixel::{SixelEncoder, SixelPalette, dithered_rgb};
 use tidepool::output::graphics::{GraphicsMode, push_rgb};
 use tidepool::term::probe::{self, Environment, GraphicsRequest, ProbeOptions, WinSize};
 use tiny_skia::{Color, FilterQuality, Pixmap, PixmapPaint, Rect, Transform};
@@ -177,7 +177,19 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
     let mut out = Vec::new();
     draw(&picture, &mut out, &mut text)?;
     write(&out)?;
-    std::fs::write(format!("{report}.png"), tidepool::output::png::encode(&picture))?;
+    // What the terminal should show: the picture, or for sixel the dithered picture.
+    let expected = if choice.mode == GraphicsMode::Sixel {
+        let mut rgb = Vec::new();
+        push_rgb(&picture, &mut rgb);
+        let shown = dithered_rgb(sixel_enc.palette(), &rgb, picture.width(), picture.height());
+        let image = image::RgbImage::from_raw(picture.width(), picture.height(), shown).expect("RGB of the size");
+        let mut png = Vec::new();
+        image.write_to(&mut io::Cursor::new(&mut png), image::ImageFormat::Png).map_err(io::Error::other)?;
+        png
+    } else {
+        tidepool::output::png::encode(&picture)
+    };
+    std::fs::write(format!("{report}.png"), expected)?;
     std::thread::sleep(Duration::from_secs_f64(seconds / 2.0));
 
     let mut restore = Vec::new();

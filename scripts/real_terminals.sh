@@ -13,9 +13,11 @@
 # Each run probes, draws the pool's golden picture over every row but the last, then paints a
 # red square and sends only that change; the screenshot (`import -window root`) is taken after
 # the change. The picture's region of the screenshot is compared with the picture the demo meant
-# to show (REPORT.png, scaled to the region the terminal drew it in) by ImageMagick's normalized
-# RMSE; a run passes at RMSE <= $TOLERANCE (sixel's ordered dither and the terminals' scaling
-# differ from ImageMagick's by a few percent; a missing or misplaced picture is > 0.2).
+# to show (REPORT.png: the picture, for sixel its dithered version; scaled to the region the
+# terminal drew it in when the terminal scales) by ImageMagick's normalized RMSE. kitty and sixel
+# pass at RMSE <= $EXACT (they are pixel-exact when the picture is not scaled: measured 0);
+# half-block cells at <= $TOLERANCE (two pixels a cell against the full picture: measured
+# 0.04-0.07; a missing or misplaced picture measures > 0.2).
 #
 # STATUS: the player (`tidepool play --graphics ...`) is not wired yet (issue 12 is reshaping
 # it; see INTEGRATION-graphics.md). Once it is, the same runs should start `tidepool play`
@@ -24,6 +26,7 @@
 set -u
 OUT=${1:-target/real_terminals}
 TOLERANCE=${TOLERANCE:-0.08}
+EXACT=${EXACT:-0.01}
 mkdir -p "$OUT"
 OUT=$(cd "$OUT" && pwd)
 
@@ -37,6 +40,13 @@ if [ ${#need[@]} -gt 0 ]; then
 fi
 
 cargo build --example graphics_demo || exit 2
+# How long each demo shows its picture, in seconds.
+SECONDS_SHOWN=10
+# The player waits 150 ms for the terminal's answers. Terminals started under Xvfb with
+# software OpenGL on a shared machine answer their first query late (kitty took 150-160 ms at
+# its window's start here, 20-60 ms after), so the demo waits longer; each report records how
+# long the answers really took ("probe took").
+export GRAPHICS_DEMO_BUDGET_MS=${GRAPHICS_DEMO_BUDGET_MS:-1000}
 DEMO=$(pwd)/target/debug/examples/graphics_demo
 
 export DISPLAY=${DISPLAY_NUMBER:-:77}
@@ -66,7 +76,9 @@ run() {
   rm -f "$report" "$report.png"
   "$@" &
   local pid=$!
-  sleep 9
+  # The demo draws at once, changes the picture after SECONDS/2 and ends after SECONDS: the
+  # screenshot is taken between the change and the end.
+  sleep "$SECONDS_SHOWN"
   import -window root "$OUT/$name-screen.png"
   wait $pid 2>/dev/null
   if [ ! -f "$report" ]; then
@@ -77,28 +89,36 @@ run() {
   mode=$(sed -n 's/^ *mode: \([A-Za-z0-9]*\),$/\1/p' "$report" | tail -1)
   read -r sw sh < <(awk '/shown_px/{getline a; getline b; gsub(/[ ,]/,"",a); gsub(/[ ,]/,"",b); print a, b}' "$report")
   read -r cw ch < <(awk '/cell_px: \(/{getline a; getline b; gsub(/[ ,]/,"",a); gsub(/[ ,]/,"",b); print a, b}' "$report" | tail -1)
-  # The text area's top-left in the screenshot: xterm has a 2-pixel border; kitty centres the
-  # cell grid in its 960x640 window.
-  local x0=2 y0=2
+  # The text area's top-left in the screenshot: xterm's starts at (3, 3) (its window border and
+  # 2-pixel internal border; the offset where its sixel matches best); kitty centres the cell
+  # grid in its 960x640 window.
+  local x0=3 y0=3
   if [[ $name == kitty* ]]; then
     x0=$(( (960 % cw) / 2 ))
     y0=$(( (640 % ch) / 2 ))
   fi
   convert "$OUT/$name-screen.png" -crop "${sw}x${sh}+${x0}+${y0}" +repage "$OUT/$name-region.png"
   convert "$report.png" -resize "${sw}x${sh}!" "$OUT/$name-expected.png"
-  local rmse
-  rmse=$(compare -metric RMSE "$OUT/$name-region.png" "$OUT/$name-expected.png" null: 2>&1 | sed -n 's/.*(\(.*\))/\1/p')
-  local verdict=FAIL
-  awk -v r="$rmse" -v t="$TOLERANCE" 'BEGIN{exit !(r <= t)}' && verdict=ok
+  local rmse verdict=FAIL
+  rmse=$(compare -metric RMSE "$OUT/$name-region.png" "$OUT/$name-expected.png" null: 2>&1 | sed -n 's/^[0-9.e+-]* (\([0-9.e+-]*\))$/\1/p')
+  if [ -z "$rmse" ]; then
+    rmse="(compare failed)"
+  elif awk -v r="$rmse" -v t="$([ "$mode" = Cells ] && echo "$TOLERANCE" || echo "$EXACT")" 'BEGIN{exit !(r <= t)}'; then
+    verdict=ok
+  fi
   printf '%-16s mode %-6s region %sx%s+%s+%s  RMSE %s  %s\n' "$name" "$mode" "$sw" "$sh" "$x0" "$y0" "$rmse" "$verdict" \
     | tee -a "$OUT/summary.txt"
 }
 
 : >"$OUT/summary.txt"
-run kitty "${KITTY[@]}" "$DEMO" auto "$OUT/kitty.txt" 8
-run kitty-direct "${KITTY[@]}" env SSH_TTY=/dev/pts/fake "$DEMO" auto "$OUT/kitty-direct.txt" 8
-run xterm "${XTERM[@]}" -e "$DEMO" auto "$OUT/xterm.txt" 8
-run kitty-tmux-on "${KITTY[@]}" tmux -L tp-on -f "$OUT/tmux-on.conf" new-session "$DEMO auto $OUT/kitty-tmux-on.txt 8"
-run kitty-tmux-off "${KITTY[@]}" tmux -L tp-off -f "$OUT/tmux-off.conf" new-session "$DEMO auto $OUT/kitty-tmux-off.txt 8"
-run xterm-tmux "${XTERM[@]}" -e tmux -L tp-x -f "$OUT/tmux-on.conf" new-session "$DEMO auto $OUT/xterm-tmux.txt 8"
+S=$SECONDS_SHOWN
+# Inside tmux the demo starts a second late: tmux passes nothing through before its client has
+# attached to the new session (a player started from a running tmux pane never meets this).
+B="sleep 1; env GRAPHICS_DEMO_BUDGET_MS=$GRAPHICS_DEMO_BUDGET_MS"
+run kitty "${KITTY[@]}" "$DEMO" auto "$OUT/kitty.txt" $S
+run kitty-direct "${KITTY[@]}" env SSH_TTY=/dev/pts/fake "$DEMO" auto "$OUT/kitty-direct.txt" $S
+run xterm "${XTERM[@]}" -e "$DEMO" auto "$OUT/xterm.txt" $S
+run kitty-tmux-on "${KITTY[@]}" tmux -L tp-on -f "$OUT/tmux-on.conf" new-session "$B $DEMO auto $OUT/kitty-tmux-on.txt $S"
+run kitty-tmux-off "${KITTY[@]}" tmux -L tp-off -f "$OUT/tmux-off.conf" new-session "$B $DEMO auto $OUT/kitty-tmux-off.txt $S"
+run xterm-tmux "${XTERM[@]}" -e tmux -L tp-x -f "$OUT/tmux-on.conf" new-session "$B $DEMO auto $OUT/xterm-tmux.txt $S"
 echo "screenshots and reports in $OUT"
