@@ -372,7 +372,8 @@ impl Probe {
         support.tmux_passthrough = env.tmux && (da1_seen >= 2 || support.kitty);
         if !support.iterm2 && !env.tmux {
             // No query says iTerm2 without its cell-size reply; its name is the fallback.
-            support.iterm2 = answered && env.term_program.as_deref() == Some("iTerm.app");
+            // (A terminal that did not answer gets nothing at all, below.)
+            support.iterm2 = env.term_program.as_deref() == Some("iTerm.app");
         }
         let (cols, rows) = (u32::from(self.options.winsize.cols), u32::from(self.options.winsize.rows));
         let per_cell = |(w, h): (u32, u32)| (cols > 0 && rows > 0).then(|| (w / cols, h / rows));

@@ -161,6 +161,9 @@ fn changed_cells_are_sent_alone_and_match_the_whole_picture() {
     }
     assert!(shown == dithered_rgb(&palette, &second, w, h));
     assert!(part.len() < whole.len() / 50, "the patch took {} bytes, the whole {}", part.len(), whole.len());
+    let mut again = Vec::new();
+    assert_eq!(enc.encode(&second, w, h, &mut again), Update::Unchanged, "nothing changed since");
+    assert!(again.is_empty());
 
     // A change in the last cell row, whose block cannot grow to whole bands inside the
     // picture (352 + 12 > 360), sends the whole picture instead.
