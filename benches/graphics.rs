@@ -7,6 +7,8 @@
 //! - `graphics/sixel_next_1280x750`: the next frame after two simulation steps (dither, find the
 //!   changed cells, encode them);
 //! - `graphics/kitty_direct_1280x752`: zlib level 1 + base64 chunks of a whole frame;
+//! - `graphics/kitty_direct_next_1280x752`: the next frame with frame edits (kitty itself): only
+//!   the changed rectangle is compressed and sent;
 //! - `graphics/kitty_direct_640x376`: the same at half the resolution (the terminal scales it
 //!   to the same cells): what a remote or busy player falls back to;
 //! - `graphics/kitty_tempfile_1280x752`: a whole frame through a file in /dev/shm (raw RGB);
@@ -86,9 +88,15 @@ fn graphics(c: &mut Criterion) {
     let update = enc.encode(&sb, sw, sh, &mut out);
     println!("sixel {sw}x{sh}: whole frame {sixel_full} bytes; next frame {update:?} {} bytes", out.len());
     out.clear();
-    let mut kenc = KittyEncoder::new(KittyOptions::new(kitty.cells));
+    let mut kenc = KittyEncoder::new(KittyOptions { frame_edits: true, ..KittyOptions::new(kitty.cells) });
     kenc.encode(&ka_rgb, kw, kh, &mut out).unwrap();
     println!("kitty direct {kw}x{kh}: whole frame {} bytes", out.len());
+    out.clear();
+    let update = kenc.encode(&kb_rgb, kw, kh, &mut out).unwrap();
+    println!(
+        "kitty direct {kw}x{kh}, frame edits: next frame {update:?} {} bytes (with frame edits off: whole)",
+        out.len()
+    );
     out.clear();
     let mut it = Iterm2Encoder::new((0, 0), kitty.cells, false);
     it.encode(&ka, &mut out);
@@ -150,6 +158,15 @@ fn graphics(c: &mut Criterion) {
             out.clear();
             enc.invalidate();
             enc.encode(black_box(&kb_rgb), kw, kh, &mut out).unwrap()
+        })
+    });
+    group.bench_function("kitty_direct_next_1280x752", |b| {
+        let mut enc = KittyEncoder::new(KittyOptions { frame_edits: true, ..KittyOptions::new(kitty.cells) });
+        let mut flip = false;
+        b.iter(|| {
+            out.clear();
+            flip = !flip;
+            enc.encode(black_box(if flip { &ka_rgb } else { &kb_rgb }), kw, kh, &mut out).unwrap()
         })
     });
     let half = (kw / 2, kh / 2);
