@@ -127,6 +127,11 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
     picture.draw_pixmap(0, 0, golden.as_ref(), &paint, scale, None);
 
     let mut out = b"\x1b[?1049h\x1b[?25l\x1b[2J".to_vec();
+    // GRAPHICS_DEMO_LABEL: a text label in the picture's top-left cells, drawn before the
+    // picture (kitty at z=-1 keeps it readable; sixel paints over it).
+    if let Ok(label) = std::env::var("GRAPHICS_DEMO_LABEL") {
+        out.extend_from_slice(format!("\x1b[2;3H\x1b[1;33m{label}\x1b[0m").as_bytes());
+    }
     let status = format!(" graphics_demo: {} ", choice.mode.name());
     out.extend_from_slice(format!("\x1b[{rows};1H\x1b[7m{status}\x1b[0m").as_bytes());
     let mut kitty_enc = KittyEncoder::new(KittyOptions {
@@ -134,6 +139,8 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
         placeholders: choice.kitty_placeholders,
         frame_edits: support.kitty_frame_edits,
         medium: if support.kitty_temp_file { Medium::TempFile(kitty::temp_dir()) } else { Medium::Direct },
+        // Under text glyphs, as the player should place it (INTEGRATION-graphics.md).
+        z_index: -1,
         ..KittyOptions::new(l.cells)
     });
     let registers = support.sixel.map_or(probe::DEFAULT_SIXEL_REGISTERS, |s| s.registers);
