@@ -9,11 +9,11 @@
 //! which mode), waits half of `SECONDS` (default 4), paints a red square into the picture and
 //! sends only that change (a kitty frame edit or a sixel cell block where the terminal allows),
 //! writes the picture the terminal should show to `REPORT.png` (for sixel the dithered one), waits the other half and restores the
-//! terminal (kitty's image deleted). The reply reader is a thread reading stdin into a channel,
-//! so the deadline needs no `poll`.
+//! terminal (kitty's image deleted). Replies are read with `probe::read_fd_with_deadline`, as
+//! the player should.
 
-use std::io::{self, Read, Write};
-use std::sync::mpsc;
+use std::io::{self, Write};
+use std::os::fd::AsFd;
 use std::time::{Duration, Instant};
 
 use tidepool::output::graphics::geometry::{SCALED_CAP, layout};
@@ -53,37 +53,15 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
     let kitty_file = if env.ssh { None } else { kitty::write_temp_file(&kitty::temp_dir(), 0, &[0, 0, 0]).ok() };
     let options = ProbeOptions { env, winsize, kitty_file: kitty_file.clone() };
 
-    // Replies are read by a thread; the probe waits on its channel with a deadline.
-    let (tx, rx) = mpsc::channel::<Vec<u8>>();
-    std::thread::spawn(move || {
-        let mut stdin = io::stdin().lock();
-        let mut buf = [0u8; 4096];
-        while let Ok(n @ 1..) = stdin.read(&mut buf) {
-            if tx.send(buf[..n].to_vec()).is_err() {
-                break;
-            }
-        }
-    });
-    let mut pending: Vec<u8> = Vec::new();
+    // Replies are read from stdin with `poll` and a deadline; each read is logged for the report.
     let started = Instant::now();
     let log = std::cell::RefCell::new(String::new());
+    let stdin = io::stdin();
     let mut read = |buf: &mut [u8], deadline: Instant| -> io::Result<usize> {
-        if pending.is_empty() {
-            match rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
-                Ok(bytes) => {
-                    log.borrow_mut().push_str(&format!(
-                        "{:?} {:?}\n",
-                        started.elapsed(),
-                        String::from_utf8_lossy(&bytes)
-                    ));
-                    pending = bytes
-                }
-                Err(_) => return Ok(0),
-            }
+        let n = probe::read_fd_with_deadline(stdin.as_fd(), buf, deadline)?;
+        if n > 0 {
+            log.borrow_mut().push_str(&format!("{:?} {:?}\n", started.elapsed(), String::from_utf8_lossy(&buf[..n])));
         }
-        let n = pending.len().min(buf.len());
-        buf[..n].copy_from_slice(&pending[..n]);
-        pending.drain(..n);
         Ok(n)
     };
     let mut stdout = io::stdout().lock();

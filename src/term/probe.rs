@@ -423,6 +423,26 @@ pub fn run_probe(
     Ok(probe.finish())
 }
 
+/// A `read_with_deadline` for [`run_probe`] on a terminal (or any pollable descriptor): waits
+/// until input is there or `deadline` has passed (`poll`), then reads what is there. Returns 0
+/// when the deadline passed with nothing to read. Unlike a reader thread, it leaves nothing
+/// blocked on the terminal for the player's own input reader to compete with.
+#[cfg(unix)]
+pub fn read_fd_with_deadline(fd: std::os::fd::BorrowedFd<'_>, buf: &mut [u8], deadline: Instant) -> io::Result<usize> {
+    use rustix::event::{PollFd, PollFlags, Timespec, poll};
+    loop {
+        let wait = deadline.saturating_duration_since(Instant::now());
+        let timeout = Timespec { tv_sec: wait.as_secs() as i64, tv_nsec: i64::from(wait.subsec_nanos()) };
+        let mut fds = [PollFd::new(&fd, PollFlags::IN)];
+        match poll(&mut fds, Some(&timeout)) {
+            Ok(0) => return Ok(0),
+            Ok(_) => return rustix::io::read(fd, buf).map_err(io::Error::from),
+            Err(rustix::io::Errno::INTR) => continue,
+            Err(e) => return Err(e.into()),
+        }
+    }
+}
+
 /// What `--graphics` asks for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum GraphicsRequest {
