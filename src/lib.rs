@@ -37,6 +37,7 @@ mod storage;
 mod term;
 
 pub mod encode;
+pub mod graphics;
 #[cfg(feature = "player")]
 pub mod player;
 pub mod replay;

@@ -7,3 +7,4 @@ pub use crate::term::player::{
 };
 pub use crate::term::screen::{FrameBuilder, Overlay};
 pub use crate::term::tty::{ENTER, RESTORE, play, restore};
+pub use crate::term::{probe, replies};

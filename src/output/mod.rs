@@ -8,6 +8,7 @@ pub mod diff;
 pub mod frame;
 #[cfg(feature = "animation")]
 pub mod gif;
+pub mod graphics;
 pub mod halfblock;
 pub mod heightmap;
 pub mod png;

@@ -6,6 +6,8 @@
 pub mod input;
 pub mod pacing;
 pub mod player;
+pub mod probe;
+pub mod replies;
 pub mod screen;
 pub mod tty;
 pub mod ui;

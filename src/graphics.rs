@@ -1,0 +1,7 @@
+//! Real pixels in terminals that can show them: the kitty graphics protocol, sixel and iTerm2's
+//! inline images, with tmux passthrough and the geometry that fits a picture to a cell area.
+//! Each encoder is pure (a picture in, bytes out), keeps what it needs to send only what
+//! changed, and is tested by decoding its own output.
+
+pub use crate::output::graphics::geometry::{self, Layout, layout};
+pub use crate::output::graphics::{GraphicsMode, iterm2, kitty, kitty_decode, push_rgb, rgb, sixel, tmux};

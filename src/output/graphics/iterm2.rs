@@ -1,0 +1,111 @@
+//! iTerm2 inline images (also WezTerm): OSC 1337 `File=` with a base64 PNG, scaled by the
+//! terminal to a cell area.
+//!
+//! `width` and `height` are given in cells and `preserveAspectRatio=0`, so the picture fills
+//! exactly the area the player reserved (its aspect already matches: see
+//! [`crate::output::graphics::geometry`]). `doNotMoveCursor=1` keeps the cursor where it was
+//! (terminals that do not know the key ignore it; the picture ends above the last row, so even
+//! a moved cursor does not scroll). The PNG comes from [`crate::encode::png`], whose bytes depend
+//! only on the pixels; an unchanged picture sends nothing. The protocol has no partial update:
+//! each frame is a whole new image.
+
+use base64::Engine;
+use base64::engine::general_purpose::STANDARD as BASE64;
+use tiny_skia::Pixmap;
+
+use crate::output::graphics::tmux;
+
+/// The encoder, with the picture the terminal shows.
+#[derive(Debug)]
+pub struct Iterm2Encoder {
+    /// The picture's top-left cell (column, row), 0-based.
+    origin: (u16, u16),
+    /// The cell area the picture fills (columns, rows).
+    cells: (u16, u16),
+    /// Wrap for tmux passthrough.
+    tmux: bool,
+    shown: Option<(u32, u32, Vec<u8>)>,
+}
+
+impl Iterm2Encoder {
+    /// An encoder for a picture over `cells` from cell `origin`.
+    pub fn new(origin: (u16, u16), cells: (u16, u16), tmux: bool) -> Iterm2Encoder {
+        Iterm2Encoder { origin, cells, tmux, shown: None }
+    }
+
+    /// Forgets what the terminal shows: the next picture is sent.
+    pub fn invalidate(&mut self) {
+        self.shown = None;
+    }
+
+    /// Appends the bytes that show `pixmap`; returns false (and appends nothing) when it is the
+    /// picture already shown.
+    pub fn encode(&mut self, pixmap: &Pixmap, out: &mut Vec<u8>) -> bool {
+        let (w, h) = (pixmap.width(), pixmap.height());
+        if matches!(&self.shown, Some((sw, sh, data)) if (*sw, *sh) == (w, h) && data == pixmap.data()) {
+            return false;
+        }
+        let png = crate::output::png::encode(pixmap);
+        out.extend_from_slice(
+            format!("\x1b[{};{}H", u32::from(self.origin.1) + 1, u32::from(self.origin.0) + 1).as_bytes(),
+        );
+        let mut command = format!(
+            "\x1b]1337;File=inline=1;size={};width={};height={};preserveAspectRatio=0;doNotMoveCursor=1:",
+            png.len(),
+            self.cells.0,
+            self.cells.1
+        )
+        .into_bytes();
+        let start = command.len();
+        command.resize(start + png.len().div_ceil(3) * 4, 0);
+        let n = BASE64.encode_slice(&png, &mut command[start..]).expect("sized for the base64");
+        command.truncate(start + n);
+        command.push(0x07);
+        if self.tmux {
+            tmux::push_wrapped(out, &command);
+        } else {
+            out.extend_from_slice(&command);
+        }
+        match &mut self.shown {
+            Some((sw, sh, data)) if (*sw, *sh) == (w, h) => data.copy_from_slice(pixmap.data()),
+            shown => *shown = Some((w, h, pixmap.data().to_vec())),
+        }
+        true
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use tiny_skia::ColorU8;
+
+    #[test]
+    fn an_inline_png_of_the_picture_scaled_to_the_cells() {
+        let mut p = Pixmap::new(7, 5).unwrap();
+        for (i, px) in p.pixels_mut().iter_mut().enumerate() {
+            *px = ColorU8::from_rgba(i as u8 * 7, 255 - i as u8, 3, 255).premultiply();
+        }
+        let mut enc = Iterm2Encoder::new((1, 2), (30, 9), false);
+        let mut out = Vec::new();
+        assert!(enc.encode(&p, &mut out));
+        let text = String::from_utf8(out.clone()).unwrap();
+        let head = "\x1b[3;2H\x1b]1337;File=inline=1;size=";
+        assert!(text.starts_with(head), "{text:?}");
+        let (args, payload) = text[head.len()..].split_once(':').unwrap();
+        assert!(args.ends_with(";width=30;height=9;preserveAspectRatio=0;doNotMoveCursor=1"), "{args}");
+        let payload = payload.strip_suffix('\x07').expect("ends with BEL");
+        let png = BASE64.decode(payload).unwrap();
+        assert_eq!(args.split(';').next().unwrap(), png.len().to_string(), "size= is the PNG's byte count");
+        let decoded = image::load_from_memory(&png).unwrap().to_rgb8();
+        assert_eq!(decoded.into_raw(), crate::output::graphics::rgb(&p));
+
+        // Unchanged: nothing; changed: sent again; tmux: wrapped.
+        let mut again = Vec::new();
+        assert!(!enc.encode(&p, &mut again) && again.is_empty());
+        p.pixels_mut()[0] = ColorU8::from_rgba(1, 1, 1, 255).premultiply();
+        assert!(enc.encode(&p, &mut again));
+        let mut wrapped = Vec::new();
+        Iterm2Encoder::new((0, 0), (30, 9), true).encode(&p, &mut wrapped);
+        assert!(wrapped.starts_with(b"\x1b[1;1H\x1bPtmux;\x1b\x1b]1337;File="));
+    }
+}

@@ -1,0 +1,349 @@
+//! The kitty graphics protocol encoder: one image id, replaced in place every frame.
+//!
+//! A frame is one transmit-and-display command (`a=T`) for the same image id and placement id:
+//! the terminal replaces the old image and its placement with the new one, so nothing piles up
+//! and nothing flickers (inside synchronized output). The pixels go as 24-bit RGB (`f=24`):
+//! - **direct** (any terminal, also over SSH): zlib-compressed (`o=z`) and base64-encoded, in
+//!   chunks of at most [`CHUNK_BASE64`] bytes, `m=1` on all but the last;
+//! - **temporary file** (`t=t`, the terminal on this machine, as the probe found out): the raw
+//!   RGB is written to a file whose name contains `tty-graphics-protocol` in `/dev/shm` (memory,
+//!   not disk) or the temp directory; the command carries only the path. The terminal reads the
+//!   file and deletes it. No base64, no compression: the cheapest route by far. POSIX shared
+//!   memory (`t=s`) would save one copy more but needs `shm_open` through `unsafe` FFI; a file
+//!   in `/dev/shm` is the same memory without it.
+//!
+//! Responses are suppressed (`q=2`): a reply arriving during play would otherwise reach the
+//! input as keys. The placement is scaled to a cell area (`c=`, `r=`), and the cursor is not
+//! moved (`C=1`), so the caller's idea of the cursor stays right.
+//!
+//! **Changed rectangle.** When only part of the picture changed and the terminal answered the
+//! probe's frame-edit test ([`crate::term::probe`]), the frame is sent as an edit of the image's
+//! root frame (`a=f,r=1,x=,y=,s=,v=,X=1`): the animation part of the protocol, which composes a
+//! rectangle of new pixels onto an existing frame with plain replacement. The bounding box of
+//! the changed pixels is sent if it is at most [`EDIT_MAX_FRACTION`] of the picture; otherwise
+//! the whole image. Terminals that implement the protocol without animation (Ghostty, Konsole)
+//! answer the probe's edit with an error or not at all, and get whole frames.
+//!
+//! **tmux.** Every command can be wrapped for passthrough ([`crate::output::graphics::tmux`]),
+//! chunk by chunk. A placement made by a passed-through command is not known to tmux and would
+//! stay put when panes move, so in tmux the image gets a *virtual* placement (`U=1`) and is
+//! shown through Unicode placeholder text ([`push_placeholders`]).
+
+use std::io::{self, Write};
+use std::path::{Path, PathBuf};
+
+use base64::Engine;
+use base64::engine::general_purpose::STANDARD as BASE64;
+use flate2::Compression;
+use flate2::write::ZlibEncoder;
+
+pub use crate::output::graphics::kitty_placeholder::push_placeholders;
+use crate::output::graphics::tmux;
+
+/// The most base64 bytes in one chunk (the protocol's limit).
+pub const CHUNK_BASE64: usize = 4096;
+/// Raw bytes per chunk: base64 turns 3 bytes into 4.
+const CHUNK_RAW: usize = CHUNK_BASE64 / 4 * 3;
+/// tidepool's image id: arbitrary, below 2^24 so Unicode placeholders carry it in one colour.
+pub const IMAGE_ID: u32 = 0x0074_6470;
+/// The one placement of [`IMAGE_ID`].
+pub const PLACEMENT_ID: u32 = 1;
+/// zlib level for direct transmission: 1 is the fastest; higher levels cost several times the
+/// CPU for a few percent fewer bytes on rendered water.
+pub const ZLIB_LEVEL: u32 = 1;
+/// A changed rectangle is sent as a frame edit only if its area is at most this fraction of the
+/// picture's; above it, the whole picture costs about the same and is simpler for the terminal.
+pub const EDIT_MAX_FRACTION: f64 = 0.5;
+/// The marker kitty requires in a temporary file's path before it deletes the file.
+pub const TEMP_FILE_MARKER: &str = "tty-graphics-protocol";
+
+/// How the pixels reach the terminal.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Medium {
+    /// In the escape codes, zlib-compressed and base64-encoded.
+    Direct,
+    /// Through temporary files in this directory (see [`temp_dir`]).
+    TempFile(PathBuf),
+}
+
+/// Where and how the image is shown.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct KittyOptions {
+    /// The image id ([`IMAGE_ID`]).
+    pub image_id: u32,
+    /// The top-left cell of the picture, 0-based (column, row).
+    pub origin: (u16, u16),
+    /// The cell area the picture is scaled to (columns, rows).
+    pub cells: (u16, u16),
+    /// Wrap every command for tmux passthrough.
+    pub tmux: bool,
+    /// Show the image through Unicode placeholders (a virtual placement, `U=1`).
+    pub placeholders: bool,
+    /// Send changed rectangles as frame edits (only when the probe saw them work).
+    pub frame_edits: bool,
+    /// How the pixels travel.
+    pub medium: Medium,
+    /// Stacking order: 0 draws over text; negative values draw under text glyphs.
+    pub z_index: i32,
+}
+
+impl KittyOptions {
+    /// Direct transmission of [`IMAGE_ID`] over `cells` at the top-left corner; no tmux, no
+    /// placeholders, no frame edits.
+    pub fn new(cells: (u16, u16)) -> KittyOptions {
+        KittyOptions {
+            image_id: IMAGE_ID,
+            origin: (0, 0),
+            cells,
+            tmux: false,
+            placeholders: false,
+            frame_edits: false,
+            medium: Medium::Direct,
+            z_index: 0,
+        }
+    }
+}
+
+/// What a call to [`KittyEncoder::encode`] sent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Update {
+    /// The picture is what the terminal already shows: no bytes.
+    Unchanged,
+    /// The whole picture.
+    Full,
+    /// Only this rectangle (x, y, width, height), as an edit of the shown image.
+    Rect(u32, u32, u32, u32),
+}
+
+/// The encoder, with what the terminal shows (for "no change, no bytes" and changed rectangles).
+#[derive(Debug)]
+pub struct KittyEncoder {
+    options: KittyOptions,
+    /// The picture the terminal has: (width, height, RGB); `None` before the first frame and
+    /// after [`KittyEncoder::invalidate`].
+    shown: Option<(u32, u32, Vec<u8>)>,
+    /// Reused buffers: the rectangle's pixels, the compressed data.
+    rect: Vec<u8>,
+    zlib: Vec<u8>,
+    /// Counts temporary files, so each has its own name.
+    files: u64,
+    /// Placeholder text must be (re)printed before the next frame.
+    placeholders_due: bool,
+}
+
+impl KittyEncoder {
+    /// An encoder with nothing shown yet.
+    pub fn new(options: KittyOptions) -> KittyEncoder {
+        KittyEncoder { options, shown: None, rect: Vec::new(), zlib: Vec::new(), files: 0, placeholders_due: true }
+    }
+
+    /// The options in force.
+    pub fn options(&self) -> &KittyOptions {
+        &self.options
+    }
+
+    /// Changes the options (after a resize: a new cell area); the next frame is sent whole.
+    pub fn set_options(&mut self, options: KittyOptions) {
+        self.options = options;
+        self.invalidate();
+    }
+
+    /// Forgets what the terminal shows (the screen was cleared): the next frame is sent whole.
+    pub fn invalidate(&mut self) {
+        self.shown = None;
+        self.placeholders_due = true;
+    }
+
+    /// Appends the bytes that make the terminal show `rgb` (`width x height`, 3 bytes a pixel,
+    /// row-major), and says what was sent. Nothing is appended when the picture is unchanged.
+    /// Fails only when a temporary file cannot be written (then nothing is appended).
+    pub fn encode(&mut self, rgb: &[u8], width: u32, height: u32, out: &mut Vec<u8>) -> io::Result<Update> {
+        assert_eq!(rgb.len(), width as usize * height as usize * 3, "RGB buffer does not match {width}x{height}");
+        let update = match &self.shown {
+            Some((w, h, old)) if (*w, *h) == (width, height) => match changed_rect(old, rgb, width, height) {
+                None => return Ok(Update::Unchanged),
+                Some((x, y, rw, rh))
+                    if self.options.frame_edits
+                        && f64::from(rw) * f64::from(rh)
+                            <= EDIT_MAX_FRACTION * f64::from(width) * f64::from(height) =>
+                {
+                    Update::Rect(x, y, rw, rh)
+                }
+                Some(_) => Update::Full,
+            },
+            _ => Update::Full,
+        };
+        let start = out.len();
+        let result = match update {
+            Update::Rect(x, y, w, h) => {
+                self.rect.clear();
+                for row in y..y + h {
+                    let from = (row as usize * width as usize + x as usize) * 3;
+                    self.rect.extend_from_slice(&rgb[from..from + w as usize * 3]);
+                }
+                let rect = std::mem::take(&mut self.rect);
+                let r = self.push_edit(out, &rect, (x, y, w, h));
+                self.rect = rect;
+                r
+            }
+            _ => self.push_full(out, rgb, width, height),
+        };
+        if let Err(e) = result {
+            out.truncate(start);
+            return Err(e);
+        }
+        match &mut self.shown {
+            Some((w, h, old)) if (*w, *h) == (width, height) => old.copy_from_slice(rgb),
+            shown => *shown = Some((width, height, rgb.to_vec())),
+        }
+        Ok(update)
+    }
+
+    fn push_full(&mut self, out: &mut Vec<u8>, rgb: &[u8], width: u32, height: u32) -> io::Result<()> {
+        let o = &self.options;
+        let (cols, rows) = o.cells;
+        let mut keys = format!("a=T,i={},f=24,s={width},v={height},c={cols},r={rows},q=2", o.image_id);
+        if o.placeholders {
+            keys.push_str(",U=1");
+        } else {
+            keys.push_str(&format!(",p={PLACEMENT_ID},C=1"));
+            if o.z_index != 0 {
+                keys.push_str(&format!(",z={}", o.z_index));
+            }
+            out.extend_from_slice(
+                format!("\x1b[{};{}H", u32::from(o.origin.1) + 1, u32::from(o.origin.0) + 1).as_bytes(),
+            );
+        }
+        self.push_pixels(out, &keys, "", rgb)?;
+        if self.options.placeholders && self.placeholders_due {
+            let o = &self.options;
+            push_placeholders(out, o.image_id, o.origin.0, o.origin.1, o.cells.0, o.cells.1);
+            self.placeholders_due = false;
+        }
+        Ok(())
+    }
+
+    fn push_edit(&mut self, out: &mut Vec<u8>, rect: &[u8], (x, y, w, h): (u32, u32, u32, u32)) -> io::Result<()> {
+        let keys = format!("a=f,r=1,i={},f=24,x={x},y={y},s={w},v={h},X=1,q=2", self.options.image_id);
+        self.push_pixels(out, &keys, "a=f,", rect)
+    }
+
+    /// Appends the command(s) carrying `data` by the configured medium. `more_keys` go on
+    /// continuation chunks before `m=` (`a=f,` for frame edits, as the protocol requires).
+    fn push_pixels(&mut self, out: &mut Vec<u8>, keys: &str, more_keys: &str, data: &[u8]) -> io::Result<()> {
+        match self.options.medium.clone() {
+            Medium::TempFile(dir) => {
+                self.files += 1;
+                let path = write_temp_file(&dir, self.files, data)?;
+                let command = temp_file_command(keys, &path);
+                push_command(out, &command, self.options.tmux);
+            }
+            Medium::Direct => {
+                self.zlib.clear();
+                let mut z = ZlibEncoder::new(std::mem::take(&mut self.zlib), Compression::new(ZLIB_LEVEL));
+                z.write_all(data)?;
+                self.zlib = z.finish()?;
+                push_chunked(out, &format!("{keys},o=z"), more_keys, &self.zlib, self.options.tmux);
+            }
+        }
+        Ok(())
+    }
+
+    /// Appends the bytes that delete the image and its data (for the restore; also after a
+    /// switch to another mode). Harmless when nothing was shown.
+    pub fn push_delete(&self, out: &mut Vec<u8>) {
+        push_delete(out, self.options.image_id, self.options.tmux);
+    }
+}
+
+/// Appends a delete of image `image_id` with its data (`a=d,d=I`), responses suppressed.
+pub fn push_delete(out: &mut Vec<u8>, image_id: u32, tmux: bool) {
+    push_command(out, format!("\x1b_Ga=d,d=I,i={image_id},q=2\x1b\\").as_bytes(), tmux);
+}
+
+/// Appends one escape sequence, wrapped for tmux if asked.
+fn push_command(out: &mut Vec<u8>, command: &[u8], tmux: bool) {
+    if tmux {
+        tmux::push_wrapped(out, command);
+    } else {
+        out.extend_from_slice(command);
+    }
+}
+
+/// Appends `data` base64-encoded in chunks: the first with `keys`, the rest with
+/// `more_keys` and `q=2`; `m=1` on all but the last.
+pub fn push_chunked(out: &mut Vec<u8>, keys: &str, more_keys: &str, data: &[u8], tmux: bool) {
+    let chunks = data.len().div_ceil(CHUNK_RAW).max(1);
+    let mut command = Vec::with_capacity(CHUNK_BASE64 + 64);
+    let mut encoded = [0u8; CHUNK_BASE64];
+    for i in 0..chunks {
+        let part = &data[(i * CHUNK_RAW).min(data.len())..((i + 1) * CHUNK_RAW).min(data.len())];
+        let more = u8::from(i + 1 < chunks);
+        command.clear();
+        command.extend_from_slice(b"\x1b_G");
+        if i == 0 {
+            command.extend_from_slice(keys.as_bytes());
+            command.extend_from_slice(format!(",m={more};").as_bytes());
+        } else {
+            command.extend_from_slice(format!("{more_keys}m={more},q=2;").as_bytes());
+        }
+        let n = BASE64.encode_slice(part, &mut encoded).expect("a chunk's base64 fits its buffer");
+        command.extend_from_slice(&encoded[..n]);
+        command.extend_from_slice(b"\x1b\\");
+        push_command(out, &command, tmux);
+    }
+}
+
+/// The command that makes the terminal read pixels from `path` (`t=t`): `keys` plus the
+/// medium, the base64-encoded path as payload.
+fn temp_file_command(keys: &str, path: &Path) -> Vec<u8> {
+    let path = path.as_os_str().as_encoded_bytes();
+    format!("\x1b_G{keys},t=t;{}\x1b\\", BASE64.encode(path)).into_bytes()
+}
+
+/// Where temporary files go: `/dev/shm` when it exists (memory, not disk), else the system's
+/// temporary directory (which kitty also accepts).
+pub fn temp_dir() -> PathBuf {
+    let shm = Path::new("/dev/shm");
+    if shm.is_dir() { shm.to_path_buf() } else { std::env::temp_dir() }
+}
+
+/// The name of temporary file `n` of this process: it carries [`TEMP_FILE_MARKER`], which the
+/// terminal needs before it deletes a file.
+pub fn temp_file_path(dir: &Path, n: u64) -> PathBuf {
+    dir.join(format!("tidepool-{}-{n}-{TEMP_FILE_MARKER}.rgb", std::process::id()))
+}
+
+/// Writes `data` to temporary file `n` in `dir` (created new: an existing file of that name is
+/// not followed or overwritten) and returns its path.
+pub fn write_temp_file(dir: &Path, n: u64, data: &[u8]) -> io::Result<PathBuf> {
+    let path = temp_file_path(dir, n);
+    let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(&path)?;
+    if let Err(e) = file.write_all(data) {
+        let _ = std::fs::remove_file(&path);
+        return Err(e);
+    }
+    Ok(path)
+}
+
+/// The bounding box (x, y, width, height) of the pixels that differ between two RGB pictures of
+/// the same size, or `None` when they are equal.
+pub fn changed_rect(old: &[u8], new: &[u8], width: u32, height: u32) -> Option<(u32, u32, u32, u32)> {
+    let stride = width as usize * 3;
+    let rows_differ = |y: usize| old[y * stride..(y + 1) * stride] != new[y * stride..(y + 1) * stride];
+    let top = (0..height as usize).find(|&y| rows_differ(y))?;
+    let bottom = (top..height as usize).rev().find(|&y| rows_differ(y)).unwrap_or(top);
+    let (mut left, mut right) = (width as usize, 0);
+    for y in top..=bottom {
+        let (a, b) = (&old[y * stride..(y + 1) * stride], &new[y * stride..(y + 1) * stride]);
+        if let Some(first) = a.iter().zip(b).position(|(p, q)| p != q) {
+            left = left.min(first / 3);
+            let last = a.iter().zip(b).rposition(|(p, q)| p != q).unwrap_or(first);
+            right = right.max(last / 3);
+        }
+    }
+    Some((left as u32, top as u32, (right - left + 1) as u32, (bottom - top + 1) as u32))
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,414 @@
+//! The sixel encoder: a fixed palette, ordered dithering, run-length encoding, one pixel per
+//! pixel.
+//!
+//! **Fixed palette.** The colour registers hold an evenly spaced RGB cube whose size the
+//! terminal's register count decides ([`SixelPalette::for_registers`]): with 256 registers it is
+//! 6 levels of red, 7 of green, 6 of blue (252 colours). Green gets the extra level because the
+//! eye is most sensitive to it (it carries ~60% of luminance). The remaining 4 registers are
+//! left unused rather than spent on greys: a grey ramp beside the cube would need a
+//! nearest-colour search per pixel, which costs the speed that dithering each channel on its
+//! own (three table look-ups a pixel) buys, and water has little pure grey; the cube's
+//! dither already averages to the right grey. A per-frame palette (what most sixel encoders
+//! make, by median cut or k-means) changes when the water moves, so every pixel's colour
+//! shifts with it: it shimmers and nothing can be skipped.
+//!
+//! **Ordered dithering.** Each channel is dithered between its two nearest levels with an 8x8
+//! Bayer threshold: the output depends only on the pixel's colour and position, so the same
+//! picture gives the same bytes every frame and still water sends nothing. (Error diffusion
+//! carries each pixel's error to its neighbours, so one changed pixel changes the rest of the
+//! picture.) The 64 thresholds average a level step exactly, so flat colours keep their mean.
+//!
+//! **Bytes.** Raster attributes `"1;1;W;H` ask for square pixels, one per screen pixel; `P2=1`
+//! leaves pixels no colour covers as they are. The picture is cut into bands of six rows; in
+//! each band every colour used gets one pass (`#n`, then its sixels from its first to its last
+//! column, `$` back to the band's start), runs of four or more equal sixels are `!n`. Colours
+//! and columns are collected per band in one pass over the band's pixels (each column's at most
+//! six registers and their bits, appended to each register's list), so the cost grows with the
+//! pixels, not with pixels x colours, and nothing of palette x width size is touched.
+//!
+//! **Changed rectangles.** Only the text rows and columns whose dithered pixels changed are sent,
+//! as a smaller sixel image placed at the top-left cell of that block (a sixel image is drawn
+//! from the cursor's cell). The rectangle is widened to whole cells and its height to whole
+//! six-row bands (some decoders size an image by its bands); when that would reach below the
+//! picture, the whole picture is sent. Dithering uses the picture's coordinates, so the pieces
+//! match the whole picture exactly. Whole pictures should be a multiple of 6 rows tall for the
+//! same reason ([`crate::output::graphics::geometry`] picks such sizes).
+
+/// The most colour registers used, whatever the terminal offers: 256 registers give a palette
+/// whose dither is hard to see; more would make every band's colour passes longer.
+pub const MAX_REGISTERS: u16 = 256;
+/// The fewest registers a palette is built for (2 levels a channel).
+pub const MIN_REGISTERS: u16 = 8;
+/// The side of the Bayer matrix.
+const BAYER_SIDE: usize = 8;
+/// A run of this many equal sixels or more is written `!n` (`!4x` is shorter than `xxxx`).
+const MIN_RUN: usize = 4;
+
+/// 8x8 Bayer thresholds, 0..64.
+const BAYER8: [[u8; 8]; 8] = [
+    [0, 32, 8, 40, 2, 34, 10, 42],
+    [48, 16, 56, 24, 50, 18, 58, 26],
+    [12, 44, 4, 36, 14, 46, 6, 38],
+    [60, 28, 52, 20, 62, 30, 54, 22],
+    [3, 35, 11, 43, 1, 33, 9, 41],
+    [51, 19, 59, 27, 49, 17, 57, 25],
+    [15, 47, 7, 39, 13, 45, 5, 37],
+    [63, 31, 55, 23, 61, 29, 53, 21],
+];
+
+/// An RGB cube of colour registers.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SixelPalette {
+    /// Levels of red, green and blue.
+    levels: [u8; 3],
+}
+
+impl SixelPalette {
+    /// The largest cube that fits in `registers` (clamped to [`MIN_REGISTERS`]..=
+    /// [`MAX_REGISTERS`]): levels are added green, red, blue in turn while they fit, so 256
+    /// registers give 6x7x6, 64 give 4x4x4, 16 give 2x4x2.
+    pub fn for_registers(registers: u16) -> SixelPalette {
+        let n = u32::from(registers.clamp(MIN_REGISTERS, MAX_REGISTERS));
+        let mut levels = [2u32; 3];
+        loop {
+            let mut grew = false;
+            for channel in [1, 0, 2] {
+                let mut bigger = levels;
+                bigger[channel] += 1;
+                if bigger.iter().product::<u32>() <= n {
+                    levels = bigger;
+                    grew = true;
+                }
+            }
+            if !grew {
+                break;
+            }
+        }
+        SixelPalette { levels: levels.map(|l| l as u8) }
+    }
+
+    /// Levels of red, green and blue.
+    pub fn levels(&self) -> [u8; 3] {
+        self.levels
+    }
+
+    /// Number of colours.
+    pub fn len(&self) -> usize {
+        self.levels.iter().map(|&l| usize::from(l)).product()
+    }
+
+    /// Whether the palette is empty (never: at least 2 levels a channel).
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Level `i` of a channel with `levels` levels, in percent as sixel colour registers take it.
+    fn percent(i: u8, levels: u8) -> u8 {
+        ((200 * u32::from(i) + u32::from(levels) - 1) / (2 * (u32::from(levels) - 1))) as u8
+    }
+
+    /// The 0..=255 value a terminal makes of a percentage: `(p * 255 + 50) / 100`, as xterm.
+    fn value(percent: u8) -> u8 {
+        ((u32::from(percent) * 255 + 50) / 100) as u8
+    }
+
+    /// The register's colour in percent (what the stream defines).
+    pub fn percent_rgb(&self, index: u8) -> [u8; 3] {
+        let [lr, lg, lb] = self.levels;
+        let i = index as usize;
+        let (r, g, b) =
+            (i / (usize::from(lg) * usize::from(lb)), i / usize::from(lb) % usize::from(lg), i % usize::from(lb));
+        [Self::percent(r as u8, lr), Self::percent(g as u8, lg), Self::percent(b as u8, lb)]
+    }
+
+    /// The register's colour as the terminal shows it.
+    pub fn rgb(&self, index: u8) -> [u8; 3] {
+        self.percent_rgb(index).map(Self::value)
+    }
+
+    /// For each channel, Bayer threshold and value: the channel's share of the register index.
+    fn tables(&self) -> Vec<[[u8; 256]; 64]> {
+        let [_, lg, lb] = self.levels.map(u16::from);
+        let strides = [lg * lb, lb, 1];
+        (0..3)
+            .map(|c| {
+                let levels = self.levels[c];
+                let values: Vec<u16> = (0..levels).map(|i| u16::from(Self::value(Self::percent(i, levels)))).collect();
+                let mut table = [[0u8; 256]; 64];
+                for (t, row) in table.iter_mut().enumerate() {
+                    for (v, entry) in row.iter_mut().enumerate() {
+                        let v = v as u16;
+                        // The level just below (or at) v, and whether v rounds up at threshold t:
+                        // up when the fraction of the step exceeds (t + 0.5) / 64.
+                        let lo = values.iter().rposition(|&l| l <= v).unwrap_or(0);
+                        let level = if lo + 1 < values.len() {
+                            let (a, b) = (values[lo], values[lo + 1]);
+                            let up = 128 * (v - a) > (2 * t as u16 + 1) * (b - a);
+                            lo + usize::from(up)
+                        } else {
+                            lo
+                        };
+                        *entry = (level as u16 * strides[c]) as u8;
+                    }
+                }
+                table
+            })
+            .collect()
+    }
+}
+
+/// What a call to [`SixelEncoder::encode`] sent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Update {
+    /// The dithered picture is what the terminal shows: no bytes.
+    Unchanged,
+    /// The whole picture.
+    Full,
+    /// Only this block of whole cells (x, y, width, height in pixels).
+    Rect(u32, u32, u32, u32),
+}
+
+/// The encoder, with the dithered picture the terminal shows.
+#[derive(Debug)]
+pub struct SixelEncoder {
+    palette: SixelPalette,
+    tables: Vec<[[u8; 256]; 64]>,
+    /// The picture's top-left cell (column, row), 0-based.
+    origin: (u16, u16),
+    /// The cell size in pixels, for changed rectangles; `None`: always whole pictures.
+    cell_px: Option<(u16, u16)>,
+    /// The dithered picture being encoded and the one the terminal shows: (width, height,
+    /// register per pixel).
+    current: Vec<u8>,
+    shown: Option<(u32, u32, Vec<u8>)>,
+    /// Per band: for each register, the columns it covers (ascending) with their sixel bits,
+    /// as `column << 8 | bits`; and the registers used.
+    columns: Vec<Vec<u32>>,
+    used: Vec<u8>,
+}
+
+impl SixelEncoder {
+    /// An encoder for `palette`, the picture's top-left at cell `origin`; changed rectangles
+    /// are used when the cell size in pixels is known.
+    pub fn new(palette: SixelPalette, origin: (u16, u16), cell_px: Option<(u16, u16)>) -> SixelEncoder {
+        let tables = palette.tables();
+        let n = palette.len();
+        SixelEncoder {
+            palette,
+            tables,
+            origin,
+            cell_px: cell_px.filter(|&(w, h)| w > 0 && h > 0),
+            current: Vec::new(),
+            shown: None,
+            columns: vec![Vec::new(); n],
+            used: Vec::new(),
+        }
+    }
+
+    /// The palette.
+    pub fn palette(&self) -> &SixelPalette {
+        &self.palette
+    }
+
+    /// Forgets what the terminal shows (a resize, a cleared screen): the next picture is sent
+    /// whole.
+    pub fn invalidate(&mut self) {
+        self.shown = None;
+    }
+
+    /// The register of every pixel of `rgb` (`width x height`, 3 bytes a pixel), dithered.
+    pub fn dither_into(&self, rgb: &[u8], width: u32, height: u32, out: &mut Vec<u8>) {
+        assert_eq!(rgb.len(), width as usize * height as usize * 3, "RGB buffer does not match {width}x{height}");
+        out.clear();
+        out.reserve(width as usize * height as usize);
+        let [tr, tg, tb] = [&self.tables[0], &self.tables[1], &self.tables[2]];
+        for (y, row) in rgb.chunks_exact(width as usize * 3).enumerate() {
+            let thresholds = &BAYER8[y % BAYER_SIDE];
+            for (x, p) in row.chunks_exact(3).enumerate() {
+                let t = usize::from(thresholds[x % BAYER_SIDE]);
+                out.push(tr[t][usize::from(p[0])] + tg[t][usize::from(p[1])] + tb[t][usize::from(p[2])]);
+            }
+        }
+    }
+
+    /// Appends the bytes that make the terminal show `rgb` (`width x height`, 3 bytes a pixel)
+    /// from the origin cell, and says what was sent. Nothing is appended when the dithered
+    /// picture is unchanged. The caller keeps the picture off the last text row.
+    pub fn encode(&mut self, rgb: &[u8], width: u32, height: u32, out: &mut Vec<u8>) -> Update {
+        let mut current = std::mem::take(&mut self.current);
+        self.dither_into(rgb, width, height, &mut current);
+        let update = match (&self.shown, self.cell_px) {
+            (Some((w, h, old)), Some((cw, ch))) if (*w, *h) == (width, height) => {
+                match changed_cells(old, &current, width, height, (u32::from(cw), u32::from(ch))) {
+                    None => Update::Unchanged,
+                    Some((0, 0, w, h)) if (w, h) == (width, height) => Update::Full,
+                    Some(r) => Update::Rect(r.0, r.1, r.2, r.3),
+                }
+            }
+            (Some((w, h, old)), None) if (*w, *h) == (width, height) && *old == current => Update::Unchanged,
+            _ => Update::Full,
+        };
+        let (x, y, w, h) = match update {
+            Update::Unchanged => {
+                self.current = current;
+                return update;
+            }
+            Update::Full => (0, 0, width, height),
+            Update::Rect(x, y, w, h) => (x, y, w, h),
+        };
+        let (cw, ch) = self.cell_px.map_or((1, 1), |(w, h)| (u32::from(w), u32::from(h)));
+        let (col, row) = (u32::from(self.origin.0) + x / cw, u32::from(self.origin.1) + y / ch);
+        out.extend_from_slice(format!("\x1b[{};{}H", row + 1, col + 1).as_bytes());
+        self.push_image(out, &current, width, (x, y, w, h));
+        self.current = match self.shown.take() {
+            Some((w, h, old)) if (w, h) == (width, height) => old,
+            _ => Vec::new(),
+        };
+        self.shown = Some((width, height, current));
+        update
+    }
+
+    /// Appends one sixel image of the `(x, y, w, h)` block of the dithered picture `pixels`
+    /// (`stride` pixels a row).
+    fn push_image(&mut self, out: &mut Vec<u8>, pixels: &[u8], stride: u32, (x0, y0, w, h): (u32, u32, u32, u32)) {
+        out.extend_from_slice(format!("\x1bP0;1;0q\"1;1;{w};{h}").as_bytes());
+        for i in 0..self.palette.len() {
+            let [r, g, b] = self.palette.percent_rgb(i as u8);
+            out.extend_from_slice(format!("#{i};2;{r};{g};{b}").as_bytes());
+        }
+        let (w, stride) = (w as usize, stride as usize);
+        for band in (0..h as usize).step_by(6) {
+            self.used.clear();
+            let rows: Vec<&[u8]> = (0..6.min(h as usize - band))
+                .map(|dy| {
+                    let start = (y0 as usize + band + dy) * stride + x0 as usize;
+                    &pixels[start..start + w]
+                })
+                .collect();
+            for x in 0..w {
+                // The (at most six) registers of this column and their sixel bits.
+                let (mut regs, mut bits, mut n) = ([0u8; 6], [0u8; 6], 0);
+                for (dy, row) in rows.iter().enumerate() {
+                    let c = row[x];
+                    match regs[..n].iter().position(|&r| r == c) {
+                        Some(k) => bits[k] |= 1 << dy,
+                        None => {
+                            (regs[n], bits[n]) = (c, 1 << dy);
+                            n += 1;
+                        }
+                    }
+                }
+                for k in 0..n {
+                    let cols = &mut self.columns[usize::from(regs[k])];
+                    if cols.is_empty() {
+                        self.used.push(regs[k]);
+                    }
+                    cols.push((x as u32) << 8 | u32::from(bits[k]));
+                }
+            }
+            self.used.sort_unstable();
+            for (n, &c) in self.used.iter().enumerate() {
+                if n > 0 {
+                    out.push(b'$');
+                }
+                out.push(b'#');
+                push_decimal(out, usize::from(c));
+                let cols = &mut self.columns[usize::from(c)];
+                push_colour_pass(out, cols);
+                cols.clear();
+            }
+            out.push(b'-');
+        }
+        out.extend_from_slice(b"\x1b\\");
+    }
+}
+
+/// Appends one colour's pass over a band from its covered columns (`column << 8 | sixel bits`,
+/// ascending): empty sixels (`?`) up to each covered column, runs of equal sixels as `!n`.
+fn push_colour_pass(out: &mut Vec<u8>, cols: &[u32]) {
+    let mut next = 0usize; // the column the pass has reached
+    let mut i = 0;
+    while i < cols.len() {
+        let (x, sixel) = ((cols[i] >> 8) as usize, cols[i] as u8);
+        push_run(out, b'?', x - next);
+        let mut run = 1;
+        while i + run < cols.len() && cols[i + run] == cols[i] + ((run as u32) << 8) {
+            run += 1;
+        }
+        push_run(out, 63 + sixel, run);
+        next = x + run;
+        i += run;
+    }
+}
+
+/// Appends `n` copies of the sixel character `ch`.
+#[inline]
+fn push_run(out: &mut Vec<u8>, ch: u8, n: usize) {
+    if n >= MIN_RUN {
+        out.push(b'!');
+        push_decimal(out, n);
+        out.push(ch);
+    } else {
+        out.extend(std::iter::repeat_n(ch, n));
+    }
+}
+
+fn push_decimal(out: &mut Vec<u8>, v: usize) {
+    let mut digits = [0u8; 20];
+    let mut n = v;
+    let mut i = digits.len();
+    loop {
+        i -= 1;
+        digits[i] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
+            break;
+        }
+    }
+    out.extend_from_slice(&digits[i..]);
+}
+
+/// The block of whole cells (x, y, width, height in pixels, clipped to the picture) that holds
+/// every pixel differing between `old` and `new`, or `None` when they are equal.
+fn changed_cells(
+    old: &[u8],
+    new: &[u8],
+    width: u32,
+    height: u32,
+    (cw, ch): (u32, u32),
+) -> Option<(u32, u32, u32, u32)> {
+    let stride = width as usize;
+    let row = |y: usize| (&old[y * stride..(y + 1) * stride], &new[y * stride..(y + 1) * stride]);
+    let top = (0..height as usize).find(|&y| row(y).0 != row(y).1)?;
+    let bottom = (top..height as usize).rev().find(|&y| row(y).0 != row(y).1).unwrap_or(top);
+    let (mut left, mut right) = (stride, 0);
+    for y in top..=bottom {
+        let (a, b) = row(y);
+        if let Some(first) = a.iter().zip(b).position(|(p, q)| p != q) {
+            left = left.min(first);
+            right = right.max(a.iter().zip(b).rposition(|(p, q)| p != q).unwrap_or(first));
+        }
+    }
+    let (x0, y0) = (left as u32 / cw * cw, top as u32 / ch * ch);
+    let x1 = ((right as u32 + 1).div_ceil(cw) * cw).min(width);
+    let y1 = ((bottom as u32 + 1).div_ceil(ch) * ch).min(height);
+    // Whole bands: a terminal may size an image by its bands; one that ends below the
+    // picture could reach the status line.
+    let h = (y1 - y0).div_ceil(6) * 6;
+    if y0 + h > height {
+        return Some((0, 0, width, height));
+    }
+    Some((x0, y0, x1 - x0, h))
+}
+
+/// The picture the terminal shows for `rgb` after dithering with `palette` (each pixel its
+/// register's colour): what a decoded stream must equal.
+pub fn dithered_rgb(palette: &SixelPalette, rgb: &[u8], width: u32, height: u32) -> Vec<u8> {
+    let encoder = SixelEncoder::new(palette.clone(), (0, 0), None);
+    let mut indices = Vec::new();
+    encoder.dither_into(rgb, width, height, &mut indices);
+    indices.iter().flat_map(|&i| palette.rgb(i)).collect()
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,175 @@
+use super::*;
+use crate::output::graphics::test_pictures::{golden_pool, noise};
+
+/// Decodes one sixel image with an independent decoder (icy_sixel) into its RGB, checking its
+/// size is `w x h`: every pixel of it painted; a decoder that sizes images by whole six-row
+/// bands may add rows below, which must be left unpainted (transparent, `P2=1`).
+fn decode(stream: &[u8], w: u32, h: u32) -> Vec<u8> {
+    let start = stream.windows(2).position(|w| w == b"\x1bP").expect("a DCS");
+    let image = icy_sixel::SixelImage::decode(&stream[start..]).expect("icy_sixel decodes the stream");
+    assert_eq!(image.width as u32, w);
+    assert!(image.height as u32 == h || image.height as u32 == h.div_ceil(6) * 6, "{}x{}", image.width, image.height);
+    let split = w as usize * h as usize * 4;
+    assert!(image.pixels[..split].chunks_exact(4).all(|p| p[3] == 255), "a pixel was left unpainted");
+    assert!(image.pixels[split..].chunks_exact(4).all(|p| p[3] == 0), "a pixel below the picture was painted");
+    image.pixels[..split].chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect()
+}
+
+#[test]
+fn palettes_fit_the_registers() {
+    assert_eq!(SixelPalette::for_registers(256).levels(), [6, 7, 6]);
+    assert_eq!(SixelPalette::for_registers(256).len(), 252);
+    assert_eq!(SixelPalette::for_registers(4096).levels(), [6, 7, 6], "capped at 256 registers");
+    assert_eq!(SixelPalette::for_registers(64).levels(), [4, 4, 4]);
+    assert_eq!(SixelPalette::for_registers(16).levels(), [2, 4, 2]);
+    assert_eq!(SixelPalette::for_registers(0).levels(), [2, 2, 2]);
+    let p = SixelPalette::for_registers(256);
+    assert_eq!(p.rgb(0), [0, 0, 0]);
+    assert_eq!(p.rgb(251), [255, 255, 255]);
+    assert_eq!(p.percent_rgb(1), [0, 0, 20], "blue is the fastest-varying channel");
+    assert_eq!(p.percent_rgb(6), [0, 17, 0], "green levels are sixths: 16.7% rounds to 17");
+    assert_eq!(p.rgb(6), [0, 43, 0]);
+}
+
+#[test]
+fn a_frame_decodes_to_the_dithered_scene() {
+    let (w, h, rgb) = golden_pool();
+    let palette = SixelPalette::for_registers(256);
+    let mut enc = SixelEncoder::new(palette.clone(), (0, 0), None);
+    let mut out = Vec::new();
+    assert_eq!(enc.encode(&rgb, w, h, &mut out), Update::Full);
+    assert!(out.starts_with(b"\x1b[1;1H\x1bP0;1;0q\"1;1;640;360"));
+    let decoded = decode(&out, w, h);
+    assert!(decoded == dithered_rgb(&palette, &rgb, w, h), "decoded pixels differ from the dithered picture");
+    // And the dither stays close to the source: the mean of each channel within 2 levels of 255.
+    let mean =
+        |v: &[u8], c: usize| v.iter().skip(c).step_by(3).map(|&x| f64::from(x)).sum::<f64>() / (v.len() / 3) as f64;
+    for c in 0..3 {
+        assert!((mean(&decoded, c) - mean(&rgb, c)).abs() < 2.0, "channel {c} drifted");
+    }
+}
+
+#[test]
+fn odd_sizes_and_small_palettes_decode_exactly() {
+    for (w, h, registers) in [(37, 13, 256), (1, 1, 16), (9, 6, 64), (50, 7, 16)] {
+        let rgb = noise(w, h, u64::from(w * h));
+        let palette = SixelPalette::for_registers(registers);
+        let mut out = Vec::new();
+        SixelEncoder::new(palette.clone(), (3, 2), None).encode(&rgb, w, h, &mut out);
+        assert!(out.starts_with(b"\x1b[3;4H"), "placed at the origin cell");
+        let decoded = decode(&out, w, h);
+        assert!(decoded == dithered_rgb(&palette, &rgb, w, h), "{w}x{h} with {registers} registers");
+    }
+}
+
+#[test]
+fn dithering_is_ordered_stable_and_keeps_the_mean() {
+    let palette = SixelPalette::for_registers(256);
+    let enc = SixelEncoder::new(palette.clone(), (0, 0), None);
+    // A flat colour between levels: a mix of the two nearest levels whose mean is the colour.
+    let flat: Vec<u8> = [90u8, 200, 33].repeat(16 * 16);
+    let mut idx = Vec::new();
+    enc.dither_into(&flat, 16, 16, &mut idx);
+    let distinct: std::collections::BTreeSet<u8> = idx.iter().copied().collect();
+    assert!(distinct.len() > 1, "a colour between levels must dither");
+    let shown = dithered_rgb(&palette, &flat, 16, 16);
+    for (c, &want) in flat[..3].iter().enumerate() {
+        let mean = shown.iter().skip(c).step_by(3).map(|&v| f64::from(v)).sum::<f64>() / 256.0;
+        assert!((mean - f64::from(want)).abs() < 1.5, "channel {c}: mean {mean}");
+    }
+    // The pattern repeats every 8 pixels and depends on nothing else.
+    for y in 0..8 {
+        for x in 0..8 {
+            assert_eq!(idx[y * 16 + x], idx[(y + 8) * 16 + x + 8]);
+        }
+    }
+    // One changed pixel changes one register (error diffusion would change its neighbours).
+    let mut changed = flat.clone();
+    changed[(5 * 16 + 5) * 3] = 250;
+    let mut idx2 = Vec::new();
+    enc.dither_into(&changed, 16, 16, &mut idx2);
+    let differing: Vec<usize> = (0..256).filter(|&i| idx[i] != idx2[i]).collect();
+    assert_eq!(differing, vec![5 * 16 + 5]);
+    // Palette colours dither to themselves everywhere.
+    for i in [0u8, 7, 100, 251] {
+        let c = palette.rgb(i);
+        let mut one = Vec::new();
+        enc.dither_into(&c.repeat(64), 8, 8, &mut one);
+        assert!(one.iter().all(|&j| j == i), "register {i}");
+    }
+}
+
+#[test]
+fn the_same_picture_gives_the_same_bytes_and_still_water_sends_nothing() {
+    let (w, h, rgb) = golden_pool();
+    let palette = SixelPalette::for_registers(256);
+    let (mut a, mut b) = (Vec::new(), Vec::new());
+    SixelEncoder::new(palette.clone(), (0, 0), None).encode(&rgb, w, h, &mut a);
+    let mut enc = SixelEncoder::new(palette, (0, 0), None);
+    enc.encode(&rgb, w, h, &mut b);
+    assert!(a == b, "two encoders disagree");
+    let mut again = Vec::new();
+    assert_eq!(enc.encode(&rgb, w, h, &mut again), Update::Unchanged);
+    assert!(again.is_empty());
+    enc.invalidate();
+    assert_eq!(enc.encode(&rgb, w, h, &mut again), Update::Full);
+    assert!(again == a);
+}
+
+#[test]
+fn runs_are_length_encoded() {
+    // 100 black pixels in one band: one colour, one run.
+    let palette = SixelPalette::for_registers(256);
+    let mut out = Vec::new();
+    SixelEncoder::new(palette, (0, 0), None).encode(&[0; 100 * 6 * 3], 100, 6, &mut out);
+    let text = String::from_utf8(out).unwrap();
+    assert!(text.ends_with("#0!100~-\x1b\\"), "{:?}", &text[text.len() - 20..]);
+    // A two-row stripe of white over black: passes overlap with `$`, empties are skipped.
+    let mut rgb = vec![0u8; 10 * 6 * 3];
+    rgb[..10 * 2 * 3].fill(255);
+    let mut out = Vec::new();
+    SixelEncoder::new(SixelPalette::for_registers(256), (0, 0), None).encode(&rgb, 10, 6, &mut out);
+    let text = String::from_utf8(out).unwrap();
+    // Black covers rows 2..6 (bits 0b111100 -> '?' + 60 = '{'), white rows 0..2 ('?' + 3 = 'B').
+    assert!(text.ends_with("#0!10{$#251!10B-\x1b\\"), "{:?}", &text[text.len() - 24..]);
+}
+
+#[test]
+fn changed_cells_are_sent_alone_and_match_the_whole_picture() {
+    let (w, h, first) = golden_pool();
+    let palette = SixelPalette::for_registers(256);
+    let mut second = first.clone();
+    for y in 40..45 {
+        for x in 100..103 {
+            second[(y * w as usize + x) * 3 + 1] ^= 0x80;
+        }
+    }
+    let mut enc = SixelEncoder::new(palette.clone(), (1, 1), Some((8, 16)));
+    let mut whole = Vec::new();
+    enc.encode(&first, w, h, &mut whole);
+    let mut part = Vec::new();
+    // Pixels 100..103 x 40..45 lie in cell column 12, cell row 2: the block 96..104 x 32..48,
+    // made 18 rows tall (whole sixel bands).
+    assert_eq!(enc.encode(&second, w, h, &mut part), Update::Rect(96, 32, 8, 18));
+    assert!(part.starts_with(b"\x1b[4;14H"), "placed at the block's cell (origin + (12, 2))");
+    let patch = decode(&part, 8, 18);
+    // The patch pasted on the first picture gives the second.
+    let mut shown = decode(&whole, w, h);
+    for y in 0..18 {
+        let to = ((32 + y) * w as usize + 96) * 3;
+        shown[to..to + 24].copy_from_slice(&patch[y * 24..(y + 1) * 24]);
+    }
+    assert!(shown == dithered_rgb(&palette, &second, w, h));
+    assert!(part.len() < whole.len() / 50, "the patch took {} bytes, the whole {}", part.len(), whole.len());
+    let mut again = Vec::new();
+    assert_eq!(enc.encode(&second, w, h, &mut again), Update::Unchanged, "nothing changed since");
+    assert!(again.is_empty());
+
+    // A change in the last cell row, whose block cannot grow to whole bands inside the
+    // picture (352 + 12 > 360), sends the whole picture instead.
+    let mut third = second.clone();
+    third[(358 * w as usize + 5) * 3] ^= 0xff;
+    let mut out = Vec::new();
+    assert_eq!(enc.encode(&third, w, h, &mut out), Update::Full);
+    assert!(decode(&out, w, h) == dithered_rgb(&palette, &third, w, h));
+}

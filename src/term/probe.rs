@@ -1,0 +1,515 @@
+//! Which pictures the terminal can show, found by asking it: the queries to send, a pure state
+//! machine that folds the replies (with the window size and, only as a fallback, environment
+//! hints) into a [`GraphicsSupport`], and the choice of a [`GraphicsMode`] for `--graphics`.
+//!
+//! **The queries** ([`queries`]), all sent at once, DA1 last: a terminal answers in order, so
+//! when the DA1 reply arrives every other answer it will ever give has arrived.
+//! - the kitty graphics query (`a=q`, id 31, a 1x1 RGB image): any kitty-protocol terminal
+//!   answers `OK` before DA1;
+//! - on this machine only (not over SSH), the same query through a temporary file (`t=t`): an
+//!   `OK` means the file medium works ([`crate::output::graphics::kitty::Medium::TempFile`]);
+//! - a root-frame edit of a scratch image (then deleted): an `OK` means changed rectangles can
+//!   be sent as frame edits (kitty); terminals without the animation part answer with an error
+//!   or not at all;
+//! - a virtual placement (`a=p,U=1`) of another scratch image (then deleted): an `OK` means
+//!   Unicode placeholders work (kitty 0.28+); kitty 0.26 (Debian 12's) rejects the unknown key
+//!   without a word, checked under Xvfb, while it answers `OK` to the same put without `U=1`;
+//! - XTSMGRAPHICS: colour registers (`CSI ? 1 ; 1 ; 0 S`) and the largest sixel image
+//!   (`CSI ? 2 ; 1 ; 0 S`);
+//! - `CSI 16 t` (cell size) and `CSI 14 t` (text area size), for when TIOCGWINSZ has no pixels;
+//! - DECRQM for SGR-pixels mouse (`?1016`) and synchronized output (`?2026`);
+//! - iTerm2's `OSC 1337 ; ReportCellSize`, which only iTerm2 answers;
+//! - DA1 (`CSI c`): sixel when its attributes include 4.
+//!
+//! **tmux** answers DA1 itself and swallows what it does not understand, so inside tmux (the
+//! `TMUX` variable) the probe sends a plain DA1 *first* (tmux answers at once: its attributes
+//! say whether tmux itself draws sixel), then the kitty queries, `CSI 16 t`, iTerm2's query and
+//! a second DA1, all wrapped for passthrough. With `allow-passthrough on` the outer terminal
+//! answers them, so a second DA1 arrives (and the kitty `OK` before it, if the outer terminal
+//! speaks kitty); with it off nothing more arrives and the probe ends at its deadline.
+//! Passthrough is on when a second DA1 or a kitty reply arrived. kitty inside tmux draws through
+//! Unicode placeholders (`U=1`), which tmux moves and clips with the pane; without passthrough
+//! the player draws cells and says how to turn it on ([`TMUX_HINT`]). SGR-pixels mouse stays
+//! off inside tmux.
+//!
+//! **No answer, a slow answer, garbage.** If the final DA1 does not arrive within the budget
+//! ([`PROBE_BUDGET`]), or an escape sequence that is not a reply arrives first, the terminal
+//! gets cells. Bytes that are not replies (keys typed during the probe) are handed back in
+//! [`ProbeOutcome::leftover`] for the input parser. Replies arriving after the probe ended are
+//! dropped by the input parser with [`crate::term::replies::parse_reply`].
+//!
+//! **Environment hints** are used only where no query answers: iTerm2 without its cell-size
+//! reply (`TERM_PROGRAM=iTerm.app`), and to skip the file query over SSH.
+
+use std::io;
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use base64::Engine;
+use base64::engine::general_purpose::STANDARD as BASE64;
+
+use crate::output::graphics::GraphicsMode;
+use crate::output::graphics::{kitty, tmux};
+use crate::term::replies::{Expecting, Parsed, Reply, parse_reply};
+
+/// The longest the probe waits for the terminal's answers.
+pub const PROBE_BUDGET: Duration = Duration::from_millis(150);
+/// The kitty query's image id (the protocol's example; nothing is stored under it).
+pub const KITTY_QUERY_ID: u32 = 31;
+/// The id of the kitty query through a temporary file.
+pub const KITTY_FILE_QUERY_ID: u32 = kitty::IMAGE_ID + 1;
+/// The id of the scratch image the frame-edit test edits (deleted at once).
+pub const KITTY_EDIT_PROBE_ID: u32 = kitty::IMAGE_ID + 2;
+/// The id of the scratch image the Unicode-placeholder test places virtually (deleted at once).
+pub const KITTY_PLACEHOLDER_PROBE_ID: u32 = kitty::IMAGE_ID + 3;
+/// The most bytes the probe keeps (replies and leftover keys) before it gives up.
+pub const MAX_PROBE_BYTES: usize = 64 * 1024;
+/// What the status line says in tmux when passthrough is off.
+pub const TMUX_HINT: &str = "tmux hides pictures: `set -g allow-passthrough on` for kitty graphics";
+/// What the status line says in tmux when the outer terminal speaks kitty graphics but has no
+/// Unicode placeholders, which images inside tmux need.
+pub const PLACEHOLDER_HINT: &str = "pictures inside tmux need kitty 0.28+ (Unicode placeholders)";
+/// A 1x1 black RGB pixel, base64.
+const ONE_PIXEL: &str = "AAAA";
+
+/// The environment variables the probe looks at.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Environment {
+    /// Inside tmux (`TMUX` is set).
+    pub tmux: bool,
+    /// Over SSH (`SSH_CONNECTION` or `SSH_TTY` is set): no temporary-file query.
+    pub ssh: bool,
+    /// `TERM_PROGRAM`, a fallback hint only.
+    pub term_program: Option<String>,
+}
+
+impl Environment {
+    /// Reads the variables through `var` (`std::env::var` in the player, a table in tests).
+    pub fn from_lookup(var: impl Fn(&str) -> Option<String>) -> Environment {
+        let set = |name: &str| var(name).is_some_and(|v| !v.is_empty());
+        Environment {
+            tmux: set("TMUX"),
+            ssh: set("SSH_CONNECTION") || set("SSH_TTY"),
+            term_program: var("TERM_PROGRAM").filter(|v| !v.is_empty()),
+        }
+    }
+
+    /// The process's environment.
+    pub fn current() -> Environment {
+        Environment::from_lookup(|name| std::env::var(name).ok())
+    }
+}
+
+/// The terminal's size as TIOCGWINSZ gives it (pixels 0 when the terminal does not say).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct WinSize {
+    /// Columns.
+    pub cols: u16,
+    /// Rows.
+    pub rows: u16,
+    /// Width in pixels, or 0.
+    pub x_px: u16,
+    /// Height in pixels, or 0.
+    pub y_px: u16,
+}
+
+impl WinSize {
+    /// The window size of the terminal on stdout (crossterm's TIOCGWINSZ).
+    pub fn current() -> io::Result<WinSize> {
+        let w = crossterm::terminal::window_size()?;
+        Ok(WinSize { cols: w.columns, rows: w.rows, x_px: w.width, y_px: w.height })
+    }
+
+    /// The cell size in pixels the pixel fields imply, if they are filled in.
+    pub fn cell_px(&self) -> Option<(u16, u16)> {
+        (self.x_px > 0 && self.y_px > 0 && self.cols > 0 && self.rows > 0)
+            .then(|| (self.x_px / self.cols, self.y_px / self.rows))
+            .filter(|&(w, h)| w > 0 && h > 0)
+    }
+}
+
+/// What the probe starts from.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct ProbeOptions {
+    /// The environment hints.
+    pub env: Environment,
+    /// The window size.
+    pub winsize: WinSize,
+    /// A temporary file holding one RGB pixel (3 bytes) whose name carries
+    /// [`kitty::TEMP_FILE_MARKER`], for the file-medium query; `None` skips that query (always
+    /// over SSH). The caller writes it before and removes it after the probe if the terminal
+    /// did not.
+    pub kitty_file: Option<std::path::PathBuf>,
+}
+
+/// Sixel support.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SixelSupport {
+    /// Colour registers (XTSMGRAPHICS; 16, the VT340's, when the terminal does not say).
+    pub registers: u16,
+    /// The largest image, in pixels, if the terminal says.
+    pub max_w: Option<u32>,
+    /// The largest image's height.
+    pub max_h: Option<u32>,
+}
+
+/// Colour registers assumed when DA1 says sixel but XTSMGRAPHICS does not answer (a VT340's).
+pub const DEFAULT_SIXEL_REGISTERS: u16 = 16;
+
+/// What the terminal can do, as far as the probe found out.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct GraphicsSupport {
+    /// The terminal answered the probe in time (the final DA1 arrived) and nothing garbled
+    /// came first. Without it, `auto` means cells.
+    pub answered: bool,
+    /// An escape sequence that is not a reply arrived before the answers were complete.
+    pub garbled: bool,
+    /// The kitty graphics protocol.
+    pub kitty: bool,
+    /// kitty's temporary-file medium works (the terminal is on this machine).
+    pub kitty_temp_file: bool,
+    /// kitty root-frame edits work (changed rectangles).
+    pub kitty_frame_edits: bool,
+    /// kitty Unicode placeholders work (needed inside tmux).
+    pub kitty_placeholders: bool,
+    /// Sixel (DA1 attribute 4).
+    pub sixel: Option<SixelSupport>,
+    /// iTerm2 inline images.
+    pub iterm2: bool,
+    /// The cell size in pixels (TIOCGWINSZ, else `CSI 16 t`, else `CSI 14 t` / the grid, else
+    /// iTerm2's report).
+    pub cell_px: Option<(u16, u16)>,
+    /// SGR-pixels mouse reporting (mode 1016) is available (never inside tmux).
+    pub sgr_pixels_mouse: bool,
+    /// Synchronized output (mode 2026) is known to the terminal.
+    pub sync_output: bool,
+    /// Inside tmux.
+    pub tmux: bool,
+    /// tmux passes sequences through to the outer terminal.
+    pub tmux_passthrough: bool,
+}
+
+/// The bytes to send (see the module docs), for the options given.
+pub fn queries(options: &ProbeOptions) -> Vec<u8> {
+    let mut kitty_queries = format!("\x1b_Gi={KITTY_QUERY_ID},s=1,v=1,a=q,t=d,f=24;{ONE_PIXEL}\x1b\\").into_bytes();
+    if let Some(path) = options.kitty_file.as_deref().filter(|_| !options.env.ssh) {
+        kitty_queries.extend_from_slice(file_query(path).as_bytes());
+    }
+    let (edit, virt) = (KITTY_EDIT_PROBE_ID, KITTY_PLACEHOLDER_PROBE_ID);
+    kitty_queries.extend_from_slice(
+        format!(
+            "\x1b_Ga=t,i={edit},s=1,v=1,f=24,q=1;{ONE_PIXEL}\x1b\\\x1b_Ga=f,r=1,i={edit},s=1,v=1,f=24,X=1;{ONE_PIXEL}\x1b\\\x1b_Ga=d,d=I,i={edit},q=2\x1b\\\
+             \x1b_Ga=t,i={virt},s=1,v=1,f=24,q=1;{ONE_PIXEL}\x1b\\\x1b_Ga=p,U=1,i={virt},c=1,r=1\x1b\\\x1b_Ga=d,d=I,i={virt},q=2\x1b\\"
+        )
+        .as_bytes(),
+    );
+    const SIXEL: &[u8] = b"\x1b[?1;1;0S\x1b[?2;1;0S";
+    const CELLS: &[u8] = b"\x1b[16t\x1b[14t";
+    const ITERM2: &[u8] = b"\x1b]1337;ReportCellSize\x1b\\";
+    const MODES: &[u8] = b"\x1b[?1016$p\x1b[?2026$p";
+    const DA1: &[u8] = b"\x1b[c";
+    let mut out = Vec::new();
+    if options.env.tmux {
+        // tmux answers these itself, at once.
+        for q in [SIXEL, b"\x1b[?2026$p", DA1] {
+            out.extend_from_slice(q);
+        }
+        // These reach the outer terminal only through passthrough; each sequence on its own.
+        let mut outer: Vec<&[u8]> = split_sequences(&kitty_queries);
+        outer.extend([&b"\x1b[16t"[..], ITERM2, DA1]);
+        for q in outer {
+            tmux::push_wrapped(&mut out, q);
+        }
+    } else {
+        for q in [&kitty_queries[..], SIXEL, CELLS, MODES, ITERM2, DA1] {
+            out.extend_from_slice(q);
+        }
+    }
+    out
+}
+
+fn file_query(path: &Path) -> String {
+    let path = BASE64.encode(path.as_os_str().as_encoded_bytes());
+    format!("\x1b_Gi={KITTY_FILE_QUERY_ID},s=1,v=1,a=q,t=t,f=24;{path}\x1b\\")
+}
+
+/// Splits a run of APC commands into its sequences (each ends with `ESC \`).
+fn split_sequences(bytes: &[u8]) -> Vec<&[u8]> {
+    let mut out = Vec::new();
+    let mut start = 0;
+    for i in 1..bytes.len() {
+        if bytes[i - 1] == 0x1b && bytes[i] == b'\\' {
+            out.push(&bytes[start..=i]);
+            start = i + 1;
+        }
+    }
+    out
+}
+
+/// The probe's state: the replies so far.
+#[derive(Clone, Debug, Default)]
+pub struct Probe {
+    options: ProbeOptions,
+    /// Bytes not yet recognised (a reply may be cut between reads).
+    pending: Vec<u8>,
+    replies: Vec<Reply>,
+    /// DA1 replies seen.
+    da1: u8,
+    /// Replies seen before the first DA1 (tmux's) and before the last.
+    garbled: bool,
+    leftover: Vec<u8>,
+}
+
+/// What the probe found, and the bytes it read that were not replies.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ProbeOutcome {
+    /// The capabilities.
+    pub support: GraphicsSupport,
+    /// Input that arrived during the probe (keys), in order, for the input parser.
+    pub leftover: Vec<u8>,
+}
+
+impl Probe {
+    /// A probe that has sent [`queries`]`(&options)`.
+    pub fn new(options: ProbeOptions) -> Probe {
+        Probe { options, ..Probe::default() }
+    }
+
+    /// How many DA1 replies end the probe: 2 in tmux (tmux's and the outer terminal's).
+    fn da1_wanted(&self) -> u8 {
+        if self.options.env.tmux { 2 } else { 1 }
+    }
+
+    /// Whether every answer has arrived.
+    pub fn done(&self) -> bool {
+        self.da1 >= self.da1_wanted()
+    }
+
+    /// Feeds bytes read from the terminal; returns [`Probe::done`].
+    pub fn feed(&mut self, bytes: &[u8]) -> bool {
+        self.pending.extend_from_slice(bytes);
+        let mut used = 0;
+        while used < self.pending.len() && !self.done() {
+            match parse_reply(&self.pending[used..], Expecting::NOTHING) {
+                Parsed::Complete(reply, n) => {
+                    used += n;
+                    if matches!(reply, Reply::PrimaryAttributes(_)) {
+                        self.da1 += 1;
+                    }
+                    if self.replies.len() < MAX_PROBE_BYTES / 8 {
+                        self.replies.push(reply);
+                    }
+                }
+                Parsed::Incomplete => break,
+                Parsed::NotAReply => {
+                    // A key typed during the probe, or garbage. An escape sequence here is
+                    // taken as garbage (a terminal answering wrongly), since keys with ESC are
+                    // unlikely in the first 150 ms; its bytes still go to the input.
+                    self.garbled |= self.pending[used] == 0x1b;
+                    self.leftover.push(self.pending[used]);
+                    used += 1;
+                }
+            }
+        }
+        self.pending.drain(..used);
+        if self.pending.len() + self.leftover.len() > MAX_PROBE_BYTES {
+            self.garbled = true;
+            self.leftover.append(&mut self.pending);
+            self.da1 = self.da1_wanted(); // stop: this is no terminal answering
+        }
+        self.done()
+    }
+
+    /// What the replies say. The probe may end early ([`Probe::done`]) or at its deadline.
+    pub fn finish(mut self) -> ProbeOutcome {
+        let env = &self.options.env;
+        let tmux_answered = env.tmux && self.da1 >= 1;
+        let answered = !self.garbled && (self.done() || tmux_answered);
+        let mut support = GraphicsSupport { answered, garbled: self.garbled, tmux: env.tmux, ..Default::default() };
+        let (mut da1_seen, mut cell_reply, mut text_area, mut iterm2_cell) = (0, None, None, None);
+        for reply in &self.replies {
+            match reply {
+                Reply::KittyGraphics { id: Some(id), message } if message == "OK" => match *id {
+                    KITTY_QUERY_ID => support.kitty = true,
+                    KITTY_FILE_QUERY_ID => support.kitty_temp_file = true,
+                    KITTY_EDIT_PROBE_ID => support.kitty_frame_edits = true,
+                    KITTY_PLACEHOLDER_PROBE_ID => support.kitty_placeholders = true,
+                    _ => {}
+                },
+                Reply::PrimaryAttributes(attrs) => {
+                    // Outside tmux the only DA1; inside, the first is tmux's own: sixel there
+                    // means tmux draws sixel itself.
+                    if da1_seen == 0 && attrs.contains(&4) {
+                        support.sixel =
+                            Some(SixelSupport { registers: DEFAULT_SIXEL_REGISTERS, max_w: None, max_h: None });
+                    }
+                    da1_seen += 1;
+                }
+                Reply::CellSize { width, height } => cell_reply = Some((*width, *height)),
+                Reply::TextAreaSize { width, height } => text_area = Some((*width, *height)),
+                Reply::Iterm2CellSize { width, height, scale } => {
+                    support.iterm2 = true;
+                    iterm2_cell = Some(((width * scale).round() as u32, (height * scale).round() as u32));
+                }
+                Reply::ModeReport { mode: 1016, state: 1..=3, private: true } => support.sgr_pixels_mouse = !env.tmux,
+                Reply::ModeReport { mode: 2026, state: 1..=3, private: true } => support.sync_output = true,
+                _ => {}
+            }
+        }
+        if let Some(sixel) = &mut support.sixel {
+            for reply in &self.replies {
+                match reply {
+                    Reply::GraphicsAttribute { item: 1, status: 0, values } if !values.is_empty() => {
+                        sixel.registers = values[0].clamp(1, u32::from(u16::MAX)) as u16;
+                    }
+                    Reply::GraphicsAttribute { item: 2, status: 0, values } if values.len() >= 2 => {
+                        (sixel.max_w, sixel.max_h) = (Some(values[0]), Some(values[1]));
+                    }
+                    _ => {}
+                }
+            }
+        }
+        support.tmux_passthrough = env.tmux && (da1_seen >= 2 || support.kitty);
+        if !support.iterm2 && !env.tmux {
+            // No query says iTerm2 without its cell-size reply; its name is the fallback.
+            // (A terminal that did not answer gets nothing at all, below.)
+            support.iterm2 = env.term_program.as_deref() == Some("iTerm.app");
+        }
+        let (cols, rows) = (u32::from(self.options.winsize.cols), u32::from(self.options.winsize.rows));
+        let per_cell = |(w, h): (u32, u32)| (cols > 0 && rows > 0).then(|| (w / cols, h / rows));
+        let fits =
+            |c: (u32, u32)| (c.0 > 0 && c.1 > 0 && c.0 <= 1024 && c.1 <= 1024).then_some((c.0 as u16, c.1 as u16));
+        support.cell_px = self
+            .options
+            .winsize
+            .cell_px()
+            .or_else(|| cell_reply.and_then(fits))
+            .or_else(|| text_area.and_then(per_cell).and_then(fits))
+            .or_else(|| iterm2_cell.and_then(fits));
+        if !answered {
+            // Nothing that arrived can be trusted to be complete.
+            support = GraphicsSupport {
+                garbled: self.garbled,
+                tmux: env.tmux,
+                cell_px: support.cell_px,
+                ..Default::default()
+            };
+        }
+        let mut leftover = std::mem::take(&mut self.leftover);
+        leftover.extend_from_slice(&self.pending);
+        ProbeOutcome { support, leftover }
+    }
+}
+
+/// Sends the queries with `write`, reads the answers with `read_with_deadline` until they are
+/// complete or `budget` has passed (measured with `now`), and folds them. `read_with_deadline`
+/// reads what is available into the buffer, waiting at most until the deadline, and returns 0
+/// when the deadline passed with nothing to read (a real one polls the tty's descriptor).
+pub fn run_probe(
+    options: &ProbeOptions,
+    write: &mut dyn FnMut(&[u8]) -> io::Result<()>,
+    read_with_deadline: &mut dyn FnMut(&mut [u8], Instant) -> io::Result<usize>,
+    now: &dyn Fn() -> Instant,
+    budget: Duration,
+) -> io::Result<ProbeOutcome> {
+    let deadline = now() + budget;
+    write(&queries(options))?;
+    let mut probe = Probe::new(options.clone());
+    let mut buf = [0u8; 4096];
+    while !probe.done() && now() < deadline {
+        let n = read_with_deadline(&mut buf, deadline)?;
+        probe.feed(&buf[..n]);
+    }
+    Ok(probe.finish())
+}
+
+/// A `read_with_deadline` for [`run_probe`] on a terminal (or any pollable descriptor): waits
+/// until input is there or `deadline` has passed (`poll`), then reads what is there. Returns 0
+/// when the deadline passed with nothing to read. Unlike a reader thread, it leaves nothing
+/// blocked on the terminal for the player's own input reader to compete with.
+#[cfg(unix)]
+pub fn read_fd_with_deadline(fd: std::os::fd::BorrowedFd<'_>, buf: &mut [u8], deadline: Instant) -> io::Result<usize> {
+    use rustix::event::{PollFd, PollFlags, Timespec, poll};
+    loop {
+        let wait = deadline.saturating_duration_since(Instant::now());
+        let timeout = Timespec { tv_sec: wait.as_secs() as i64, tv_nsec: i64::from(wait.subsec_nanos()) };
+        let mut fds = [PollFd::new(&fd, PollFlags::IN)];
+        match poll(&mut fds, Some(&timeout)) {
+            Ok(0) => return Ok(0),
+            Ok(_) => return rustix::io::read(fd, buf).map_err(io::Error::from),
+            Err(rustix::io::Errno::INTR) => continue,
+            Err(e) => return Err(e.into()),
+        }
+    }
+}
+
+/// What `--graphics` asks for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GraphicsRequest {
+    /// The best the terminal answered for.
+    Auto,
+    /// This protocol, whatever the probe said.
+    Force(GraphicsMode),
+}
+
+/// The mode to draw with and how.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct GraphicsChoice {
+    /// The protocol.
+    pub mode: GraphicsMode,
+    /// Wrap the protocol's sequences for tmux passthrough.
+    pub tmux_wrap: bool,
+    /// kitty through Unicode placeholders (inside tmux).
+    pub kitty_placeholders: bool,
+    /// A note for the status line (how to get pictures), if any.
+    pub hint: Option<&'static str>,
+}
+
+/// Whether to probe at all: only when both input and output are terminals (`render --out -`
+/// into a pipe or file sends no query and draws cells).
+pub fn should_probe(stdin_is_tty: bool, stdout_is_tty: bool) -> bool {
+    stdin_is_tty && stdout_is_tty
+}
+
+/// The mode for `request` given what the probe found (`None`: no probe was made). `auto`
+/// prefers kitty (exact colours, scaled by the terminal, changed rectangles), then sixel, then
+/// iTerm2 (a whole PNG every frame), then cells. Inside tmux kitty needs passthrough and
+/// Unicode placeholders (the probe tests both), sixel is used only when tmux draws it itself, and iTerm2 is not used (its
+/// images are not placed through tmux). A forced mode is used as asked, wrapped for tmux when
+/// inside it.
+pub fn choose(request: GraphicsRequest, support: Option<&GraphicsSupport>) -> GraphicsChoice {
+    let cells = |hint| GraphicsChoice { mode: GraphicsMode::Cells, tmux_wrap: false, kitty_placeholders: false, hint };
+    let Some(s) = support else {
+        return match request {
+            GraphicsRequest::Force(mode) => {
+                GraphicsChoice { mode, tmux_wrap: false, kitty_placeholders: false, hint: None }
+            }
+            GraphicsRequest::Auto => cells(None),
+        };
+    };
+    let kitty = GraphicsChoice { mode: GraphicsMode::Kitty, tmux_wrap: s.tmux, kitty_placeholders: s.tmux, hint: None };
+    match request {
+        GraphicsRequest::Force(GraphicsMode::Kitty) => {
+            GraphicsChoice { hint: (s.tmux && !s.tmux_passthrough).then_some(TMUX_HINT), ..kitty }
+        }
+        GraphicsRequest::Force(GraphicsMode::Iterm2) => {
+            GraphicsChoice { mode: GraphicsMode::Iterm2, tmux_wrap: s.tmux, kitty_placeholders: false, hint: None }
+        }
+        GraphicsRequest::Force(mode) => {
+            GraphicsChoice { mode, tmux_wrap: false, kitty_placeholders: false, hint: None }
+        }
+        GraphicsRequest::Auto if !s.answered => cells(None),
+        GraphicsRequest::Auto if s.kitty && (!s.tmux || s.kitty_placeholders) => kitty,
+        GraphicsRequest::Auto if s.sixel.is_some() => {
+            GraphicsChoice { mode: GraphicsMode::Sixel, tmux_wrap: false, kitty_placeholders: false, hint: None }
+        }
+        GraphicsRequest::Auto if s.iterm2 && !s.tmux => {
+            GraphicsChoice { mode: GraphicsMode::Iterm2, tmux_wrap: false, kitty_placeholders: false, hint: None }
+        }
+        GraphicsRequest::Auto if s.tmux && !s.tmux_passthrough => cells(Some(TMUX_HINT)),
+        GraphicsRequest::Auto => cells((s.tmux && s.kitty).then_some(PLACEHOLDER_HINT)),
+    }
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,334 @@
+use std::cell::{Cell, RefCell};
+
+use super::*;
+use crate::output::graphics::kitty_decode;
+
+const MS: Duration = Duration::from_millis(1);
+
+/// A scripted terminal: each reply chunk arrives at its time after the queries were written.
+/// The clock is fake: reading jumps it to the next chunk's time or to the deadline.
+struct FakeTerminal {
+    script: Vec<(Duration, Vec<u8>)>,
+}
+
+struct Run {
+    outcome: ProbeOutcome,
+    written: Vec<u8>,
+    took: Duration,
+}
+
+impl FakeTerminal {
+    fn new(script: &[(u64, &[u8])]) -> FakeTerminal {
+        FakeTerminal { script: script.iter().map(|&(ms, b)| (Duration::from_millis(ms), b.to_vec())).collect() }
+    }
+
+    fn run(&self, options: &ProbeOptions) -> Run {
+        let start = Instant::now();
+        let clock = Cell::new(start);
+        let written = RefCell::new(Vec::new());
+        let next = Cell::new(0usize);
+        let offset = Cell::new(0usize); // bytes of the current chunk already read
+        let mut write = |b: &[u8]| {
+            written.borrow_mut().extend_from_slice(b);
+            Ok(())
+        };
+        let mut read = |buf: &mut [u8], deadline: Instant| {
+            let Some((at, chunk)) = self.script.get(next.get()) else {
+                clock.set(deadline);
+                return Ok(0);
+            };
+            if start + *at > deadline {
+                clock.set(deadline);
+                return Ok(0);
+            }
+            clock.set(clock.get().max(start + *at));
+            let rest = &chunk[offset.get()..];
+            let n = rest.len().min(buf.len());
+            buf[..n].copy_from_slice(&rest[..n]);
+            if n == rest.len() {
+                next.set(next.get() + 1);
+                offset.set(0);
+            } else {
+                offset.set(offset.get() + n);
+            }
+            Ok(n)
+        };
+        let now = || clock.get();
+        let outcome = run_probe(options, &mut write, &mut read, &now, PROBE_BUDGET).unwrap();
+        Run { outcome, written: written.into_inner(), took: clock.get() - start }
+    }
+}
+
+fn options(tmux: bool) -> ProbeOptions {
+    ProbeOptions {
+        env: Environment { tmux, ..Environment::default() },
+        winsize: WinSize { cols: 160, rows: 48, x_px: 0, y_px: 0 },
+        kitty_file: None,
+    }
+}
+
+const KITTY_OK: &[u8] = b"\x1b_Gi=31;OK\x1b\\";
+const XTERM_DA1: &[u8] = b"\x1b[?63;1;2;3;4;6;9;15;16;22;28;29c";
+
+fn kitty_answers() -> Vec<u8> {
+    let mut v = KITTY_OK.to_vec();
+    v.extend_from_slice(format!("\x1b_Gi={KITTY_EDIT_PROBE_ID};OK\x1b\\").as_bytes());
+    v.extend_from_slice(b"\x1b[6;16;8t\x1b[4;752;1280t\x1b[?1016;2$y\x1b[?2026;2$y\x1b[?62;22;52c");
+    v
+}
+
+#[test]
+fn kitty_answers_everything() {
+    let answers = kitty_answers();
+    // The answers cut into three reads, one in the middle of the first APC.
+    let run = FakeTerminal::new(&[(2, &answers[..5]), (3, &answers[5..40]), (4, &answers[40..])]).run(&options(false));
+    let s = &run.outcome.support;
+    assert!(s.answered && s.kitty && s.kitty_frame_edits && !s.kitty_temp_file, "{s:?}");
+    assert_eq!((s.sixel, s.cell_px, s.sgr_pixels_mouse, s.sync_output), (None, Some((8, 16)), true, true));
+    assert_eq!(run.took, 4 * MS, "done as soon as DA1 arrived");
+    assert!(run.outcome.leftover.is_empty());
+    let choice = choose(GraphicsRequest::Auto, Some(s));
+    assert_eq!(
+        choice,
+        GraphicsChoice { mode: GraphicsMode::Kitty, tmux_wrap: false, kitty_placeholders: false, hint: None }
+    );
+}
+
+#[test]
+fn xterm_vt340_gets_sixel_with_its_registers_and_limit() {
+    let run =
+        FakeTerminal::new(&[(3, b"\x1b[?1;0;256S\x1b[?2;0;1000;1000S\x1b[6;17;9t\x1b[?1016;2$y"), (4, XTERM_DA1)])
+            .run(&options(false));
+    let s = &run.outcome.support;
+    assert!(s.answered && !s.kitty && !s.iterm2);
+    assert_eq!(s.sixel, Some(SixelSupport { registers: 256, max_w: Some(1000), max_h: Some(1000) }));
+    assert_eq!(s.cell_px, Some((9, 17)));
+    assert_eq!(choose(GraphicsRequest::Auto, Some(s)).mode, GraphicsMode::Sixel);
+    // DA1 alone: sixel with the VT340's 16 registers.
+    let s = FakeTerminal::new(&[(1, XTERM_DA1)]).run(&options(false)).outcome.support;
+    assert_eq!(s.sixel, Some(SixelSupport { registers: 16, max_w: None, max_h: None }));
+}
+
+#[test]
+fn no_answer_means_cells_after_the_budget() {
+    let run = FakeTerminal::new(&[]).run(&options(false));
+    assert!(!run.outcome.support.answered);
+    assert_eq!(run.took, PROBE_BUDGET);
+    assert_eq!(choose(GraphicsRequest::Auto, Some(&run.outcome.support)).mode, GraphicsMode::Cells);
+}
+
+#[test]
+fn a_slow_answer_means_cells() {
+    let answers = kitty_answers();
+    let run = FakeTerminal::new(&[(20, &answers[..30]), (300, &answers[30..])]).run(&options(false));
+    let s = &run.outcome.support;
+    assert!(!s.answered && !s.kitty, "a partial answer is not trusted: {s:?}");
+    assert_eq!(run.took, PROBE_BUDGET);
+    assert_eq!(choose(GraphicsRequest::Auto, Some(s)).mode, GraphicsMode::Cells);
+    // The unfinished reply is handed on (the input parser drops it when the rest arrives).
+    assert!(!run.outcome.leftover.is_empty());
+}
+
+#[test]
+fn garbage_means_cells() {
+    for garbage in [&b"\x1b[?62;4\x01c"[..], b"\x1b\x1b\x1b[[[", b"\x1b_Gi=31;O\x1bK\x1b\\"] {
+        let mut script = garbage.to_vec();
+        script.extend_from_slice(KITTY_OK);
+        script.extend_from_slice(XTERM_DA1);
+        let run = FakeTerminal::new(&[(2, &script)]).run(&options(false));
+        let s = &run.outcome.support;
+        assert!(s.garbled && !s.answered, "{:?}: {s:?}", String::from_utf8_lossy(garbage));
+        assert_eq!(choose(GraphicsRequest::Auto, Some(s)).mode, GraphicsMode::Cells);
+    }
+    // A flood that never ends stops the probe at the byte bound.
+    let flood = vec![b'x'; 2 * MAX_PROBE_BYTES];
+    let run = FakeTerminal::new(&[(1, &flood)]).run(&options(false));
+    assert!(run.outcome.support.garbled && !run.outcome.support.answered);
+}
+
+#[test]
+fn keys_typed_during_the_probe_are_kept() {
+    let mut script = b"q".to_vec();
+    script.extend_from_slice(KITTY_OK);
+    script.extend_from_slice(b"7");
+    script.extend_from_slice(b"\x1b[?62c");
+    script.extend_from_slice(b"x");
+    let run = FakeTerminal::new(&[(2, &script)]).run(&options(false));
+    assert!(run.outcome.support.kitty && run.outcome.support.answered);
+    assert_eq!(run.outcome.leftover, b"q7x");
+}
+
+#[test]
+fn tmux_with_passthrough_gets_kitty_through_placeholders() {
+    let mut outer = KITTY_OK.to_vec();
+    outer.extend_from_slice(format!("\x1b_Gi={KITTY_PLACEHOLDER_PROBE_ID};OK\x1b\\").as_bytes());
+    outer.extend_from_slice(b"\x1b[6;16;8t\x1b[?62;22;52c");
+    let run = FakeTerminal::new(&[(1, b"\x1b[?2026;2$y\x1b[?1;2c"), (20, &outer)]).run(&options(true));
+    let s = &run.outcome.support;
+    assert!(s.answered && s.tmux && s.tmux_passthrough && s.kitty && s.kitty_placeholders, "{s:?}");
+    assert_eq!((s.sixel, s.cell_px, s.sgr_pixels_mouse), (None, Some((8, 16)), false));
+    assert_eq!(run.took, 20 * MS, "done at the outer terminal's DA1");
+    assert_eq!(
+        choose(GraphicsRequest::Auto, Some(s)),
+        GraphicsChoice { mode: GraphicsMode::Kitty, tmux_wrap: true, kitty_placeholders: true, hint: None }
+    );
+    // kitty without placeholders (0.26, silent on `U=1`): cells and a hint, even with
+    // passthrough.
+    let run_old = FakeTerminal::new(&[(1, b"\x1b[?1;2c"), (20, b"\x1b_Gi=31;OK\x1b\\\x1b[?62;c")]).run(&options(true));
+    let old = &run_old.outcome.support;
+    assert!(old.kitty && old.tmux_passthrough && !old.kitty_placeholders);
+    assert_eq!(
+        choose(GraphicsRequest::Auto, Some(old)),
+        GraphicsChoice {
+            mode: GraphicsMode::Cells,
+            tmux_wrap: false,
+            kitty_placeholders: false,
+            hint: Some(PLACEHOLDER_HINT)
+        }
+    );
+    // Passthrough shown by the outer terminal's DA1 alone (xterm in tmux): no hint, cells.
+    let xterm = FakeTerminal::new(&[(1, b"\x1b[?1;2c"), (5, XTERM_DA1)]).run(&options(true)).outcome.support;
+    assert!(xterm.tmux_passthrough && !xterm.kitty && xterm.sixel.is_none(), "tmux's own DA1 decides sixel");
+    assert_eq!(
+        choose(GraphicsRequest::Auto, Some(&xterm)),
+        GraphicsChoice { mode: GraphicsMode::Cells, tmux_wrap: false, kitty_placeholders: false, hint: None }
+    );
+    // What went out: tmux's own queries plain, DA1 among them before anything wrapped; the
+    // kitty query wrapped.
+    let first_wrap = run.written.windows(7).position(|w| w == tmux::PASSTHROUGH_BEGIN).unwrap();
+    let plain_da1 = run.written.windows(3).position(|w| w == b"\x1b[c").unwrap();
+    assert!(plain_da1 < first_wrap);
+    let state = kitty_decode::decode(&run.written).unwrap();
+    assert!(state.commands.iter().any(|k| k.get(&'a').map(String::as_str) == Some("q")));
+    // After tmux's own queries, everything is wrapped.
+    let mut rest = &run.written[first_wrap..];
+    while !rest.is_empty() {
+        let (_, len) = tmux::unwrap(rest).expect("only passthrough sequences after the plain ones");
+        rest = &rest[len..];
+    }
+}
+
+#[test]
+fn tmux_without_passthrough_gets_cells_and_a_hint() {
+    let run = FakeTerminal::new(&[(1, b"\x1b[?2026;2$y\x1b[?1;2c")]).run(&options(true));
+    let s = &run.outcome.support;
+    assert!(s.answered && s.tmux && !s.tmux_passthrough && !s.kitty);
+    assert_eq!(run.took, PROBE_BUDGET, "waits for an outer answer that never comes");
+    assert_eq!(
+        choose(GraphicsRequest::Auto, Some(s)),
+        GraphicsChoice {
+            mode: GraphicsMode::Cells,
+            tmux_wrap: false,
+            kitty_placeholders: false,
+            hint: Some(TMUX_HINT)
+        }
+    );
+    // tmux that draws sixel itself says so in its own DA1.
+    let s = FakeTerminal::new(&[(1, b"\x1b[?1;2;4c")]).run(&options(true)).outcome.support;
+    assert_eq!(choose(GraphicsRequest::Auto, Some(&s)).mode, GraphicsMode::Sixel);
+    // Forcing kitty wraps it and still shows the hint.
+    let forced = choose(GraphicsRequest::Force(GraphicsMode::Kitty), Some(&run.outcome.support));
+    assert!(forced.tmux_wrap && forced.kitty_placeholders && forced.hint.is_some());
+}
+
+#[test]
+fn iterm2_by_its_reply_or_by_name_as_a_fallback() {
+    let run =
+        FakeTerminal::new(&[(2, b"\x1b]1337;ReportCellSize=17.0;8.0;2.0\x1b\\\x1b[?62;22c")]).run(&options(false));
+    let s = &run.outcome.support;
+    assert!(s.iterm2 && s.answered);
+    assert_eq!(s.cell_px, Some((16, 34)), "points times scale");
+    assert_eq!(choose(GraphicsRequest::Auto, Some(s)).mode, GraphicsMode::Iterm2);
+    let mut by_name = options(false);
+    by_name.env.term_program = Some("iTerm.app".into());
+    assert!(FakeTerminal::new(&[(2, b"\x1b[?62;22c")]).run(&by_name).outcome.support.iterm2);
+    assert!(!FakeTerminal::new(&[]).run(&by_name).outcome.support.iterm2, "a name without an answer is nothing");
+}
+
+#[test]
+fn the_window_size_pixels_come_first() {
+    let mut o = options(false);
+    o.winsize = WinSize { cols: 100, rows: 40, x_px: 1000, y_px: 800 };
+    let s = FakeTerminal::new(&[(1, b"\x1b[6;16;8t\x1b[?62c")]).run(&o).outcome.support;
+    assert_eq!(s.cell_px, Some((10, 20)));
+    // No pixels anywhere but the text area: divided by the grid.
+    let s = FakeTerminal::new(&[(1, b"\x1b[4;800;1000t\x1b[?62c")]).run(&options(false)).outcome.support;
+    assert_eq!(s.cell_px, Some((6, 16)), "1000/160, 800/48");
+}
+
+#[test]
+fn the_file_query_is_sent_only_on_this_machine() {
+    let mut o = options(false);
+    o.kitty_file = Some("/dev/shm/tidepool-1-tty-graphics-protocol.rgb".into());
+    let q = String::from_utf8(queries(&o)).unwrap();
+    assert!(q.contains(&format!("i={KITTY_FILE_QUERY_ID},s=1,v=1,a=q,t=t")), "{q:?}");
+    let reply = format!("\x1b_Gi={KITTY_FILE_QUERY_ID};OK\x1b\\\x1b[?62c");
+    assert!(FakeTerminal::new(&[(1, reply.as_bytes())]).run(&o).outcome.support.kitty_temp_file);
+    o.env.ssh = true;
+    assert!(!String::from_utf8(queries(&o)).unwrap().contains("t=t"));
+}
+
+#[test]
+fn queries_end_with_da1_and_carry_every_question() {
+    let q = queries(&options(false));
+    assert!(q.ends_with(b"\x1b[c"));
+    let text = String::from_utf8_lossy(&q);
+    for part in [
+        "a=q",
+        "\x1b[?1;1;0S",
+        "\x1b[?2;1;0S",
+        "\x1b[16t",
+        "\x1b[14t",
+        "\x1b[?1016$p",
+        "\x1b[?2026$p",
+        "1337;ReportCellSize",
+    ] {
+        assert!(text.contains(part), "{part:?} missing");
+    }
+    // The frame-edit test edits and deletes its scratch image.
+    let state = kitty_decode::decode(&q).unwrap();
+    let actions: Vec<&str> = state.commands.iter().map(|k| k.get(&'a').map_or("t", String::as_str)).collect();
+    assert_eq!(actions, ["q", "t", "f", "d", "t", "p", "d"]);
+    assert!(state.images.is_empty(), "the scratch images are deleted");
+    assert!(state.commands[5].get(&'U').is_some_and(|u| u == "1") && !state.commands[5].contains_key(&'q'), "answered");
+}
+
+#[test]
+fn no_terminal_no_query() {
+    assert!(!should_probe(true, false) && !should_probe(false, true) && should_probe(true, true));
+    assert_eq!(choose(GraphicsRequest::Auto, None).mode, GraphicsMode::Cells);
+    assert_eq!(choose(GraphicsRequest::Force(GraphicsMode::Sixel), None).mode, GraphicsMode::Sixel);
+    let env = Environment::from_lookup(|k| match k {
+        "TMUX" => Some("/tmp/tmux-0/default,1,0".into()),
+        "SSH_TTY" => Some("/dev/pts/1".into()),
+        "TERM_PROGRAM" => Some(String::new()),
+        _ => None,
+    });
+    assert_eq!(env, Environment { tmux: true, ssh: true, term_program: None });
+}
+
+#[test]
+fn a_real_descriptor_is_read_until_the_deadline() {
+    use std::io::Write;
+    use std::os::fd::AsFd;
+    let (reader, mut writer) = std::io::pipe().unwrap();
+    let feeder = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(20));
+        writer.write_all(&kitty_answers()).unwrap();
+        writer
+    });
+    let mut sent = Vec::new();
+    let mut write = |b: &[u8]| {
+        sent.extend_from_slice(b);
+        Ok(())
+    };
+    let mut read = |buf: &mut [u8], deadline: Instant| read_fd_with_deadline(reader.as_fd(), buf, deadline);
+    let outcome = run_probe(&options(false), &mut write, &mut read, &Instant::now, Duration::from_secs(5)).unwrap();
+    assert!(outcome.support.answered && outcome.support.kitty && outcome.support.kitty_frame_edits);
+    assert!(sent.ends_with(b"\x1b[c"));
+    // Nothing more to read: it returns 0 once the deadline has passed.
+    let _writer = feeder.join().unwrap();
+    let deadline = Instant::now() + Duration::from_millis(30);
+    assert_eq!(read_fd_with_deadline(reader.as_fd(), &mut [0; 16], deadline).unwrap(), 0);
+    assert!(Instant::now() >= deadline, "returned before its deadline");
+}
