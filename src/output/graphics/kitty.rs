@@ -29,6 +29,7 @@
 //! stay put when panes move, so in tmux the image gets a *virtual* placement (`U=1`) and is
 //! shown through Unicode placeholder text ([`push_placeholders`]).
 
+pub use super::Update;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
@@ -102,17 +103,6 @@ impl KittyOptions {
             z_index: 0,
         }
     }
-}
-
-/// What a call to [`KittyEncoder::encode`] sent.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Update {
-    /// The picture is what the terminal already shows: no bytes.
-    Unchanged,
-    /// The whole picture.
-    Full,
-    /// Only this rectangle (x, y, width, height), as an edit of the shown image.
-    Rect(u32, u32, u32, u32),
 }
 
 /// The encoder, with what the terminal shows (for "no change, no bytes" and changed rectangles).

@@ -52,6 +52,18 @@ impl GraphicsMode {
     }
 }
 
+/// What a call to an encoder's `encode` sent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Update {
+    /// The picture is what the terminal already shows: no bytes.
+    Unchanged,
+    /// The whole picture.
+    Full,
+    /// Only this rectangle (x, y, width, height in pixels): an edit of the shown image
+    /// (kitty) or a block of whole cells (sixel).
+    Rect(u32, u32, u32, u32),
+}
+
 /// Appends the pixmap's pixels as straight (un-premultiplied) RGB, 3 bytes a pixel, row-major.
 /// Alpha is dropped: the player's pictures are opaque.
 pub fn push_rgb(pixmap: &Pixmap, out: &mut Vec<u8>) {

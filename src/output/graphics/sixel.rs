@@ -34,6 +34,8 @@
 //! match the whole picture exactly. Whole pictures should be a multiple of 6 rows tall for the
 //! same reason ([`crate::output::graphics::geometry`] picks such sizes).
 
+pub use super::Update;
+
 /// The most colour registers used, whatever the terminal offers: 256 registers give a palette
 /// whose dither is hard to see; more would make every band's colour passes longer.
 pub const MAX_REGISTERS: u16 = 256;
@@ -155,17 +157,6 @@ impl SixelPalette {
             })
             .collect()
     }
-}
-
-/// What a call to [`SixelEncoder::encode`] sent.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Update {
-    /// The dithered picture is what the terminal shows: no bytes.
-    Unchanged,
-    /// The whole picture.
-    Full,
-    /// Only this block of whole cells (x, y, width, height in pixels).
-    Rect(u32, u32, u32, u32),
 }
 
 /// The encoder, with the dithered picture the terminal shows.
