@@ -2,6 +2,7 @@
 
 pub mod apng;
 pub mod atomic;
+pub mod bucket;
 pub mod color;
 pub mod cursor;
 pub mod diff;
@@ -9,5 +10,7 @@ pub mod frame;
 pub mod gif;
 pub mod halfblock;
 pub mod heightmap;
+pub mod oklab;
 pub mod png;
+pub mod rate;
 pub mod vt;
