@@ -12,5 +12,6 @@ pub mod halfblock;
 pub mod heightmap;
 pub mod oklab;
 pub mod png;
+pub mod quality;
 pub mod rate;
 pub mod vt;

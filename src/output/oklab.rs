@@ -52,15 +52,15 @@ static LINEAR: std::sync::LazyLock<[f32; 256]> = std::sync::LazyLock::new(|| {
     })
 });
 
-/// The cube root of `x >= 0`: a first guess from the float's bits (exponent divided by three),
-/// then three Newton steps.
+/// The cube root of `x >= 0`: a first guess from the float's bits (exponent divided by three,
+/// within 4%), then two Newton steps (within 2e-6 relative).
 #[inline]
 fn cbrt(x: f32) -> f32 {
     if x <= 0.0 {
         return 0.0;
     }
     let mut y = f32::from_bits(x.to_bits() / 3 + 0x2a51_4067);
-    for _ in 0..3 {
+    for _ in 0..2 {
         y = (2.0 * y + x / (y * y)) * (1.0 / 3.0);
     }
     y
@@ -93,7 +93,7 @@ mod tests {
             let (fast, reference) = (cbrt(x), libm::cbrtf(x));
             worst = worst.max((fast - reference).abs());
         }
-        assert!(worst < 2e-7, "{worst}");
+        assert!(worst < 2e-6, "{worst}");
         assert_eq!(cbrt(0.0), 0.0);
     }
 

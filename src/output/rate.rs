@@ -41,16 +41,17 @@
 //! - With an unlimited budget ([`UNLIMITED`]) every candidate is drawn exactly, in screen
 //!   order: the bytes are exactly those of [`crate::output::diff::encode_into`].
 
+mod candidates;
 mod emit;
 
 use tiny_skia::Pixmap;
 
-use self::emit::{EXACT, FLAT, Pen, Plan, Room, SKIP};
+use self::candidates::{Item, LabMemo, MAX_VARIANTS, Measure, Palette, Weighing};
+use self::emit::{EXACT, Pen, Plan, Room, SKIP};
 use crate::output::color::{Color, ColorMode};
-use crate::output::diff::{EncodeOptions, SYNC_BEGIN, SYNC_END, Shown, best_draw};
+use crate::output::diff::{EncodeOptions, SYNC_BEGIN, SYNC_END, Shown};
 use crate::output::frame::{Cell, Frame};
-use crate::output::halfblock::Rgb;
-use crate::output::oklab::{self, JND, Lab};
+use crate::output::oklab::JND;
 
 /// A budget that never runs out: every change is sent exactly.
 pub const UNLIMITED: usize = usize::MAX;
@@ -64,6 +65,12 @@ pub const TEXT_MISMATCH_ERROR: f32 = 8.0;
 pub const MOVE_ESTIMATE: usize = 4;
 /// Layouts tried per frame to fit the exact bytes to the budget.
 const MAX_LAYOUTS: usize = 6;
+/// A layout that leaves less than this fraction (1/N) of the budget unspent is kept: another
+/// layout costs as much CPU as the first, and what is left carries over in the bucket.
+const GOOD_ENOUGH: usize = 16;
+/// After a layout, the next one aims at this share of the budget (by the estimates calibrated
+/// on the layout), so that it likely fits.
+const AIM: f64 = 0.97;
 /// Clears the screen to the default colours: what an unknown screen becomes when it cannot be
 /// painted whole.
 pub const CLEAR: &[u8] = b"\x1b[0m\x1b[2J";
@@ -145,59 +152,32 @@ pub struct Report {
     pub pending: usize,
 }
 
-/// One step of a cell's improvement: its approximate variant, or from there (or from what is
-/// shown) to exact.
-#[derive(Clone, Copy, Debug)]
-struct Item {
-    /// 0: a noticeable error; 1: below the JND; 2: no error removed (convergence only).
-    tier: u8,
-    /// Error removed per byte.
-    ratio: f32,
-    /// The cell's index.
-    cell: u32,
-    /// [`FLAT`] or [`EXACT`].
-    variant: u8,
-    /// Estimated bytes of this step.
-    cost: u32,
-}
-
-/// `rgb` packed with a valid bit, as a memo key (0: nothing memoized).
-fn key(rgb: Rgb) -> u32 {
-    1 << 24 | u32::from(rgb[0]) << 16 | u32::from(rgb[1]) << 8 | u32::from(rgb[2])
-}
-
-/// OKLab values remembered per cell half, recomputed only when the colour changes.
-#[derive(Clone, Debug, Default)]
-struct LabMemo {
-    entries: Vec<[(u32, Lab); 2]>,
-}
-
-impl LabMemo {
-    fn resize(&mut self, cells: usize) {
-        self.entries.resize(cells, [(0, Lab::default()); 2]);
-    }
-
-    #[inline]
-    fn get(&mut self, cell: usize, half: usize, rgb: Rgb) -> Lab {
-        let entry = &mut self.entries[cell][half];
-        let k = key(rgb);
-        if entry.0 != k {
-            *entry = (k, oklab::from_rgb(rgb));
-        }
-        entry.1
-    }
-}
-
 /// The rate-controlled encoder: scratch buffers only, no state that changes what it sends.
 #[derive(Clone, Debug, Default)]
 pub struct RateEncoder {
     items: Vec<Item>,
+    /// The candidates' sort keys (see `candidates::order_key`).
+    order: Vec<u64>,
+    /// Per cell: its bytes drawn exactly alone, and its errors (valid for candidates).
+    fresh: Vec<u16>,
+    measures: Vec<Measure>,
+    /// Per cell, its nearest palette colours and the frame count they were found at.
+    palettes: Vec<(u32, Palette)>,
+    /// Frames encoded (wrapping), to stamp per-frame memos.
+    frames: u32,
+    /// Candidates picked to be weighed next.
+    pick: Vec<bool>,
+    /// How many candidates of `order` are weighed, and how.
+    weighed: usize,
+    weighing: Weighing,
     choice: Vec<u8>,
-    flat: Vec<Color>,
+    variants: Vec<[Cell; MAX_VARIANTS]>,
     candidate: Vec<bool>,
     shown_lab: LabMemo,
     truth_lab: LabMemo,
     attempt: (Vec<u8>, Vec<(u32, Cell)>),
+    /// How many of the sorted steps the best layout took.
+    best_taken: usize,
     best: (Vec<u8>, Vec<(u32, Cell)>),
 }
 
@@ -231,8 +211,12 @@ impl RateEncoder {
         let (cols, rows) = (wanted.cols(), wanted.rows());
         let cells = cols * rows;
         self.choice.resize(cells, SKIP);
-        self.flat.resize(cells, Color::Default);
+        self.variants.resize(cells, [Cell::BLANK; MAX_VARIANTS]);
         self.candidate.resize(cells, false);
+        self.fresh.resize(cells, 0);
+        self.pick.resize(cells, false);
+        self.measures.resize(cells, Measure::default());
+        self.palettes.resize(cells, (0, Palette::default()));
         self.shown_lab.resize(cells);
         self.truth_lab.resize(cells);
         let overhead = if options.sync { SYNC_BEGIN.len() + SYNC_END.len() } else { 0 };
@@ -244,7 +228,7 @@ impl RateEncoder {
             self.choice.fill(EXACT);
             self.attempt.0.clear();
             self.attempt.1.clear();
-            let plan = Plan { shown: wanted, wanted, choice: &self.choice, flat: &self.flat };
+            let plan = Plan { shown: wanted, wanted, choice: &self.choice, variants: &self.variants };
             let end = plan.emit(pen, None, &mut self.attempt.0, &mut self.attempt.1);
             let markers = if cells > 1 { overhead } else { 0 };
             if self.attempt.0.len().saturating_add(markers) <= budget {
@@ -279,8 +263,23 @@ impl RateEncoder {
             let left = budget.saturating_sub(overhead + prefix.len());
             Room { one: left, many: left }
         };
-        let candidates = self.candidates(frame, target, room, options);
-        let end = self.choose(frame, wanted, pen, room, options);
+        let (candidates, alone) = self.mark(frame, wanted, options);
+        let end = match self.everything_fits(frame, wanted, pen, room, alone, options) {
+            Some(end) => end,
+            None => {
+                let mut cutoff = self.candidates(frame, target, room, alone, options);
+                let mut end = self.choose(frame, wanted, pen, room);
+                let mut more = candidates::reach(room);
+                while cutoff.is_some() && self.needs_more() {
+                    // The steps weighed ran out before the budget did: weigh more, four times
+                    // as many bytes' worth each time.
+                    more = more.saturating_mul(4);
+                    cutoff = self.weigh_upto(wanted, more);
+                    end = self.choose(frame, wanted, pen, room);
+                }
+                end
+            }
+        };
         let drawn = self.best.1.len();
         let exact = self.best.1.iter().filter(|&&(i, c)| c == wanted.cells()[i as usize]).count();
         let start = out.len();
@@ -297,195 +296,22 @@ impl RateEncoder {
     }
 }
 
-/// A cell's errors: what is shown, drawn exactly, and drawn as its flat variant.
-#[derive(Clone, Copy, Debug)]
-struct Measure {
-    /// The error of what is shown now.
-    shown: f32,
-    /// The error once drawn exactly (0 in truecolor; the quantization error in palettes).
-    exact: f32,
-    /// Whether what is shown is at least a just-noticeable difference off.
-    noticeable: bool,
-    /// The flat variant's colour and error, when it has one.
-    flat: Option<(Color, f32)>,
-    /// For convergence when drawing exactly removes no error: how far the shown cell is from
-    /// the wanted one.
-    distance: f32,
-}
-
 impl RateEncoder {
-    /// Lists the candidates' improvement steps in `self.items` (and their flat colours in
-    /// `self.flat`); returns the number of candidate cells.
-    fn candidates(&mut self, shown: &Frame, target: Target<'_>, room: Room, options: RateOptions) -> usize {
-        self.items.clear();
-        let wanted = target.frame;
-        let cols = wanted.cols();
-        let (mut count, mut alone) = (0, 0);
-        for (i, (s, w)) in shown.cells().iter().zip(wanted.cells()).enumerate() {
-            let changed = !s.close_to(w, options.threshold);
-            self.candidate[i] = changed;
-            if changed {
-                count += 1;
-                alone += best_draw(*w, None, None).len(None, None) + MOVE_ESTIMATE;
-            }
-        }
-        // How likely a candidate's left neighbour is drawn too: about the share of all the
-        // candidates that the budget pays for.
-        let together = (room.many as f32 / alone.max(1) as f32).min(1.0);
-        let cost_of = |cell: Cell, left: Option<Cell>| {
-            let fresh = (best_draw(cell, None, None).len(None, None) + MOVE_ESTIMATE) as f32;
-            match left {
-                Some(left) => {
-                    let pen = best_draw(left, None, None);
-                    let after = best_draw(cell, pen.fg, pen.bg).len(pen.fg, pen.bg) as f32;
-                    together * after + (1.0 - together) * fresh
-                }
-                None => fresh,
-            }
-        };
-        for i in 0..wanted.cells().len() {
-            if !self.candidate[i] {
-                continue;
-            }
-            if options.strategy == Strategy::ScanOrder {
-                self.items.push(Item { tier: 0, ratio: 0.0, cell: i as u32, variant: EXACT, cost: 0 });
-                continue;
-            }
-            let (x, y) = (i % cols, i / cols);
-            let (s, w) = (shown.cells()[i], wanted.cells()[i]);
-            // The pen and cursor this cell finds: its left neighbour's when that neighbour is
-            // drawn too, otherwise a jump and fresh colour codes.
-            let left = (x > 0 && self.candidate[i - 1]).then(|| wanted.cells()[i - 1]);
-            let exact_cost = cost_of(w, left).max(1.0);
-            let m = self.measure(i, (x, y), s, w, target, options);
-            let exact_benefit = m.shown - m.exact;
-            let tier = match (exact_benefit > 0.0, m.noticeable) {
-                (true, true) => 0,
-                (true, false) => 1,
-                (false, _) => 2,
-            };
-            if tier == 2 {
-                let ratio = m.distance / exact_cost;
-                self.items.push(Item { tier, ratio, cell: i as u32, variant: EXACT, cost: exact_cost as u32 });
-                continue;
-            }
-            if tier == 0
-                && let Some((colour, flat_error)) = m.flat
-            {
-                let flat_cost = cost_of(Cell::Pixels { top: colour, bottom: colour }, left).max(1.0);
-                let flat_benefit = m.shown - flat_error;
-                if flat_benefit > 0.0 && flat_cost < exact_cost && flat_benefit * exact_cost > exact_benefit * flat_cost
-                {
-                    self.flat[i] = colour;
-                    let cell = i as u32;
-                    self.items.push(Item {
-                        tier,
-                        ratio: flat_benefit / flat_cost,
-                        cell,
-                        variant: FLAT,
-                        cost: flat_cost as u32,
-                    });
-                    if exact_benefit > flat_benefit {
-                        let (benefit, cost) = (exact_benefit - flat_benefit, exact_cost - flat_cost);
-                        self.items.push(Item { tier, ratio: benefit / cost, cell, variant: EXACT, cost: cost as u32 });
-                    }
-                    continue;
-                }
-            }
-            let ratio = exact_benefit / exact_cost;
-            self.items.push(Item { tier, ratio, cell: i as u32, variant: EXACT, cost: exact_cost as u32 });
-        }
-        count
-    }
-
-    /// The errors of cell `i` at `(x, y)`, shown as `s`, wanted as `w`.
-    fn measure(
-        &mut self,
-        i: usize,
-        (x, y): (usize, usize),
-        s: Cell,
-        w: Cell,
-        target: Target<'_>,
-        options: RateOptions,
-    ) -> Measure {
-        let unmeasurable = Measure {
-            shown: TEXT_MISMATCH_ERROR,
-            exact: 0.0,
-            noticeable: true,
-            flat: None,
-            distance: TEXT_MISMATCH_ERROR,
-        };
-        let Cell::Pixels { top: wt, bottom: wb } = w else { return unmeasurable };
-        let (Some(wt_rgb), Some(wb_rgb)) = (wt.rgb(), wb.rgb()) else { return unmeasurable };
-        let (rt, rb) = match target.truth {
-            Some((picture, mode)) => (
-                truth(picture, mode, (x, 2 * y), wt).unwrap_or(wt_rgb),
-                truth(picture, mode, (x, 2 * y + 1), wb).unwrap_or(wb_rgb),
-            ),
-            None => (wt_rgb, wb_rgb),
-        };
-        let (lrt, lrb) = (self.truth_lab.get(i, 0, rt), self.truth_lab.get(i, 1, rb));
-        let exact = if (wt_rgb, wb_rgb) == (rt, rb) {
-            0.0
-        } else {
-            oklab::from_rgb(wt_rgb).distance2(lrt) + oklab::from_rgb(wb_rgb).distance2(lrb)
-        };
-        let flat = (options.approximate && wt != wb).then(|| {
-            let mean = [0, 1, 2].map(|c| (u16::from(rt[c]) + u16::from(rb[c])).div_ceil(2) as u8);
-            match target.truth {
-                Some((_, mode)) => {
-                    let colour = mode.quantize(mean, x as u32, 2 * y as u32);
-                    let lab = colour.rgb().map_or(lrt, oklab::from_rgb);
-                    (colour, lab.distance2(lrt) + lab.distance2(lrb))
-                }
-                // The mean's OKLab is close to the mean of the two OKLab values, which are
-                // each half their distance from it.
-                None => (Color::Rgb(mean), lrt.distance2(lrb) / 2.0),
-            }
-        });
-        let (shown, noticeable, distance) = match s {
-            Cell::Pixels { top: st, bottom: sb } => match (st.rgb(), sb.rgb()) {
-                (Some(st_rgb), Some(sb_rgb)) => {
-                    let (lst, lsb) = (self.shown_lab.get(i, 0, st_rgb), self.shown_lab.get(i, 1, sb_rgb));
-                    let (dt, db) = (lst.distance2(lrt), lsb.distance2(lrb));
-                    let jnd2 = options.jnd * options.jnd;
-                    let distance = lst.distance2(oklab::from_rgb(wt_rgb)) + lsb.distance2(oklab::from_rgb(wb_rgb));
-                    (dt + db, dt.max(db) >= jnd2, distance)
-                }
-                _ => (TEXT_MISMATCH_ERROR, true, TEXT_MISMATCH_ERROR),
-            },
-            Cell::Text { .. } => (TEXT_MISMATCH_ERROR, true, TEXT_MISMATCH_ERROR),
-        };
-        Measure { shown, exact, noticeable, flat, distance }
-    }
-
     /// Chooses which steps to send within `room` and lays them out; the bytes and the drawn
     /// cells are left in `self.best`. Returns the pen afterwards.
-    fn choose(&mut self, shown: &Frame, wanted: &Frame, pen: Pen, room: Room, options: RateOptions) -> Pen {
+    fn choose(&mut self, shown: &Frame, wanted: &Frame, pen: Pen, room: Room) -> Pen {
         self.best.0.clear();
         self.best.1.clear();
+        self.best_taken = 0;
         if self.items.is_empty() {
             return pen;
         }
-        let unlimited = room.many == UNLIMITED;
-        if unlimited || options.strategy == Strategy::ScanOrder {
-            // Every candidate, exactly, in screen order (until the budget runs out).
-            self.set_choice(self.items.len());
-            for c in self.choice.iter_mut().filter(|c| **c != SKIP) {
-                *c = EXACT;
-            }
-            let plan = Plan { shown, wanted, choice: &self.choice, flat: &self.flat };
-            let limit = (!unlimited).then_some(room);
-            return plan.emit(pen, limit, &mut self.best.0, &mut self.best.1);
-        }
-        self.items.sort_unstable_by(|a, b| {
-            a.tier
-                .cmp(&b.tier)
-                .then(b.ratio.total_cmp(&a.ratio))
-                .then(a.cell.cmp(&b.cell))
-                .then(a.variant.cmp(&b.variant))
-        });
         let n = self.items.len();
+        // Only the front of the order matters: sort what the budget could reach (by the
+        // cheapest step, twice over), and more later if a layout needs it.
+        let cheapest = self.items.iter().map(|i| i.cost.max(1) as usize).min().unwrap_or(1);
+        let mut sorted = 0;
+        self.sort_front(&mut sorted, (2 * room.many / cheapest).saturating_add(64).min(n));
         let fits = |items: &[Item], from: usize, bytes: usize| {
             let (mut k, mut sum) = (from, 0usize);
             while k < items.len() && sum + items[k].cost as usize <= bytes {
@@ -495,77 +321,109 @@ impl RateEncoder {
             k
         };
         // At least the most valuable step, which may go alone without the markers.
-        let mut k = fits(&self.items, 0, room.many).max(1);
+        let mut k = fits(&self.items[..sorted], 0, room.many).max(1);
         let (mut best_k, mut best_pen) = (0, pen);
         for layout in 0..MAX_LAYOUTS {
             self.set_choice(k);
             self.attempt.0.clear();
             self.attempt.1.clear();
-            let plan = Plan { shown, wanted, choice: &self.choice, flat: &self.flat };
+            let plan = Plan { shown, wanted, choice: &self.choice, variants: &self.variants };
             // The last layout stops where the budget does, so that it always fits.
             let last = layout + 1 == MAX_LAYOUTS;
             let end = plan.emit(pen, last.then_some(room), &mut self.attempt.0, &mut self.attempt.1);
             let (cost, drawn) = (self.attempt.0.len(), self.attempt.1.len());
             let fit = room.fits(cost, drawn);
-            if std::env::var_os("RATE_DEBUG").is_some() {
-                eprintln!(
-                    "layout {layout}: k {k} of {n}, cost {cost}, drawn {drawn}, room {room:?}, fit {fit}, first {:?}",
-                    &self.items[..3.min(n)]
-                );
-            }
             if fit && drawn > self.best.1.len() {
                 std::mem::swap(&mut self.attempt, &mut self.best);
                 (best_k, best_pen) = (k, end);
+                self.best_taken = k;
             }
-            if fit {
-                if k == n {
-                    break;
-                }
-                let more = fits(&self.items, k, room.many.saturating_sub(cost));
-                if more == k {
-                    break;
-                }
-                k = more;
-            } else {
-                // Drop the least valuable steps: as many as the estimate says save the excess
-                // (and half as much again), but no more than in proportion to the overshoot,
-                // in case the estimates were much too low.
-                let limit = if drawn <= 1 { room.one } else { room.many };
-                let excess = (cost - limit) * 3 / 2;
-                let proportional = (k as f64 * limit as f64 / cost as f64 * 0.9) as usize;
-                let (mut shrunk, mut removed) = (k, 0);
-                while shrunk > best_k && removed < excess {
-                    shrunk -= 1;
-                    removed += self.items[shrunk].cost as usize;
-                }
-                k = shrunk.max(proportional.min(k - 1));
-                if k <= best_k && !self.best.1.is_empty() || k == 0 {
-                    break;
-                }
+            let limit = if drawn <= 1 { room.one } else { room.many };
+            // Close enough: what is left carries over to the next frame in the bucket.
+            if fit && (k == n || limit - cost < limit / GOOD_ENOUGH) {
+                break;
+            }
+            // Calibrate the estimates by this layout and aim a little under the budget.
+            let estimated: usize = self.items[..k].iter().map(|i| i.cost as usize).sum();
+            let scale = estimated.max(1) as f64 / cost.max(1) as f64;
+            let aim = (limit as f64 * scale * AIM) as usize;
+            self.sort_front(&mut sorted, (2 * aim / cheapest).saturating_add(64).min(n));
+            let next = fits(&self.items[..sorted], 0, aim);
+            k = match fit {
+                true if next <= k => break,
+                true => next,
+                // Over: fewer steps, at least one fewer, never fewer than a layout that fit.
+                false => next.min(k - 1).max(best_k + 1).min(k - 1),
+            };
+            if k == 0 || !fit && k <= best_k {
+                break;
             }
         }
         best_pen
+    }
+
+    /// Draws every candidate exactly when that fits in `room` (or the budget is unlimited, or
+    /// the order is the naive one, which draws them in screen order until the budget runs
+    /// out): nothing to weigh then. `alone` is the candidates' bytes drawn one by one, which
+    /// their bytes in runs rarely exceed by much.
+    fn everything_fits(
+        &mut self,
+        shown: &Frame,
+        wanted: &Frame,
+        pen: Pen,
+        room: Room,
+        alone: usize,
+        options: RateOptions,
+    ) -> Option<Pen> {
+        self.best.0.clear();
+        self.best.1.clear();
+        let unlimited = room.many == UNLIMITED;
+        let naive = options.strategy == Strategy::ScanOrder;
+        if !unlimited && !naive && alone / 2 > room.many {
+            return None;
+        }
+        for (c, &candidate) in self.choice.iter_mut().zip(&self.candidate) {
+            *c = if candidate { EXACT } else { SKIP };
+        }
+        let plan = Plan { shown, wanted, choice: &self.choice, variants: &self.variants };
+        let limit = (naive && !unlimited).then_some(room);
+        let end = plan.emit(pen, limit, &mut self.best.0, &mut self.best.1);
+        if unlimited || naive || room.fits(self.best.0.len(), self.best.1.len()) {
+            return Some(end);
+        }
+        self.best.0.clear();
+        self.best.1.clear();
+        None
+    }
+
+    /// Whether the chosen steps took every step weighed: the budget outlasted them, so more
+    /// candidates are worth weighing.
+    fn needs_more(&self) -> bool {
+        self.best_taken == self.items.len()
+    }
+
+    /// Puts the `upto` most valuable steps first, in order (the first `sorted` already are).
+    fn sort_front(&mut self, sorted: &mut usize, upto: usize) {
+        if upto <= *sorted {
+            return;
+        }
+        let rest = &mut self.items[*sorted..];
+        let m = upto - *sorted;
+        if m < rest.len() {
+            rest.select_nth_unstable_by_key(m, |item| item.order);
+        }
+        rest[..m].sort_unstable_by_key(|item| item.order);
+        *sorted = upto;
     }
 
     /// Sets `self.choice` from the first `k` steps: each cell's highest variant among them.
     fn set_choice(&mut self, k: usize) {
         self.choice.fill(SKIP);
         for item in &self.items[..k] {
-            let c = &mut self.choice[item.cell as usize];
-            *c = (*c).max(item.variant);
+            let c = &mut self.choice[item.cell()];
+            *c = (*c).max(item.rank());
         }
     }
-}
-
-/// The true colour of picture pixel `(x, y)` when the wanted colour is its quantization in
-/// `mode` (otherwise the cell holds something else, such as an overlay).
-fn truth(picture: &Pixmap, mode: ColorMode, (x, y): (usize, usize), wanted: Color) -> Option<Rgb> {
-    if x >= picture.width() as usize || y >= picture.height() as usize {
-        return None;
-    }
-    let c = picture.pixels()[y * picture.width() as usize + x].demultiply();
-    let rgb = [c.red(), c.green(), c.blue()];
-    (mode.quantize(rgb, x as u32, y as u32) == wanted).then_some(rgb)
 }
 
 /// Appends `body` wrapped in synchronized output (when `sync`), after `prefix`.

@@ -12,10 +12,9 @@ use crate::output::frame::{Cell, Frame};
 
 /// A cell that is not drawn this frame.
 pub(super) const SKIP: u8 = 0;
-/// A cell drawn as a space (or full block) of one colour, `flat[i]`.
-pub(super) const FLAT: u8 = 1;
-/// A cell drawn exactly as wanted.
-pub(super) const EXACT: u8 = 2;
+/// A cell drawn exactly as wanted. Choices `1..=MAX_VARIANTS` draw the cell's variant of that
+/// rank.
+pub(super) const EXACT: u8 = u8::MAX;
 
 /// The terminal's cursor and the colours in effect (`None`: unknown).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -48,10 +47,10 @@ pub(super) struct Plan<'a> {
     pub shown: &'a Frame,
     /// The wanted frame.
     pub wanted: &'a Frame,
-    /// Per cell: [`SKIP`], [`FLAT`] or [`EXACT`].
+    /// Per cell: [`SKIP`], [`EXACT`] or the rank of a variant.
     pub choice: &'a [u8],
-    /// Per cell, the colour of its flat variant (read only where the choice is [`FLAT`]).
-    pub flat: &'a [Color],
+    /// Per cell, its variants by rank (read only where the choice is a rank).
+    pub variants: &'a [[Cell; super::MAX_VARIANTS]],
 }
 
 impl Plan<'_> {
@@ -67,8 +66,8 @@ impl Plan<'_> {
             }
             let (x, y) = (i % cols, i / cols);
             let cell = match choice {
-                FLAT => Cell::Pixels { top: self.flat[i], bottom: self.flat[i] },
-                _ => self.wanted.get(x, y),
+                EXACT => self.wanted.get(x, y),
+                rank => self.variants[i][usize::from(rank) - 1],
             };
             let (before, saved) = (out.len(), pen);
             self.reach(&mut pen, (x, y), out);

@@ -234,7 +234,7 @@ fn frames_to_converge(mode: ColorMode, rate: usize, approximate: bool) -> (usize
     let (still, p) = busy_frame(cols as u32, rows as u32, 10, mode);
     // Drawn one at a time, a cell costs at most an absolute move (8 bytes here), its colour
     // codes from a fresh pen and its glyph.
-    let alone: usize = still.cells().iter().map(|&c| best_draw(c, None, None).len(None, None) + 8).sum();
+    let alone: usize = still.cells().iter().map(|&c| diff::best_draw(c, None, None).len(None, None) + 8).sum();
     for n in 1..=1000 {
         let report = frame(&mut shown, Target::with_truth(&still, &p, mode), &mut screen);
         if report.pending == 0 {
