@@ -5,6 +5,7 @@ use tiny_skia::{ColorU8, Pixmap};
 use super::*;
 use crate::output::bucket::ByteBucket;
 use crate::output::diff;
+use crate::output::oklab;
 use crate::output::vt::Screen;
 
 fn picture(cols: u32, rows: u32, f: impl Fn(u32, u32) -> [u8; 3]) -> Pixmap {
@@ -162,43 +163,66 @@ fn field_with_changes(changes: &[(usize, u8)]) -> (Frame, Frame) {
 
 #[test]
 fn the_largest_errors_go_first() {
-    // Three big changes scattered late in screen order, thirty small ones early.
-    let mut changes: Vec<(usize, u8)> = (0..30).map(|i| (i * 3, 2)).collect();
-    changes.extend([(150, 120), (200, 90), (239, 60)]);
+    // Every change noticeable, of many sizes, scattered; the three largest late in screen
+    // order, in cells of their own colours (so each costs about the same).
+    let mut changes: Vec<(usize, u8)> = (0..40).map(|i| (i * 5 + 1, 20 + (i % 7) as u8 * 5)).collect();
+    changes.extend([(212, 150), (225, 140), (238, 130)]);
     let (before, after) = field_with_changes(&changes);
     let options = RateOptions { sync: false, ..RateOptions::default() };
     let (_, shown) = encode(&Shown::UNKNOWN, Target::new(&before), UNLIMITED, options);
-    // Enough for the three big cells and a little more, far from enough for all.
-    let (bytes, next) = encode(&shown, Target::new(&after), 150, options);
-    assert!(bytes.len() <= 150);
+    // Enough for about three cells of the forty-three.
+    let (bytes, next) = encode(&shown, Target::new(&after), 90, options);
+    assert!(bytes.len() <= 90);
     let model = next.frame.as_ref().unwrap();
-    for (i, delta) in &changes {
-        let sent = model.get(i % 40, i / 40) == after.get(i % 40, i / 40);
-        if *delta >= 60 {
-            assert!(sent, "the change of {delta} at cell {i} was sent");
-        }
-    }
-    // The naive order sends the early small ones instead.
+    // Drawn exactly or approximately: touched.
+    let touched: Vec<u8> = changes
+        .iter()
+        .filter(|(i, _)| model.get(i % 40, i / 40) != before.get(i % 40, i / 40))
+        .map(|&(_, d)| d)
+        .collect();
+    assert_eq!(touched, [150, 140, 130], "the three largest changes only: {:?}", String::from_utf8_lossy(&bytes));
+    // The naive order sends the early ones instead.
     let naive = RateOptions { strategy: Strategy::ScanOrder, ..options };
-    let (_, scan) = encode(&shown, Target::new(&after), 150, naive);
-    assert_ne!(scan.frame.as_ref().unwrap().get(30, 3), after.get(30, 3), "naive did not reach the big change");
+    let (_, scan) = encode(&shown, Target::new(&after), 90, naive);
+    assert_ne!(scan.frame.as_ref().unwrap().get(212 % 40, 212 / 40), after.get(212 % 40, 212 / 40));
+}
+
+/// The largest grey step from 100 that stays below `fraction` of the JND (or the smallest at
+/// or above it, when `above`).
+fn grey_step(fraction: f32, above: bool) -> u8 {
+    let grey = oklab::from_rgb([100; 3]);
+    let distance = |d: u8| grey.distance(oklab::from_rgb([100 + d; 3]));
+    if above {
+        (1..100).find(|&d| distance(d) >= fraction * JND).unwrap()
+    } else {
+        (1..100).take_while(|&d| distance(d) < fraction * JND).last().unwrap()
+    }
 }
 
 #[test]
 fn changes_below_the_jnd_wait_while_larger_ones_are_pending() {
-    // One noticeable change and many unnoticeable ones that are individually cheaper per
-    // unit of error... but below the JND.
-    let mut changes: Vec<(usize, u8)> = (0..20).map(|i| (i, 3)).collect();
-    changes.push((235, 40));
-    let (before, after) = field_with_changes(&changes);
+    // A run of thirty cells whose both halves changed just below the JND: cheap (after the
+    // first, each is a space in the colour already in effect) and together worth more per
+    // byte than one isolated cell whose upper half changed just above it.
+    let (small, big) = (grey_step(0.95, false), grey_step(1.05, true));
+    let (mut before, _) = field_with_changes(&[]);
+    before.set(20, 5, Cell::Pixels { top: Color::Rgb([100; 3]), bottom: Color::Rgb([7, 50, 200]) });
+    let mut after = before.clone();
+    for x in 0..30 {
+        after.set(x, 0, Cell::Pixels { top: Color::Rgb([100 + small; 3]), bottom: Color::Rgb([100 + small; 3]) });
+    }
+    after.set(20, 5, Cell::Pixels { top: Color::Rgb([100 + big; 3]), bottom: Color::Rgb([7, 50, 200]) });
     let options = RateOptions { sync: false, ..RateOptions::default() };
     let (_, shown) = encode(&Shown::UNKNOWN, Target::new(&before), UNLIMITED, options);
-    // A budget for about one cell: it must be the noticeable one.
-    let (bytes, next) = encode(&shown, Target::new(&after), 45, options);
+    // A budget for the noticeable cell, or for most of the run.
+    let (bytes, next) = encode(&shown, Target::new(&after), 40, options);
     let model = next.frame.as_ref().unwrap();
     assert!(!bytes.is_empty());
-    assert_eq!(model.get(235 % 40, 235 / 40), after.get(235 % 40, 235 / 40), "{:?}", String::from_utf8_lossy(&bytes));
-    assert!((0..20).all(|i| model.get(i, 0) == before.get(i, 0)), "no small change went before it");
+    assert_eq!(model.get(20, 5), after.get(20, 5), "{:?}", String::from_utf8_lossy(&bytes));
+    assert!((0..30).all(|x| model.get(x, 0) == before.get(x, 0)), "no change below the JND went before it");
+    // Once it is sent, the run follows.
+    let (_, next) = encode(&next, Target::new(&after), 200, options);
+    assert!((0..30).all(|x| next.frame.as_ref().unwrap().get(x, 0) == after.get(x, 0)));
 }
 
 /// Whether two frames look the same (a space's foreground does not matter).
@@ -407,6 +431,8 @@ mod properties {
             let strategy = if naive { Order::ScanOrder } else { Order::ErrorPerByte };
             let options = RateOptions { sync, approximate, strategy, ..RateOptions::default() };
             let mut screen = terminal(cols, rows);
+            // Whatever the terminal showed before: the first frame must not rely on it.
+            screen.feed("\x1b[38;5;1;48;5;2mgarbage\u{2580}".repeat(cols * rows).as_bytes());
             let mut shown = Shown::UNKNOWN;
             let mut encoder = RateEncoder::new();
             for (i, frame) in frames.iter().enumerate() {
