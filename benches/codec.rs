@@ -21,6 +21,7 @@
 //!     CODEC=table cargo bench --bench codec    # the table only (about a minute)
 //!     CODEC=cpu cargo bench --bench codec      # the CPU figures only
 //!     CODEC=stale cargo bench --bench codec    # PSNR of the true frame k frames late
+//!     CODEC=quick cargo bench --bench codec    # the rate-controlled rows alone, for tuning
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::hint::black_box;

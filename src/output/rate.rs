@@ -263,7 +263,8 @@ impl RateEncoder {
             let left = budget.saturating_sub(overhead + prefix.len());
             Room { one: left, many: left }
         };
-        let (candidates, alone) = self.mark(frame, wanted, options);
+        let weigh = budget != UNLIMITED && options.strategy == Strategy::ErrorPerByte;
+        let (candidates, alone) = self.mark(frame, wanted, options, weigh);
         let end = match self.everything_fits(frame, wanted, pen, room, alone, options) {
             Some(end) => end,
             None => {

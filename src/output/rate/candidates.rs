@@ -366,9 +366,10 @@ impl RateEncoder {
         *palette
     }
 
-    /// Marks the cells that differ (`self.candidate`) and their bytes drawn exactly alone
-    /// (`self.fresh`); returns how many there are and those bytes in all.
-    pub(super) fn mark(&mut self, shown: &Frame, wanted: &Frame, options: RateOptions) -> (usize, usize) {
+    /// Marks the cells that differ (`self.candidate`) and, when they are to be weighed, their
+    /// bytes drawn exactly alone (`self.fresh`); returns how many there are and those bytes in
+    /// all.
+    pub(super) fn mark(&mut self, shown: &Frame, wanted: &Frame, options: RateOptions, weigh: bool) -> (usize, usize) {
         // A new frame: every memo stamped with an older count is stale.
         self.frames = self.frames.wrapping_add(1);
         if self.frames == 0 {
@@ -379,7 +380,9 @@ impl RateEncoder {
         for (i, (s, w)) in shown.cells().iter().zip(wanted.cells()).enumerate() {
             let changed = !s.close_to(w, options.threshold);
             self.candidate[i] = changed;
-            if changed {
+            if changed && !weigh {
+                count += 1;
+            } else if changed {
                 let fresh = draw_cost(*w, None) + MOVE_ESTIMATE;
                 self.fresh[i] = fresh.min(usize::from(u16::MAX)) as u16;
                 count += 1;
