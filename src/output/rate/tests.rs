@@ -97,6 +97,19 @@ fn unlimited_is_byte_identical_to_the_diff_encoder() {
 }
 
 #[test]
+fn a_single_cell_goes_without_the_sync_markers() {
+    let (a, _) = busy_frame(12, 5, 1, ColorMode::TrueColor);
+    let mut b = a.clone();
+    b.set(7, 2, Cell::Pixels { top: Color::Rgb([1, 2, 3]), bottom: Color::Rgb([4, 5, 6]) });
+    let (_, old) = diff::encode(&Shown::UNKNOWN, &a, EncodeOptions::default());
+    let (today, _) = diff::encode(&old, &b, EncodeOptions::default());
+    let (bytes, next) = encode(&old, Target::new(&b), UNLIMITED, RateOptions::default());
+    assert_eq!(bytes.len() + SYNC_BEGIN.len() + SYNC_END.len(), today.len());
+    assert_eq!(&today[SYNC_BEGIN.len()..today.len() - SYNC_END.len()], &bytes[..]);
+    assert_eq!(next.frame.as_ref(), Some(&b));
+}
+
+#[test]
 fn the_terminal_shows_what_the_model_claims_under_any_budget() {
     for mode in [ColorMode::TrueColor, ColorMode::Palette256, ColorMode::Palette16] {
         for budget in [40, 90, 300, 1500, UNLIMITED] {
