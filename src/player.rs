@@ -3,7 +3,7 @@
 //! loop over any input and output, such as an SSH channel.
 
 pub use crate::term::player::{
-    DEFAULT_STONE_RADIUS, PlayerConfig, STONE_RADII, TEST_PANIC_VAR, TerminalInput, picture_size, run,
+    Bandwidth, DEFAULT_STONE_RADIUS, PlayerConfig, STONE_RADII, TEST_PANIC_VAR, TerminalInput, picture_size, run,
 };
 pub use crate::term::screen::{FrameBuilder, Overlay};
 pub use crate::term::tty::{ENTER, RESTORE, play, restore};

@@ -4,6 +4,7 @@
 //! `FromStr` instead; these are the plain numbers.
 
 pub use crate::numbers::finite as parse_number;
+pub use crate::sim::breeze::{DEFAULT_LEVEL as DEFAULT_BREEZE, MAX_LEVEL as MAX_BREEZE, parse_level as parse_breeze};
 pub use crate::sim::lake::{parse_octaves, parse_persistence};
 pub use crate::sim::rain::parse_rate as parse_rain_rate;
 pub use crate::sim::wind::{parse_lake_wind, parse_sea_wind};

@@ -118,15 +118,16 @@ impl io::Write for FrameCounter {
     }
 }
 
-/// The player's real loop on a fake terminal, at 240 fps so the test is quick; returns the
+/// The player's real loop on a fake terminal, at 60 fps (a step every frame, so every frame is
+/// drawn and sent); returns the
 /// allocations of [`COUNTED`] frames after [`WARM_UP`].
 fn player_frames(scene: SceneSpec) -> usize {
     let quit = Arc::new(AtomicBool::new(false));
     let marks = Arc::new(Mutex::new(Vec::with_capacity(2)));
     let config = PlayerConfig {
         scenes: vec![scene],
-        fps: 240,
-        max_bps: None,
+        fps: 60,
+        bandwidth: tidepool::player::Bandwidth::Unlimited,
         color: ColorMode::TrueColor,
         encode: EncodeOptions { threshold: 0, sync: true },
         seed: 1,

@@ -64,12 +64,12 @@ impl Shown {
 }
 
 /// The upper half block `▀`, lower half block `▄` and full block `█`.
-const UPPER: char = '\u{2580}';
-const LOWER: char = '\u{2584}';
-const FULL: char = '\u{2588}';
+pub(crate) const UPPER: char = '\u{2580}';
+pub(crate) const LOWER: char = '\u{2584}';
+pub(crate) const FULL: char = '\u{2588}';
 
 /// Length of one SGR colour parameter list (without `ESC[` and `m`).
-fn color_params_len(c: Color, background: bool) -> usize {
+pub(crate) fn color_params_len(c: Color, background: bool) -> usize {
     let digits = |v: u8| match v {
         0..=9 => 1,
         10..=99 => 2,
@@ -101,7 +101,7 @@ fn push_u8(out: &mut Vec<u8>, v: u8) {
     out.push(b'0' + v % 10);
 }
 
-fn push_color_params(out: &mut Vec<u8>, c: Color, background: bool) {
+pub(crate) fn push_color_params(out: &mut Vec<u8>, c: Color, background: bool) {
     let base = if background { 40 } else { 30 };
     match c {
         Color::Default => push_u8(out, base + 9),
@@ -126,15 +126,15 @@ fn push_color_params(out: &mut Vec<u8>, c: Color, background: bool) {
 
 /// A glyph with the colours it needs (`None`: this colour does not matter).
 #[derive(Clone, Copy)]
-struct Draw {
-    ch: char,
-    fg: Option<Color>,
-    bg: Option<Color>,
+pub(crate) struct Draw {
+    pub(crate) ch: char,
+    pub(crate) fg: Option<Color>,
+    pub(crate) bg: Option<Color>,
 }
 
 impl Draw {
     /// Bytes of SGR needed before printing, given the colours in effect.
-    fn sgr_len(&self, pen_fg: Option<Color>, pen_bg: Option<Color>) -> usize {
+    pub(crate) fn sgr_len(&self, pen_fg: Option<Color>, pen_bg: Option<Color>) -> usize {
         let fg = self.fg.filter(|&c| pen_fg != Some(c));
         let bg = self.bg.filter(|&c| pen_bg != Some(c));
         match (fg, bg) {
@@ -145,13 +145,13 @@ impl Draw {
         }
     }
 
-    fn len(&self, pen_fg: Option<Color>, pen_bg: Option<Color>) -> usize {
+    pub(crate) fn len(&self, pen_fg: Option<Color>, pen_bg: Option<Color>) -> usize {
         self.sgr_len(pen_fg, pen_bg) + self.ch.len_utf8()
     }
 }
 
 /// The cheapest way to draw `cell` with the colours in effect.
-fn best_draw(cell: Cell, fg: Option<Color>, bg: Option<Color>) -> Draw {
+pub(crate) fn best_draw(cell: Cell, fg: Option<Color>, bg: Option<Color>) -> Draw {
     match cell {
         Cell::Text { ch, fg: f, bg: b } => Draw { ch, fg: (ch != ' ').then_some(f), bg: Some(b) },
         Cell::Pixels { top, bottom } if top == bottom => {

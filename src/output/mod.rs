@@ -2,6 +2,7 @@
 
 #[cfg(feature = "animation")]
 pub mod apng;
+pub mod bucket;
 pub mod color;
 pub mod cursor;
 pub mod diff;
@@ -11,6 +12,9 @@ pub mod gif;
 pub mod graphics;
 pub mod halfblock;
 pub mod heightmap;
+pub mod oklab;
 pub mod png;
+pub mod quality;
+pub mod rate;
 pub mod units;
 pub mod vt;

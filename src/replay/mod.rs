@@ -121,6 +121,9 @@ pub struct PoolOptions {
     pub sun: Sun,
     /// The floor image, or `null` for the built-in tiles.
     pub background: Option<PathBuf>,
+    /// The breeze's level; a header without it (recorded before the breeze existed) means 0.
+    #[serde(default, deserialize_with = "breeze")]
+    pub breeze: f64,
 }
 
 impl PoolOptions {
@@ -136,6 +139,7 @@ impl PoolOptions {
             depth: caustics.unwrap_or_default().depth_px(),
             sun: settings.look.sun,
             background,
+            breeze: settings.breeze,
         }
     }
 
@@ -146,6 +150,7 @@ impl PoolOptions {
         PoolSettings {
             damping: self.damping,
             rain_rate: self.rain,
+            breeze: self.breeze,
             seed,
             look: PoolLook { refraction: self.refraction, shading: self.shading, caustics, sun: self.sun },
             floor,
@@ -384,7 +389,7 @@ fn parse_event(line: &str, limits: &Limits) -> Result<Entry, String> {
     let name = map.keys().next().expect("one entry").clone();
     if !Event::NAMES.contains(&name.as_str()) {
         return Err(format!(
-            "unknown event \"{name}\"; this tidepool knows stone, rain, damping, clear, resize, screenshot, wind, noise and end"
+            "unknown event \"{name}\"; this tidepool knows stone, rain, damping, breeze, clear, resize, screenshot, wind, noise and end"
         ));
     }
     if name == "resize" {
@@ -438,6 +443,11 @@ mod display_from_str {
 fn rain<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
     let text = crate::numbers::text_or_number(deserializer)?;
     crate::sim::rain::parse_rate(&text).map_err(|e| serde::de::Error::custom(format!("rain: {e}")))
+}
+
+fn breeze<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
+    let text = crate::numbers::text_or_number(deserializer)?;
+    crate::sim::breeze::parse_level(&text).map_err(|e| serde::de::Error::custom(format!("breeze: {e}")))
 }
 
 fn depth<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<f32, D::Error> {

@@ -25,6 +25,9 @@ pub enum Event {
     /// The damping changed.
     #[serde(with = "damping")]
     Damping(Damping),
+    /// The breeze's level changed (0: still water).
+    #[serde(with = "breeze")]
+    Breeze(f64),
     /// The water was stilled.
     #[serde(serialize_with = "flag::serialize", deserialize_with = "flag::deserialize")]
     Clear,
@@ -55,8 +58,8 @@ pub enum Event {
 
 impl Event {
     /// The names of the events, as the replay file spells them.
-    pub const NAMES: [&'static str; 9] =
-        ["stone", "rain", "damping", "clear", "resize", "screenshot", "wind", "noise", "end"];
+    pub const NAMES: [&'static str; 10] =
+        ["stone", "rain", "damping", "breeze", "clear", "resize", "screenshot", "wind", "noise", "end"];
 }
 
 /// `true` in the file; nothing else is accepted.
@@ -100,6 +103,20 @@ mod rain {
     pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
         let rate = f64::deserialize(deserializer)?;
         crate::sim::rain::check_rate(rate).map_err(|e| serde::de::Error::custom(format!("bad rain: {e}")))
+    }
+}
+
+/// A level, checked by [`crate::sim::breeze::check_level`].
+mod breeze {
+    use super::*;
+
+    pub fn serialize<S: Serializer>(level: &f64, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_f64(*level)
+    }
+
+    pub fn deserialize<'de, D: Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
+        let level = f64::deserialize(deserializer)?;
+        crate::sim::breeze::check_level(level).map_err(|e| serde::de::Error::custom(format!("bad breeze: {e}")))
     }
 }
 
@@ -187,6 +204,7 @@ mod tests {
         round_trip(Event::Stone(Stone::new(-3, 4, 5, 160).unwrap()), r#"{"stone":[-3,4,5,160]}"#);
         round_trip(Event::Rain(0.25), r#"{"rain":0.25}"#);
         round_trip(Event::Damping(Damping::OFF), r#"{"damping":"off"}"#);
+        round_trip(Event::Breeze(1.5), r#"{"breeze":1.5}"#);
         round_trip(Event::Clear, r#"{"clear":true}"#);
         round_trip(Event::Resize([30, 12]), r#"{"resize":[30,12]}"#);
         round_trip(Event::Screenshot("a b.png".into()), r#"{"screenshot":"a b.png"}"#);

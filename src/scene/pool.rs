@@ -7,6 +7,7 @@ use crate::error::{Error, Result};
 use crate::output::heightmap::Heightmap;
 use crate::render::background;
 use crate::render::pool::{PoolLook, PoolRenderer};
+use crate::sim::breeze::Breeze;
 use crate::sim::rain::Rain;
 use crate::sim::ripple::{Damping, RipplePool, Stone};
 use crate::simd::Simd;
@@ -18,6 +19,8 @@ pub struct PoolSettings {
     pub damping: Damping,
     /// Raindrops per step on average (0 for none; at most 10,000).
     pub rain_rate: f64,
+    /// The breeze's level (0: the papers' still water; at most 4).
+    pub breeze: f64,
     /// Seed of the rain.
     pub seed: u64,
     /// How the water is drawn.
@@ -27,11 +30,13 @@ pub struct PoolSettings {
 }
 
 impl Default for PoolSettings {
-    /// The papers' damping, no rain, seed 1, the default look over the built-in tiled floor.
+    /// The papers' damping, no rain, no breeze, seed 1, the default look over the built-in tiled
+    /// floor.
     fn default() -> Self {
         PoolSettings {
             damping: Damping::PAPERS,
             rain_rate: 0.0,
+            breeze: 0.0,
             seed: 1,
             look: PoolLook::default(),
             floor: background::pool_floor(),
@@ -44,20 +49,23 @@ impl Default for PoolSettings {
 pub struct PoolScene {
     pool: RipplePool,
     rain: Rain,
+    breeze: Breeze,
     renderer: PoolRenderer,
     floor: Pixmap,
     drops: Vec<Stone>,
     /// The rate `r` switches the rain back on to.
     rain_when_on: f64,
+    /// The level `b` switches the breeze back on to.
+    breeze_when_on: f64,
 }
 
 /// The rain rate the player's `r` key switches on when the pool started without rain.
 pub const DEFAULT_TOGGLE_RAIN: f64 = 0.02;
-/// The weight of a stone dropped by the player. At terminal size a ring of weight 48 still
-/// reads clearly, and every changed cell costs ~36 bytes in exact truecolor, so a heavier
-/// default stone would set the whole pool in motion and cost every frame (measured: the
-/// README's bytes-per-frame figure).
-pub const PLAYER_STONE_WEIGHT: i16 = 48;
+/// The weight of a stone dropped by the player. With the papers' integer damping a ring of
+/// weight 48 is flattened within a second (small amplitudes lose a unit a step), so it neither
+/// crosses the pool nor stands out from the breeze; a ring of 128 crosses most of a
+/// 160-pixel pool and dominates the wavelets.
+pub const PLAYER_STONE_WEIGHT: i16 = 128;
 /// A right click drops a stone this many times wider and twice as heavy.
 pub const BIG_STONE_FACTOR: u32 = 2;
 /// Stirring drops small light stones this many pixels apart along the drag.
@@ -76,10 +84,12 @@ impl PoolScene {
         Some(PoolScene {
             pool: RipplePool::new(width as usize, height as usize, settings.damping),
             rain: Rain::new(settings.rain_rate, settings.seed),
+            breeze: Breeze::new(settings.breeze, settings.seed),
             renderer: PoolRenderer::new(fitted, settings.look),
             floor: settings.floor,
             drops: Vec::new(),
             rain_when_on: if settings.rain_rate > 0.0 { settings.rain_rate } else { DEFAULT_TOGGLE_RAIN },
+            breeze_when_on: if settings.breeze > 0.0 { settings.breeze } else { crate::sim::breeze::DEFAULT_LEVEL },
         })
     }
 
@@ -110,23 +120,27 @@ impl PoolScene {
         self.pool.drop_stone(stone);
     }
 
-    /// `steps` simulation steps: each step's raindrops land, then the water moves.
+    /// `steps` simulation steps: each step the breeze adds its wave packets, the raindrops
+    /// land, then the water moves.
     ///
     /// The rain is drawn step by step (so the random stream is the same as single steps), and
     /// the calm runs between raindrops go to [`RipplePool::advance`] in one piece, which
-    /// computes them many times faster than single steps.
+    /// computes them many times faster than single steps. A breeze touches every step, so with
+    /// one the steps run one at a time.
     pub fn advance(&mut self, steps: u64) {
         let (width, height) = (self.pool.width(), self.pool.height());
+        let breezy = self.breeze.level() > 0.0;
         let mut calm = 0;
         for _ in 0..steps {
             self.drops.clear();
             self.rain.drops(width, height, &mut self.drops);
-            if self.drops.is_empty() {
+            if self.drops.is_empty() && !breezy {
                 calm += 1;
                 continue;
             }
             self.pool.advance(calm);
             calm = 0;
+            self.breeze.excite(&mut self.pool);
             for &drop in &self.drops {
                 self.pool.drop_stone(drop);
             }
@@ -231,6 +245,12 @@ impl Scene for PoolScene {
                 self.rain.set_rate(rate);
             }
             Event::Damping(d) => self.pool.set_damping(d),
+            Event::Breeze(level) => {
+                if level > 0.0 {
+                    self.breeze_when_on = level;
+                }
+                self.breeze.set_level(level);
+            }
             Event::Clear => self.pool.clear(),
             Event::Resize([w, h]) => {
                 PoolScene::resize(self, w, h);
@@ -284,6 +304,10 @@ impl Controls for PoolScene {
                 let d = self.pool.damping();
                 vec![Event::Damping(if stronger { d.stronger() } else { d.weaker() })]
             }
+            Action::Key('b') => {
+                let level = if self.breeze.level() > 0.0 { 0.0 } else { self.breeze_when_on };
+                vec![Event::Breeze(level)]
+            }
             Action::Key(_) => Vec::new(),
         }
     }
@@ -295,11 +319,14 @@ impl Controls for PoolScene {
             rate if rate > 0.0 => write!(out, "rain {rate}"),
             _ => write!(out, "rain off"),
         };
+        if self.breeze.level() > 0.0 {
+            let _ = write!(out, " \u{b7} breeze {}", self.breeze.level());
+        }
         let _ = write!(out, " \u{b7} damping {}", self.pool.damping());
     }
 
     fn help(&self) -> Vec<(&'static str, &'static str)> {
-        vec![("r", "rain on/off"), ("c", "clear the water"), ("[ ]", "damp more / less")]
+        vec![("r", "rain on/off"), ("b", "breeze on/off"), ("c", "clear the water"), ("[ ]", "damp more / less")]
     }
 }
 
@@ -378,7 +405,7 @@ mod tests {
     fn actions_resolve_to_events_that_apply() {
         let mut scene = PoolScene::new(40, 30, settings(0.0)).unwrap();
         let events = scene.resolve(Action::Stone { x: 10, y: 12, radius: 3, big: true });
-        assert_eq!(events, vec![Event::Stone(Stone::new(10, 12, 6, 96).unwrap())]);
+        assert_eq!(events, vec![Event::Stone(Stone::new(10, 12, 6, 256).unwrap())]);
         scene.apply(&events[0]);
         assert!(scene.pool().heights()[12 * 40 + 10] < 0);
         let stir = scene.resolve(Action::Stir { from: (5, 5), to: (15, 5) });

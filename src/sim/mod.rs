@@ -1,5 +1,6 @@
 //! Simulations: state that advances in time. Nothing here draws or does I/O.
 
+pub mod breeze;
 pub mod fbm;
 pub mod lake;
 pub mod noise;

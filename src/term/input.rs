@@ -78,6 +78,9 @@ pub enum Input {
     Resize(u16, u16),
     /// The terminal answered a cursor position request (`CSI 6n`): row and column, from 1.
     CursorReport(u16, u16),
+    /// The terminal answered a device attributes request (`CSI c`): the player's round-trip
+    /// measurement.
+    DeviceAttributes,
 }
 
 /// An incremental parser: feed it bytes as they arrive, get inputs out.
@@ -283,7 +286,9 @@ fn parse_csi(b: &[u8], stale: bool) -> Parsed {
                 _ => None,
             }
         }
-        // Device attributes, mode reports, window reports, graphics attributes, unknown keys.
+        (Some(b'?'), b'c') => Some(Input::DeviceAttributes),
+        // Other device attributes, mode reports, window reports, graphics attributes, unknown
+        // keys.
         _ => None,
     };
     Parsed::Item(len, input)

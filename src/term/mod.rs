@@ -4,6 +4,7 @@
 //! bytes themselves come from the pure encoder in [`crate::output::diff`].
 
 pub mod input;
+pub mod link;
 pub mod pacing;
 pub mod player;
 pub mod probe;

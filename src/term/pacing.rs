@@ -57,19 +57,18 @@ impl SimClock {
     }
 }
 
-/// Decides when the next frame may be drawn: at most `fps` a second, and no faster than
-/// `max_bps` lets the last frame's bytes through.
+/// Decides when the next frame may be drawn: at most `fps` a second. (How many bytes a frame
+/// may send is the byte bucket's business: see `output/bucket.rs`.)
 #[derive(Clone, Debug)]
 pub struct FramePacer {
     interval: Duration,
-    max_bps: Option<u64>,
     next: Instant,
 }
 
 impl FramePacer {
-    /// A pacer for `fps` frames a second and an optional byte rate, ready at `now`.
-    pub fn new(fps: u32, max_bps: Option<u64>, now: Instant) -> FramePacer {
-        FramePacer { interval: Duration::from_secs_f64(1.0 / f64::from(fps.max(1))), max_bps, next: now }
+    /// A pacer for `fps` frames a second, ready at `now`.
+    pub fn new(fps: u32, now: Instant) -> FramePacer {
+        FramePacer { interval: Duration::from_secs_f64(1.0 / f64::from(fps.max(1))), next: now }
     }
 
     /// When the next frame is due.
@@ -82,16 +81,12 @@ impl FramePacer {
         now >= self.next
     }
 
-    /// Notes that a frame of `bytes` was sent (or skipped, with 0 bytes) at `now`.
-    pub fn sent(&mut self, now: Instant, bytes: usize) {
+    /// Notes that a frame was sent (or skipped) at `now`.
+    pub fn sent(&mut self, now: Instant) {
         // Keep the cadence; if more than a frame late, start again from now.
         let mut next = self.next + self.interval;
         if next < now {
             next = now + self.interval;
-        }
-        if let Some(bps) = self.max_bps {
-            let budget = Duration::from_secs_f64(bytes as f64 / bps as f64);
-            next = next.max(now + budget);
         }
         self.next = next;
     }
@@ -173,17 +168,14 @@ mod tests {
     }
 
     #[test]
-    fn pacer_keeps_the_frame_rate_and_the_byte_budget() {
+    fn pacer_keeps_the_frame_rate() {
         let t0 = Instant::now();
-        let mut p = FramePacer::new(25, None, t0);
+        let mut p = FramePacer::new(25, t0);
         assert!(p.ready(t0));
-        p.sent(t0, 10_000);
+        p.sent(t0);
         assert!(!p.ready(t0 + ms(39)) && p.ready(t0 + ms(40)));
-        let mut capped = FramePacer::new(25, Some(100_000), t0);
-        capped.sent(t0, 10_000);
-        assert!(!capped.ready(t0 + ms(99)) && capped.ready(t0 + ms(100)), "10 kB at 100 kB/s: 10 fps");
-        capped.sent(t0 + ms(100), 100);
-        assert!(capped.ready(t0 + ms(140)), "small frames go at the full rate");
+        p.sent(t0 + ms(200));
+        assert!(!p.ready(t0 + ms(239)) && p.ready(t0 + ms(240)), "a late frame starts the cadence again");
     }
 
     #[test]

@@ -17,14 +17,17 @@ use rand_chacha::ChaCha8Rng;
 use tiny_skia::Pixmap;
 
 use super::input::{Input, InputParser, coalesce};
+use super::link::{self, Change, LinkControl};
 use super::pacing::{FramePacer, Meter, SimClock};
 use super::screen::{FrameBuilder, Overlay, big_enough};
 use super::ui;
 use super::writer::FrameWriter;
 use crate::error::{Error, Result};
+use crate::output::bucket::ByteBucket;
 use crate::output::color::ColorMode;
-use crate::output::diff::{EncodeOptions, Shown, encode_into};
+use crate::output::diff::{EncodeOptions, Shown};
 use crate::output::frame::Frame;
+use crate::output::rate::{RateEncoder, RateOptions, Target};
 use crate::replay::{FORMAT, Header, PoolOptions, Recorder};
 use crate::scene::{Action, Event, Playable, SceneSpec};
 use crate::storage::Storage;
@@ -39,6 +42,9 @@ const AIM_VISIBLE: Duration = Duration::from_secs(4);
 const MESSAGE_VISIBLE: Duration = Duration::from_secs(4);
 /// How long [`PlayerConfig::greeting`] stays.
 const GREETING_VISIBLE: Duration = Duration::from_secs(10);
+/// How long the player waits, when it quits, for the answers to its last questions (so that
+/// they do not reach the shell).
+const REPLY_GRACE: Duration = Duration::from_millis(300);
 /// The longest the loop waits for input before looking at the clock, the size and the quit flag.
 const MAX_WAIT: Duration = Duration::from_millis(50);
 /// Random stones use their own generator, seeded from `--seed` xor this, so that pressing
@@ -58,6 +64,20 @@ pub trait TerminalInput: Send {
     fn size(&mut self) -> std::io::Result<(u16, u16)>;
 }
 
+/// How many bytes a second the player may send.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Bandwidth {
+    /// Found by itself from the terminal's answers (see `term/link.rs`).
+    Auto,
+    /// This many bytes a second.
+    Fixed(u64),
+    /// No limit: every frame is sent whole (what changed of it).
+    Unlimited,
+}
+
+/// Above this rate approximate cells are not worth their CPU: the link carries exact ones.
+const APPROXIMATE_BELOW: f64 = 1_000_000.0;
+
 /// How the player runs.
 #[derive(Clone)]
 pub struct PlayerConfig {
@@ -65,8 +85,8 @@ pub struct PlayerConfig {
     pub scenes: Vec<SceneSpec>,
     /// Display frames per second.
     pub fps: u32,
-    /// Output byte rate cap.
-    pub max_bps: Option<u64>,
+    /// What the link carries.
+    pub bandwidth: Bandwidth,
     /// Terminal colours.
     pub color: ColorMode,
     /// Encoder options.
@@ -88,6 +108,7 @@ impl std::fmt::Debug for PlayerConfig {
         f.debug_struct("PlayerConfig")
             .field("scenes", &self.scenes.iter().map(SceneSpec::kind).collect::<Vec<_>>())
             .field("fps", &self.fps)
+            .field("bandwidth", &self.bandwidth)
             .field("color", &self.color)
             .finish_non_exhaustive()
     }
@@ -192,7 +213,17 @@ impl Player {
         let writer = FrameWriter::spawn(move |bytes| output.write_all(bytes).and_then(|()| output.flush()))
             .map_err(Error::Output)?;
         let start = Instant::now();
-        let mut pacer = FramePacer::new(self.config.fps, self.config.max_bps, start);
+        let mut pacer = FramePacer::new(self.config.fps, start);
+        let auto = self.config.bandwidth == Bandwidth::Auto;
+        let mut link = LinkControl::new();
+        let mut bucket = match self.config.bandwidth {
+            Bandwidth::Auto => ByteBucket::new(link::START_RATE),
+            Bandwidth::Fixed(rate) => ByteBucket::new(rate as f64),
+            Bandwidth::Unlimited => ByteBucket::unlimited(),
+        };
+        let mut encoder = RateEncoder::new();
+        // Every byte written, for the link's delivery rate.
+        let mut bytes_sent = 0u64;
         let mut meter = Meter::new(start);
         let mut shown = Shown::UNKNOWN;
         let (w, h) = self.scene.size();
@@ -205,9 +236,9 @@ impl Player {
         // A buffer kept back from a frame that had nothing to send, so it is not lost.
         let mut unused: Option<Vec<u8>> = None;
         let read_error = |source| Error::Terminal { action: "cannot read the terminal", source };
-        loop {
+        'play: loop {
             if self.config.quit.load(Ordering::SeqCst) {
-                return Ok(());
+                break 'play;
             }
             let now = Instant::now();
             let mut deadline = self.sim.next_due().map_or(pacer.next_due(), |s| s.min(pacer.next_due()));
@@ -227,13 +258,30 @@ impl Player {
             if size != self.term {
                 inputs.push(Input::Resize(size.0, size.1));
             }
+            // A key or a click draws its frame at once, not at the next tick.
+            let mut urgent = false;
             for input in coalesce(inputs.drain(..)) {
-                if let Input::Resize(..) = input {
-                    shown = Shown::UNKNOWN;
+                match input {
+                    Input::DeviceAttributes => {
+                        if auto && link.answered(now) == Change::Down {
+                            bucket.drain();
+                        }
+                        continue;
+                    }
+                    Input::CursorReport(..) => continue,
+                    Input::Resize(..) => shown = Shown::UNKNOWN,
+                    _ => {}
                 }
+                urgent = true;
                 if let Flow::Quit = self.handle(input)? {
-                    return Ok(());
+                    break 'play;
                 }
+            }
+            if auto {
+                if link.tick(now) == Change::Down {
+                    bucket.drain();
+                }
+                bucket.set_rate(link.rate());
             }
             let now = Instant::now();
             let due = self.sim.due(now);
@@ -246,12 +294,12 @@ impl Player {
                 return Err(Error::Output(e));
             }
             meter.tick(now);
-            if !pacer.ready(now) {
+            if !pacer.ready(now) && !urgent {
                 continue;
             }
             if !writer.idle() {
                 // The terminal is still busy with the last frame: drop this one.
-                pacer.sent(now, 0);
+                pacer.sent(now);
                 continue;
             }
             let size = self.scene.size();
@@ -262,21 +310,59 @@ impl Player {
                     height: size.1,
                 })?;
             }
-            let frame = self.frame(&mut builder, &mut pixmap, &meter, now);
+            bucket.refill(now);
+            let rate = bucket.rate();
+            let frame = self.frame(&mut builder, &mut pixmap, &meter, rate, now);
+            let target = match self.config.color {
+                ColorMode::TrueColor => Target::new(frame),
+                mode => Target::with_truth(frame, &pixmap, mode),
+            };
+            let options = RateOptions {
+                approximate: rate.is_some_and(|r| r < APPROXIMATE_BELOW),
+                ..RateOptions::from(self.config.encode)
+            };
             let mut bytes = unused.take().unwrap_or_else(|| writer.buffer());
-            encode_into(&mut shown, frame, self.config.encode, &mut bytes);
+            let report = encoder.encode_into(&mut shown, target, bucket.budget(), options, &mut bytes);
+            bucket.spend(report.bytes);
+            if auto && report.bytes > 0 && link.probe_due() {
+                // The question goes after the frame: its answer says the frame has arrived.
+                bytes.extend_from_slice(link::PROBE);
+                link.probed(now, bytes_sent + bytes.len() as u64);
+            }
             let len = bytes.len();
+            bytes_sent += len as u64;
             if len > 0 {
                 writer.send(bytes);
             } else {
                 unused = Some(bytes);
             }
             meter.frame(now, len);
-            pacer.sent(now, len);
+            pacer.sent(now);
             if test_panic && len > 0 {
                 panic!("{TEST_PANIC_VAR} is set: panicking on purpose to test the terminal restore");
             }
         }
+        // A question asked but not yet answered would reach the shell as typed text once the
+        // terminal is restored: wait a little for the answers (and for the last frame, which
+        // carries the question, to be written).
+        let grace = Instant::now() + REPLY_GRACE;
+        while !link.probe_due() && Instant::now() < grace {
+            bytes_in.clear();
+            let wait = grace.saturating_duration_since(Instant::now());
+            if !writer.idle() {
+                std::thread::sleep(wait.min(Duration::from_millis(2)));
+                continue;
+            }
+            if !input.read(&mut bytes_in, wait.min(MAX_WAIT)).map_err(read_error)? {
+                break;
+            }
+            inputs.clear();
+            parser.feed(&bytes_in, Instant::now(), &mut inputs);
+            for _ in inputs.iter().filter(|i| **i == Input::DeviceAttributes) {
+                link.answered(Instant::now());
+            }
+        }
+        Ok(())
     }
 
     /// The frame to show now, built by `builder` (which keeps its buffers between frames).
@@ -285,6 +371,7 @@ impl Player {
         builder: &'b mut FrameBuilder,
         pixmap: &mut Pixmap,
         meter: &Meter,
+        bandwidth: Option<f64>,
         now: Instant,
     ) -> &'b Frame {
         let overlay = Overlay {
@@ -293,6 +380,7 @@ impl Player {
             message: self.message.as_ref().filter(|(_, until)| now < *until).map(|(m, _)| m.as_str()),
             fps: meter.fps,
             bytes_per_second: meter.bytes_per_second,
+            bandwidth: bandwidth.map(|b| b as u64),
             stone: self.radius,
             paused: self.sim.paused(),
         };
@@ -384,7 +472,7 @@ impl Player {
                     self.aim = (self.aim.0.min(size.0 as i32 - 1), self.aim.1.min((size.1 as i32 - 1) & !1));
                 }
             }
-            Input::CursorReport(..) => {}
+            Input::CursorReport(..) | Input::DeviceAttributes => {}
         }
         Ok(Flow::Continue)
     }

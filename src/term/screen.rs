@@ -7,7 +7,7 @@ use tiny_skia::Pixmap;
 use super::ui::{self, MIN_SIZE, Status};
 use crate::output::color::ColorMode;
 use crate::output::frame::Frame;
-use crate::output::units::write_human_rate;
+use crate::output::units::{write_human_bytes, write_human_rate};
 use crate::scene::Playable;
 
 /// What goes over the picture this frame.
@@ -23,6 +23,8 @@ pub struct Overlay<'a> {
     pub fps: u32,
     /// Bytes sent per second.
     pub bytes_per_second: u64,
+    /// The link's rate in effect, bytes per second (`None`: no limit).
+    pub bandwidth: Option<u64>,
     /// The stone radius in pixels (shown when the scene takes stones).
     pub stone: u32,
     /// Whether the simulation is paused.
@@ -30,7 +32,7 @@ pub struct Overlay<'a> {
 }
 
 /// Bytes reserved for the formatted byte rate.
-const RATE_ROOM: usize = 16;
+const RATE_ROOM: usize = 40;
 /// Bytes reserved for the scene's status summary.
 const DETAIL_ROOM: usize = 128;
 
@@ -85,6 +87,12 @@ impl FrameBuilder {
             ui::help_overlay(&mut self.frame, lines, color);
         }
         write_human_rate(&mut self.rate, overlay.bytes_per_second);
+        if let Some(bandwidth) = overlay.bandwidth {
+            // The rate in effect: what the link is found (or told) to carry.
+            self.rate.push_str(" of ");
+            write_human_bytes(&mut self.rate, bandwidth);
+            self.rate.push_str("/s");
+        }
         scene.status(&mut self.detail);
         let status = Status {
             scene: scene.kind().name(),

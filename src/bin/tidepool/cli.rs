@@ -80,8 +80,9 @@ pub struct BenchArgs {
 }
 
 const PLAY_KEYS: &str = "\
-Keys: space stone at random · arrows/hjkl aim, enter drop · r rain · c clear · +/- stone size ·
-[/] damping · p pause · s screenshot (PNG) · tab next scene · ? help · q, Esc, Ctrl-C quit.
+Keys: space stone at random · arrows/hjkl aim, enter drop · r rain · b breeze · c clear ·
++/- stone size · [/] damping · p pause · s screenshot (PNG) · tab next scene · ? help ·
+q, Esc, Ctrl-C quit.
 Mouse: left click drops a stone, drag stirs the water, right click drops a big stone.
 The lake: 0-9 wind by Beaufort number · [/] less/more wind · c calm · o/O octaves ·
 </> persistence · n value/gradient noise.
@@ -89,15 +90,17 @@ The lake: 0-9 wind by Beaufort number · [/] less/more wind · c calm · o/O oct
 Examples:
   tidepool                                      # the pool, full screen
   tidepool play pool --rain 0.1 --damping 6     # more rain, longer ripples
-  tidepool play --max-bps 200k                  # a slow SSH link: cap the output rate
+  tidepool play --bandwidth 200k                # a fixed link rate (default: found by itself)
+  tidepool play --breeze 0 --rain 0             # the papers' still water
   tidepool play --record s.jsonl                # then: tidepool render pool --replay s.jsonl
   tidepool play lake --wind 0                   # a calm lake mirroring its shore";
 
 /// `tidepool play [scene]`.
 ///
-/// The player damps more than `render` (shift 4, not 5): a terminal pool is a few hundred
-/// pixels at most, and at the papers' damping a ring crosses it twice before it fades, so the
-/// water never settles, looks busy and costs every cell's bytes on every frame.
+/// The player's water is alive at rest: a light breeze, rain you can see, and stones whose
+/// rings cross the pool (damping shift 6, a little less than the papers' 5, because the
+/// breeze's wavelets keep the water moving; the rate-controlled encoder makes that affordable
+/// on any link).
 #[derive(Args, Debug, Clone)]
 #[command(after_help = PLAY_KEYS, mut_arg("damping", |a| a.default_value(PLAYER_DAMPING)))]
 pub struct PlayCommand {
@@ -141,9 +144,15 @@ pub struct PlayCommand {
     #[arg(long)]
     pub no_sync: bool,
 
-    /// Cap the output at N bytes per second (suffixes k and M: 200k, 1.5M) by lowering the
-    /// frame rate, for slow links.
-    #[arg(long, value_name = "N", value_parser = parse_bps)]
+    /// Bytes per second the link carries: `auto` finds it by itself from the terminal's
+    /// answers (and adapts as it changes), a number (suffixes k and M: 200k, 1.5M) fixes it,
+    /// `unlimited` sends every change whole. On a slow link the picture is sent approximately
+    /// and refined as the budget allows; frames never queue up.
+    #[arg(long, value_name = "BYTES/s|auto|unlimited", default_value = "auto", value_parser = parse_bandwidth)]
+    pub bandwidth: tidepool::player::Bandwidth,
+
+    /// The same as --bandwidth N (kept for scripts written before --bandwidth).
+    #[arg(long, value_name = "N", value_parser = parse_bps, conflicts_with = "bandwidth", hide = true)]
     pub max_bps: Option<u64>,
 
     /// Record the session as JSON lines, for `tidepool render pool --replay FILE` (the pool only).
@@ -152,7 +161,7 @@ pub struct PlayCommand {
 }
 
 /// The player's default `--damping`.
-pub const PLAYER_DAMPING: &str = "4";
+pub const PLAYER_DAMPING: &str = "6";
 
 /// The scenes `play` knows; `tab` cycles through them in this order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -190,6 +199,16 @@ pub enum ColorChoice {
     Palette16,
 }
 
+/// Parses `--bandwidth`: `auto`, `unlimited` or a byte rate.
+pub fn parse_bandwidth(text: &str) -> Result<tidepool::player::Bandwidth, String> {
+    use tidepool::player::Bandwidth;
+    match text.trim() {
+        t if t.eq_ignore_ascii_case("auto") => Ok(Bandwidth::Auto),
+        t if t.eq_ignore_ascii_case("unlimited") || t.eq_ignore_ascii_case("off") => Ok(Bandwidth::Unlimited),
+        t => parse_bps(t).map(Bandwidth::Fixed).map_err(|e| format!("{e}, or auto or unlimited")),
+    }
+}
+
 /// Parses a byte rate: a whole number with an optional `k` (1000) or `M` (1,000,000) suffix.
 pub fn parse_bps(text: &str) -> Result<u64, String> {
     let t = text.trim();
@@ -204,7 +223,7 @@ pub fn parse_bps(text: &str) -> Result<u64, String> {
         return Err(format!("'{text}' is below 1k bytes per second, too little to draw a frame; e.g. 200k"));
     }
     if bytes > 1e12 {
-        return Err(format!("'{text}' is beyond any link; leave --max-bps out for no cap"));
+        return Err(format!("'{text}' is beyond any link; use unlimited for no cap"));
     }
     Ok(bytes as u64)
 }
@@ -316,9 +335,14 @@ pub struct OutputArgs {
 #[derive(Args, Debug, Clone)]
 pub struct PoolArgs {
     /// Raindrops per simulation step on average (radius 2, weight 64), a number >= 0.
-    /// [default: 0 for render, 0.02 for play]
+    /// [default: 0 for render, 0.05 for play]
     #[arg(long, value_name = "RATE", value_parser = parse_rate, allow_negative_numbers = true)]
     pub rain: Option<f64>,
+
+    /// A light breeze of fine wavelets running over the water, so it is never still (0..=4;
+    /// 0 is the papers' still water). [default: 0 for render, 1 for play]
+    #[arg(long, value_name = "LEVEL", value_parser = parse_breeze, allow_negative_numbers = true)]
+    pub breeze: Option<f64>,
 
     /// Damping: each step the water loses 1/2^SHIFT of its amplitude (SHIFT 1..=15; higher
     /// calms more slowly), or `off` for none.
@@ -368,12 +392,14 @@ impl PoolArgs {
         }
     }
 
-    /// The pool's settings from these flags, with `seed` and the rain when `--rain` is not
-    /// given; the floor is `--background` decoded, or the built-in tiles.
-    pub fn settings(&self, seed: u64, default_rain: f64) -> crate::error::Result<tidepool::PoolSettings> {
+    /// The pool's settings from these flags, with `seed`, and the rain and breeze when
+    /// `--rain` and `--breeze` are not given; the floor is `--background` decoded, or the
+    /// built-in tiles.
+    pub fn settings(&self, seed: u64, defaults: (f64, f64)) -> crate::error::Result<tidepool::PoolSettings> {
         Ok(tidepool::PoolSettings {
             damping: self.damping,
-            rain_rate: self.rain.unwrap_or(default_rain),
+            rain_rate: self.rain.unwrap_or(defaults.0),
+            breeze: self.breeze.unwrap_or(defaults.1),
             seed,
             look: self.look(),
             floor: self.floor()?,
@@ -445,6 +471,11 @@ pub fn parse_rate(text: &str) -> Result<f64, String> {
     values::parse_rain_rate(text).map_err(|e| e.to_string())
 }
 
+/// Parses a breeze level, 0..=4.
+pub fn parse_breeze(text: &str) -> Result<f64, String> {
+    values::parse_breeze(text).map_err(|e| e.to_string())
+}
+
 /// Parses a refraction factor (finite, 0..=100) or `auto`.
 pub fn parse_refraction(text: &str) -> Result<Refraction, String> {
     check(text)
@@ -482,6 +513,18 @@ mod tests {
     }
 
     #[test]
+    fn bandwidths() {
+        use tidepool::player::Bandwidth;
+        assert_eq!(parse_bandwidth("auto"), Ok(Bandwidth::Auto));
+        assert_eq!(parse_bandwidth("unlimited"), Ok(Bandwidth::Unlimited));
+        assert_eq!(parse_bandwidth("250k"), Ok(Bandwidth::Fixed(250_000)));
+        for bad in ["0", "-5k", "fast", ""] {
+            assert!(parse_bandwidth(bad).unwrap_err().contains("auto or unlimited"), "{bad}");
+        }
+        assert!(Cli::try_parse_from(["tidepool", "play", "--bandwidth", "1k", "--max-bps", "2k"]).is_err());
+    }
+
+    #[test]
     fn byte_rates() {
         assert_eq!(parse_bps("200k"), Ok(200_000));
         assert_eq!(parse_bps("1.5M"), Ok(1_500_000));
@@ -510,7 +553,8 @@ mod tests {
         let cli = Cli::try_parse_from(["tidepool", "play"]).unwrap();
         let Some(Command::Play(play)) = cli.command else { panic!("not play") };
         assert_eq!((play.scene, play.fps, play.color, play.pool.rain), (PlayScene::Pool, 30, ColorChoice::Auto, None));
-        assert_eq!(play.pool.damping.shift(), Some(4), "the player damps more than render");
+        assert_eq!(play.pool.damping.shift(), Some(6), "the player's own damping");
+        assert_eq!(play.bandwidth, tidepool::player::Bandwidth::Auto);
         let cli = Cli::try_parse_from(["tidepool", "render", "pool"]).unwrap();
         let Some(Command::Render(RenderCommand { scene: RenderScene::Pool(pool) })) = cli.command else { panic!() };
         assert_eq!(pool.pool.damping, Damping::PAPERS);

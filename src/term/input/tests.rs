@@ -59,8 +59,9 @@ fn mouse_reports() {
 fn terminal_replies_are_never_keys() {
     // A kitty graphics reply, device attributes, a mode report, a cell size, XTSMGRAPHICS,
     // an OSC colour reply and an XTGETTCAP reply, in one burst with one real key after them.
-    let burst = b"\x1b_Gi=31;OK\x1b\\\x1b[?62;4;22c\x1b[?1016;2$y\x1b[6;16;8t\x1b[?1;0;256S\x1b]11;rgb:0000/0000/0000\x07\x1bP1+r544e=787465726d\x1b\\5";
+    let burst = b"\x1b_Gi=31;OK\x1b\\\x1b[>1;10;0c\x1b[?1016;2$y\x1b[6;16;8t\x1b[?1;0;256S\x1b]11;rgb:0000/0000/0000\x07\x1bP1+r544e=787465726d\x1b\\5";
     assert_eq!(parse(burst), vec![Input::Other('5')]);
+    assert_eq!(parse(b"\x1b[?62;4;22c"), vec![Input::DeviceAttributes], "the round trip's answer");
     assert_eq!(parse(b"\x1b[12;40R"), vec![Input::CursorReport(12, 40)]);
 }
 

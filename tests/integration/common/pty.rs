@@ -9,11 +9,18 @@ use std::time::{Duration, Instant};
 use portable_pty::{Child, CommandBuilder, ExitStatus, MasterPty, PtySize, native_pty_system};
 use tidepool::terminal::Screen;
 
+/// The primary device attributes question the player asks after frames, and a VT220-like
+/// answer (as xterm gives).
+const DA1_QUESTION: &[u8] = b"\x1b[c";
+const DA1_ANSWER: &[u8] = b"\x1b[?62;22c";
+
 /// A player running in a pty.
 pub struct Player {
     pub child: Box<dyn Child + Send + Sync>,
     pub master: Box<dyn MasterPty + Send>,
-    writer: Box<dyn Write + Send>,
+    /// The keyboard side, shared with the reader thread (which answers the player's device
+    /// attributes questions, as a terminal does).
+    writer: Arc<Mutex<Box<dyn Write + Send>>>,
     output: Arc<Mutex<Vec<u8>>>,
     /// The reader saw the end of the output (every end of the pty closed: the player exited).
     drained: Arc<AtomicBool>,
@@ -48,7 +55,8 @@ impl Player {
         let child = pair.slave.spawn_command(cmd).unwrap();
         drop(pair.slave);
         let mut reader = pair.master.try_clone_reader().unwrap();
-        let writer = pair.master.take_writer().unwrap();
+        let writer = Arc::new(Mutex::new(pair.master.take_writer().unwrap()));
+        let answers = Arc::clone(&writer);
         let output = Arc::new(Mutex::new(Vec::new()));
         let sink = Arc::clone(&output);
         let drained = Arc::new(AtomicBool::new(false));
@@ -59,7 +67,16 @@ impl Player {
                 if n == 0 {
                     break;
                 }
-                sink.lock().unwrap().extend_from_slice(&buf[..n]);
+                let mut out = sink.lock().unwrap();
+                // A question may straddle two reads: look from just before this chunk.
+                let from = out.len().saturating_sub(2);
+                out.extend_from_slice(&buf[..n]);
+                let questions = out[from..].windows(3).filter(|w| *w == DA1_QUESTION).count();
+                drop(out);
+                for _ in 0..questions {
+                    let mut w = answers.lock().unwrap();
+                    let _ = w.write_all(DA1_ANSWER).and_then(|()| w.flush());
+                }
             }
             done.store(true, Ordering::SeqCst);
         });
@@ -68,8 +85,9 @@ impl Player {
 
     /// Types bytes into the terminal.
     pub fn send(&mut self, bytes: &[u8]) {
-        self.writer.write_all(bytes).unwrap();
-        self.writer.flush().unwrap();
+        let mut w = self.writer.lock().unwrap();
+        w.write_all(bytes).unwrap();
+        w.flush().unwrap();
     }
 
     /// Everything written so far.

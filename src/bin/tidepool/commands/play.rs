@@ -15,8 +15,9 @@ use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneKind, Sc
 use crate::cli::{ColorChoice, PlayCommand};
 use crate::error::{Error, Result};
 
-/// The player's rain when `--rain` is not given: about one drop a second at 60 steps/s.
-pub const DEFAULT_PLAYER_RAIN: f64 = 0.02;
+/// The player's rain when `--rain` is not given: three drops a second at 60 steps/s, seen as
+/// small rings.
+pub const DEFAULT_PLAYER_RAIN: f64 = 0.05;
 /// `--color-threshold` when `SSH_CONNECTION` is set: invisible in a moving picture, and it
 /// saves the bytes of colours that only flicker by a step or two.
 pub const SSH_COLOR_THRESHOLD: u8 = 3;
@@ -66,7 +67,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
     if let Some(path) = &command.record {
         crate::files::check_writable(path).map_err(|message| Error::arg("--record", message))?;
     }
-    let pool = command.pool.settings(command.seed, DEFAULT_PLAYER_RAIN)?;
+    let pool = command.pool.settings(command.seed, (DEFAULT_PLAYER_RAIN, tidepool::values::DEFAULT_BREEZE))?;
     let default_view = OceanView::default();
     let ocean = OceanSettings {
         sea: SeaParams {
@@ -95,7 +96,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
     let config = PlayerConfig {
         scenes,
         fps: command.fps,
-        max_bps: command.max_bps,
+        bandwidth: command.max_bps.map_or(command.bandwidth, tidepool::player::Bandwidth::Fixed),
         color,
         encode: EncodeOptions { threshold, sync: !command.no_sync },
         seed: command.seed,

@@ -1,0 +1,148 @@
+//! The byte budget of the rate-controlled encoder: a bucket filled at the link's rate, from
+//! which each frame takes what it sends.
+//!
+//! What a frame does not spend carries over, so a rate smaller than one cell a frame (1 kB/s
+//! is 33 bytes a frame at 30 fps, less than one truecolor cell with its synchronized-output
+//! markers) still sends a cell every few frames. The bucket holds at most [`MAX_BURST`] of
+//! the rate (and never less than [`MIN_CAPACITY`] bytes, enough for any single cell): after a
+//! quiet spell, one frame may send a burst that the link drains in that time, and no more, so
+//! that no backlog forms behind it. Time comes in as an argument, so tests run on made-up
+//! clocks.
+
+use std::time::{Duration, Instant};
+
+/// The most link time one frame may fill after the bucket has been left to fill up.
+pub const MAX_BURST: Duration = Duration::from_millis(100);
+/// The smallest capacity, in bytes: room for the costliest cell (a jump, both truecolor codes
+/// and a glyph, about 50 bytes), the screen clear and the synchronized-output markers.
+pub const MIN_CAPACITY: f64 = 256.0;
+
+/// A byte bucket refilled at a fixed rate, or an unlimited one.
+#[derive(Clone, Debug)]
+pub struct ByteBucket {
+    /// Bytes per second; `None` for no limit.
+    rate: Option<f64>,
+    level: f64,
+    last: Option<Instant>,
+}
+
+impl ByteBucket {
+    /// A bucket filled at `bytes_per_second` (at least 1), starting empty.
+    pub fn new(bytes_per_second: f64) -> ByteBucket {
+        ByteBucket { rate: Some(bytes_per_second.max(1.0)), level: 0.0, last: None }
+    }
+
+    /// A bucket that never runs dry: [`ByteBucket::budget`] is
+    /// [`crate::output::rate::UNLIMITED`].
+    pub fn unlimited() -> ByteBucket {
+        ByteBucket { rate: None, level: 0.0, last: None }
+    }
+
+    /// The rate in bytes per second (`None`: unlimited).
+    pub fn rate(&self) -> Option<f64> {
+        self.rate
+    }
+
+    /// Changes the rate from now on (what is in the bucket stays, up to the new capacity).
+    pub fn set_rate(&mut self, bytes_per_second: Option<f64>) {
+        self.rate = bytes_per_second.map(|r| r.max(1.0));
+        self.level = self.level.min(self.capacity());
+    }
+
+    /// The most the bucket holds, in bytes.
+    pub fn capacity(&self) -> f64 {
+        match self.rate {
+            Some(rate) => (rate * MAX_BURST.as_secs_f64()).max(MIN_CAPACITY),
+            None => f64::INFINITY,
+        }
+    }
+
+    /// Adds the bytes the rate allows since the last refill (nothing at the first call, which
+    /// starts the clock).
+    pub fn refill(&mut self, now: Instant) {
+        if let (Some(rate), Some(last)) = (self.rate, self.last) {
+            let elapsed = now.saturating_duration_since(last).as_secs_f64();
+            self.level = (self.level + rate * elapsed).min(self.capacity());
+        }
+        if self.last.is_none_or(|last| now > last) {
+            self.last = Some(now);
+        }
+    }
+
+    /// The bytes the next frame may send.
+    pub fn budget(&self) -> usize {
+        match self.rate {
+            // A hair over, so that 99.99999 bytes of float arithmetic is the 100 it stands for.
+            Some(_) => (self.level + 1e-6) as usize,
+            None => crate::output::rate::UNLIMITED,
+        }
+    }
+
+    /// Takes the bytes a frame sent.
+    pub fn spend(&mut self, bytes: usize) {
+        if self.rate.is_some() {
+            self.level = (self.level - bytes as f64).max(0.0);
+        }
+    }
+
+    /// Empties the bucket (for example when the link is found congested).
+    pub fn drain(&mut self) {
+        self.level = 0.0;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const FRAME: Duration = Duration::from_nanos(1_000_000_000 / 30);
+
+    #[test]
+    fn a_small_rate_adds_up_over_frames() {
+        let start = Instant::now();
+        let mut bucket = ByteBucket::new(1000.0);
+        bucket.refill(start);
+        assert_eq!(bucket.budget(), 0, "starts empty");
+        let mut budgets = Vec::new();
+        for frame in 1..=4 {
+            bucket.refill(start + FRAME * frame);
+            budgets.push(bucket.budget());
+        }
+        assert_eq!(budgets, [33, 66, 100, 133], "1 kB/s is 33 bytes a frame, carried over");
+        bucket.spend(120);
+        assert_eq!(bucket.budget(), 13);
+    }
+
+    #[test]
+    fn the_bucket_holds_at_most_a_burst() {
+        let start = Instant::now();
+        let mut bucket = ByteBucket::new(100_000.0);
+        bucket.refill(start);
+        bucket.refill(start + Duration::from_secs(10));
+        assert_eq!(bucket.budget(), 10_000, "100 ms of 100 kB/s");
+        let mut slow = ByteBucket::new(10.0);
+        slow.refill(start);
+        slow.refill(start + Duration::from_secs(100));
+        assert_eq!(slow.budget(), MIN_CAPACITY as usize, "room for a cell even on a very slow link");
+        slow.set_rate(Some(1.0));
+        assert_eq!(slow.budget(), MIN_CAPACITY as usize);
+    }
+
+    #[test]
+    fn a_clock_going_backwards_adds_nothing() {
+        let start = Instant::now() + Duration::from_secs(5);
+        let mut bucket = ByteBucket::new(1000.0);
+        bucket.refill(start);
+        bucket.refill(start - Duration::from_secs(1));
+        bucket.refill(start + Duration::from_millis(100));
+        assert_eq!(bucket.budget(), 100);
+    }
+
+    #[test]
+    fn unlimited_is_unlimited() {
+        let mut bucket = ByteBucket::unlimited();
+        bucket.refill(Instant::now());
+        bucket.spend(1 << 30);
+        assert_eq!(bucket.budget(), crate::output::rate::UNLIMITED);
+    }
+}
