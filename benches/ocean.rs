@@ -13,7 +13,7 @@ use tidepool::sim::ocean::SeaParams;
 
 fn scene(width: u32, height: u32, ssaa: u32) -> OceanScene {
     let settings = OceanSettings {
-        sea: SeaParams { wind_m_s: 10.0, wind_from_deg: 330.0, seed: 1 },
+        sea: SeaParams { wind_m_s: 10.0, wind_from_deg: 330.0, seed: 1, ..SeaParams::default() },
         view: OceanView { ssaa, ..OceanView::default() },
     };
     OceanScene::new(settings, width, height, SeaTexture::builtin()).expect("valid size")

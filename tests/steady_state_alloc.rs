@@ -58,8 +58,10 @@ fn ocean_frames_allocate_only_inside_tiny_skia(w: u32, h: u32) {
     use tidepool::render::texture::SeaTexture;
     use tidepool::scene::ocean::{OceanScene, OceanSettings};
     use tidepool::sim::ocean::SeaParams;
-    let settings =
-        OceanSettings { sea: SeaParams { wind_m_s: 10.0, wind_from_deg: 330.0, seed: 1 }, view: OceanView::default() };
+    let settings = OceanSettings {
+        sea: SeaParams { wind_m_s: 10.0, wind_from_deg: 330.0, seed: 1, ..SeaParams::default() },
+        view: OceanView::default(),
+    };
     let mut scene = OceanScene::new(settings, w, h, SeaTexture::builtin()).unwrap();
     tidepool::scene::playable::Playable::render(&mut scene, &mut tiny_skia::Pixmap::new(w, h).unwrap());
     let triangles = scene.renderer().triangle_count();

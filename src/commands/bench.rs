@@ -57,7 +57,12 @@ fn rough_pool(w: usize, h: usize) -> RipplePool {
 fn other_scenes(w: u32, h: u32, ssaa: u32) -> Vec<(&'static str, Box<dyn Playable>)> {
     let mut scenes: Vec<(&'static str, Box<dyn Playable>)> = Vec::new();
     let ocean = OceanSettings {
-        sea: SeaParams { wind_m_s: crate::cli::ocean::DEFAULT_WIND_M_S, wind_from_deg: 330.0, seed: 1 },
+        sea: SeaParams {
+            wind_m_s: crate::cli::ocean::DEFAULT_WIND_M_S,
+            wind_from_deg: 330.0,
+            seed: 1,
+            ..SeaParams::default()
+        },
         view: OceanView { ssaa, ..OceanView::default() },
     };
     if let Some(scene) = OceanScene::new(ocean, w, h, SeaTexture::builtin()) {

@@ -26,7 +26,12 @@ pub fn default_ssaa(format: Format) -> u32 {
 /// The validated settings of a `render ocean` command line.
 pub fn settings(args: &RenderOcean, format: Format) -> OceanSettings {
     OceanSettings {
-        sea: SeaParams { wind_m_s: args.wind.speed_m_s(), wind_from_deg: args.direction, seed: args.output.seed },
+        sea: SeaParams {
+            wind_m_s: args.wind.speed_m_s(),
+            wind_from_deg: args.direction,
+            seed: args.output.seed,
+            ..SeaParams::default()
+        },
         view: OceanView {
             camera: args.camera.unwrap_or(CameraPose::DEFAULT),
             sun_azimuth_deg: args.sun.0 as f32,

@@ -75,6 +75,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
             wind_m_s: command.wind.speed_m_s(),
             wind_from_deg: command.direction.unwrap_or(crate::cli::ocean::DEFAULT_DIRECTION_DEG),
             seed: command.seed,
+            ..SeaParams::default()
         },
         view: OceanView {
             sun_azimuth_deg: command.pool.sun.map_or(default_view.sun_azimuth_deg, |s| s.azimuth_deg),

@@ -180,7 +180,7 @@ mod tests {
 
     #[test]
     fn renders_opaque_and_deterministic_and_supersampled() {
-        let sea = Sea::new(SeaParams { wind_m_s: 9.0, wind_from_deg: 300.0, seed: 3 });
+        let sea = Sea::new(SeaParams { wind_m_s: 9.0, wind_from_deg: 300.0, seed: 3, ..SeaParams::default() });
         let frame = sea.frame(2.0);
         let draw = |ssaa| {
             let view = OceanView { ssaa, ..OceanView::default() };

@@ -252,7 +252,7 @@ mod tests {
 
     fn scene(wind: f64) -> OceanScene {
         let settings = OceanSettings {
-            sea: SeaParams { wind_m_s: wind, wind_from_deg: 0.0, seed: 5 },
+            sea: SeaParams { wind_m_s: wind, wind_from_deg: 0.0, seed: 5, ..SeaParams::default() },
             view: OceanView::default(),
         };
         OceanScene::new(settings, 64, 36, SeaTexture::builtin()).unwrap()
