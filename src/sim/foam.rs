@@ -262,8 +262,41 @@ impl FoamTracker {
 mod tests {
     use super::*;
     use crate::sim::looping::LoopPeriod;
-    use crate::sim::ocean::SeaParams;
+    use crate::sim::ocean::{SeaParams, whitecap_fraction};
     use crate::sim::spectra::{SeaSpectrum, SpectrumChoice};
+
+    /// Mean foam over a grid of resting points (not the calibration's probes) followed for
+    /// `seconds` after the warm-up, one value per foam step.
+    pub(crate) fn measured_coverage(sea: &Sea, seconds: f64) -> f64 {
+        let span = 16.0 * sea.spectrum().peak_wavelength_m().unwrap() as f32;
+        let points: Vec<[f32; 2]> = (0..1024)
+            .map(|i| [span * ((i % 32) as f32 + 0.5) / 32.0 - 900.0, span * ((i / 32) as f32 + 0.5) / 32.0])
+            .collect();
+        let footprints = vec![Footprint::default(); points.len()];
+        let mut tracker = FoamTracker::new();
+        let step = FoamClock::of(sea).step_s();
+        let (mut sum, mut count) = (0.0f64, 0usize);
+        let mut t = 500.0;
+        while t < 500.0 + seconds {
+            sum += tracker.update(sea, &points, &footprints, t).iter().map(|&f| f64::from(f)).sum::<f64>();
+            count += points.len();
+            t += step;
+        }
+        sum / count as f64
+    }
+
+    #[test]
+    fn whitecaps_follow_monahan() {
+        // The calibration aims at Monahan's fraction; measured elsewhere and later, the foam
+        // must stay within half of it (no absolute slack: zero foam fails).
+        assert!((whitecap_fraction(10.0) - 3.84e-6 * 10f64.powf(3.41)).abs() < 1e-12);
+        for wind in [8.0, 15.0, 22.0] {
+            let sea = Sea::new(SeaParams { wind_m_s: wind, choppiness: 1.0, seed: 4, ..SeaParams::default() });
+            let want = whitecap_fraction(wind);
+            let cover = measured_coverage(&sea, 20.0);
+            assert!((cover / want - 1.0).abs() < 0.5, "U = {wind}: {cover} vs Monahan {want}");
+        }
+    }
 
     #[test]
     fn memory_fades_and_forgets_exactly() {
