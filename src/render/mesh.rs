@@ -169,6 +169,11 @@ impl MeshTopology {
         &self.footprints
     }
 
+    /// Pixels between neighbouring samples.
+    pub fn spacing_px(&self) -> f32 {
+        self.spacing_px
+    }
+
     /// Triangles as point indices, far to near.
     pub fn triangles(&self) -> &[[u32; 3]] {
         &self.triangles
@@ -434,7 +439,7 @@ struct Face {
 
 /// Samples the surface at every point, in parallel chunks (the result does not depend on how
 /// the chunks are spread over cores: each point is sampled alone).
-fn sample_all<S: Surface + ?Sized>(
+pub(crate) fn sample_all<S: Surface + ?Sized>(
     surface: &S,
     ground: &[[f32; 2]],
     footprints: &[Footprint],

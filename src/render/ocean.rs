@@ -1,5 +1,10 @@
 //! The ocean renderer: sky, then the sea mesh, at `ssaa` times the size, filtered down.
 //!
+//! The sea is sampled at the mesh's vertices (displaced sideways by its choppiness), its foam
+//! followed at those resting points through time ([`FoamTracker`]: a still picture warms it
+//! up, a stream of frames continues it), and drawn with smooth shading and per-pixel foam
+//! ([`super::smooth`]).
+//!
 //! The mesh density is tied to the output resolution ([`mesh_spacing_px`]): about 3 output
 //! pixels between samples for a terminal frame (so its few pixels still show facets), growing
 //! to about 8 at 1920x1080 so the triangle count (and time) stays bounded while each facet
@@ -9,12 +14,35 @@
 use tiny_skia::Pixmap;
 
 use super::camera::{Camera, CameraPose};
+use super::foam_texture::{FOAM_STREAK, FOAM_TILE_ACROSS_M};
 use super::mesh::{MeshRenderer, Shading};
 use super::shade::{Facet, WaterLook, shade_facet};
 use super::sky::Sky;
+use super::smooth::{FoamLayout, SmoothShader};
 use super::supersample::{Downsample, downsample};
 use super::texture::SeaTexture;
-use crate::sim::ocean::{SeaFrame, cox_munk_slope_variance};
+use crate::sim::foam::FoamTracker;
+use crate::sim::ocean::{Sea, SeaFrame, cox_munk_slope_variance};
+
+/// How fast foam drifts downwind with the surface water, as a fraction of the wind speed
+/// (the wind drift of the top centimetres, about 3 %).
+pub const FOAM_DRIFT_FRACTION: f64 = 0.03;
+
+/// How far the foam texture has drifted downwind at `time_s`, m: modulo one texture length,
+/// and for a looping sea at a speed that crosses a whole number of texture lengths per loop.
+pub fn foam_drift_m(sea: &Sea, time_s: f64) -> f32 {
+    let length = f64::from(FOAM_TILE_ACROSS_M * FOAM_STREAK);
+    let speed = FOAM_DRIFT_FRACTION * sea.params().wind_m_s;
+    match sea.params().loop_period {
+        Some(p) => {
+            let lengths = (speed * p.seconds() / length).round() as u64;
+            let (_, tick) = p.loops_and_tick(time_s);
+            let turns = lengths.wrapping_mul(u64::from(tick)) & 0xFFFF_FFFF;
+            (turns as f64 / 4_294_967_296.0 * length) as f32
+        }
+        None => (speed * time_s).rem_euclid(length) as f32,
+    }
+}
 
 /// How the sea is looked at.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,6 +90,8 @@ pub struct OceanRenderer {
     texture: SeaTexture,
     look: WaterLook,
     mesh: MeshRenderer,
+    smooth: SmoothShader,
+    foam: FoamTracker,
     supersampled: Option<Pixmap>,
 }
 
@@ -85,6 +115,8 @@ impl OceanRenderer {
             texture,
             look: WaterLook::default(),
             mesh: MeshRenderer::new(),
+            smooth: SmoothShader::new(),
+            foam: FoamTracker::new(),
             supersampled,
         })
     }
@@ -147,18 +179,28 @@ impl OceanRenderer {
 
     /// Draws `frame` into `out`, which must be `width x height`.
     ///
+    /// Foam continues from the previous frame when the sea and camera are the same and time
+    /// moved on; otherwise it is warmed up ([`crate::sim::foam::FoamClock::warm_up_steps`]),
+    /// so a frame's picture does not depend on the frames drawn before it.
+    ///
     /// # Panics
     /// When `out` has another size (a programming error).
     pub fn render(&mut self, frame: &SeaFrame<'_>, out: &mut Pixmap) {
         assert_eq!((out.width(), out.height()), (self.width, self.height), "output size");
         let spacing = mesh_spacing_px(self.width, self.height) * self.view.ssaa as f32;
-        self.mesh.prepare(&self.camera, spacing);
-        let below = self.far_sea(frame.sea().params().wind_m_s);
+        if self.mesh.prepare(&self.camera, spacing) {
+            self.foam.reset();
+        }
+        let sea = frame.sea();
+        let below = self.far_sea(sea.params().wind_m_s);
+        let Some(topology) = self.mesh.topology() else { return };
+        let foam = self.foam.update(sea, topology.points(), topology.footprints(), frame.time_s());
+        let layout = FoamLayout { downwind: sea.downwind(), drift_m: foam_drift_m(sea, frame.time_s()) };
         let shading =
             Shading { environment: &self.sky, light: self.sky.light(), look: self.look, texture: &self.texture };
         let target = self.supersampled.as_mut().unwrap_or(out);
         self.sky.draw(&self.camera, below, target);
-        self.mesh.draw(frame, &shading, target);
+        self.smooth.draw(topology, frame, foam, layout, &shading, target);
         if let Some(big) = &self.supersampled {
             downsample(big, self.view.ssaa, self.view.downsample, out);
         }

@@ -80,6 +80,14 @@ const FAR_PX: f32 = 1_048_576.0;
 /// So two triangles sharing an edge cover each pixel along it exactly once, whatever order
 /// they come in. Degenerate triangles fill nothing. Allocates nothing.
 pub fn fill_triangle_ids(ids: &mut [u32], width: usize, rows: usize, points: [(f32, f32); 3], id: u32) {
+    for_each_span(width, rows, points, |y, x0, x1| ids[y * width + x0..=y * width + x1].fill(id));
+}
+
+/// Calls `span(y, x0, x1)` for every row `y` of a `width x rows` picture with the pixels
+/// `x0..=x1` whose centres lie inside the triangle `points`: exactly the pixels
+/// [`fill_triangle_ids`] fills (the same exact, watertight rule), for fills that compute each
+/// pixel (the ocean's smooth shading).
+pub fn for_each_span(width: usize, rows: usize, points: [(f32, f32); 3], mut span: impl FnMut(usize, usize, usize)) {
     // (A NaN coordinate snaps to 0: a wrong triangle, never a panic.)
     let snap = |v: f32| (v.clamp(-FAR_PX, FAR_PX) * SUBPIXELS).round() as i64;
     let mut p = points.map(|(x, y)| (snap(x), snap(y)));
@@ -122,8 +130,7 @@ pub fn fill_triangle_ids(ids: &mut [u32], width: usize, rows: usize, points: [(f
             }
         }
         if lo <= hi {
-            let row = y as usize * width;
-            ids[row + lo as usize..=row + hi as usize].fill(id);
+            span(y as usize, lo as usize, hi as usize);
         }
     }
 }

@@ -36,13 +36,13 @@ use super::surface::Footprint;
 /// The foam clock's step, s.
 pub const FOAM_STEP_S: f64 = 0.1;
 /// The time over which foam fades to 1/e, s.
-pub const FOAM_FADE_S: f64 = 2.0;
+pub const FOAM_FADE_S: f64 = 1.5;
 /// Foam thinner than this is gone (exactly 0).
-pub const FOAM_FORGET: f32 = 1.0 / 128.0;
+pub const FOAM_FORGET: f32 = 1.0 / 64.0;
 /// Width of the source's ramp, in standard deviations of the fold indicator.
 pub const RAMP: f32 = 0.5;
 /// Resting points the calibration follows.
-pub const PROBES: usize = 512;
+pub const PROBES: usize = 384;
 /// How long the calibration measures after its warm-up, s.
 pub const MEASURE_S: f64 = 40.0;
 /// The side of the calibration's square, peak wavelengths.

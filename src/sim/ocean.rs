@@ -402,7 +402,7 @@ impl Sea {
     /// [`Sea::frame`] reusing `buffer` (from [`SeaFrame::into_buffer`]), so that a stream of
     /// frames allocates nothing.
     pub fn frame_in(&self, time_s: f64, buffer: Vec<f32>) -> SeaFrame<'_> {
-        self.frame_at(self.time(time_s), buffer)
+        SeaFrame { time_s, ..self.frame_at(self.time(time_s), buffer) }
     }
 
     /// The sea at a [`SeaTime`], reusing `buffer`.
@@ -430,7 +430,11 @@ impl Sea {
             };
             [at(0), at(1)]
         });
-        SeaFrame { sea: self, phase, tail_offset, time }
+        let time_s = match time {
+            SeaTime::Seconds(t) => t,
+            SeaTime::Tick(u) => f64::from(u) / 4_294_967_296.0 * self.params.loop_period.map_or(0.0, |p| p.seconds()),
+        };
+        SeaFrame { sea: self, phase, tail_offset, time, time_s }
     }
 }
 
@@ -463,6 +467,7 @@ pub struct SeaFrame<'a> {
     phase: Vec<f32>,
     tail_offset: [f32; 2],
     time: SeaTime,
+    time_s: f64,
 }
 
 /// The sums of one pass over the components: height, resolved slope variance,
@@ -500,6 +505,12 @@ impl SeaFrame<'_> {
         self.time
     }
 
+    /// Its moment in seconds, as given to [`Sea::frame_in`] (for a frame made from a
+    /// [`SeaTime::Tick`], the time within the loop).
+    pub fn time_s(&self) -> f64 {
+        self.time_s
+    }
+
     /// One pass over the components a footprint keeps, in eight lanes of independent sums
     /// added in a fixed order (the compiler may vectorise lanes, never reorder a float sum):
     /// the same result on every run and machine.
@@ -510,35 +521,46 @@ impl SeaFrame<'_> {
         // shorter side alias whatever their direction, and are left out exactly.
         let n = sea.wavelength.partition_point(|&w| w > 2.0 * footprint.min_m());
         let mut acc = [[0.0f32; LANES]; 8];
+        let lane =
+            |v: &Vec<f32>, base: usize| -> [f32; LANES] { v[base..base + LANES].try_into().expect("whole lanes") };
         let mut base = 0;
         while base < n {
-            let r = base..base + LANES;
-            let mut amp: [f32; LANES] = l.amp[r.clone()].try_into().expect("whole lanes");
-            for a in amp.iter_mut().skip(n - base) {
-                *a = 0.0;
-            }
-            let (kx, ky, phase) = (&l.kx[r.clone()], &l.ky[r.clone()], &self.phase[r.clone()]);
-            for i in 0..LANES {
-                let weight = resolution_weight(footprint.phase_step(kx[i], ky[i]));
-                let a = weight * amp[i];
-                let theta = kx[i] * x + ky[i] * y + phase[i];
-                if PASS == HEIGHT {
-                    acc[0][i] += a * fast_cos(theta);
-                } else if PASS == DISPLACED {
-                    let (s, c) = fast_sincos(theta);
-                    acc[0][i] += a * c;
-                    acc[3][i] += a * s * l.ux[base + i];
-                    acc[4][i] += a * s * l.uy[base + i];
-                    acc[5][i] += a * c * l.sqrt_k[base + i];
-                    acc[6][i] += a * s * l.sqrt_k[base + i];
-                } else {
-                    let c = fast_cos(theta) * if amp[i] == 0.0 { 0.0 } else { weight };
-                    acc[5][i] += l.dxx[base + i] * c;
-                    acc[6][i] += l.dyy[base + i] * c;
-                    acc[7][i] += l.dxy[base + i] * c;
+            // Lanes past the footprint's cut count for nothing.
+            let live: [f32; LANES] = std::array::from_fn(|i| if base + i < n { 1.0 } else { 0.0 });
+            let (kx, ky, amp, phase) =
+                (lane(&l.kx, base), lane(&l.ky, base), lane(&l.amp, base), lane(&self.phase, base));
+            if PASS == HEIGHT {
+                for i in 0..LANES {
+                    let a = resolution_weight(footprint.phase_step(kx[i], ky[i])) * amp[i] * live[i];
+                    acc[0][i] += a * fast_cos(kx[i] * x + ky[i] * y + phase[i]);
+                    let a2 = 0.5 * a * a;
+                    acc[2][i] += a2 * (kx[i] * kx[i] + ky[i] * ky[i]);
                 }
-                let a2 = 0.5 * a * a;
-                acc[2][i] += a2 * (kx[i] * kx[i] + ky[i] * ky[i]);
+            } else if PASS == DISPLACED {
+                let (ux, uy, sk) = (lane(&l.ux, base), lane(&l.uy, base), lane(&l.sqrt_k, base));
+                for i in 0..LANES {
+                    let a = resolution_weight(footprint.phase_step(kx[i], ky[i])) * amp[i] * live[i];
+                    let (s, c) = fast_sincos(kx[i] * x + ky[i] * y + phase[i]);
+                    acc[0][i] += a * c;
+                    acc[3][i] += a * s * ux[i];
+                    acc[4][i] += a * s * uy[i];
+                    acc[5][i] += a * c * sk[i];
+                    acc[6][i] += a * s * sk[i];
+                    let a2 = 0.5 * a * a;
+                    acc[2][i] += a2 * (kx[i] * kx[i] + ky[i] * ky[i]);
+                }
+            } else {
+                let (dxx, dyy, dxy) = (lane(&l.dxx, base), lane(&l.dyy, base), lane(&l.dxy, base));
+                for i in 0..LANES {
+                    let w = resolution_weight(footprint.phase_step(kx[i], ky[i])) * live[i];
+                    let c = w * fast_cos(kx[i] * x + ky[i] * y + phase[i]);
+                    acc[5][i] += dxx[i] * c;
+                    acc[6][i] += dyy[i] * c;
+                    acc[7][i] += dxy[i] * c;
+                    let a = w * amp[i];
+                    let a2 = 0.5 * a * a;
+                    acc[2][i] += a2 * (kx[i] * kx[i] + ky[i] * ky[i]);
+                }
             }
             base += LANES;
         }
