@@ -9,5 +9,6 @@ pub mod frame;
 pub mod gif;
 pub mod halfblock;
 pub mod heightmap;
+pub mod maps;
 pub mod png;
 pub mod vt;

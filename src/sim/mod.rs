@@ -7,6 +7,7 @@ pub mod lake;
 pub mod looping;
 pub mod noise;
 pub mod ocean;
+pub mod patch;
 pub mod rain;
 pub mod ripple;
 pub mod sea_state;
