@@ -17,9 +17,9 @@ pub const FOAM_TEXELS: usize = 256;
 /// Metres one copy of the texture spans across the wind.
 pub const FOAM_TILE_ACROSS_M: f32 = 24.0;
 /// How much longer it is along the wind.
-pub const FOAM_STREAK: f32 = 4.0;
+pub const FOAM_STREAK: f32 = 5.0;
 /// Softness of a foam edge, in the texture's uniform units.
-pub const FOAM_EDGE: f32 = 0.12;
+pub const FOAM_EDGE: f32 = 0.3;
 /// Lattice spacing of the coarsest octave, texels, and the octaves' weights.
 const OCTAVES: [(usize, f32); 4] = [(32, 1.0), (16, 0.55), (8, 0.3), (4, 0.16)];
 

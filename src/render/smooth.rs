@@ -29,7 +29,10 @@ use super::vec3::{Vec3, add, cross, length, normalize, scale, sub};
 use crate::sim::surface::{Surface, SurfaceSample};
 
 /// Foam is a froth over water, never a solid sheet: at most this much of a pixel's colour.
-pub const FOAM_OPACITY: f32 = 0.88;
+pub const FOAM_OPACITY: f32 = 0.9;
+/// How opaque the thinnest foam is, as a fraction of [`FOAM_OPACITY`]: fresh foam (cover 1)
+/// is dense, fading foam a translucent lace.
+pub const THIN_FOAM: f32 = 0.35;
 
 /// Where the foam texture lies on the water this frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -221,7 +224,9 @@ impl SmoothShader {
                         let mut rgb = c;
                         if let Some(f) = &fm {
                             let n = texture.sample(level, f[4], f[5]);
-                            let cover = FOAM_OPACITY * coverage(f[3].clamp(0.0, 1.0), n, detail);
+                            let cover = f[3].clamp(0.0, 1.0);
+                            let cover =
+                                FOAM_OPACITY * (THIN_FOAM + (1.0 - THIN_FOAM) * cover) * coverage(cover, n, detail);
                             rgb = mix(rgb, [f[0], f[1], f[2]], cover);
                         }
                         out.copy_from_slice(&[table.encode(rgb[0]), table.encode(rgb[1]), table.encode(rgb[2]), 255]);
