@@ -20,6 +20,17 @@ use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use super::heightmap::{Heightmap, encode_npy, encode_png16};
 use crate::sim::patch::PatchMaps;
 
+/// The refusal of maps sent to standard output (a command-line combination the binary checks).
+pub const MAPS_TO_STDOUT: &str = "maps are files in a folder and cannot go to standard output; drop --out - or --maps";
+
+/// Checks that `path` can hold maps: a folder, or nothing yet (it will be created).
+pub fn check_folder(path: &std::path::Path) -> Result<(), String> {
+    if path.exists() && !path.is_dir() {
+        return Err(format!("'{}' is a file; maps go into a folder (it is created if missing)", path.display()));
+    }
+    Ok(())
+}
+
 /// PNG levels per metre for heights and displacements: centimetres.
 pub const MAP_PNG_SCALE: f32 = 100.0;
 
@@ -133,5 +144,11 @@ mod tests {
         let disp = image::load_from_memory(&files[3].1).unwrap();
         assert_eq!(disp.as_rgb16().unwrap().get_pixel(1, 1).0, [32778, 32748, 32768]);
         assert_eq!(file_names(None)[0], "height.npy");
+        let file = std::env::temp_dir().join("tidepool_maps_check_folder.txt");
+        std::fs::write(&file, b"x").unwrap();
+        assert!(check_folder(&file).unwrap_err().contains("is a file"));
+        assert!(check_folder(&std::env::temp_dir()).is_ok());
+        assert!(check_folder(&std::env::temp_dir().join("tidepool-no-such-folder")).is_ok());
+        std::fs::remove_file(file).unwrap();
     }
 }

@@ -24,7 +24,7 @@ pub fn angular_frequency(k: f64, depth_m: Option<f64>) -> f64 {
 pub fn wavenumber(omega: f64, depth_m: Option<f64>) -> f64 {
     let k0 = omega * omega / G;
     let Some(h) = depth_m else { return k0 };
-    if !(k0 > 0.0) || k0 * h >= DEEP_KH {
+    if k0.is_nan() || k0 <= 0.0 || k0 * h >= DEEP_KH {
         return k0.max(0.0);
     }
     let mut k = k0 / (k0 * h).tanh().sqrt();

@@ -328,6 +328,7 @@ mod tests {
         let plain = FoamClock::of(&Sea::new(params));
         let (n, frac) = plain.step_at(1.25);
         assert!(n == 12 && (frac - 0.5).abs() < 1e-5, "{n} {frac}");
-        assert!(plain.warm_up_steps() > 90);
+        // 1.5 s to 1/e, forgotten below 1/64: ln 64 · 1.5 s = 6.2 s, 63 steps of 0.1 s.
+        assert_eq!(plain.warm_up_steps(), 64);
     }
 }

@@ -106,6 +106,26 @@ pub fn check_patch(size: usize, extent_m: f64) -> Result<(), String> {
     Ok(())
 }
 
+/// A map's side when it is square: maps tile, so width and height must agree.
+pub fn check_map_size(width: usize, height: usize) -> Result<usize, String> {
+    if width != height {
+        return Err(format!(
+            "maps are square so that they tile; give a square size such as 1024x1024 (not {width}x{height})"
+        ));
+    }
+    check_patch(width, PATCH_EXTENT_RANGE_M.0)?;
+    Ok(width)
+}
+
+/// How many peak wavelengths a map spans when no extent is given.
+pub const DEFAULT_MAP_WAVELENGTHS: f64 = 10.0;
+
+/// The default side of a map of `spectrum`'s sea, m ([`DEFAULT_MAP_WAVELENGTHS`] peak
+/// wavelengths; 100 m for a calm).
+pub fn default_extent_m(spectrum: &SeaSpectrum) -> f64 {
+    spectrum.peak_wavelength_m().map_or(100.0, |l| DEFAULT_MAP_WAVELENGTHS * l)
+}
+
 /// A lattice index as a signed wavenumber index.
 fn signed(i: usize, n: usize) -> i64 {
     if i < n / 2 { i as i64 } else { i as i64 - n as i64 }

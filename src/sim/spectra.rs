@@ -146,7 +146,7 @@ impl Jonswap {
 
     /// The peak frequency, Hz: 3.5·(g/U)·x^-0.33, never below PM's 0.13·g/U (None for a calm).
     pub fn peak_hz(&self, wind_m_s: f64) -> Option<f64> {
-        if !(wind_m_s > 0.0) {
+        if wind_m_s.is_nan() || wind_m_s <= 0.0 {
             return None;
         }
         let developed = PEAK_FACTOR * G / wind_m_s;
@@ -408,7 +408,7 @@ impl SeaSpectrum {
     /// The variance carried by frequencies below `f_hz`, m².
     pub fn cumulative_variance(&self, f_hz: f64) -> f64 {
         let Some((lo, step, table)) = &self.table else { return self.pm.cumulative_variance(f_hz) };
-        if !(f_hz > 0.0) {
+        if f_hz.is_nan() || f_hz <= 0.0 {
             return 0.0;
         }
         if !f_hz.is_finite() {
