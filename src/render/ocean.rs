@@ -73,14 +73,21 @@ impl Default for OceanView {
     }
 }
 
-/// The densest mesh, output pixels between samples: a terminal frame (160x94) gets a vertex
-/// every 1.6 pixels, so the smooth shading has the short waves to show (at 3.2 its few
+/// Output pixels between mesh samples for a `width x height` picture: √(W·H)/180, within
+/// 3.2..=8 (a terminal frame gets a triangle per 5 or so pixels, 1080p one per 30). The lake
+/// uses this spacing; the ocean's smooth shading goes denser on small pictures
+/// ([`ocean_spacing_px`]).
+pub fn mesh_spacing_px(width: u32, height: u32) -> f32 {
+    ((f64::from(width) * f64::from(height)).sqrt() / 180.0).clamp(3.2, 8.0) as f32
+}
+
+/// The ocean's densest mesh, output pixels between samples: a terminal frame (160x94) gets a
+/// vertex every 1.6 pixels, so the smooth shading has the short waves to show (at 3.2 its few
 /// pixels were smoothed flat).
 pub const MIN_SPACING_PX: f32 = 1.6;
 
-/// Output pixels between mesh samples for a `width x height` picture: √(W·H)/180, within
-/// [`MIN_SPACING_PX`]..=8 (1080p gets a vertex every 8 pixels).
-pub fn mesh_spacing_px(width: u32, height: u32) -> f32 {
+/// The ocean's mesh spacing: √(W·H)/180 within [`MIN_SPACING_PX`]..=8 (1080p: every 8 pixels).
+pub fn ocean_spacing_px(width: u32, height: u32) -> f32 {
     ((f64::from(width) * f64::from(height)).sqrt() / 180.0).clamp(f64::from(MIN_SPACING_PX), 8.0) as f32
 }
 
@@ -192,7 +199,7 @@ impl OceanRenderer {
     /// When `out` has another size (a programming error).
     pub fn render(&mut self, frame: &SeaFrame<'_>, out: &mut Pixmap) {
         assert_eq!((out.width(), out.height()), (self.width, self.height), "output size");
-        let spacing = mesh_spacing_px(self.width, self.height) * self.view.ssaa as f32;
+        let spacing = ocean_spacing_px(self.width, self.height) * self.view.ssaa as f32;
         if self.mesh.prepare(&self.camera, spacing) {
             self.foam.reset();
         }
@@ -219,7 +226,8 @@ mod tests {
 
     #[test]
     fn spacing_follows_the_resolution() {
-        assert_eq!(mesh_spacing_px(160, 96), MIN_SPACING_PX);
+        assert_eq!(mesh_spacing_px(160, 96), 3.2);
+        assert_eq!(ocean_spacing_px(160, 96), MIN_SPACING_PX);
         assert_eq!(mesh_spacing_px(1920, 1080), 8.0);
         let mid = mesh_spacing_px(1280, 720);
         assert!(mid > 5.0 && mid < 5.5);
