@@ -5,7 +5,8 @@
 //! where a mesh row spans a whole crest, the faces between two rows alternate between the
 //! crest's front and back slopes — a saw-tooth along every far crest. Here each vertex gets a
 //! normal (the area-weighted mean of its faces' normals) and is shaded once
-//! ([`shade_facet`]); each pixel interpolates its face's three colours (Gouraud shading), so
+//! ([`shade_facet`]) and encoded to sRGB levels; each pixel interpolates its face's three
+//! levels (Gouraud shading in sRGB, so a pixel costs three adds and three casts), so
 //! neighbouring faces meet without a step and a far crest is a soft band. Foam is a per-pixel
 //! pass: the vertex foam cover F (from [`crate::sim::foam::FoamTracker`]) is interpolated,
 //! and the pixel foams where F exceeds the [`FoamTexture`] there, laid on the resting water
@@ -20,7 +21,7 @@ use rayon::prelude::*;
 use tiny_skia::Pixmap;
 
 use super::foam_texture::{FOAM_STREAK, FOAM_TILE_ACROSS_M, FoamTexture, coverage, detail_for};
-use super::light::{Rgb, SrgbTable, mix};
+use super::light::{Rgb, mix, to_srgb8};
 use super::mesh::{BAND_ROWS, MeshTopology, Shading, sample_all};
 use super::raster::for_each_span;
 use super::shade::{Facet, shade_facet};
@@ -62,6 +63,7 @@ pub struct SmoothShader {
     world: Vec<Vec3>,
     screen: Vec<Option<(f32, f32)>>,
     normals: Vec<Vec3>,
+    /// sRGB levels (+0.5) of the water and of full foam at each vertex.
     water: Vec<Rgb>,
     foam_rgb: Vec<Rgb>,
     /// Foam cover and texture coordinates (u, v) per vertex.
@@ -142,9 +144,10 @@ impl SmoothShader {
                     slope_variance: samples[i].unresolved_slope_variance,
                     height_m: p[2],
                 };
-                *water = shade_facet(&shading.look, &shading.light, shading.environment, &facet);
-                *foam_rgb =
-                    shade_facet(&shading.look, &shading.light, shading.environment, &Facet { foam: 1.0, ..facet });
+                let level = |c: Rgb| to_srgb8(c).map(|v| f32::from(v) + 0.5);
+                *water = level(shade_facet(&shading.look, &shading.light, shading.environment, &facet));
+                let foam_facet = Facet { foam: 1.0, ..facet };
+                *foam_rgb = level(shade_facet(&shading.look, &shading.light, shading.environment, &foam_facet));
                 let g = ground[i];
                 let along = g[0] * dx + g[1] * dy - layout.drift_m;
                 let across = -g[0] * dy + g[1] * dx;
@@ -195,7 +198,6 @@ impl SmoothShader {
     fn fill(&self, out: &mut Pixmap) {
         let width = out.width() as usize;
         let rows = out.height() as usize;
-        let table = SrgbTable::shared();
         let texture = FoamTexture::shared();
         let (faces, water, foam_rgb, foam_uv) = (&self.faces, &self.water, &self.foam_rgb, &self.foam_uv);
         out.data_mut().par_chunks_mut(BAND_ROWS * width * 4).enumerate().for_each(|(band, bytes)| {
@@ -229,7 +231,8 @@ impl SmoothShader {
                                 FOAM_OPACITY * (THIN_FOAM + (1.0 - THIN_FOAM) * cover) * coverage(cover, n, detail);
                             rgb = mix(rgb, [f[0], f[1], f[2]], cover);
                         }
-                        out.copy_from_slice(&[table.encode(rgb[0]), table.encode(rgb[1]), table.encode(rgb[2]), 255]);
+                        // Levels carry +0.5, so the cast rounds (and saturates).
+                        out.copy_from_slice(&[rgb[0] as u8, rgb[1] as u8, rgb[2] as u8, 255]);
                         c = colour.step(c);
                         if let (Some(f), Some(p)) = (fm.as_mut(), foam.as_ref()) {
                             *f = p.step(*f);

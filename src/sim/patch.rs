@@ -75,6 +75,8 @@ pub struct PatchSea {
     harmonic: Vec<u32>,
     kx: Vec<f32>,
     ky: Vec<f32>,
+    /// |k| (1 where k = 0, whose wave is silent).
+    k: Vec<f32>,
     fft: Arc<dyn Fft<f32>>,
     sigma: f32,
     threshold: f32,
@@ -182,6 +184,7 @@ impl PatchSea {
             amp,
             omega,
             harmonic,
+            k: kxs.iter().zip(&kys).map(|(x, y)| if *x == 0.0 && *y == 0.0 { 1.0 } else { x.hypot(*y) }).collect(),
             kx: kxs,
             ky: kys,
             fft,
@@ -234,23 +237,22 @@ impl PatchSea {
     /// fields f = re Σ c_f·e^(ik·x) and g = re Σ c_g·e^(ik·x). Each real field's spectrum is
     /// the Hermitian S(k) = (c(k) + conj(c(-k)))/2, and the transform of S_f + i·S_g is
     /// f + i·g.
+    /// Every lattice wave at `time`: a·e^(iφ)·e^(-iωt).
+    fn waves(&self, time: SeaTime) -> Vec<Complex32> {
+        (0..self.amp.len())
+            .into_par_iter()
+            .map(|i| if self.amp[i].norm_sqr() == 0.0 { self.amp[i] } else { self.amp[i] * self.rotation(i, time) })
+            .collect()
+    }
+
     fn real_fields(
         &self,
-        time: SeaTime,
-        waves: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
+        waves: &[Complex32],
+        coefficients: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
     ) -> (Vec<f32>, Vec<f32>) {
         let n = self.size;
-        let zero = Complex32::new(0.0, 0.0);
-        let coefficients: Vec<(Complex32, Complex32)> = (0..n * n)
-            .into_par_iter()
-            .map(|i| {
-                if self.amp[i].norm_sqr() == 0.0 {
-                    (zero, zero)
-                } else {
-                    waves(i, self.amp[i] * self.rotation(i, time))
-                }
-            })
-            .collect();
+        let coefficients: Vec<(Complex32, Complex32)> =
+            (0..n * n).into_par_iter().map(|i| coefficients(i, waves[i])).collect();
         let mut buf: Vec<Complex32> = (0..n * n)
             .into_par_iter()
             .map(|i| {
@@ -268,29 +270,25 @@ impl PatchSea {
     }
 
     /// The displacement's gradient per unit λ, each times -1: g_ab = Σ a·(k_a·k_b/k)·cos θ.
-    fn fold_fields(&self, time: SeaTime) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
+    fn fold_fields(&self, waves: &[Complex32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
         let coef = |i: usize| {
-            let (kx, ky) = (self.kx[i], self.ky[i]);
-            let k = kx.hypot(ky).max(f32::MIN_POSITIVE);
+            let (kx, ky, k) = (self.kx[i], self.ky[i], self.k[i]);
             (kx * kx / k, ky * ky / k, kx * ky / k)
         };
-        let (gxx, gyy) = self.real_fields(time, |i, w| (w * coef(i).0, w * coef(i).1));
-        let (gxy, _) = self.real_fields(time, |i, w| (w * coef(i).2, Complex32::new(0.0, 0.0)));
+        let (gxx, gyy) = self.real_fields(waves, |i, w| (w * coef(i).0, w * coef(i).1));
+        let (gxy, _) = self.real_fields(waves, |i, w| (w * coef(i).2, Complex32::new(0.0, 0.0)));
         (gxx, gyy, gxy)
     }
 
     fn lagrangian(&self, time: SeaTime) -> (Lagrangian, Vec<Complex32>) {
         let i_unit = Complex32::new(0.0, 1.0);
-        let unit = |i: usize| {
-            let (kx, ky) = (self.kx[i], self.ky[i]);
-            let k = kx.hypot(ky).max(f32::MIN_POSITIVE);
-            (kx / k, ky / k, k)
-        };
+        let unit = |i: usize| (self.kx[i] / self.k[i], self.ky[i] / self.k[i], self.k[i]);
+        let waves = self.waves(time);
         // The displacement per unit λ is -Σ a·û·sin θ = re Σ (i·û·w)·e^(ik·x); slopes re Σ (i·k·w)·e^(ik·x).
-        let (h, dx) = self.real_fields(time, |i, w| (w, i_unit * w * unit(i).0));
-        let (dy, hx) = self.real_fields(time, |i, w| (i_unit * w * unit(i).1, i_unit * w * self.kx[i]));
-        let (hy, _) = self.real_fields(time, |i, w| (i_unit * w * self.ky[i], Complex32::new(0.0, 0.0)));
-        let (gxx, gyy, gxy) = self.fold_fields(time);
+        let (h, dx) = self.real_fields(&waves, |i, w| (w, i_unit * w * unit(i).0));
+        let (dy, hx) = self.real_fields(&waves, |i, w| (i_unit * w * unit(i).1, i_unit * w * self.kx[i]));
+        let (hy, _) = self.real_fields(&waves, |i, w| (i_unit * w * self.ky[i], Complex32::new(0.0, 0.0)));
+        let (gxx, gyy, gxy) = self.fold_fields(&waves);
         // B = Σ a·√k·e^(iθ): the waves themselves, a complex field.
         let n = self.size;
         let mut b: Vec<Complex32> = (0..n * n)
@@ -320,7 +318,8 @@ impl PatchSea {
         };
         let (decay, z, lambda, sigma) = (self.clock.decay(), self.threshold, self.params.choppiness as f32, self.sigma);
         for n in first..=now {
-            let (gxx, gyy, gxy) = self.fold_fields(self.clock.time_of(n));
+            let waves = self.waves(self.clock.time_of(n));
+            let (gxx, gyy, gxy) = self.fold_fields(&waves);
             self.foam.par_iter_mut().enumerate().for_each(|(i, f)| {
                 let q = if sigma > 0.0 {
                     (gxx[i] + gyy[i] - lambda * (gxx[i] * gyy[i] - gxy[i] * gxy[i])) / sigma
@@ -365,14 +364,14 @@ impl PatchSea {
                     // Lattice units: column c is x = c, row r is y = -r (north up).
                     let (mut px, mut py) = (c as f32, r as f32);
                     for _ in 0..EULER_ITERATIONS {
-                        let dxv = lerp(&lag.dx, n, px, py) * lambda / cell;
-                        let dyv = lerp(&lag.dy, n, px, py) * lambda / cell;
+                        let at = Bilinear::new(n, px, py);
+                        let (dxv, dyv) = (at.of(&lag.dx) * lambda / cell, at.of(&lag.dy) * lambda / cell);
                         (px, py) = (c as f32 - dxv, r as f32 + dyv);
                     }
                     height[c] = cubic(&h_l, n, px, py);
-                    let (hx, hy) = (lerp(&lag.hx, n, px, py), lerp(&lag.hy, n, px, py));
-                    let (gxx, gyy, gxy) =
-                        (lerp(&lag.gxx, n, px, py), lerp(&lag.gyy, n, px, py), lerp(&lag.gxy, n, px, py));
+                    let at = Bilinear::new(n, px, py);
+                    let (hx, hy) = (at.of(&lag.hx), at.of(&lag.hy));
+                    let (gxx, gyy, gxy) = (at.of(&lag.gxx), at.of(&lag.gyy), at.of(&lag.gxy));
                     // ∇D = -λ·g; the Eulerian gradient is (I + ∇D)^-T ∇h.
                     let (a, d, bc) = (1.0 - lambda * gxx, 1.0 - lambda * gyy, -lambda * gxy);
                     let det = a * d - bc * bc;
@@ -380,7 +379,7 @@ impl PatchSea {
                         if det.abs() > 1e-3 { ((d * hx - bc * hy) / det, (a * hy - bc * hx) / det) } else { (hx, hy) };
                     let len = (ex * ex + ey * ey + 1.0).sqrt();
                     normal[c] = [-ex / len, -ey / len, 1.0 / len];
-                    foam[c] = lerp(&foam_l, n, px, py).clamp(0.0, 1.0);
+                    foam[c] = at.of(&foam_l).clamp(0.0, 1.0);
                 }
             },
         );
@@ -402,22 +401,64 @@ fn transpose_square(m: &mut [Complex32], n: usize) {
     }
 }
 
-/// Bilinear interpolation of a periodic n x n field at (x, y) lattice units.
-fn lerp(f: &[f32], n: usize, x: f32, y: f32) -> f32 {
-    let (fx, fy) = (x.floor(), y.floor());
-    let (tx, ty) = (x - fx, y - fy);
-    let w = |v: f32| (v as i64).rem_euclid(n as i64) as usize;
-    let (x0, y0, x1, y1) = (w(fx), w(fy), w(fx + 1.0), w(fy + 1.0));
-    let top = f[y0 * n + x0] + (f[y0 * n + x1] - f[y0 * n + x0]) * tx;
-    let bottom = f[y1 * n + x0] + (f[y1 * n + x1] - f[y1 * n + x0]) * tx;
-    top + (bottom - top) * ty
+/// A coordinate wrapped into 0..n (lattice units) with floats (no integer division).
+#[inline(always)]
+fn wrap(v: f32, n: usize) -> f32 {
+    let nf = n as f32;
+    let w = v - (v / nf).floor() * nf;
+    if w >= nf { 0.0 } else { w }
+}
+
+/// The four lattice points around a position of a periodic n x n field and their weights,
+/// for reading several fields at one point.
+struct Bilinear {
+    i00: usize,
+    i01: usize,
+    i10: usize,
+    i11: usize,
+    tx: f32,
+    ty: f32,
+}
+
+impl Bilinear {
+    #[inline(always)]
+    fn new(n: usize, x: f32, y: f32) -> Bilinear {
+        let (x, y) = (wrap(x, n), wrap(y, n));
+        let (x0, y0) = ((x as usize).min(n - 1), (y as usize).min(n - 1));
+        let (x1, y1) = (if x0 + 1 == n { 0 } else { x0 + 1 }, if y0 + 1 == n { 0 } else { y0 + 1 });
+        Bilinear {
+            i00: y0 * n + x0,
+            i01: y0 * n + x1,
+            i10: y1 * n + x0,
+            i11: y1 * n + x1,
+            tx: x - x0 as f32,
+            ty: y - y0 as f32,
+        }
+    }
+
+    #[inline(always)]
+    fn of(&self, f: &[f32]) -> f32 {
+        let top = f[self.i00] + (f[self.i01] - f[self.i00]) * self.tx;
+        let bottom = f[self.i10] + (f[self.i11] - f[self.i10]) * self.tx;
+        top + (bottom - top) * self.ty
+    }
 }
 
 /// Catmull–Rom interpolation of a periodic n x n field at (x, y) lattice units.
 fn cubic(f: &[f32], n: usize, x: f32, y: f32) -> f32 {
+    let (x, y) = (wrap(x, n), wrap(y, n));
     let (fx, fy) = (x.floor(), y.floor());
     let (tx, ty) = (x - fx, y - fy);
-    let w = |v: f32| (v as i64).rem_euclid(n as i64) as usize;
+    let (ix, iy) = (fx as usize + n, fy as usize + n);
+    let w = |i: usize| {
+        if i >= 2 * n {
+            i - 2 * n
+        } else if i >= n {
+            i - n
+        } else {
+            i
+        }
+    };
     let weights = |t: f32| {
         let (t2, t3) = (t * t, t * t * t);
         [-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0, -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2]
@@ -425,9 +466,9 @@ fn cubic(f: &[f32], n: usize, x: f32, y: f32) -> f32 {
     let (wx, wy) = (weights(tx), weights(ty));
     let mut sum = 0.0;
     for (j, wyj) in wy.iter().enumerate() {
-        let row = w(fy + j as f32 - 1.0) * n;
+        let row = w(iy + j - 1) * n;
         for (i, wxi) in wx.iter().enumerate() {
-            sum += wyj * wxi * f[row + w(fx + i as f32 - 1.0)];
+            sum += wyj * wxi * f[row + w(ix + i - 1)];
         }
     }
     sum
