@@ -1,23 +1,38 @@
-//! `render/ocean`: one ocean frame at terminal size (160x96, no supersampling) and at
-//! 1920x1080 with 2x2 supersampling, the camera still (the triangulation is reused, as in the
-//! player), the sea moving on 1/30 s per frame. `render/ocean_new_camera` adds building the
-//! triangulation. Triangle counts are printed once.
+//! `render/ocean`: one ocean frame at terminal size (160x96 and the player's 160x94, no
+//! supersampling) and at 1920x1080 with 2x2 supersampling, the camera still (the
+//! triangulation is reused, as in the player), the sea moving on 1/30 s per frame: a linear
+//! sea (choppiness 0) and `chop_foam` (the default, physical choppiness; foam is followed in
+//! every case). `render/ocean_new_camera` adds building the triangulation. `maps/1024`: the
+//! tileable maps (height, displacement, normals, foam) of a 1024x1024 patch for one time step
+//! of a series 1/30 s apart (foam continues), encoding and writing not counted;
+//! `maps/1024_surface` without foam. Scene descriptions are printed once.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use tiny_skia::Pixmap;
 
-use tidepool::{OceanScene, OceanSettings, OceanView, Scene};
+use tidepool::sea::{DEFAULT_CHOPPINESS, PatchSea};
+use tidepool::{OceanScene, OceanSettings, OceanView, Scene, SeaParams};
 
-fn scene(width: u32, height: u32, ssaa: u32) -> OceanScene {
-    let settings = OceanSettings { view: OceanView { ssaa, ..OceanView::default() }, ..OceanSettings::default() };
+fn scene(width: u32, height: u32, ssaa: u32, choppiness: f64) -> OceanScene {
+    let settings = OceanSettings {
+        sea: SeaParams { choppiness, ..SeaParams::default() },
+        view: OceanView { ssaa, ..OceanView::default() },
+        ..OceanSettings::default()
+    };
     OceanScene::new(settings, width, height).expect("valid size")
 }
 
 fn render_ocean(c: &mut Criterion) {
     let mut group = c.benchmark_group("render/ocean");
     group.sample_size(20);
-    for (name, w, h, ssaa) in [("160x96_ssaa1", 160, 96, 1), ("1920x1080_ssaa2", 1920, 1080, 2)] {
-        let mut s = scene(w, h, ssaa);
+    let cases = [
+        ("160x96_ssaa1", 160, 96, 1, 0.0),
+        ("160x94_ssaa1_chop_foam", 160, 94, 1, DEFAULT_CHOPPINESS),
+        ("1920x1080_ssaa2", 1920, 1080, 2, 0.0),
+        ("1920x1080_ssaa2_chop_foam", 1920, 1080, 2, DEFAULT_CHOPPINESS),
+    ];
+    for (name, w, h, ssaa, chop) in cases {
+        let mut s = scene(w, h, ssaa, chop);
         let mut out = Pixmap::new(w, h).unwrap();
         s.render(&mut out);
         eprintln!("render/ocean/{name}: {}", s.describe());
@@ -33,10 +48,27 @@ fn render_ocean(c: &mut Criterion) {
     group.sample_size(10);
     for (name, w, h, ssaa) in [("160x96_ssaa1", 160, 96, 1), ("1920x1080_ssaa2", 1920, 1080, 2)] {
         let mut out = Pixmap::new(w, h).unwrap();
-        group.bench_function(name, |b| b.iter(|| scene(w, h, ssaa).render(&mut out)));
+        group.bench_function(name, |b| b.iter(|| scene(w, h, ssaa, DEFAULT_CHOPPINESS).render(&mut out)));
     }
     group.finish();
 }
 
-criterion_group!(benches, render_ocean);
+fn maps(c: &mut Criterion) {
+    let mut group = c.benchmark_group("maps");
+    group.sample_size(10);
+    let params = SeaParams { wind_m_s: 12.0, choppiness: DEFAULT_CHOPPINESS, ..SeaParams::default() };
+    let mut patch = PatchSea::new(params, 1024, 1000.0).expect("valid patch");
+    let mut t = 0.0;
+    patch.maps(t);
+    group.bench_function("1024", |b| {
+        b.iter(|| {
+            t += 1.0 / 30.0;
+            patch.maps(t)
+        })
+    });
+    group.bench_function("1024_surface", |b| b.iter(|| patch.surface(3.0)));
+    group.finish();
+}
+
+criterion_group!(benches, render_ocean, maps);
 criterion_main!(benches);

@@ -1,8 +1,34 @@
-//! The sea state a wind raises: the Pierson–Moskowitz spectrum, the Beaufort and WMO scales,
-//! and a plot of the spectrum.
+//! The sea state a wind raises and what an engine needs from it: the spectra
+//! (Pierson–Moskowitz, JONSWAP, TMA), the Beaufort and WMO scales, choppiness, seamless loops,
+//! tileable maps and plots of the spectrum.
+//!
+//! ```
+//! use tidepool::sea::{PatchSea, SeaSpectrum, SpectrumChoice, SpectrumKind};
+//! use tidepool::SeaParams;
+//!
+//! let choice = SpectrumChoice::new(SpectrumKind::Jonswap, None, Some(50.0), None)?;
+//! let spectrum = SeaSpectrum::new(12.0, choice);
+//! assert!(spectrum.significant_height_m() > 1.0);
+//! let params = SeaParams { wind_m_s: 12.0, spectrum: choice, choppiness: 1.0, ..SeaParams::default() };
+//! let maps = PatchSea::new(params, 64, 300.0)?.maps(0.0);
+//! assert_eq!(maps.height.len(), 64 * 64);
+//! let files = tidepool::encode::sea_maps(&maps, None);
+//! assert_eq!(files[0].0, "height.npy");
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 
-pub use crate::render::plot::spectrum_plot;
+pub use crate::render::plot::{sea_spectrum_plot, spectrum_plot};
 pub use crate::render::texture::SEA_TEXTURE_TILE_M;
+pub use crate::sim::looping::{LoopPeriod, MAX_LOOP_S, MIN_PEAK_PERIODS};
+pub use crate::sim::ocean::{DEFAULT_CHOPPINESS, MAX_CHOPPINESS, check_choppiness, whitecap_fraction};
+pub use crate::sim::patch::{
+    DEFAULT_MAP_WAVELENGTHS, PATCH_EXTENT_RANGE_M, PATCH_SIZE_RANGE, PatchMaps, PatchSea, check_map_size, check_patch,
+    default_extent_m as default_map_extent_m,
+};
 pub use crate::sim::sea_state::{beaufort_number, beaufort_speed_m_s, wmo_sea_state, wmo_sea_state_name};
+pub use crate::sim::spectra::{
+    DEFAULT_GAMMA, DEPTH_RANGE_M, Depth, FETCH_RANGE_KM, GAMMA_RANGE, Jonswap, SeaSpectrum, SpectrumChoice,
+    SpectrumChoiceError, SpectrumKind,
+};
 pub use crate::sim::spectrum::PiersonMoskowitz;
 pub use crate::sim::wind::{DEFAULT_SEA_WIND_M_S, DEFAULT_WIND_FROM_DEG, MAX_LAKE_WIND_M_S, MAX_SEA_WIND_M_S};

@@ -20,18 +20,25 @@ pub struct Heightmap {
 /// Encodes NPY format 1.0: `{'descr': '<f4', 'fortran_order': False, 'shape': (H, W), }`,
 /// space-padded so the data starts at a multiple of 64 bytes, then little-endian float32s.
 pub fn encode_npy(map: &Heightmap) -> Vec<u8> {
-    let dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': ({}, {}), }}", map.height, map.width);
+    encode_npy_shaped(&[map.height, map.width], &map.values)
+}
+
+/// NPY 1.0 of float32s in C order with any `shape` (whose product is `values.len()`).
+pub fn encode_npy_shaped(shape: &[usize], values: &[f32]) -> Vec<u8> {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    let tuple = if dims.len() == 1 { format!("({},)", dims[0]) } else { format!("({})", dims.join(", ")) };
+    let dict = format!("{{'descr': '<f4', 'fortran_order': False, 'shape': {tuple}, }}");
     // magic (6) + version (2) + header length (2) + dict + padding + '\n' = multiple of 64.
     let unpadded = 10 + dict.len() + 1;
     let padding = unpadded.next_multiple_of(64) - unpadded;
     let header_len = dict.len() + padding + 1;
-    let mut out = Vec::with_capacity(10 + header_len + map.values.len() * 4);
+    let mut out = Vec::with_capacity(10 + header_len + values.len() * 4);
     out.extend_from_slice(b"\x93NUMPY\x01\x00");
     out.extend_from_slice(&(header_len as u16).to_le_bytes());
     out.extend_from_slice(dict.as_bytes());
     out.resize(out.len() + padding, b' ');
     out.push(b'\n');
-    for v in &map.values {
+    for v in values {
         out.extend_from_slice(&v.to_le_bytes());
     }
     out
@@ -40,17 +47,27 @@ pub fn encode_npy(map: &Heightmap) -> Vec<u8> {
 /// Encodes a 16-bit greyscale PNG where a pixel is `round(value · png_levels_per_unit) + 32768`,
 /// clamped to 0..=65535.
 pub fn encode_png16(map: &Heightmap) -> Vec<u8> {
-    let scale = map.png_levels_per_unit;
-    let mut samples = Vec::with_capacity(map.values.len() * 2);
-    for &v in &map.values {
+    let samples = levels16(&map.values, map.png_levels_per_unit);
+    encode_map_png(map.width, map.height, image::ExtendedColorType::L16, &samples)
+}
+
+/// Values to 16-bit PNG levels, `round(v · scale) + 32768` clamped, in native byte order (as
+/// `image` takes 16-bit samples; it writes PNG's big-endian).
+pub(crate) fn levels16(values: &[f32], scale: f32) -> Vec<u8> {
+    let mut samples = Vec::with_capacity(values.len() * 2);
+    for &v in values {
         let level = ((v * scale).round() + 32768.0).clamp(0.0, 65535.0) as u16;
-        // `image` takes 16-bit samples in native byte order and writes PNG's big-endian.
         samples.extend_from_slice(&level.to_ne_bytes());
     }
+    samples
+}
+
+/// A PNG of `width x height` samples of `colour` (adaptive filters, default compression).
+pub(crate) fn encode_map_png(width: usize, height: usize, colour: image::ExtendedColorType, samples: &[u8]) -> Vec<u8> {
     let mut out = Vec::new();
     PngEncoder::new_with_quality(&mut out, CompressionType::Default, FilterType::Adaptive)
-        .write_image(&samples, map.width as u32, map.height as u32, image::ExtendedColorType::L16)
-        .expect("encoding a PNG into memory cannot fail for a valid heightmap");
+        .write_image(samples, width as u32, height as u32, colour)
+        .expect("encoding a PNG into memory cannot fail for a valid map");
     out
 }
 

@@ -12,6 +12,7 @@ pub mod gif;
 pub mod graphics;
 pub mod halfblock;
 pub mod heightmap;
+pub mod maps;
 pub mod oklab;
 pub mod png;
 pub mod quality;

@@ -15,27 +15,27 @@
 //! 2. **Triangulation**: spade's Delaunay triangulation of the screen positions, sorted far to
 //!    near once (painter's order for a height field seen from above: the horizontal distance
 //!    of a triangle does not change when heights do). Kept while the camera does not move.
-//! 3. **Per frame** ([`MeshRenderer::draw`]): sample the surface at every point (on all cores),
-//!    displace, project, and fill each triangle with one colour from its face normal
-//!    ([`crate::render::shade::shade_facet`]) with tiny-skia, anti-aliasing off (triangles
-//!    that turned over on the screen are back faces and skipped): AA fills leave
-//!    half-transparent seams along shared edges, non-AA fills of a mesh are watertight. Smooth
-//!    edges come from supersampling ([`crate::render::supersample`]).
-//! 4. **Or deferred** ([`MeshRenderer::draw_ids`]): the same faces, but each pixel gets the
-//!    number of the face it shows ([`FaceIds`]) and [`MeshRenderer::facet`] gives that face's
-//!    [`Facet`], for a renderer that shades per pixel. The numbers are written by
-//!    [`crate::render::raster::fill_triangle_ids`], an exact integer fill of the pixels whose
-//!    centres lie inside (as tiny-skia's non-AA fill does, watertight): tiny-skia would need
-//!    the numbers as colours and allocates an edge list for every triangle, and the player's
-//!    frames must not allocate.
+//! 3. **Per frame**, one of two ways:
+//!    - **shaded at the vertices** ([`crate::render::smooth::SmoothShader`], the ocean): sample
+//!      the surface at every point (on all cores), displace, project, shade each vertex and
+//!      interpolate across each face; one colour per face made a mosaic at terminal size and a
+//!      saw-tooth along far crests;
+//!    - **face numbers** ([`MeshRenderer::draw_ids`], the lake): each pixel gets the number of
+//!      the face it shows ([`FaceIds`]) and [`MeshRenderer::facet`] gives that face's
+//!      [`Facet`], for a renderer that shades per pixel.
+//!
+//!    Both fill with [`crate::render::raster`]'s exact integer rule (pixels whose centres lie
+//!    inside; watertight, as tiny-skia's non-AA fill is not at the picture's border), skip
+//!    triangles that turned over on the screen (back faces), and allocate nothing per frame.
+//!    Smooth edges come from supersampling ([`crate::render::supersample`]).
 //!
 //! # The two users
 //!
 //! ```text
-//! // The ocean (crate::render::ocean): one colour per face.
+//! // The ocean (crate::render::ocean): shaded vertices, foam per pixel.
 //! sky.draw(&camera, far_sea_colour, &mut big);
 //! mesh.prepare(&camera, spacing_px * ssaa as f32);              // no-op if nothing moved
-//! mesh.draw(&sea_frame, &Shading { environment: &sky, light: sky.light(), look, texture }, &mut big);
+//! smooth.draw(mesh.topology(), &sea_frame, foam, layout, &shading, &mut big);
 //! supersample::downsample(&big, ssaa, Downsample::Box, &mut out);
 //!
 //! // The lake (crate::render::lake): face numbers, then a per-pixel mirror.
@@ -57,12 +57,11 @@
 
 use rayon::prelude::*;
 use spade::{DelaunayTriangulation, Point2, Triangulation};
-use tiny_skia::{BlendMode, Paint, Pixmap, PixmapMut};
 
 use super::camera::Camera;
-use super::light::{Light, to_srgb8};
-use super::raster::{TriangleFiller, fill_triangle_ids};
-use super::shade::{Facet, WaterLook, shade_facet};
+use super::light::Light;
+use super::raster::fill_triangle_ids;
+use super::shade::{Facet, WaterLook};
 use super::sky::Environment;
 use super::texture::SeaTexture;
 use super::vec3::{Vec3, cross, length, normalize, scale, sub};
@@ -154,16 +153,24 @@ impl MeshTopology {
         MeshTopology { camera: *camera, spacing_px, ground, footprints, triangles }
     }
 
-    #[cfg(test)]
+    /// The camera the mesh was built for.
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
     /// Sample points (east, north metres).
     pub fn points(&self) -> &[[f32; 2]] {
         &self.ground
     }
 
-    #[cfg(test)]
     /// Each point's footprint.
     pub fn footprints(&self) -> &[Footprint] {
         &self.footprints
+    }
+
+    /// Pixels between neighbouring samples.
+    pub fn spacing_px(&self) -> f32 {
+        self.spacing_px
     }
 
     /// Triangles as point indices, far to near.
@@ -221,38 +228,6 @@ impl MeshRenderer {
         self.topology.as_ref().map_or(0, |t| t.triangles.len())
     }
 
-    /// Samples `surface`, then fills the mesh back to front into `out` (the camera's size) over
-    /// whatever is already there. Call [`MeshRenderer::prepare`] first.
-    ///
-    /// # Panics
-    /// Without a prior `prepare` (a programming error).
-    pub fn draw<S: Surface + ?Sized, E: Environment + ?Sized>(
-        &mut self,
-        surface: &S,
-        shading: &Shading<'_, E>,
-        out: &mut Pixmap,
-    ) {
-        self.shade_faces(surface, Some(shading.texture), |facet| {
-            to_srgb8(shade_facet(&shading.look, &shading.light, shading.environment, facet))
-        });
-        let faces = &self.faces;
-        let width = out.width();
-        let rows = out.height() as usize;
-        out.data_mut().par_chunks_mut(BAND_ROWS * width as usize * 4).enumerate().for_each(|(band, bytes)| {
-            let y0 = (band * BAND_ROWS) as f32;
-            let band_rows = (rows - band * BAND_ROWS).min(BAND_ROWS);
-            let y1 = y0 + band_rows as f32;
-            let Some(mut pixmap) = PixmapMut::from_bytes(bytes, width, band_rows as u32) else { return };
-            let mut paint = Paint { anti_alias: false, blend_mode: BlendMode::Source, ..Paint::default() };
-            let mut filler = TriangleFiller::new();
-            for face in faces.iter().flatten().filter(|f| f.max_y >= y0 && f.min_y <= y1) {
-                let [r, g, b] = face.colour;
-                paint.set_color_rgba8(r, g, b, 255);
-                filler.fill(&mut pixmap, &paint, face.points.map(|(x, y)| (x, y - y0)));
-            }
-        });
-    }
-
     /// Samples `surface`, then writes into `ids` (the camera's size) the number of the face
     /// each pixel shows: triangle `i` of the topology as `i + 1`, back to front, so the nearest
     /// face wins. Pixels no face covers keep their value ([`FaceIds::clear`] them first, or
@@ -264,7 +239,7 @@ impl MeshRenderer {
     pub fn draw_ids<S: Surface + ?Sized>(&mut self, surface: &S, ids: &mut FaceIds) {
         let camera = self.topology.as_ref().expect("MeshRenderer::prepare before draw_ids").camera;
         assert_eq!((ids.width, ids.height), (camera.width() as usize, camera.height() as usize), "face id size");
-        self.shade_faces(surface, None, |_| [0; 3]);
+        self.shade_faces(surface);
         let faces = &self.faces;
         let (width, rows) = (ids.width, ids.height);
         if width == 0 {
@@ -305,13 +280,9 @@ impl MeshRenderer {
         &self.samples
     }
 
-    /// Samples the surface, projects it and describes every visible triangle, with the colour
-    /// `colour` gives its facet. `texture: None` leaves the albedo black.
-    fn shade_faces<S, F>(&mut self, surface: &S, texture: Option<&SeaTexture>, colour: F)
-    where
-        S: Surface + ?Sized,
-        F: Fn(&Facet) -> [u8; 3] + Sync,
-    {
+    /// Samples the surface, projects it and describes every visible triangle (its albedo
+    /// black: the callers shade per pixel).
+    fn shade_faces<S: Surface + ?Sized>(&mut self, surface: &S) {
         let topo = self.topology.as_ref().expect("MeshRenderer::prepare before drawing");
         let n = topo.ground.len();
         self.samples.resize(n, SurfaceSample::default());
@@ -354,13 +325,11 @@ impl MeshRenderer {
                 let to_eye = sub(eye, centroid);
                 let distance_m = length(to_eye);
                 let (sa, sb, sc) = (&samples[a], &samples[b], &samples[c]);
-                let size_m =
-                    (topo.footprints[a].mean_m() + topo.footprints[b].mean_m() + topo.footprints[c].mean_m()) / 3.0;
                 let facet = Facet {
                     normal,
                     to_eye: scale(to_eye, 1.0 / distance_m.max(1e-6)),
                     distance_m,
-                    albedo: texture.map_or([0.0; 3], |t| t.sample(centroid[0], centroid[1], size_m)),
+                    albedo: [0.0; 3],
                     foam: (sa.foam + sb.foam + sc.foam) / 3.0,
                     slope_variance: (sa.unresolved_slope_variance
                         + sb.unresolved_slope_variance
@@ -368,7 +337,7 @@ impl MeshRenderer {
                         / 3.0,
                     height_m: centroid[2],
                 };
-                Some(Face { points: [pa, pb, pc], min_y, max_y, colour: colour(&facet), facet })
+                Some(Face { points: [pa, pb, pc], min_y, max_y, facet })
             })
             .collect_into_vec(&mut self.faces);
     }
@@ -404,20 +373,18 @@ impl FaceIds {
 /// cores (a face is translated by the band's origin before filling).
 pub const BAND_ROWS: usize = 128;
 
-/// A shaded triangle ready to fill: screen points, vertical extent, colour, and what the
-/// colour was made from.
+/// A projected triangle ready to fill: screen points, vertical extent and its facet.
 #[derive(Clone, Copy, Debug)]
 struct Face {
     points: [(f32, f32); 3],
     min_y: f32,
     max_y: f32,
-    colour: [u8; 3],
     facet: Facet,
 }
 
 /// Samples the surface at every point, in parallel chunks (the result does not depend on how
 /// the chunks are spread over cores: each point is sampled alone).
-fn sample_all<S: Surface + ?Sized>(
+pub(crate) fn sample_all<S: Surface + ?Sized>(
     surface: &S,
     ground: &[[f32; 2]],
     footprints: &[Footprint],
@@ -437,7 +404,6 @@ fn sample_all<S: Surface + ?Sized>(
 mod tests {
     use super::*;
     use crate::render::camera::CameraPose;
-    use crate::render::sky::Sky;
 
     /// A tilted plane and a calm, for checking the mesh without the ocean.
     struct Flat(f32);
@@ -473,30 +439,6 @@ mod tests {
     }
 
     #[test]
-    fn a_calm_mesh_covers_the_sea_without_gaps() {
-        let cam = camera();
-        let sky = Sky::new(30.0, 30.0);
-        let texture = SeaTexture::builtin();
-        let mut out = Pixmap::new(160, 96).unwrap();
-        // Paint a marker colour first: any pixel left below the horizon is a hole in the mesh.
-        out.fill(tiny_skia::Color::from_rgba8(255, 0, 255, 255));
-        let mut renderer = MeshRenderer::new();
-        assert!(renderer.prepare(&cam, 4.0));
-        assert!(!renderer.prepare(&cam, 4.0), "the triangulation is kept");
-        let shading = Shading { environment: &sky, light: sky.light(), look: WaterLook::default(), texture: &texture };
-        renderer.draw(&Flat(0.0), &shading, &mut out);
-        // Near the horizon the lattice stops at the horizon distance, which at the sides of the
-        // picture is reached lower down; that sliver is the sky's far-sea colour (see Sky::draw).
-        let first_row = (cam.horizon_y() + 0.1 * 96.0).ceil() as usize;
-        for y in first_row..96 {
-            for x in 0..160 {
-                let p = out.pixels()[y * 160 + x];
-                assert!(!(p.red() == 255 && p.green() == 0 && p.blue() == 255), "hole at ({x}, {y})");
-            }
-        }
-    }
-
-    #[test]
     fn face_ids_cover_the_sea_and_name_their_facets() {
         let cam = camera();
         let mut renderer = MeshRenderer::new();
@@ -524,22 +466,5 @@ mod tests {
         assert!((f.height_m - 0.02 * centroid[0]).abs() < 1e-3);
         assert!((centroid[2] - f.height_m).abs() < 1e-3);
         assert!(renderer.facet(usize::MAX).is_none());
-    }
-
-    #[test]
-    fn tilting_the_surface_changes_the_picture() {
-        let cam = camera();
-        let sky = Sky::new(0.0, 20.0);
-        let texture = SeaTexture::builtin();
-        let shading = Shading { environment: &sky, light: sky.light(), look: WaterLook::default(), texture: &texture };
-        let draw = |s: &dyn Surface| {
-            let mut out = Pixmap::new(160, 96).unwrap();
-            let mut r = MeshRenderer::new();
-            r.prepare(&cam, 4.0);
-            r.draw(s, &shading, &mut out);
-            out
-        };
-        assert_ne!(draw(&Flat(0.0)).data(), draw(&Flat(0.05)).data());
-        assert_eq!(draw(&Flat(0.05)).data(), draw(&Flat(0.05)).data());
     }
 }

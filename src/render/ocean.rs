@@ -1,5 +1,10 @@
 //! The ocean renderer: sky, then the sea mesh, at `ssaa` times the size, filtered down.
 //!
+//! The sea is sampled at the mesh's vertices (displaced sideways by its choppiness), its foam
+//! followed at those resting points through time ([`FoamTracker`]: a still picture warms it
+//! up, a stream of frames continues it), and drawn with smooth shading and per-pixel foam
+//! ([`super::smooth`]).
+//!
 //! The mesh density is tied to the output resolution ([`mesh_spacing_px`]): about 3 output
 //! pixels between samples for a terminal frame (so its few pixels still show facets), growing
 //! to about 8 at 1920x1080 so the triangle count (and time) stays bounded while each facet
@@ -9,12 +14,35 @@
 use tiny_skia::Pixmap;
 
 use super::camera::{Camera, CameraPose};
+use super::foam_texture::{FOAM_STREAK, FOAM_TILE_ACROSS_M};
 use super::mesh::{MeshRenderer, Shading};
 use super::shade::{Facet, WaterLook, shade_facet};
 use super::sky::Sky;
+use super::smooth::{FoamLayout, SmoothShader};
 use super::supersample::{Downsample, downsample};
 use super::texture::SeaTexture;
-use crate::sim::ocean::{SeaFrame, cox_munk_slope_variance};
+use crate::sim::foam::FoamTracker;
+use crate::sim::ocean::{Sea, SeaFrame, cox_munk_slope_variance};
+
+/// How fast foam drifts downwind with the surface water, as a fraction of the wind speed
+/// (the wind drift of the top centimetres, about 3 %).
+pub const FOAM_DRIFT_FRACTION: f64 = 0.03;
+
+/// How far the foam texture has drifted downwind at `time_s`, m: modulo one texture length,
+/// and for a looping sea at a speed that crosses a whole number of texture lengths per loop.
+pub fn foam_drift_m(sea: &Sea, time_s: f64) -> f32 {
+    let length = f64::from(FOAM_TILE_ACROSS_M * FOAM_STREAK);
+    let speed = FOAM_DRIFT_FRACTION * sea.params().wind_m_s;
+    match sea.params().loop_period {
+        Some(p) => {
+            let lengths = (speed * p.seconds() / length).round() as u64;
+            let (_, tick) = p.loops_and_tick(time_s);
+            let turns = lengths.wrapping_mul(u64::from(tick)) & 0xFFFF_FFFF;
+            (turns as f64 / 4_294_967_296.0 * length) as f32
+        }
+        None => (speed * time_s).rem_euclid(length) as f32,
+    }
+}
 
 /// How the sea is looked at.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -46,9 +74,21 @@ impl Default for OceanView {
 }
 
 /// Output pixels between mesh samples for a `width x height` picture: √(W·H)/180, within
-/// 3.2..=8 (a terminal frame gets a triangle per 5 or so pixels, 1080p one per 30).
+/// 3.2..=8 (a terminal frame gets a triangle per 5 or so pixels, 1080p one per 30). The lake
+/// uses this spacing; the ocean's smooth shading goes denser on small pictures
+/// ([`ocean_spacing_px`]).
 pub fn mesh_spacing_px(width: u32, height: u32) -> f32 {
     ((f64::from(width) * f64::from(height)).sqrt() / 180.0).clamp(3.2, 8.0) as f32
+}
+
+/// The ocean's densest mesh, output pixels between samples: a terminal frame (160x94) gets a
+/// vertex every 2.4 pixels, so the smooth shading has the short waves to show (at 3.2 its few
+/// pixels were smoothed flat; 1.6 looked a little crisper but cost twice as much).
+pub const MIN_SPACING_PX: f32 = 2.4;
+
+/// The ocean's mesh spacing: √(W·H)/180 within [`MIN_SPACING_PX`]..=8 (1080p: every 8 pixels).
+pub fn ocean_spacing_px(width: u32, height: u32) -> f32 {
+    ((f64::from(width) * f64::from(height)).sqrt() / 180.0).clamp(f64::from(MIN_SPACING_PX), 8.0) as f32
 }
 
 /// Draws a sea into pictures of one size, keeping its mesh and buffers between frames.
@@ -62,6 +102,8 @@ pub struct OceanRenderer {
     texture: SeaTexture,
     look: WaterLook,
     mesh: MeshRenderer,
+    smooth: SmoothShader,
+    foam: FoamTracker,
     supersampled: Option<Pixmap>,
 }
 
@@ -85,6 +127,8 @@ impl OceanRenderer {
             texture,
             look: WaterLook::default(),
             mesh: MeshRenderer::new(),
+            smooth: SmoothShader::new(),
+            foam: FoamTracker::new(),
             supersampled,
         })
     }
@@ -147,18 +191,28 @@ impl OceanRenderer {
 
     /// Draws `frame` into `out`, which must be `width x height`.
     ///
+    /// Foam continues from the previous frame when the sea and camera are the same and time
+    /// moved on; otherwise it is warmed up ([`crate::sim::foam::FoamClock::warm_up_steps`]),
+    /// so a frame's picture does not depend on the frames drawn before it.
+    ///
     /// # Panics
     /// When `out` has another size (a programming error).
     pub fn render(&mut self, frame: &SeaFrame<'_>, out: &mut Pixmap) {
         assert_eq!((out.width(), out.height()), (self.width, self.height), "output size");
-        let spacing = mesh_spacing_px(self.width, self.height) * self.view.ssaa as f32;
-        self.mesh.prepare(&self.camera, spacing);
-        let below = self.far_sea(frame.sea().params().wind_m_s);
+        let spacing = ocean_spacing_px(self.width, self.height) * self.view.ssaa as f32;
+        if self.mesh.prepare(&self.camera, spacing) {
+            self.foam.reset();
+        }
+        let sea = frame.sea();
+        let below = self.far_sea(sea.params().wind_m_s);
+        let Some(topology) = self.mesh.topology() else { return };
+        let foam = self.foam.update(sea, topology.points(), topology.footprints(), frame.time_s());
+        let layout = FoamLayout { downwind: sea.downwind(), drift_m: foam_drift_m(sea, frame.time_s()) };
         let shading =
             Shading { environment: &self.sky, light: self.sky.light(), look: self.look, texture: &self.texture };
         let target = self.supersampled.as_mut().unwrap_or(out);
         self.sky.draw(&self.camera, below, target);
-        self.mesh.draw(frame, &shading, target);
+        self.smooth.draw(topology, frame, foam, layout, &shading, target);
         if let Some(big) = &self.supersampled {
             downsample(big, self.view.ssaa, self.view.downsample, out);
         }
@@ -173,6 +227,7 @@ mod tests {
     #[test]
     fn spacing_follows_the_resolution() {
         assert_eq!(mesh_spacing_px(160, 96), 3.2);
+        assert_eq!(ocean_spacing_px(160, 96), MIN_SPACING_PX);
         assert_eq!(mesh_spacing_px(1920, 1080), 8.0);
         let mid = mesh_spacing_px(1280, 720);
         assert!(mid > 5.0 && mid < 5.5);
@@ -180,7 +235,7 @@ mod tests {
 
     #[test]
     fn renders_opaque_and_deterministic_and_supersampled() {
-        let sea = Sea::new(SeaParams { wind_m_s: 9.0, wind_from_deg: 300.0, seed: 3 });
+        let sea = Sea::new(SeaParams { wind_m_s: 9.0, wind_from_deg: 300.0, seed: 3, ..SeaParams::default() });
         let frame = sea.frame(2.0);
         let draw = |ssaa| {
             let view = OceanView { ssaa, ..OceanView::default() };

@@ -5,6 +5,7 @@
 use font8x8::UnicodeFonts;
 use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
+use crate::sim::spectra::{SeaSpectrum, SpectrumChoice};
 use crate::sim::spectrum::{PiersonMoskowitz, spreading};
 
 /// Plot width, px.
@@ -147,10 +148,24 @@ fn line(out: &mut Pixmap, a: (f32, f32), b: (f32, f32), rgb: [u8; 3], stroke: &S
 
 /// The plot of `sea`: E(f) from 0 to 3·fm, and D(theta) at fm over -180..180 degrees.
 pub fn spectrum_plot(sea: &PiersonMoskowitz) -> Pixmap {
+    sea_spectrum_plot(&SeaSpectrum::new(sea.wind_m_s(), SpectrumChoice::PiersonMoskowitz))
+}
+
+/// The plot of any spectrum: E(f) from 0 to 3·fp and D(theta) at fp, its name, γ, fetch and
+/// depth in the heading (a Pierson–Moskowitz sea plots exactly as [`spectrum_plot`]).
+pub fn sea_spectrum_plot(sea: &SeaSpectrum) -> Pixmap {
     let mut out = Pixmap::new(WIDTH, HEIGHT).expect("a fixed, valid size");
     out.fill(Color::WHITE);
-    let heading =
-        format!("Pierson-Moskowitz sea, U = {} m/s, Hs = {:.2} m", label(sea.wind_m_s()), sea.significant_height_m());
+    let (u, hs) = (label(sea.wind_m_s()), sea.significant_height_m());
+    let heading = match sea.choice() {
+        SpectrumChoice::PiersonMoskowitz => format!("Pierson-Moskowitz sea, U = {u} m/s, Hs = {hs:.2} m"),
+        SpectrumChoice::Jonswap(j) | SpectrumChoice::Tma(j, _) => {
+            let fetch = j.fetch_km().map_or("unlimited".to_string(), |f| format!("{} km", label(f)));
+            let depth = sea.depth_m().map_or(String::new(), |d| format!(", h = {} m", label(d)));
+            let name = if sea.depth_m().is_some() { "TMA" } else { "JONSWAP" };
+            format!("{name}, U = {u} m/s, gamma {}, fetch {fetch}{depth}, Hs = {hs:.2} m", label(j.gamma()))
+        }
+    };
     draw_text(&mut out, 20, 12, &heading, INK);
     let Some(fm) = sea.peak_hz() else {
         draw_text(&mut out, 20, 200, "calm: no wind, no waves (E = 0 everywhere)", INK);

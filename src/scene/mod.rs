@@ -16,6 +16,8 @@ mod controls;
 mod event;
 pub mod lake;
 pub mod ocean;
+#[cfg(test)]
+mod ocean_physics_tests;
 pub mod pool;
 mod script;
 

@@ -34,7 +34,12 @@ impl Default for OceanSettings {
     /// texture, time 0.
     fn default() -> Self {
         OceanSettings {
-            sea: SeaParams { wind_m_s: DEFAULT_SEA_WIND_M_S, wind_from_deg: DEFAULT_WIND_FROM_DEG, seed: 1 },
+            sea: SeaParams {
+                wind_m_s: DEFAULT_SEA_WIND_M_S,
+                wind_from_deg: DEFAULT_WIND_FROM_DEG,
+                seed: 1,
+                ..SeaParams::default()
+            },
             view: OceanView::default(),
             texture: SeaTexture::builtin(),
             start_time_s: 0.0,
@@ -301,7 +306,7 @@ mod tests {
 
     fn scene(wind: f64) -> OceanScene {
         let settings = OceanSettings {
-            sea: SeaParams { wind_m_s: wind, wind_from_deg: 0.0, seed: 5 },
+            sea: SeaParams { wind_m_s: wind, wind_from_deg: 0.0, seed: 5, ..SeaParams::default() },
             ..OceanSettings::default()
         };
         OceanScene::new(settings, 64, 36).unwrap()

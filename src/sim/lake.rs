@@ -400,6 +400,7 @@ impl Surface for LakeFrame {
             height_m: rough * self.scale_m * height,
             foam: 0.0,
             unresolved_slope_variance: rough2 * unresolved,
+            ..SurfaceSample::default()
         }
     }
 }

@@ -56,6 +56,10 @@ fn len(v: [f32; 2]) -> f32 {
 pub struct SurfaceSample {
     /// Height above the mean level, m (only what the footprint resolves).
     pub height_m: f32,
+    /// How far the water that rests at the sampled point is carried across the plane (east,
+    /// north metres): the horizontal displacement of a choppy sea (zero for other surfaces).
+    /// The renderer draws the point at (x, y) + this, at `height_m`.
+    pub displacement_m: [f32; 2],
     /// Foam (whitecap) cover at the point, 0..=1.
     pub foam: f32,
     /// Slope variance (per axis) of the waves too short for the footprint; the renderer

@@ -17,7 +17,12 @@ fn the_command_line_draws_the_librarys_seas() {
     assert!(out.status.success(), "{}", stderr(&out));
     let spec = |ssaa, time| {
         SceneSpec::Ocean(OceanSettings {
-            sea: SeaParams { wind_m_s: beaufort_speed_m_s(8).unwrap(), wind_from_deg: 200.0, seed: 1 },
+            sea: SeaParams {
+                wind_m_s: beaufort_speed_m_s(8).unwrap(),
+                wind_from_deg: 200.0,
+                seed: 1,
+                ..SeaParams::default()
+            },
             view: OceanView { ssaa, ..OceanView::default() },
             start_time_s: time,
             ..OceanSettings::default()
@@ -147,6 +152,19 @@ fn bad_flags_are_one_line_errors_with_status_2() {
         (&["render", "ocean", "--extent", "300"], "--heightmap"),
         (&["render", "ocean", "--texture", "missing.png"], "no such file"),
         (&["spectrum", "--out", "plot.jpg"], ".png"),
+        (&["render", "ocean", "--spectrum", "jonswap", "--fetch", "0"], "--fetch: a fetch of 0 km"),
+        (&["render", "ocean", "--spectrum", "tma", "--depth", "-1"], "--depth: a water depth of -1 m"),
+        (&["render", "ocean", "--spectrum", "jonswap", "--gamma", "0"], "--gamma"),
+        (&["render", "ocean", "--loop", "0", "--frames", "3", "--out", "a.gif"], "--loop: a loop of 0 s"),
+        (&["render", "ocean", "--loop", "inf", "--frames", "3", "--out", "a.gif"], "--loop"),
+        (&["render", "ocean", "--loop", "1", "--frames", "3", "--out", "a.gif"], "at least 10 peak periods"),
+        (&["render", "ocean", "--loop", "30"], "add --frames N or --maps DIR"),
+        (&["render", "ocean", "--choppiness", "NaN"], "--choppiness"),
+        (&["render", "ocean", "--spectrum", "pm", "--gamma", "3"], "--gamma: the peak enhancement"),
+        (&["render", "ocean", "--spectrum", "pm", "--fetch", "100"], "--fetch: the peak enhancement"),
+        (&["render", "ocean", "--depth", "4"], "only the tma spectrum feels the bottom"),
+        (&["render", "ocean", "--size", "300x200", "--maps", "m"], "maps are square"),
+        (&["render", "ocean", "--maps", "m", "--out", "-"], "cannot go to standard output"),
     ];
     for (args, needle) in cases {
         let out = run_in(&dir, args);
@@ -156,4 +174,68 @@ fn bad_flags_are_one_line_errors_with_status_2() {
         assert!(!err.contains("panicked"), "{args:?}: {err}");
     }
     assert!(std::fs::read_dir(&dir).unwrap().next().is_none(), "no file written by a refused command");
+}
+
+/// The little-endian f32 payload of a 2-D `.npy` file: (rows, columns, values).
+fn read_npy_2d(bytes: &[u8]) -> (usize, usize, Vec<f32>) {
+    assert_eq!(&bytes[..6], b"\x93NUMPY", "an .npy file");
+    let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+    let header = std::str::from_utf8(&bytes[10..10 + header_len]).unwrap();
+    assert!(header.contains("'descr': '<f4'"), "{header}");
+    let shape = header.split("'shape': (").nth(1).unwrap().split(')').next().unwrap();
+    let dims: Vec<usize> = shape.split(',').filter_map(|d| d.trim().parse().ok()).collect();
+    let values =
+        bytes[10 + header_len..].chunks_exact(4).map(|c| f32::from_le_bytes(c.try_into().unwrap())).collect::<Vec<_>>();
+    assert_eq!(values.len(), dims.iter().product::<usize>());
+    (dims[0], dims[1], values)
+}
+
+/// `--maps` writes a tileable patch: the step across the seam (last column to first, last row
+/// to first) is no bigger than the steps inside it; with `--loop`, the maps a whole loop later
+/// are the same bytes; a file where the folder should be is refused and left alone.
+#[test]
+fn maps_tile_across_their_edges_and_loop_in_time() {
+    let dir = scratch("ocean_maps");
+    let out = run_in(&dir, &["render", "ocean", "--maps", "m", "--size", "64x64", "--wind", "12"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir.join("m")).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    names.sort();
+    assert_eq!(names, ["displacement.npy", "displacement.png", "foam.png", "height.npy", "height.png", "normal.png"]);
+    let (rows, cols, h) = read_npy_2d(&std::fs::read(dir.join("m/height.npy")).unwrap());
+    assert_eq!((rows, cols), (64, 64));
+    let at = |r: usize, c: usize| h[r * cols + c];
+    let (mut inside, mut seam) = (0.0f32, 0.0f32);
+    for r in 0..rows {
+        for c in 0..cols - 1 {
+            inside = inside.max((at(r, c + 1) - at(r, c)).abs()).max((at(c + 1, r) - at(c, r)).abs());
+        }
+        seam = seam.max((at(r, 0) - at(r, cols - 1)).abs()).max((at(0, r) - at(rows - 1, r)).abs());
+    }
+    assert!(inside > 0.05, "a sea with waves: largest step {inside} m");
+    assert!(seam <= inside, "the seam steps {seam} m, more than any step inside ({inside} m)");
+
+    // A loop of 80 s: the maps at --time 80 are the maps at --time 0.
+    for (folder, time) in [("t0", "0"), ("t80", "80")] {
+        let out =
+            run_in(&dir, &["render", "ocean", "--maps", folder, "--size", "32x32", "--loop", "80", "--time", time]);
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    for name in ["height.npy", "displacement.npy", "normal.png", "foam.png"] {
+        let a = std::fs::read(dir.join("t0").join(name)).unwrap();
+        assert_eq!(a, std::fs::read(dir.join("t80").join(name)).unwrap(), "{name} a loop later");
+    }
+    let out = run_in(&dir, &["render", "ocean", "--maps", "t0", "--size", "32x32", "--time", "7"]);
+    assert!(out.status.success());
+    assert_ne!(
+        std::fs::read(dir.join("t0/height.npy")).unwrap(),
+        std::fs::read(dir.join("t80/height.npy")).unwrap(),
+        "time moves the maps"
+    );
+
+    std::fs::write(dir.join("afile"), b"keep me").unwrap();
+    let out = run_in(&dir, &["render", "ocean", "--maps", "afile", "--size", "32x32"]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(stderr(&out).contains("--maps: 'afile' is a file"), "{}", stderr(&out));
+    assert_eq!(std::fs::read(dir.join("afile")).unwrap(), b"keep me");
 }

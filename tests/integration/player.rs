@@ -110,12 +110,13 @@ fn still_water_sends_only_the_status_line() {
             .map(|(x, y)| s.cell(x, y))
             .collect::<Vec<_>>()
     };
-    let mut sizes = [(&b"+"[..], "stone 4"), (b"-", "stone 3")].into_iter().cycle();
+    // Each round trip ends at stone 3, so the window below starts from a known size.
     loop {
         let before = p.screen();
-        let (key, status) = sizes.next().unwrap();
-        p.send(key);
-        p.wait_for_status(status, WAIT);
+        for (key, status) in [(&b"+"[..], "stone 4"), (b"-", "stone 3")] {
+            p.send(key);
+            p.wait_for_status(status, WAIT);
+        }
         let after = p.screen();
         if picture(&before) == picture(&after) && cells(&before) == cells(&after) {
             break;

@@ -121,6 +121,10 @@ pub struct PlayCommand {
     #[arg(long, value_name = "DEG", value_parser = ocean::parse_degrees, allow_hyphen_values = true)]
     pub direction: Option<f64>,
 
+    /// The ocean's spectrum and choppiness.
+    #[command(flatten)]
+    pub shape: ocean::SeaShapeArgs,
+
     /// Seed for everything random (rain, random stones); the same seed and the same inputs
     /// give the same water.
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]

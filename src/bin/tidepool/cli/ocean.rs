@@ -4,8 +4,13 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use tidepool::CameraPose;
-use tidepool::sea::{DEFAULT_SEA_WIND_M_S, beaufort_speed_m_s};
+use tidepool::sea::{
+    DEFAULT_CHOPPINESS, DEFAULT_SEA_WIND_M_S, LoopPeriod, SeaSpectrum, SpectrumChoice, SpectrumChoiceError,
+    SpectrumKind, beaufort_speed_m_s, check_choppiness,
+};
+use tidepool::{CameraPose, SeaParams};
+
+use crate::error::{Error, Result};
 
 use super::OutputArgs;
 
@@ -14,7 +19,11 @@ Examples:
   tidepool render ocean                              # ocean.png, 640x360, a 10 m/s breeze
   tidepool render ocean --beaufort 8 --direction 200 --size 1280x720 --out gale.png
   tidepool render ocean --out - --size 160x96        # in this terminal
-  tidepool render ocean --wind 10 --heightmap sea.npy --size 512x512";
+  tidepool render ocean --wind 10 --heightmap sea.npy --size 512x512
+  tidepool render ocean --spectrum jonswap --fetch 20 --wind 15 --out fetch.png
+  tidepool render ocean --spectrum tma --depth 6 --beaufort 6 --out shallow.png
+  tidepool render ocean --beaufort 6 --loop 80 --frames 160 --fps 20 --out loop.gif
+  tidepool render ocean --beaufort 7 --maps maps/ --size 1024x1024 --extent 500";
 
 const OCEAN_HEIGHTMAP_HELP: &str = "Also write the sea surface height on the --extent patch, sampled at the \
 picture's size: FILE.npy (float32 metres, numpy's format) or FILE.png (16-bit grey, value = round(height*100) + \
@@ -44,6 +53,82 @@ impl WindArgs {
     }
 }
 
+/// Which spectrum the sea follows.
+#[derive(Args, Debug, Clone, Default)]
+pub struct SpectrumArgs {
+    /// The wave spectrum: pm (Pierson-Moskowitz, fully developed: the papers'), jonswap
+    /// (fetch-limited, peak-enhanced) or tma (JONSWAP in shallow water; needs --depth).
+    /// [default: pm]
+    #[arg(long, value_name = "KIND", value_parser = parse_spectrum)]
+    pub spectrum: Option<SpectrumKind>,
+
+    /// JONSWAP's peak enhancement gamma, 1..=10 (jonswap and tma). [default: 3.3]
+    #[arg(long, value_name = "G", value_parser = parse_plain_number, allow_negative_numbers = true)]
+    pub gamma: Option<f64>,
+
+    /// The fetch: how far the wind has blown over open water, km (jonswap and tma; 0.01..=10000).
+    /// [default: unlimited, a fully developed peak]
+    #[arg(long, value_name = "KM", value_parser = parse_plain_number, allow_negative_numbers = true)]
+    pub fetch: Option<f64>,
+
+    /// The water depth for tma, metres (0.5..=10000): shallow water shortens the waves.
+    #[arg(long, value_name = "M", value_parser = parse_plain_number, allow_negative_numbers = true)]
+    pub depth: Option<f64>,
+}
+
+impl SpectrumArgs {
+    /// The checked spectrum; an impossible combination names the flag to change.
+    pub fn choice(&self) -> Result<SpectrumChoice> {
+        let kind = self.spectrum.unwrap_or_default();
+        SpectrumChoice::new(kind, self.gamma, self.fetch, self.depth).map_err(|e| {
+            let flag = match &e {
+                SpectrumChoiceError::JonswapParameterWithPm if self.gamma.is_some() => "--gamma",
+                SpectrumChoiceError::JonswapParameterWithPm => "--fetch",
+                SpectrumChoiceError::DepthWithoutTma | SpectrumChoiceError::TmaWithoutDepth => "--depth",
+                SpectrumChoiceError::Value(v) => match v.what() {
+                    "peak enhancement gamma" => "--gamma",
+                    "fetch" => "--fetch",
+                    _ => "--depth",
+                },
+            };
+            Error::arg(flag, e.to_string())
+        })
+    }
+}
+
+/// The sea's shape beyond the wind: spectrum and choppiness.
+#[derive(Args, Debug, Clone, Default)]
+pub struct SeaShapeArgs {
+    /// The spectrum.
+    #[command(flatten)]
+    pub spectrum: SpectrumArgs,
+
+    /// Horizontal displacement of the water, 0..=4: 0 moves it only up and down (round crests),
+    /// 1 is the physical displacement (sharp crests, foam where waves fold). [default: 1]
+    #[arg(long, value_name = "L", value_parser = parse_choppiness, allow_negative_numbers = true)]
+    pub choppiness: Option<f64>,
+}
+
+impl SeaShapeArgs {
+    /// The sea of these flags under `wind_m_s` from `wind_from_deg`, seeded with `seed`.
+    pub fn params(&self, wind_m_s: f64, wind_from_deg: f64, seed: u64) -> Result<SeaParams> {
+        Ok(SeaParams {
+            wind_m_s,
+            wind_from_deg,
+            seed,
+            spectrum: self.spectrum.choice()?,
+            choppiness: self.choppiness.unwrap_or(DEFAULT_CHOPPINESS),
+            loop_period: None,
+        })
+    }
+}
+
+/// Checks `--loop SECONDS` for the sea `params` (the shortest loop depends on its peak period).
+pub fn loop_period(seconds: f64, params: &SeaParams) -> Result<LoopPeriod> {
+    LoopPeriod::new(seconds, &SeaSpectrum::new(params.wind_m_s, params.spectrum))
+        .map_err(|e| Error::arg("--loop", e.to_string()))
+}
+
 /// `tidepool render ocean`.
 #[derive(Args, Debug)]
 #[command(after_help = OCEAN_EXAMPLES)]
@@ -57,6 +142,22 @@ pub struct RenderOcean {
     /// the waves travel downwind.
     #[arg(long, value_name = "DEG", default_value = "330", value_parser = parse_degrees, allow_hyphen_values = true)]
     pub direction: f64,
+
+    /// Spectrum and choppiness.
+    #[command(flatten)]
+    pub shape: SeaShapeArgs,
+
+    /// Repeat exactly every SECONDS (at least 10 peak periods, at most 3600): an animation's
+    /// frames then span one loop (frame k at --time + k*SECONDS/--frames), so the GIF or
+    /// animated PNG loops without a jump; with --maps the maps loop too.
+    #[arg(long = "loop", value_name = "SECONDS", value_parser = parse_plain_number, allow_negative_numbers = true)]
+    pub loop_seconds: Option<f64>,
+
+    /// Write tileable maps for game engines into this folder (created if missing) instead of a
+    /// picture: height.npy/.png, displacement.npy/.png, normal.png, foam.png of a periodic
+    /// patch --extent metres across at --size (square); with --frames, a numbered series.
+    #[arg(long, value_name = "DIR")]
+    pub maps: Option<PathBuf>,
 
     /// The sun: azimuth (degrees clockwise from north) and elevation (0..=90 degrees).
     #[arg(long, value_name = "AZ,EL", default_value = "15,22", value_parser = parse_sun, allow_hyphen_values = true)]
@@ -82,7 +183,8 @@ pub struct RenderOcean {
     pub ssaa: Option<u32>,
 
     /// East-west size of the --heightmap patch in metres (it spans extent·H/W north-south,
-    /// centred under the camera). [default: 8 peak wavelengths]
+    /// centred under the camera) [default: 8 peak wavelengths], or the side of the --maps
+    /// patch (1..=100000) [default: 10 peak wavelengths].
     #[arg(long, value_name = "METRES", value_parser = parse_extent)]
     pub extent: Option<f64>,
 
@@ -102,6 +204,10 @@ pub struct SpectrumCommand {
     #[command(flatten)]
     pub wind: WindArgs,
 
+    /// The spectrum.
+    #[command(flatten)]
+    pub spectrum: SpectrumArgs,
+
     /// Print JSON instead of `name: value unit` lines.
     #[arg(long)]
     pub json: bool,
@@ -109,6 +215,21 @@ pub struct SpectrumCommand {
     /// Also plot E(f) and the spreading D(theta) at the peak into this PNG file.
     #[arg(long, value_name = "FILE.png")]
     pub out: Option<PathBuf>,
+}
+
+/// Parses `pm`, `jonswap` or `tma`.
+pub fn parse_spectrum(text: &str) -> Result<SpectrumKind, String> {
+    text.parse().map_err(|e: tidepool::ValueError| e.to_string())
+}
+
+/// Parses any number, `inf` and `nan` included: the library's checks word the refusal.
+fn parse_plain_number(text: &str) -> Result<f64, String> {
+    text.trim().parse::<f64>().map_err(|_| format!("'{text}' is not a number"))
+}
+
+/// Parses a choppiness, 0..=4.
+pub fn parse_choppiness(text: &str) -> Result<f64, String> {
+    check_choppiness(parse_plain_number(text)?).map_err(|e| e.to_string())
 }
 
 fn number(text: &str, what: &'static str, example: &str) -> Result<f64, String> {

@@ -147,31 +147,35 @@ pub fn animate(
     too_large_hint: &'static str,
     print_stats: bool,
 ) -> Result<()> {
-    let mut stats = Stats::default();
-    let make = || spec.build(size.width(), size.height()).map_err(size_error(size, too_large_hint));
-    render_animation(&make, animation, target, &mut stats)?;
-    stats.print_if(print_stats);
-    Ok(())
+    let make = || -> Result<Box<dyn FrameSource + '_>> {
+        let scene = spec.build(size.width(), size.height()).map_err(size_error(size, too_large_hint))?;
+        Ok(Box::new(Stepped { scene, script: Script::new(animation.script), animation }))
+    };
+    render_frames(&make, animation.frames, animation.fps, target, print_stats)
 }
 
-fn render_animation(
-    make: &dyn Fn() -> Result<Box<dyn tidepool::Playable>>,
-    animation: &Animation<'_>,
+/// Renders `frames` frames from the sources `make` builds (fresh for each pass) to `target` at
+/// `fps`.
+pub fn render_frames<'a>(
+    make: &dyn Fn() -> Result<Box<dyn FrameSource + 'a>>,
+    frames: u32,
+    fps: u32,
     target: &AnimationTarget,
-    stats: &mut Stats,
+    print_stats: bool,
 ) -> Result<()> {
+    let mut stats = Stats::default();
     let started = Instant::now();
     let palette = match target {
         AnimationTarget::Gif(_) => {
-            let mut scene = make()?;
-            let mut script = Script::new(animation.script);
-            let sps = scene.steps_per_second();
+            let mut source = make()?;
+            let (width, height) = source.size();
             let mut samples = Vec::new();
-            for i in 0..PALETTE_SAMPLES.min(animation.frames) {
-                let k =
-                    (u64::from(i) * u64::from(animation.frames - 1) / u64::from((PALETTE_SAMPLES - 1).max(1))) as u32;
-                script.run_to(scene.as_mut(), animation.frame_step(k, sps));
-                samples.push(scene.snapshot()?);
+            for i in 0..PALETTE_SAMPLES.min(frames) {
+                let k = (u64::from(i) * u64::from(frames - 1) / u64::from((PALETTE_SAMPLES - 1).max(1))) as u32;
+                let mut pixmap =
+                    Pixmap::new(width, height).ok_or_else(|| Error::arg("--size", "cannot allocate the frames"))?;
+                source.draw(k, &mut pixmap)?;
+                samples.push(pixmap);
             }
             let palette = GifPalette::learn(&samples.iter().collect::<Vec<_>>());
             stats.record("palette", started, format!("{} sample frames", samples.len()));
@@ -180,34 +184,60 @@ fn render_animation(
         _ => None,
     };
     let started = Instant::now();
-    let mut scene = make()?;
-    let mut script = Script::new(animation.script);
-    let (width, height) = scene.size();
-    let sps = scene.steps_per_second();
+    let mut source = make()?;
+    let (width, height) = source.size();
     let mut pixmap = Pixmap::new(width, height).ok_or_else(|| Error::arg("--size", "cannot allocate the frames"))?;
-    let mut sink = Sink::open(target, width, height, animation, palette)?;
-    let mut progress = Progress::new("frames", u64::from(animation.frames));
-    for k in 0..animation.frames {
-        script.run_to(scene.as_mut(), animation.frame_step(k, sps));
-        if scene.size() != (width, height) {
-            return Err(Error::Usage(format!(
-                "the scene changed size at step {} (a replay's resize); animate the part before or after it with --steps and --frames",
-                script.step()
-            )));
-        }
-        scene.render(&mut pixmap);
+    let mut sink = Sink::open(target, width, height, frames, fps, palette)?;
+    let mut progress = Progress::new("frames", u64::from(frames));
+    for k in 0..frames {
+        source.draw(k, &mut pixmap)?;
         sink.write(k, &pixmap)?;
         progress.advance(1);
     }
     drop(progress);
     let (what, bytes) = sink.finish()?;
-    let fps = animation.fps;
     stats.record(
         "animation",
         started,
-        format!("{} frames of {width}x{height} at {fps} fps, {what}, {}", animation.frames, human_bytes(bytes as u64)),
+        format!("{frames} frames of {width}x{height} at {fps} fps, {what}, {}", human_bytes(bytes as u64)),
     );
+    stats.print_if(print_stats);
     Ok(())
+}
+
+/// Where an animation's frames come from: frame `k` drawn into a picture of `size()`. Frames
+/// are asked for in increasing order (the GIF palette's samples skip some).
+pub trait FrameSource {
+    /// The picture size, pixels.
+    fn size(&self) -> (u32, u32);
+    /// Draws frame `k` into `out`.
+    fn draw(&mut self, k: u32, out: &mut Pixmap) -> Result<()>;
+}
+
+/// A scene stepped as the player steps it, with scripted events at their steps.
+struct Stepped<'a> {
+    scene: Box<dyn tidepool::Playable>,
+    script: Script<'a>,
+    animation: &'a Animation<'a>,
+}
+
+impl FrameSource for Stepped<'_> {
+    fn size(&self) -> (u32, u32) {
+        self.scene.size()
+    }
+
+    fn draw(&mut self, k: u32, out: &mut Pixmap) -> Result<()> {
+        let step = self.animation.frame_step(k, self.scene.steps_per_second());
+        self.script.run_to(self.scene.as_mut(), step);
+        if self.scene.size() != (out.width(), out.height()) {
+            return Err(Error::Usage(format!(
+                "the scene changed size at step {} (a replay's resize); animate the part before or after it with --steps and --frames",
+                self.script.step()
+            )));
+        }
+        self.scene.render(out);
+        Ok(())
+    }
 }
 
 /// Refuses flags that mean nothing for an animation.
@@ -262,20 +292,21 @@ impl Sink {
         target: &AnimationTarget,
         width: u32,
         height: u32,
-        animation: &Animation<'_>,
+        frames: u32,
+        fps: u32,
         palette: Option<GifPalette>,
     ) -> Result<Sink> {
         Ok(match target {
             AnimationTarget::Gif(path) => {
                 let file = AtomicFile::create(path)?;
                 let palette = palette.expect("a GIF's palette is learned first");
-                let writer = GifWriter::new(file, width, height, palette, animation.fps)
+                let writer = GifWriter::new(file, width, height, palette, fps)
                     .map_err(|e| Error::io("cannot write", path, e))?;
                 Sink::Gif(Box::new(writer), path.clone())
             }
             AnimationTarget::Apng(path) => {
                 let file = SharedFile::new(AtomicFile::create(path)?);
-                let writer = ApngWriter::new(file.clone(), width, height, animation.frames, animation.fps)
+                let writer = ApngWriter::new(file.clone(), width, height, frames, fps)
                     .map_err(|e| Error::io("cannot write", path, e))?;
                 Sink::Apng(writer, file, path.clone())
             }

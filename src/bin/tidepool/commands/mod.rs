@@ -8,6 +8,7 @@ pub mod animate;
 pub mod bench;
 pub mod docs;
 pub mod lake;
+pub mod maps;
 pub mod ocean;
 pub mod output;
 pub mod play;

@@ -10,7 +10,7 @@ use std::sync::atomic::AtomicBool;
 use tidepool::player::PlayerConfig;
 use tidepool::sea::{DEFAULT_WIND_FROM_DEG, MAX_LAKE_WIND_M_S};
 use tidepool::terminal::{ColorMode, EncodeOptions};
-use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneKind, SceneSpec, SeaParams};
+use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneKind, SceneSpec};
 
 use crate::cli::{ColorChoice, PlayCommand};
 use crate::error::{Error, Result};
@@ -70,11 +70,11 @@ pub fn run(command: PlayCommand) -> Result<()> {
     let pool = command.pool.settings(command.seed, (DEFAULT_PLAYER_RAIN, tidepool::values::DEFAULT_BREEZE))?;
     let default_view = OceanView::default();
     let ocean = OceanSettings {
-        sea: SeaParams {
-            wind_m_s: command.wind.speed_m_s(),
-            wind_from_deg: command.direction.unwrap_or(DEFAULT_WIND_FROM_DEG),
-            seed: command.seed,
-        },
+        sea: command.shape.params(
+            command.wind.speed_m_s(),
+            command.direction.unwrap_or(DEFAULT_WIND_FROM_DEG),
+            command.seed,
+        )?,
         view: OceanView {
             sun_azimuth_deg: command.pool.sun.map_or(default_view.sun_azimuth_deg, |s| s.azimuth_deg()),
             sun_elevation_deg: command.pool.sun.map_or(default_view.sun_elevation_deg, |s| s.elevation_deg()),

@@ -1,0 +1,96 @@
+//! Tileable sea maps for engines ([`crate::sim::patch::PatchMaps`]) as file bytes: this
+//! module encodes, the caller writes (atomically) where it likes.
+//!
+//! | file | format | content |
+//! |---|---|---|
+//! | `height.npy` | float32 (N, N) | Eulerian height, m |
+//! | `height.png` | 16-bit grey | round(height·100) + 32768: centimetres |
+//! | `displacement.npy` | float32 (N, N, 3) | where the water resting at each texel is carried: east, north, up, m |
+//! | `displacement.png` | 16-bit RGB | the same, round(·100) + 32768 per channel |
+//! | `normal.png` | 8-bit RGB | unit normal of the height surface, OpenGL convention: R = east (+X), G = north (+Y, up the image), B = up; 128 = 0 |
+//! | `foam.png` | 8-bit grey | foam cover, 0 = none, 255 = full |
+//!
+//! Row 0 is the north edge, columns run east; texel (r, c) is the point at (c, -r)·extent/N.
+//! The maps are periodic: texel N is texel 0, so they tile without a seam. DirectX-style
+//! engines (Unreal) want the normal map's green flipped.
+
+use super::heightmap::{Heightmap, encode_map_png, encode_npy, encode_npy_shaped, encode_png16, levels16};
+use crate::sim::patch::PatchMaps;
+
+/// PNG levels per metre for heights and displacements: centimetres.
+pub const MAP_PNG_SCALE: f32 = 100.0;
+
+/// The file names of one set of maps; with `frame`, each gets `_NNNN` before its extension.
+pub fn file_names(frame: Option<u32>) -> [String; 6] {
+    let name = |stem: &str, ext: &str| match frame {
+        Some(k) => format!("{stem}_{k:04}.{ext}"),
+        None => format!("{stem}.{ext}"),
+    };
+    [
+        name("height", "npy"),
+        name("height", "png"),
+        name("displacement", "npy"),
+        name("displacement", "png"),
+        name("normal", "png"),
+        name("foam", "png"),
+    ]
+}
+
+/// Every file of `maps` as (name, bytes), in [`file_names`]' order.
+pub fn encode_maps(maps: &PatchMaps, frame: Option<u32>) -> Vec<(String, Vec<u8>)> {
+    let n = maps.size;
+    let height = Heightmap { width: n, height: n, values: maps.height.clone(), png_levels_per_unit: MAP_PNG_SCALE };
+    let flat: Vec<f32> = maps.displacement.iter().flatten().copied().collect();
+    let files = [
+        encode_npy(&height),
+        encode_png16(&height),
+        encode_npy_shaped(&[n, n, 3], &flat),
+        encode_map_png(n, n, image::ExtendedColorType::Rgb16, &levels16(&flat, MAP_PNG_SCALE)),
+        encode_map_png(n, n, image::ExtendedColorType::Rgb8, &normal_bytes(&maps.normal)),
+        encode_map_png(n, n, image::ExtendedColorType::L8, &foam_bytes(&maps.foam)),
+    ];
+    file_names(frame).into_iter().zip(files).collect()
+}
+
+/// Unit normals to 8-bit RGB: round((v + 1)·127.5).
+pub fn normal_bytes(normals: &[[f32; 3]]) -> Vec<u8> {
+    normals.iter().flat_map(|n| n.map(|v| ((v.clamp(-1.0, 1.0) + 1.0) * 127.5).round() as u8)).collect()
+}
+
+/// Foam cover to 8-bit grey.
+pub fn foam_bytes(foam: &[f32]) -> Vec<u8> {
+    foam.iter().map(|&f| (f.clamp(0.0, 1.0) * 255.0).round() as u8).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn npy_shapes_and_pngs_decode() {
+        let bytes = encode_npy_shaped(&[2, 2, 3], &[0.5; 12]);
+        let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
+        assert_eq!((10 + header_len) % 64, 0);
+        assert!(std::str::from_utf8(&bytes[10..10 + header_len]).unwrap().contains("'shape': (2, 2, 3)"));
+        assert_eq!(bytes.len(), 10 + header_len + 48);
+        let maps = PatchMaps {
+            size: 2,
+            extent_m: 10.0,
+            height: vec![0.0, 1.0, -1.0, 0.25],
+            displacement: vec![[0.1, -0.2, 0.0]; 4],
+            normal: vec![[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.6, 0.0, 0.8]],
+            foam: vec![0.0, 1.0, 0.5, 2.0],
+        };
+        let files = encode_maps(&maps, Some(7));
+        assert_eq!(files[4].0, "normal_0007.png");
+        let normal = image::load_from_memory(&files[4].1).unwrap().to_rgb8();
+        assert_eq!(normal.get_pixel(0, 0).0, [128, 128, 255]);
+        assert_eq!(normal.get_pixel(1, 0).0, [255, 128, 128]);
+        assert_eq!(normal.get_pixel(0, 1).0, [128, 0, 128]);
+        let foam = image::load_from_memory(&files[5].1).unwrap().to_luma8();
+        assert_eq!(foam.as_raw(), &vec![0, 255, 128, 255]);
+        let disp = image::load_from_memory(&files[3].1).unwrap();
+        assert_eq!(disp.as_rgb16().unwrap().get_pixel(1, 1).0, [32778, 32748, 32768]);
+        assert_eq!(file_names(None)[0], "height.npy");
+    }
+}
