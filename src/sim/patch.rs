@@ -24,7 +24,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex32;
-use rustfft::{Fft, FftPlanner};
+use rustfft::{Fft, FftPlannerScalar};
 
 use super::dispersion;
 use super::foam::{FoamClock, remember, source};
@@ -182,7 +182,9 @@ impl PatchSea {
                 }
             }
         }
-        let fft = FftPlanner::new().plan_fft_inverse(n);
+        // The scalar planner: rustfft's AVX, SSE and NEON plans pick other algorithms and round
+        // differently, and maps must be the same bytes on every machine.
+        let fft = FftPlannerScalar::new().plan_fft_inverse(n);
         let sea = Sea::new(params);
         let threshold = sea.foam_calibration().threshold;
         Ok(PatchSea {
