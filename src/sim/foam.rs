@@ -30,7 +30,7 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use super::ocean::{Sea, SeaFrame, SeaTime, whitecap_fraction};
+use super::ocean::{Sea, SeaFrame, SeaParams, SeaTime, whitecap_fraction};
 use super::surface::Footprint;
 
 /// The foam clock's step, s.
@@ -202,7 +202,10 @@ impl FoamCalibration {
 #[derive(Debug, Default)]
 pub struct FoamTracker {
     /// The sea's parameters, the number of points and the last step taken.
-    at: Option<(super::ocean::SeaParams, usize, i64)>,
+    at: Option<(SeaParams, usize, i64)>,
+    /// The threshold calibrated for a sea's parameters (calibrating takes a while; a tracker
+    /// keeps it while the sea stays the same).
+    threshold: Option<(SeaParams, f32)>,
     state: Vec<f32>,
     foam: Vec<f32>,
     phases: Vec<f32>,
@@ -237,7 +240,14 @@ impl FoamTracker {
                 now - warm
             }
         };
-        let z = sea.foam_calibration().threshold;
+        let z = match self.threshold {
+            Some((params, z)) if params == sea.params() => z,
+            _ => {
+                let z = FoamCalibration::calibrate(sea).threshold;
+                self.threshold = Some((sea.params(), z));
+                z
+            }
+        };
         let decay = clock.decay();
         for n in first..=now {
             let frame = sea.frame_at(clock.time_of(n), std::mem::take(&mut self.phases));

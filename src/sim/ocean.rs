@@ -1,6 +1,6 @@
 //! The wind-driven sea: travelling sines drawn from a spectrum (Pierson–Moskowitz, JONSWAP or
 //! TMA, [`super::spectra`]) plus a diamond-square fBm tail, moved sideways by a choppy
-//! displacement and foaming where it folds ([`super::foam`]).
+//! displacement and foaming where it folds (the foam module, `sim::foam`).
 //!
 //! # The sines
 //! [`FREQUENCY_BINS`] geometric frequency bins from [`BAND_LOW`]·fp to [`CUTOFF`]·fp times
@@ -55,13 +55,11 @@
 
 use crate::error::ValueError;
 use std::f64::consts::PI;
-use std::sync::OnceLock;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
 use super::fbm::{self, Fbm};
-use super::foam::FoamCalibration;
 use super::looping::LoopPeriod;
 use super::spectra::{SeaSpectrum, SpectrumChoice};
 use super::spectrum::{G, wavelength_m};
@@ -236,7 +234,6 @@ pub struct Sea {
     slope_total: f32,
     /// Unit vector (east, north) the wind blows towards.
     downwind: [f32; 2],
-    foam: OnceLock<FoamCalibration>,
 }
 
 impl Sea {
@@ -293,7 +290,7 @@ impl Sea {
         let slope_total = cox_munk_slope_variance(spectrum.wind_m_s()) as f32;
         let to = (params.wind_from_deg + 180.0).to_radians();
         let downwind = [to.sin() as f32, to.cos() as f32];
-        Sea { params, spectrum, components, lanes, wavelength, tail, slope_total, downwind, foam: OnceLock::new() }
+        Sea { params, spectrum, components, lanes, wavelength, tail, slope_total, downwind }
     }
 
     fn tail(spectrum: &SeaSpectrum, cutoff_hz: f64, downwind: f64, params: &SeaParams) -> Tail {
@@ -383,11 +380,6 @@ impl Sea {
     /// λ as f32.
     pub fn choppiness(&self) -> f32 {
         self.params.choppiness as f32
-    }
-
-    /// The foam threshold, calibrated on first use ([`FoamCalibration`]).
-    pub fn foam_calibration(&self) -> &FoamCalibration {
-        self.foam.get_or_init(|| FoamCalibration::calibrate(self))
     }
 
     /// The moment `time_s` seconds from 0: a tick of the loop for a looping sea.
@@ -574,7 +566,7 @@ impl SeaFrame<'_> {
 
     /// Samples the surface at the resting point (east, north) metres for a sample standing
     /// for `footprint`: its height, how far λ carries it, and the unresolved slope variance.
-    /// `foam` is 0: foam has a memory, kept by a [`super::foam::FoamTracker`].
+    /// `foam` is 0: foam has a memory, kept by the foam module's `FoamTracker`.
     pub fn sample(&self, x: f32, y: f32, footprint: &Footprint) -> SurfaceSample {
         let sea = self.sea;
         let chop = sea.choppiness();

@@ -27,7 +27,7 @@ use rustfft::num_complex::Complex32;
 use rustfft::{Fft, FftPlannerScalar};
 
 use super::dispersion;
-use super::foam::{FoamClock, remember, source};
+use super::foam::{FoamCalibration, FoamClock, remember, source};
 use super::ocean::{EULER_ITERATIONS, Sea, SeaParams, SeaTime};
 use super::spectra::SeaSpectrum;
 
@@ -186,7 +186,7 @@ impl PatchSea {
         // differently, and maps must be the same bytes on every machine.
         let fft = FftPlannerScalar::new().plan_fft_inverse(n);
         let sea = Sea::new(params);
-        let threshold = sea.foam_calibration().threshold;
+        let threshold = FoamCalibration::calibrate(&sea).threshold;
         Ok(PatchSea {
             params,
             size,
