@@ -15,4 +15,5 @@ mod ocean;
 mod player;
 mod pool;
 mod replay;
+mod slow_link;
 mod soak;

@@ -123,7 +123,7 @@ pub struct PlayCommand {
 
     /// The ocean's spectrum and choppiness.
     #[command(flatten)]
-    pub shape: ocean::SeaShapeArgs,
+    pub sea: ocean::PlaySeaArgs,
 
     /// Seed for everything random (rain, random stones); the same seed and the same inputs
     /// give the same water.

@@ -54,7 +54,7 @@ impl WindArgs {
 }
 
 /// Which spectrum the sea follows.
-#[derive(Args, Debug, Clone, Default)]
+#[derive(Args, Debug, Clone)]
 pub struct SpectrumArgs {
     /// The wave spectrum: pm (Pierson-Moskowitz, fully developed: the papers'), jonswap
     /// (fetch-limited, peak-enhanced) or tma (JONSWAP in shallow water; needs --depth).
@@ -74,6 +74,10 @@ pub struct SpectrumArgs {
     /// The water depth for tma, metres (0.5..=10000): shallow water shortens the waves.
     #[arg(long, value_name = "M", value_parser = parse_plain_number, allow_negative_numbers = true)]
     pub depth: Option<f64>,
+
+    /// The flag errors about the depth name (`play` calls it `--sea-depth`).
+    #[arg(skip = "--depth")]
+    pub depth_flag: &'static str,
 }
 
 impl SpectrumArgs {
@@ -84,11 +88,11 @@ impl SpectrumArgs {
             let flag = match &e {
                 SpectrumChoiceError::JonswapParameterWithPm if self.gamma.is_some() => "--gamma",
                 SpectrumChoiceError::JonswapParameterWithPm => "--fetch",
-                SpectrumChoiceError::DepthWithoutTma | SpectrumChoiceError::TmaWithoutDepth => "--depth",
+                SpectrumChoiceError::DepthWithoutTma | SpectrumChoiceError::TmaWithoutDepth => self.depth_flag,
                 SpectrumChoiceError::Value(v) => match v.what() {
                     "peak enhancement gamma" => "--gamma",
                     "fetch" => "--fetch",
-                    _ => "--depth",
+                    _ => self.depth_flag,
                 },
             };
             Error::arg(flag, e.to_string())
@@ -97,7 +101,7 @@ impl SpectrumArgs {
 }
 
 /// The sea's shape beyond the wind: spectrum and choppiness.
-#[derive(Args, Debug, Clone, Default)]
+#[derive(Args, Debug, Clone)]
 pub struct SeaShapeArgs {
     /// The spectrum.
     #[command(flatten)]
@@ -120,6 +124,48 @@ impl SeaShapeArgs {
             choppiness: self.choppiness.unwrap_or(DEFAULT_CHOPPINESS),
             loop_period: None,
         })
+    }
+}
+
+/// The ocean's spectrum and choppiness in `play`, where `--depth` is the pool's caustics depth:
+/// the sea's depth for tma is `--sea-depth` there.
+#[derive(Args, Debug, Clone)]
+pub struct PlaySeaArgs {
+    /// The ocean's wave spectrum: pm (fully developed: the papers'), jonswap (fetch-limited) or
+    /// tma (JONSWAP in shallow water; needs --sea-depth). [default: pm]
+    #[arg(long, value_name = "KIND", value_parser = parse_spectrum)]
+    pub spectrum: Option<SpectrumKind>,
+
+    /// JONSWAP's peak enhancement gamma, 1..=10 (jonswap and tma). [default: 3.3]
+    #[arg(long, value_name = "G", value_parser = parse_plain_number, allow_negative_numbers = true)]
+    pub gamma: Option<f64>,
+
+    /// The ocean's fetch, km (jonswap and tma; 0.01..=10000). [default: unlimited]
+    #[arg(long, value_name = "KM", value_parser = parse_plain_number, allow_negative_numbers = true)]
+    pub fetch: Option<f64>,
+
+    /// The ocean's water depth for tma, metres (0.5..=10000).
+    #[arg(long = "sea-depth", value_name = "M", value_parser = parse_plain_number, allow_negative_numbers = true)]
+    pub sea_depth: Option<f64>,
+
+    /// The ocean's horizontal displacement, 0..=4 (0 round crests, 1 physical). [default: 1]
+    #[arg(long, value_name = "L", value_parser = parse_choppiness, allow_negative_numbers = true)]
+    pub choppiness: Option<f64>,
+}
+
+impl PlaySeaArgs {
+    /// The same flags in `render ocean`'s shape.
+    pub fn shape(&self) -> SeaShapeArgs {
+        SeaShapeArgs {
+            spectrum: SpectrumArgs {
+                spectrum: self.spectrum,
+                gamma: self.gamma,
+                fetch: self.fetch,
+                depth: self.sea_depth,
+                depth_flag: "--sea-depth",
+            },
+            choppiness: self.choppiness,
+        }
     }
 }
 

@@ -70,7 +70,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
     let pool = command.pool.settings(command.seed, (DEFAULT_PLAYER_RAIN, tidepool::values::DEFAULT_BREEZE))?;
     let default_view = OceanView::default();
     let ocean = OceanSettings {
-        sea: command.shape.params(
+        sea: command.sea.shape().params(
             command.wind.speed_m_s(),
             command.direction.unwrap_or(DEFAULT_WIND_FROM_DEG),
             command.seed,
