@@ -16,6 +16,14 @@
 //! of growing; in between it holds. An answer that does not come within [`PROBE_TIMEOUT`] (or four base round
 //! trips) counts as congestion too. A terminal that never answers at all is left at the rate it
 //! has. Time comes in as an argument: the tests run on made-up clocks.
+//!
+//! A rate alone cannot keep the first seconds short on a very slow link: the first answer comes
+//! back only once the first frame has crossed the link, and until then the player would keep
+//! sending at [`START_RATE`] (at 20 kB/s, a minute of backlog in the first few seconds). So the
+//! bytes sent and not yet answered for are also capped, as TCP caps its unacknowledged bytes:
+//! [`FIRST_WINDOW`] until the first answer, then 1.5 times what the terminal was seen to take
+//! in [`WINDOW_TIME`] ([`LinkControl::window_left`]). A terminal that does not answer within
+//! [`FIRST_ANSWER_WAIT`] is taken never to answer and gets no window.
 
 use std::time::{Duration, Instant};
 
@@ -48,6 +56,17 @@ pub const DRAIN_SHARE: f64 = 0.85;
 /// The longest wait for an answer before it counts as congestion (at least four base round
 /// trips).
 pub const PROBE_TIMEOUT: Duration = Duration::from_millis(1000);
+/// The most bytes sent before the terminal's first answer: a coarse whole frame at 160x48.
+pub const FIRST_WINDOW: u64 = 24_000;
+/// Once answered, the unanswered bytes may be 1.5 times what the terminal was seen to take in this
+/// long: a queue of at most about this long, more than [`QUEUE_HIGH`] so the rate control acts
+/// first and the window bounds the worst case (the first seconds, a link that slows down).
+pub const WINDOW_TIME: Duration = Duration::from_millis(250);
+/// The smallest window once the terminal answers: a status line and a few cells.
+pub const MIN_WINDOW: u64 = 4_000;
+/// How long the first question may wait for its answer before the terminal is taken never to
+/// answer (then there is no window: nothing would ever open it).
+pub const FIRST_ANSWER_WAIT: Duration = Duration::from_secs(3);
 /// Questions in flight at most (one is the rule; a lost one is replaced).
 const MAX_IN_FLIGHT: usize = 4;
 /// Round trips remembered for the base (the shortest of them).
@@ -74,6 +93,10 @@ pub struct LinkControl {
     last_answer: Option<(Instant, u64)>,
     /// What the terminal was last seen to take, bytes per second.
     delivered: Option<f64>,
+    /// What the link can carry, bytes per second, for the window: what the terminal took while
+    /// a queue stood (then the link was the limit), else the most it was seen to take (still
+    /// water takes little and must not shrink the window).
+    capacity: Option<f64>,
     /// The last round trips, for the base.
     samples: [Duration; BASE_SAMPLES],
     sample_count: usize,
@@ -84,6 +107,13 @@ pub struct LinkControl {
     /// When the rate last fell: answers to questions sent before it still carry the old
     /// queue, so they do not make it fall again.
     fell_at: Option<Instant>,
+    /// The bytes the terminal has answered for (or given up on): everything sent up to the
+    /// last answered or lost question.
+    acknowledged: u64,
+    /// When the first question went out.
+    first_question: Option<Instant>,
+    /// The bytes sent up to the last question asked.
+    asked_up_to: u64,
 }
 
 impl Default for LinkControl {
@@ -100,11 +130,15 @@ impl LinkControl {
             in_flight: [None; MAX_IN_FLIGHT],
             last_answer: None,
             delivered: None,
+            capacity: None,
             samples: [Duration::ZERO; BASE_SAMPLES],
             sample_count: 0,
             answered: false,
             last_rtt: None,
             fell_at: None,
+            acknowledged: 0,
+            first_question: None,
+            asked_up_to: 0,
         }
     }
 
@@ -136,6 +170,8 @@ impl LinkControl {
     /// A question went out at `now`, appended to a frame; `bytes_sent` counts every byte the
     /// player has written, that frame included.
     pub fn probed(&mut self, now: Instant, bytes_sent: u64) {
+        self.first_question.get_or_insert(now);
+        self.asked_up_to = self.asked_up_to.max(bytes_sent);
         if let Some(slot) = self.in_flight.iter_mut().find(|t| t.is_none()) {
             *slot = Some((now, bytes_sent));
         }
@@ -150,11 +186,18 @@ impl LinkControl {
         };
         self.in_flight[slot] = None;
         self.answered = true;
-        if let Some((then, before)) = self.last_answer {
-            let dt = now.saturating_duration_since(then).as_secs_f64();
-            if dt > 0.0 && bytes > before {
-                self.delivered = Some((bytes - before) as f64 / dt);
-            }
+        self.acknowledged = self.acknowledged.max(bytes);
+        let took = match self.last_answer {
+            Some((then, before)) => Some((then, bytes.saturating_sub(before))),
+            // The first answer: its frame crossed the link within the round trip (a lower
+            // bound of the link's rate, what the window starts from).
+            None => Some((sent, bytes)),
+        }
+        .map(|(since, b)| (now.saturating_duration_since(since).as_secs_f64(), b))
+        .filter(|&(dt, b)| dt > 0.0 && b > 0)
+        .map(|(dt, b)| b as f64 / dt);
+        if let Some(rate) = took.filter(|_| self.last_answer.is_some()) {
+            self.delivered = Some(rate);
         }
         self.last_answer = Some((now, bytes));
         let rtt = now.saturating_duration_since(sent);
@@ -162,6 +205,12 @@ impl LinkControl {
         self.samples[self.sample_count % BASE_SAMPLES] = rtt;
         self.sample_count += 1;
         let queue = rtt.saturating_sub(self.base().unwrap_or(rtt));
+        if let Some(took) = took {
+            self.capacity = Some(match self.capacity {
+                Some(c) if queue <= QUEUE_LOW => c.max(took),
+                _ => took,
+            });
+        }
         let stale = self.fell_at.is_some_and(|fell| sent < fell);
         if stale {
             // Asked before the last fall: it measures the queue that fall is draining.
@@ -189,6 +238,29 @@ impl LinkControl {
         self.fell_at = Some(now);
     }
 
+    /// How many more bytes may go out now, `bytes_sent` counting every byte written so far:
+    /// the window less what is still unanswered for ([`usize::MAX`] for a terminal that does
+    /// not answer).
+    pub fn window_left(&self, now: Instant, bytes_sent: u64) -> usize {
+        let window = if self.answered {
+            // 1.5 times what the terminal was seen to take in WINDOW_TIME: room to grow (the
+            // window grows by half per round trip while the link keeps up), never seconds.
+            let taken = self.capacity.unwrap_or(self.rate).min(self.rate);
+            (1.5 * taken * WINDOW_TIME.as_secs_f64()).max(MIN_WINDOW as f64) as u64
+        } else if self.first_question.is_some_and(|t| now.saturating_duration_since(t) > FIRST_ANSWER_WAIT) {
+            return usize::MAX;
+        } else {
+            FIRST_WINDOW
+        };
+        usize::try_from(window.saturating_sub(bytes_sent.saturating_sub(self.acknowledged))).unwrap_or(usize::MAX)
+    }
+
+    /// Whether bytes went out after the last question: with none in flight, a question must
+    /// follow them even without a frame, or a closed window would never open.
+    pub fn unasked(&self, bytes_sent: u64) -> bool {
+        bytes_sent > self.asked_up_to
+    }
+
     /// Checks for a question unanswered too long: congestion (once per question). A terminal
     /// that has never answered is not slowed down.
     pub fn tick(&mut self, now: Instant) -> Change {
@@ -198,7 +270,11 @@ impl LinkControl {
         let limit = self.base().map_or(PROBE_TIMEOUT, |b| (4 * b).max(PROBE_TIMEOUT));
         let mut lost = false;
         for slot in &mut self.in_flight {
-            if slot.is_some_and(|(sent, _)| now.saturating_duration_since(sent) > limit) {
+            if let Some((sent, bytes)) = *slot
+                && now.saturating_duration_since(sent) > limit
+            {
+                // Its bytes are taken as delivered, or the window would never open again.
+                self.acknowledged = self.acknowledged.max(bytes);
                 // Given up on: its late answer would be matched to a newer question, so it
                 // leaves the list; the link is congested.
                 *slot = None;
@@ -225,6 +301,13 @@ mod tests {
     /// A link of `bytes_per_second` with a deep buffer (like SSH's): the terminal reads bytes
     /// at that rate after a fixed latency; the controller's rate decides what is written.
     fn simulate(bytes_per_second: f64, latency: Duration, seconds: u64) -> (Vec<f64>, Vec<Duration>) {
+        let (rates, rtts, _) = simulate_queue(bytes_per_second, latency, seconds);
+        (rates, rtts)
+    }
+
+    /// As [`simulate`], also returning the link's queue (seconds of bytes not yet read by the
+    /// terminal) after each frame, and honouring the window as the player does.
+    fn simulate_queue(bytes_per_second: f64, latency: Duration, seconds: u64) -> (Vec<f64>, Vec<Duration>, Vec<f64>) {
         let t0 = Instant::now();
         let mut link = LinkControl::new();
         let frame = Duration::from_nanos(33_333_333);
@@ -232,17 +315,19 @@ mod tests {
         let mut drained = t0;
         let mut sent = 0u64;
         let mut answers: Vec<Instant> = Vec::new();
-        let (mut rates, mut rtts) = (Vec::new(), Vec::new());
+        let (mut rates, mut rtts, mut queue) = (Vec::new(), Vec::new(), Vec::new());
         let mut now = t0;
         while now < t0 + Duration::from_secs(seconds) {
-            // A frame of what one frame's share of the rate allows (the bucket, simplified).
-            let bytes = link.rate().unwrap_or(MAX_RATE) / 30.0;
+            // A frame of what one frame's share of the rate allows (the bucket, simplified),
+            // within the window.
+            let bytes = (link.rate().unwrap_or(MAX_RATE) / 30.0).min(link.window_left(now, sent) as f64).floor();
             sent += bytes as u64;
             drained = drained.max(now) + Duration::from_secs_f64(bytes / bytes_per_second);
-            if link.probe_due() {
+            if link.probe_due() && (bytes > 0.0 || link.unasked(sent)) {
                 link.probed(now, sent);
                 answers.push(drained + latency);
             }
+            queue.push(drained.saturating_duration_since(now).as_secs_f64());
             now += frame;
             answers.sort();
             while answers.first().is_some_and(|&a| a <= now) {
@@ -253,7 +338,7 @@ mod tests {
             link.tick(now);
             rates.push(link.rate().unwrap_or(MAX_RATE));
         }
-        (rates, rtts)
+        (rates, rtts, queue)
     }
 
     #[test]
@@ -268,6 +353,64 @@ mod tests {
         late_rtts.sort();
         let p90 = late_rtts[late_rtts.len() * 9 / 10];
         assert!(p90 < ms(400), "the queue stays short: p90 round trip {p90:?}");
+    }
+
+    #[test]
+    fn a_very_slow_link_never_queues_seconds_even_at_the_start() {
+        // 20 kB/s, 30 ms away: at the start rate alone, the first second would queue 20 s.
+        let (rates, _, queue) = simulate_queue(20_000.0, ms(30), 20);
+        let worst = queue.iter().copied().fold(0.0, f64::max);
+        assert!(worst < 1.5, "the longest queue is {worst:.2} s");
+        let late = &queue[queue.len() - 300..];
+        let p90 = {
+            let mut q = late.to_vec();
+            q.sort_by(f64::total_cmp);
+            q[q.len() * 9 / 10]
+        };
+        assert!(p90 < 0.5, "the queue settles short: p90 {p90:.2} s");
+        let mean = rates[rates.len() - 300..].iter().sum::<f64>() / 300.0;
+        assert!(mean > 8_000.0, "and the link is used: {mean:.0} B/s");
+    }
+
+    #[test]
+    fn the_window_opens_with_a_bare_question_and_is_dropped_for_a_silent_terminal() {
+        let t0 = Instant::now();
+        let mut link = LinkControl::new();
+        assert_eq!(link.window_left(t0, 0), FIRST_WINDOW as usize);
+        link.probed(t0, 10_000);
+        assert_eq!(link.window_left(t0, 30_000), 0, "30 kB sent, none answered for");
+        link.answered(t0 + ms(20));
+        // Answered for 10 kB; 20 kB went out after the question: none in flight, so a bare
+        // question must follow them.
+        assert!(link.probe_due() && link.unasked(30_000));
+        link.probed(t0 + ms(21), 30_000);
+        assert!(!link.unasked(30_000));
+        link.answered(t0 + ms(40));
+        assert!(link.window_left(t0 + ms(40), 30_000) >= MIN_WINDOW as usize, "all answered for: open");
+        // A terminal that never answers gets no window once the first answer is overdue.
+        let mut silent = LinkControl::new();
+        silent.probed(t0, 5_000);
+        assert_eq!(silent.window_left(t0 + ms(100), 50_000), 0);
+        assert_eq!(silent.window_left(t0 + FIRST_ANSWER_WAIT + ms(1), 50_000), usize::MAX);
+    }
+
+    #[test]
+    fn still_water_does_not_shrink_the_window() {
+        // A local terminal takes a 24 kB frame in 2 ms; then only status lines go out for a
+        // while (tiny deliveries); a whole frame after that must still fit at once.
+        let t0 = Instant::now();
+        let mut link = LinkControl::new();
+        let mut sent = 24_000;
+        link.probed(t0, sent);
+        link.answered(t0 + ms(2));
+        for i in 1..=40 {
+            sent += 100;
+            let at = t0 + ms(33 * i);
+            link.probed(at, sent);
+            link.answered(at + ms(1));
+        }
+        let now = t0 + ms(33 * 41);
+        assert!(link.window_left(now, sent) >= 300_000, "{}", link.window_left(now, sent));
     }
 
     #[test]

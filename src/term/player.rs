@@ -235,6 +235,8 @@ impl Player {
         let mut builder = FrameBuilder::default();
         // A buffer kept back from a frame that had nothing to send, so it is not lost.
         let mut unused: Option<Vec<u8>> = None;
+        // A key or click whose frame has not gone out yet.
+        let mut owed = false;
         let read_error = |source| Error::Terminal { action: "cannot read the terminal", source };
         'play: loop {
             if self.config.quit.load(Ordering::SeqCst) {
@@ -245,7 +247,11 @@ impl Player {
             if let Some(escape) = parser.deadline() {
                 deadline = deadline.min(escape);
             }
-            let timeout = deadline.saturating_duration_since(now).min(MAX_WAIT);
+            let mut timeout = deadline.saturating_duration_since(now).min(MAX_WAIT);
+            if owed {
+                // A key's frame waits for the writer: look again soon, not at the next tick.
+                timeout = timeout.min(Duration::from_millis(1));
+            }
             bytes_in.clear();
             if !input.read(&mut bytes_in, timeout).map_err(read_error)? {
                 return Ok(());
@@ -294,14 +300,20 @@ impl Player {
                 return Err(Error::Output(e));
             }
             meter.tick(now);
-            if !pacer.ready(now) && !urgent {
+            // A key's frame is owed until it is sent, even when the writer is busy now.
+            owed |= urgent;
+            if !pacer.ready(now) && !owed {
                 continue;
             }
             if !writer.idle() {
-                // The terminal is still busy with the last frame: drop this one.
-                pacer.sent(now);
+                // The terminal is still busy with the last frame: drop this one (a key's frame
+                // goes as soon as the writer is free).
+                if !owed {
+                    pacer.sent(now);
+                }
                 continue;
             }
+            owed = false;
             let size = self.scene.size();
             if (pixmap.width(), pixmap.height()) != size {
                 pixmap = Pixmap::new(size.0, size.1).ok_or(Error::TooLarge {
@@ -322,9 +334,11 @@ impl Player {
                 ..RateOptions::from(self.config.encode)
             };
             let mut bytes = unused.take().unwrap_or_else(|| writer.buffer());
-            let report = encoder.encode_into(&mut shown, target, bucket.budget(), options, &mut bytes);
+            // On an auto link the unanswered bytes are capped too (see `link`: the first seconds).
+            let budget = if auto { bucket.budget().min(link.window_left(now, bytes_sent)) } else { bucket.budget() };
+            let report = encoder.encode_into(&mut shown, target, budget, options, &mut bytes);
             bucket.spend(report.bytes);
-            if auto && report.bytes > 0 && link.probe_due() {
+            if auto && link.probe_due() && (report.bytes > 0 || link.unasked(bytes_sent)) {
                 // The question goes after the frame: its answer says the frame has arrived.
                 bytes.extend_from_slice(link::PROBE);
                 link.probed(now, bytes_sent + bytes.len() as u64);

@@ -65,7 +65,8 @@ fn run(rate: usize, bandwidth: &str, presses: usize) -> (Vec<Duration>, f64, usi
     // The link: delivers `rate` bytes a second in 1 ms slices to the terminal end.
     let seen = Arc::new(Mutex::new(Seen::default()));
     let stop = Arc::new(std::sync::atomic::AtomicBool::new(false));
-    let (link_seen, link_backlog, answers, link_stop) = (Arc::clone(&seen), Arc::clone(&backlog), Arc::clone(&keyboard), Arc::clone(&stop));
+    let (link_seen, link_backlog, answers, link_stop) =
+        (Arc::clone(&seen), Arc::clone(&backlog), Arc::clone(&keyboard), Arc::clone(&stop));
     let link = std::thread::spawn(move || {
         let mut screen = Screen::new(COLS.into(), ROWS.into());
         screen.lf_returns = false;
