@@ -53,12 +53,12 @@ impl WindArgs {
     }
 }
 
-/// Which spectrum the sea follows.
+/// The spectrum's kind and JONSWAP's parameters (`render ocean`, `spectrum` and `play` alike).
 #[derive(Args, Debug, Clone)]
-pub struct SpectrumArgs {
+pub struct SpectrumKindArgs {
     /// The wave spectrum: pm (Pierson-Moskowitz, fully developed: the papers'), jonswap
-    /// (fetch-limited, peak-enhanced) or tma (JONSWAP in shallow water; needs --depth).
-    /// [default: pm]
+    /// (fetch-limited, peak-enhanced) or tma (JONSWAP in shallow water; needs the depth:
+    /// --depth, or --sea-depth in play). [default: pm]
     #[arg(long, value_name = "KIND", value_parser = parse_spectrum)]
     pub spectrum: Option<SpectrumKind>,
 
@@ -70,6 +70,14 @@ pub struct SpectrumArgs {
     /// [default: unlimited, a fully developed peak]
     #[arg(long, value_name = "KM", value_parser = parse_plain_number, allow_negative_numbers = true)]
     pub fetch: Option<f64>,
+}
+
+/// Which spectrum the sea follows.
+#[derive(Args, Debug, Clone)]
+pub struct SpectrumArgs {
+    /// The spectrum's kind, gamma and fetch.
+    #[command(flatten)]
+    pub kind: SpectrumKindArgs,
 
     /// The water depth for tma, metres (0.5..=10000): shallow water shortens the waves.
     #[arg(long, value_name = "M", value_parser = parse_plain_number, allow_negative_numbers = true)]
@@ -83,10 +91,10 @@ pub struct SpectrumArgs {
 impl SpectrumArgs {
     /// The checked spectrum; an impossible combination names the flag to change.
     pub fn choice(&self) -> Result<SpectrumChoice> {
-        let kind = self.spectrum.unwrap_or_default();
-        SpectrumChoice::new(kind, self.gamma, self.fetch, self.depth).map_err(|e| {
+        let SpectrumKindArgs { spectrum, gamma, fetch } = self.kind;
+        SpectrumChoice::new(spectrum.unwrap_or_default(), gamma, fetch, self.depth).map_err(|e| {
             let flag = match &e {
-                SpectrumChoiceError::JonswapParameterWithPm if self.gamma.is_some() => "--gamma",
+                SpectrumChoiceError::JonswapParameterWithPm if gamma.is_some() => "--gamma",
                 SpectrumChoiceError::JonswapParameterWithPm => "--fetch",
                 SpectrumChoiceError::DepthWithoutTma | SpectrumChoiceError::TmaWithoutDepth => self.depth_flag,
                 SpectrumChoiceError::Value(v) => match v.what() {
@@ -131,18 +139,9 @@ impl SeaShapeArgs {
 /// the sea's depth for tma is `--sea-depth` there.
 #[derive(Args, Debug, Clone)]
 pub struct PlaySeaArgs {
-    /// The ocean's wave spectrum: pm (fully developed: the papers'), jonswap (fetch-limited) or
-    /// tma (JONSWAP in shallow water; needs --sea-depth). [default: pm]
-    #[arg(long, value_name = "KIND", value_parser = parse_spectrum)]
-    pub spectrum: Option<SpectrumKind>,
-
-    /// JONSWAP's peak enhancement gamma, 1..=10 (jonswap and tma). [default: 3.3]
-    #[arg(long, value_name = "G", value_parser = parse_plain_number, allow_negative_numbers = true)]
-    pub gamma: Option<f64>,
-
-    /// The ocean's fetch, km (jonswap and tma; 0.01..=10000). [default: unlimited]
-    #[arg(long, value_name = "KM", value_parser = parse_plain_number, allow_negative_numbers = true)]
-    pub fetch: Option<f64>,
+    /// The ocean's spectrum, gamma and fetch.
+    #[command(flatten)]
+    pub kind: SpectrumKindArgs,
 
     /// The ocean's water depth for tma, metres (0.5..=10000).
     #[arg(long = "sea-depth", value_name = "M", value_parser = parse_plain_number, allow_negative_numbers = true)]
@@ -157,13 +156,7 @@ impl PlaySeaArgs {
     /// The same flags in `render ocean`'s shape.
     pub fn shape(&self) -> SeaShapeArgs {
         SeaShapeArgs {
-            spectrum: SpectrumArgs {
-                spectrum: self.spectrum,
-                gamma: self.gamma,
-                fetch: self.fetch,
-                depth: self.sea_depth,
-                depth_flag: "--sea-depth",
-            },
+            spectrum: SpectrumArgs { kind: self.kind.clone(), depth: self.sea_depth, depth_flag: "--sea-depth" },
             choppiness: self.choppiness,
         }
     }
