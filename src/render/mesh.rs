@@ -60,7 +60,7 @@ use spade::{DelaunayTriangulation, Point2, Triangulation};
 
 use super::camera::Camera;
 use super::light::Light;
-use super::raster::fill_triangle_ids;
+use super::raster::{fill_triangle_ids, shows_front};
 use super::shade::{Facet, WaterLook};
 use super::sky::Environment;
 use super::texture::SeaTexture;
@@ -305,17 +305,10 @@ impl MeshRenderer {
             .map(|t| {
                 let [a, b, c] = t.map(|i| i as usize);
                 let (pa, pb, pc) = (projected[a]?, projected[b]?, projected[c]?);
-                let (min_x, max_x) = (pa.0.min(pb.0).min(pc.0), pa.0.max(pb.0).max(pc.0));
+                if !shows_front(pa, pb, pc, w, h) {
+                    return None;
+                }
                 let (min_y, max_y) = (pa.1.min(pb.1).min(pc.1), pa.1.max(pb.1).max(pc.1));
-                if max_x < 0.0 || max_y < 0.0 || min_x > w || min_y > h {
-                    return None;
-                }
-                // spade's faces are counter-clockwise; a displaced triangle that turned over on
-                // the screen shows its underside (the far slope of a crest, folded over by a
-                // tall wave far away). A nearer front face covers that spot, so skip it.
-                if (pb.0 - pa.0) * (pc.1 - pa.1) - (pb.1 - pa.1) * (pc.0 - pa.0) <= 0.0 {
-                    return None;
-                }
                 let (wa, wb, wc) = (world[a], world[b], world[c]);
                 let mut normal = normalize(cross(sub(wb, wa), sub(wc, wa)));
                 if normal[2] < 0.0 {

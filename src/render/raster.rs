@@ -81,6 +81,17 @@ fn ceil_div(n: i64, d: i64) -> i64 {
 }
 
 /// The end points of an edge in a fixed order, whichever way the edge runs.
+/// Whether the screen triangle `a, b, c` can show on a `w` x `h` picture: its bounding box
+/// meets the picture, and it faces the camera. spade's faces are counter-clockwise; one turned
+/// over on the screen shows its underside (the far slope of a crest folded over by a tall wave
+/// far away), and a nearer front face covers that spot.
+pub fn shows_front(a: (f32, f32), b: (f32, f32), c: (f32, f32), w: f32, h: f32) -> bool {
+    let (min_x, max_x) = (a.0.min(b.0).min(c.0), a.0.max(b.0).max(c.0));
+    let (min_y, max_y) = (a.1.min(b.1).min(c.1), a.1.max(b.1).max(c.1));
+    let on_screen = max_x >= 0.0 && max_y >= 0.0 && min_x <= w && min_y <= h;
+    on_screen && (b.0 - a.0) * (c.1 - a.1) - (b.1 - a.1) * (c.0 - a.0) > 0.0
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -23,7 +23,7 @@ use tiny_skia::Pixmap;
 use super::foam_texture::{FOAM_STREAK, FOAM_TILE_ACROSS_M, FoamTexture, coverage, detail_for};
 use super::light::{Rgb, mix, to_srgb8};
 use super::mesh::{BAND_ROWS, MeshTopology, Shading, sample_all};
-use super::raster::for_each_span;
+use super::raster::{for_each_span, shows_front};
 use super::shade::{Facet, shade_facet};
 use super::sky::Environment;
 use super::vec3::{Vec3, add, cross, length, normalize, scale, sub};
@@ -164,16 +164,10 @@ impl SmoothShader {
             .map(|t| {
                 let [a, b, c] = t.map(|i| i as usize);
                 let (pa, pb, pc) = (screen[a]?, screen[b]?, screen[c]?);
-                let (min_x, max_x) = (pa.0.min(pb.0).min(pc.0), pa.0.max(pb.0).max(pc.0));
+                if !shows_front(pa, pb, pc, w, h) {
+                    return None;
+                }
                 let (min_y, max_y) = (pa.1.min(pb.1).min(pc.1), pa.1.max(pb.1).max(pc.1));
-                if max_x < 0.0 || max_y < 0.0 || min_x > w || min_y > h {
-                    return None;
-                }
-                // spade's faces are counter-clockwise; one turned over on the screen shows its
-                // underside (a far slope folded over by a tall wave): a nearer face covers it.
-                if (pb.0 - pa.0) * (pc.1 - pa.1) - (pb.1 - pa.1) * (pc.0 - pa.0) <= 0.0 {
-                    return None;
-                }
                 let foamy = foam_uv[a][0] > 0.0 || foam_uv[b][0] > 0.0 || foam_uv[c][0] > 0.0;
                 let metres = (footprints[a].mean_m() + footprints[b].mean_m() + footprints[c].mean_m()) / 3.0;
                 let per_pixel = metres / spacing;
