@@ -5,11 +5,11 @@
 //! [`InputParser`] for its bytes, [`SimClock`] for the shared clock, [`FrameBuilder::compose`]
 //! with a [`SceneInfo`] for its frames.
 
+pub use crate::term::input::{Input, InputParser, coalesce};
+pub use crate::term::pacing::SimClock;
 pub use crate::term::player::{
     Bandwidth, DEFAULT_STONE_RADIUS, PlayerConfig, STONE_RADII, TEST_PANIC_VAR, TerminalInput, picture_size, run,
 };
-pub use crate::term::input::{Input, InputParser, coalesce};
-pub use crate::term::pacing::SimClock;
 pub use crate::term::screen::{FrameBuilder, Overlay, SceneInfo, big_enough};
 pub use crate::term::tty::{ENTER, RESTORE, play, restore};
 pub use crate::term::{probe, replies};

@@ -42,12 +42,8 @@ impl AllowList {
         for (index, line) in text.lines().enumerate() {
             // Parse line by line so the error can name the line (AuthorizedKeys skips blanks/comments).
             for entry in AuthorizedKeys::new(line) {
-                let entry = entry.map_err(|e| {
-                    format!(
-                        "line {} is not an OpenSSH public key ({e}); fix or remove it",
-                        index + 1
-                    )
-                })?;
+                let entry = entry
+                    .map_err(|e| format!("line {} is not an OpenSSH public key ({e}); fix or remove it", index + 1))?;
                 keys.push(entry.public_key().key_data().clone());
                 if keys.len() > MAX_AUTHORIZED_KEYS {
                     return Err(format!("more than {MAX_AUTHORIZED_KEYS} keys; trim the file"));

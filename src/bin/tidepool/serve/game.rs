@@ -103,13 +103,7 @@ pub struct GameLinks {
 
 /// The first, empty value of the `watch` slot.
 pub fn nothing_yet(info: SceneInfo) -> Arc<Pictures> {
-    Arc::new(Pictures {
-        number: 0,
-        paused: false,
-        scene_size: (0, 0),
-        info: Arc::new(info),
-        pictures: HashMap::new(),
-    })
+    Arc::new(Pictures { number: 0, paused: false, scene_size: (0, 0), info: Arc::new(info), pictures: HashMap::new() })
 }
 
 /// Builds the first scene (so a bad scene setting fails before the server starts).
@@ -169,10 +163,14 @@ pub fn run(options: GameOptions, mut scene: Box<dyn Playable>, mut links: GameLi
             number += 1;
             scene.render(&mut pixmap);
             let players = links.players.count();
+            // The count first: a passing message may cover the end of a narrow status line.
             info.detail.clear();
-            scene.status(&mut info.detail);
-            info.detail.push_str(&format!(" \u{b7} {players} playing"));
-            let wanted: BTreeSet<Cells> = links.sizes.lock().unwrap_or_else(|p| p.into_inner()).values().copied().collect();
+            info.detail.push_str(&format!("{players} playing \u{b7} "));
+            let mut scene_detail = String::new();
+            scene.status(&mut scene_detail);
+            info.detail.push_str(&scene_detail);
+            let wanted: BTreeSet<Cells> =
+                links.sizes.lock().unwrap_or_else(|p| p.into_inner()).values().copied().collect();
             let mut pictures = HashMap::with_capacity(wanted.len());
             for cells in wanted {
                 let fit = Letterbox::fit((w, h), picture_size(cells.0, cells.1));

@@ -115,22 +115,13 @@ impl russh::server::Handler for ClientHandler {
     }
 
     async fn auth_publickey_offered(&mut self, _user: &str, offer: PublicKeyOffer<'_>) -> Result<Auth, Self::Error> {
-        Ok(if self.public() || self.listed(offer.public_key) {
-            Auth::Accept
-        } else {
-            Auth::reject()
-        })
+        Ok(if self.public() || self.listed(offer.public_key) { Auth::Accept } else { Auth::reject() })
     }
 
     async fn auth_publickey(&mut self, _user: &str, key: VerifiedPublicKey<'_>) -> Result<Auth, Self::Error> {
         let ok = self.public() || self.listed(key.public_key);
         if ok {
-            eprintln!(
-                "serve: {} #{} key {}",
-                self.peer,
-                self.id,
-                key.public_key.fingerprint(HashAlg::Sha256)
-            );
+            eprintln!("serve: {} #{} key {}", self.peer, self.id, key.public_key.fingerprint(HashAlg::Sha256));
         }
         Ok(if ok { Auth::Accept } else { Auth::reject() })
     }

@@ -101,23 +101,13 @@ fn create(path: &Path) -> Result<PrivateKey, HostKeyError> {
     if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
         // Folders we create are private (0700); existing folders are left as they are.
         use std::os::unix::fs::DirBuilderExt;
-        fs::DirBuilder::new()
-            .recursive(true)
-            .mode(0o700)
-            .create(dir)
-            .map_err(|e| {
-                HostKeyError(format!(
-                    "--host-key {shown}: cannot create its folder ({e}); choose a writable path"
-                ))
-            })?;
+        fs::DirBuilder::new().recursive(true).mode(0o700).create(dir).map_err(|e| {
+            HostKeyError(format!("--host-key {shown}: cannot create its folder ({e}); choose a writable path"))
+        })?;
     }
     let tmp = temp_sibling(path);
     let write = || -> std::io::Result<()> {
-        let mut file = fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .mode(0o600)
-            .open(&tmp)?;
+        let mut file = fs::OpenOptions::new().write(true).create_new(true).mode(0o600).open(&tmp)?;
         file.write_all(pem.as_bytes())?;
         file.sync_all()?;
         fs::hard_link(&tmp, path)?;
@@ -126,9 +116,7 @@ fn create(path: &Path) -> Result<PrivateKey, HostKeyError> {
     let result = write();
     let _ = fs::remove_file(&tmp);
     result.map_err(|e| {
-        HostKeyError(format!(
-            "--host-key {shown}: cannot write the new key ({e}); choose a writable path"
-        ))
+        HostKeyError(format!("--host-key {shown}: cannot write the new key ({e}); choose a writable path"))
     })?;
     Ok(key)
 }
@@ -143,11 +131,7 @@ fn temp_sibling(path: &Path) -> PathBuf {
 pub fn fingerprint_line(key: &PrivateKey) -> String {
     let public = key.public_key();
     let bits = key_bits(key);
-    let comment = if public.comment().is_empty() {
-        "no comment".to_string()
-    } else {
-        public.comment().to_string()
-    };
+    let comment = if public.comment().is_empty() { "no comment".to_string() } else { public.comment().to_string() };
     let kind = match public.algorithm() {
         Algorithm::Ed25519 => "ED25519".to_string(),
         Algorithm::Rsa { .. } => "RSA".to_string(),
@@ -208,12 +192,7 @@ mod tests {
     fn garbage_is_refused() {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("host_key");
-        fs::OpenOptions::new()
-            .write(true)
-            .create_new(true)
-            .mode(0o600)
-            .open(&path)
-            .unwrap();
+        fs::OpenOptions::new().write(true).create_new(true).mode(0o600).open(&path).unwrap();
         fs::write(&path, b"this is not a key\n").unwrap();
         let err = load_or_create(&path).unwrap_err().0;
         assert!(err.contains("not an OpenSSH private key"), "{err}");

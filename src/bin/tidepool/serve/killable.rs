@@ -23,19 +23,12 @@ pub struct Killable<S> {
 impl<S> Killable<S> {
     /// Wraps `inner`; cancelling `token` (or a parent of it) cuts the stream.
     pub fn new(inner: S, token: CancellationToken) -> Self {
-        Self {
-            inner,
-            cancelled: Box::pin(token.clone().cancelled_owned()),
-            token,
-        }
+        Self { inner, cancelled: Box::pin(token.clone().cancelled_owned()), token }
     }
 
     fn check(&mut self, cx: &mut Context<'_>) -> io::Result<()> {
         if self.token.is_cancelled() || self.cancelled.as_mut().poll(cx).is_ready() {
-            return Err(io::Error::new(
-                io::ErrorKind::ConnectionAborted,
-                "connection cut by the server",
-            ));
+            return Err(io::Error::new(io::ErrorKind::ConnectionAborted, "connection cut by the server"));
         }
         Ok(())
     }

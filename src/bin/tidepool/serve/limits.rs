@@ -142,10 +142,7 @@ impl ConnTracker {
         }
         *count += 1;
         inner.total += 1;
-        Ok(ConnGuard {
-            tracker: self.clone(),
-            ip,
-        })
+        Ok(ConnGuard { tracker: self.clone(), ip })
     }
 }
 
@@ -179,10 +176,7 @@ pub struct PlayerSlots {
 impl PlayerSlots {
     /// Up to `max` players.
     pub fn new(max: usize) -> Arc<Self> {
-        Arc::new(Self {
-            max,
-            taken: AtomicUsize::new(0),
-        })
+        Arc::new(Self { max, taken: AtomicUsize::new(0) })
     }
 
     /// Takes a place, or None when the pool is full.
@@ -222,11 +216,7 @@ pub struct TokenBucket {
 impl TokenBucket {
     /// A full bucket refilling at `rate` per second.
     pub fn new(rate: f64) -> Self {
-        Self {
-            rate,
-            tokens: rate,
-            last: Instant::now(),
-        }
+        Self { rate, tokens: rate, last: Instant::now() }
     }
 
     fn refill(&mut self) {
@@ -269,11 +259,7 @@ mod tests {
 
     #[test]
     fn per_address_and_total_limits() {
-        let limits = Limits {
-            max_clients: 1,
-            max_per_address: 2,
-            ..Limits::default()
-        };
+        let limits = Limits { max_clients: 1, max_per_address: 2, ..Limits::default() };
         let t = ConnTracker::new(&limits);
         let a: IpAddr = "127.0.0.1".parse().unwrap();
         let b: IpAddr = "127.0.0.2".parse().unwrap();

@@ -110,7 +110,9 @@ pub fn run(args: ServeCommand) -> Result<()> {
     let key_path = match &args.host_key {
         Some(path) => path.clone(),
         None => data_dir()
-            .ok_or_else(|| Error::arg("--host-key", "no HOME or XDG_DATA_HOME to keep the key in; pass --host-key FILE"))?
+            .ok_or_else(|| {
+                Error::arg("--host-key", "no HOME or XDG_DATA_HOME to keep the key in; pass --host-key FILE")
+            })?
             .join(HOST_KEY_FILE_NAME),
     };
     let (key, origin) = host_key::load_or_create(&key_path).map_err(|e| Error::Usage(e.0))?;
@@ -124,18 +126,16 @@ pub fn run(args: ServeCommand) -> Result<()> {
         seed: args.seed,
     })?;
     let game = game::GameOptions { scenes, size, fps: args.fps, seed: args.seed };
-    let runtime = tokio::runtime::Builder::new_multi_thread()
-        .enable_all()
-        .thread_name("tidepool-serve")
-        .build()
-        .map_err(|e| Error::Usage(format!("cannot start the server's threads ({e}); free some memory and try again")))?;
+    let runtime =
+        tokio::runtime::Builder::new_multi_thread().enable_all().thread_name("tidepool-serve").build().map_err(
+            |e| Error::Usage(format!("cannot start the server's threads ({e}); free some memory and try again")),
+        )?;
     let options = server::ServerOptions { listen, host_key: key, allow, limits, game };
     let interrupted = runtime.block_on(async move {
         let running = server::start(options).await.map_err(|e| match e {
-            server::StartError::Bind(e) => Error::arg(
-                "--listen",
-                format!("cannot listen on {listen} ({e}); pick a free port or another address"),
-            ),
+            server::StartError::Bind(e) => {
+                Error::arg("--listen", format!("cannot listen on {listen} ({e}); pick a free port or another address"))
+            }
             server::StartError::Scene(e) => Error::Lib(e),
         })?;
         let verb = match origin {

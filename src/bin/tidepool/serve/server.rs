@@ -26,6 +26,8 @@ use super::limits::{self, ConnGuard, ConnTracker, Limits, PlayerSlots, TokenBuck
 pub const SERVER_ID: &str = "SSH-2.0-tidepool";
 /// Pause after a failed accept (e.g. out of file descriptors) before accepting again.
 const ACCEPT_ERROR_PAUSE: Duration = Duration::from_millis(100);
+/// Time between keepalives to a quiet client (at most half the stall timeout).
+const KEEPALIVE_INTERVAL: Duration = Duration::from_secs(15);
 /// Time the last step of shutdown waits for cut connections to finish.
 const CUT_WAIT: Duration = Duration::from_millis(150);
 
@@ -141,7 +143,6 @@ impl Running {
     pub async fn wait(self) {
         let _ = self.join.await;
     }
-
 }
 
 /// Builds russh's configuration. Public mode offers none, publickey and keyboard-interactive;
@@ -163,7 +164,8 @@ pub fn russh_config(host_key: PrivateKey, private: bool, limits: &Limits) -> Con
         // russh resets this timer on every loop turn, including our own frames, so it is not an
         // idle timeout; it bounds the banner read and a write blocked on a full socket.
         inactivity_timeout: Some(limits.stall_timeout),
-        keepalive_interval: Some(Duration::from_secs(15)),
+        // Keepalives also keep a player watching still water from counting as inactive.
+        keepalive_interval: Some(KEEPALIVE_INTERVAL.min(limits.stall_timeout / 2)),
         keepalive_max: 3,
         window_size: limits::INPUT_WINDOW_BYTES,
         event_buffer_size: limits::SESSION_EVENT_QUEUE,
@@ -226,13 +228,7 @@ pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
         stop.store(true, Ordering::Relaxed);
         let _ = tokio::task::spawn_blocking(move || game.join()).await;
     });
-    Ok(Running {
-        local_addr,
-        stats,
-        game_stats,
-        shutdown,
-        join,
-    })
+    Ok(Running { local_addr, stats, game_stats, shutdown, join })
 }
 
 /// Why the server could not start.
@@ -276,10 +272,7 @@ async fn accept_loop(hub: &Arc<Hub>, listener: TcpListener) {
 /// whatever is left (stalled clients, handshakes) and wait briefly for the tasks to notice.
 async fn finish(hub: &Arc<Hub>) {
     hub.tasks.close();
-    if tokio::time::timeout(limits::SHUTDOWN_GRACE, hub.tasks.wait())
-        .await
-        .is_err()
-    {
+    if tokio::time::timeout(limits::SHUTDOWN_GRACE, hub.tasks.wait()).await.is_err() {
         hub.cut_all.cancel();
         let _ = tokio::time::timeout(CUT_WAIT, hub.tasks.wait()).await;
     }

@@ -16,10 +16,10 @@ use std::time::{Duration, Instant};
 use bytes::Bytes;
 use russh::ChannelWriteHalf;
 use russh::server::Msg;
-use tidepool::player::{ENTER, FrameBuilder, Input, InputParser, Overlay, RESTORE, STONE_RADII, picture_size};
-use tidepool::player::{DEFAULT_STONE_RADIUS, coalesce};
-use tidepool::terminal::{ByteBucket, ColorMode, EncodeOptions, RateEncoder, RateOptions, Shown, Target};
 use tidepool::Action;
+use tidepool::player::{DEFAULT_STONE_RADIUS, coalesce};
+use tidepool::player::{ENTER, FrameBuilder, Input, InputParser, Overlay, RESTORE, STONE_RADII, picture_size};
+use tidepool::terminal::{ByteBucket, ColorMode, EncodeOptions, RateEncoder, RateOptions, Shown, Target};
 use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
@@ -195,7 +195,7 @@ impl Viewer {
     }
 
     /// This player's overlay over `set`'s picture.
-    fn overlay<'a>(&self, set: &'a Pictures, now: Instant, fps: u32, rate: u64, bandwidth: u64) -> Overlay<'a> {
+    fn overlay<'a>(&self, set: &'a Pictures, now: Instant, fps: u32, rate: u64) -> Overlay<'a> {
         let fit = self.fit();
         let aim = self.aim_until.filter(|t| now < *t).map(|_| {
             let (x, y) = fit.to_target(self.aim.0, self.aim.1);
@@ -207,7 +207,8 @@ impl Viewer {
             message: None,
             fps,
             bytes_per_second: rate,
-            bandwidth: Some(bandwidth),
+            // The link's rate is the server's setting, the same for all: not worth the room.
+            bandwidth: None,
             stone: self.radius,
             paused: set.paused,
         }
@@ -253,7 +254,7 @@ pub(crate) async fn run(ctx: ViewerCtx) {
         actions: TokenBucket::new(hub.limits.actions_per_second as f64),
         hub: hub.clone(),
     };
-    viewer.say("a shared pool: everyone here sees your stones \u{b7} ? help \u{b7} q quit", GREETING_VISIBLE);
+    viewer.say("shared pool: all see your stones", GREETING_VISIBLE);
     hub.sizes.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewer.size);
     let mut frames = hub.frames.clone();
     frames.mark_changed();
@@ -337,7 +338,7 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 continue;
             }
             bucket.refill(now);
-            let mut overlay = viewer.overlay(&set, now, meter.fps, meter.rate, hub.limits.client_bytes_per_second);
+            let mut overlay = viewer.overlay(&set, now, meter.fps, meter.rate);
             let message = viewer.message.as_ref().filter(|(_, until)| now < *until).map(|(m, _)| m.clone());
             overlay.message = message.as_deref();
             let frame = builder.compose(viewer.size, &picture, color, &overlay, &set.info);
