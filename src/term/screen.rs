@@ -67,18 +67,53 @@ impl FrameBuilder {
         color: ColorMode,
         overlay: &Overlay<'_>,
     ) -> &Frame {
+        if big_enough(term) {
+            scene.render(pixmap);
+        }
+        self.detail.clear();
+        self.detail.reserve(DETAIL_ROOM);
+        scene.status(&mut self.detail);
+        let about = About { name: scene.kind().name(), takes_stones: scene.takes_stones(), hints: scene.hints() };
+        self.finish(term, pixmap, color, overlay, &about)
+    }
+
+    /// The frame for a `term` terminal showing a picture drawn elsewhere: `picture` (the size
+    /// [`picture_size`](super::player::picture_size) gives for `term`) with `overlay` and the
+    /// status line of `scene`. A server that shares one scene among many viewers renders the
+    /// scene once per picture size and calls this for each viewer, so the viewers need no
+    /// access to the scene itself.
+    pub fn compose(
+        &mut self,
+        term: (u16, u16),
+        picture: &Pixmap,
+        color: ColorMode,
+        overlay: &Overlay<'_>,
+        scene: &SceneInfo,
+    ) -> &Frame {
+        self.detail.clear();
+        self.detail.push_str(&scene.detail);
+        let about = About { name: scene.name, takes_stones: scene.takes_stones, hints: scene.hints };
+        self.finish(term, picture, color, overlay, &about)
+    }
+
+    fn finish(
+        &mut self,
+        term: (u16, u16),
+        pixmap: &Pixmap,
+        color: ColorMode,
+        overlay: &Overlay<'_>,
+        about: &About,
+    ) -> &Frame {
         let (cols, rows) = (usize::from(term.0), usize::from(term.1));
         self.frame.reset(cols, rows);
         // Room for the longest texts once (they grow as the figures do: `0 B/s` becomes
         // `1.23 MB/s`), so steady frames never reallocate them.
         self.rate.reserve(RATE_ROOM);
-        self.detail.reserve(DETAIL_ROOM);
         self.line.reserve(4 * cols);
         if !big_enough(term) {
             ui::too_small(&mut self.frame);
             return &self.frame;
         }
-        scene.render(pixmap);
         self.frame.draw_pixels(pixmap, color);
         if let Some((x, y)) = overlay.aim {
             ui::aim_marker(&mut self.frame, x, y);
@@ -93,18 +128,55 @@ impl FrameBuilder {
             write_human_bytes(&mut self.rate, bandwidth);
             self.rate.push_str("/s");
         }
-        scene.status(&mut self.detail);
         let status = Status {
-            scene: scene.kind().name(),
+            scene: about.name,
             fps: overlay.fps,
             rate: &self.rate,
             detail: &self.detail,
-            stone: scene.takes_stones().then_some(overlay.stone),
-            hints: scene.hints(),
+            stone: about.takes_stones.then_some(overlay.stone),
+            hints: about.hints,
             paused: overlay.paused,
             message: overlay.message,
         };
         ui::status_line(&mut self.frame, rows - 1, &status, color, &mut self.line);
         &self.frame
     }
+}
+
+/// What the status line and the help say about a scene, taken from it once so that viewers of
+/// a scene shared among many (`tidepool serve`) can draw their frames without touching it.
+#[derive(Clone, Debug)]
+pub struct SceneInfo {
+    /// The scene's name (`pool`).
+    pub name: &'static str,
+    /// The scene's status summary, plus whatever the caller adds (`3 playing`).
+    pub detail: String,
+    /// Whether the scene takes stones.
+    pub takes_stones: bool,
+    /// The status line's key hints, longest first.
+    pub hints: &'static [&'static str],
+    /// The help overlay's lines: the player's keys and the scene's own.
+    pub help: Vec<(&'static str, &'static str)>,
+}
+
+impl SceneInfo {
+    /// Takes what the status line and the help say about `scene` now.
+    pub fn of(scene: &dyn Playable) -> SceneInfo {
+        let mut detail = String::new();
+        scene.status(&mut detail);
+        SceneInfo {
+            name: scene.kind().name(),
+            detail,
+            takes_stones: scene.takes_stones(),
+            hints: scene.hints(),
+            help: ui::help_lines(&scene.help(), scene.takes_stones()),
+        }
+    }
+}
+
+/// The scene's part of the status line.
+struct About {
+    name: &'static str,
+    takes_stones: bool,
+    hints: &'static [&'static str],
 }

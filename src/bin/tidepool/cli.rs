@@ -13,6 +13,8 @@ use tidepool::{CausticsLook, Damping, Refraction, SceneKind, Size, Stone, Sun, V
 
 pub mod lake;
 pub mod ocean;
+#[cfg(feature = "serve")]
+pub mod serve;
 
 const ABOUT: &str = "Water you can play with in any terminal: a ripple pool, an ocean and a lake, \
 simulated and drawn on the CPU.";
@@ -42,6 +44,9 @@ pub enum Command {
     Spectrum(ocean::SpectrumCommand),
     /// Play with the water full-screen in this terminal: keys and the mouse drop stones.
     Play(PlayCommand),
+    /// Host one shared pool over SSH: everyone who connects plays in the same water.
+    #[cfg(feature = "serve")]
+    Serve(serve::ServeCommand),
     /// Measure how fast this machine runs tidepool, stage by stage (a few seconds).
     Bench(BenchArgs),
     /// Print shell completions: `tidepool completions bash > ~/.local/share/bash-completion/completions/tidepool`.

@@ -10,6 +10,8 @@ mod commands;
 mod error;
 mod files;
 mod progress;
+#[cfg(feature = "serve")]
+mod serve;
 mod signals;
 
 use std::process::ExitCode;

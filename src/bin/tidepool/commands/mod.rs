@@ -14,6 +14,7 @@ pub mod output;
 pub mod play;
 pub mod pool;
 pub mod replay;
+pub mod scenes;
 pub mod spectrum;
 pub mod stats;
 pub mod still;
@@ -23,6 +24,11 @@ use crate::error::Result;
 
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<()> {
+    // The server answers SIGTERM and Ctrl-C itself: it says goodbye to every player first.
+    #[cfg(feature = "serve")]
+    if let Some(Command::Serve(args)) = cli.command {
+        return crate::serve::run(args);
+    }
     crate::signals::install();
     match cli.command {
         Some(Command::Render(render)) => match render.scene {
@@ -38,6 +44,8 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Completions(args)) => docs::completions(args),
         Some(Command::Man(args)) => docs::man(args),
         Some(Command::Play(play)) => play::run(play),
+        #[cfg(feature = "serve")]
+        Some(Command::Serve(_)) => unreachable!("served above, before the signal handlers"),
         None => match <Cli as clap::Parser>::try_parse_from(["tidepool", "play"]) {
             Ok(Cli { command: Some(Command::Play(play)) }) => play::run(play),
             _ => unreachable!("`tidepool play` with no flags always parses"),

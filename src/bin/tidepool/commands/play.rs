@@ -8,16 +8,11 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use tidepool::player::PlayerConfig;
-use tidepool::sea::{DEFAULT_WIND_FROM_DEG, MAX_LAKE_WIND_M_S};
 use tidepool::terminal::{ColorMode, EncodeOptions};
-use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneKind, SceneSpec};
 
 use crate::cli::{ColorChoice, PlayCommand};
 use crate::error::{Error, Result};
 
-/// The player's rain when `--rain` is not given: three drops a second at 60 steps/s, seen as
-/// small rings.
-pub const DEFAULT_PLAYER_RAIN: f64 = 0.05;
 /// `--color-threshold` when `SSH_CONNECTION` is set: invisible in a moving picture, and it
 /// saves the bytes of colours that only flicker by a step or two.
 pub const SSH_COLOR_THRESHOLD: u8 = 3;
@@ -25,12 +20,6 @@ pub const SSH_COLOR_THRESHOLD: u8 = 3;
 /// `--color-threshold` when not given: 0 (exact) locally, [`SSH_COLOR_THRESHOLD`] over SSH.
 pub fn default_threshold(ssh_connection: Option<&str>) -> u8 {
     if ssh_connection.is_some_and(|v| !v.trim().is_empty()) { SSH_COLOR_THRESHOLD } else { 0 }
-}
-
-/// The lake the player starts with: the default breeze and noise, no supersampling (a
-/// terminal cell is two pixels; the frame budget goes to the water instead).
-pub fn lake_settings(seed: u64) -> LakeSettings {
-    LakeSettings { lake: LakeParams { seed, ..LakeParams::default() }, ..LakeSettings::default() }
 }
 
 /// What to tell a user whose terminal was guessed to have fewer than 16 million colours.
@@ -67,31 +56,14 @@ pub fn run(command: PlayCommand) -> Result<()> {
     if let Some(path) = &command.record {
         crate::files::check_writable(path).map_err(|message| Error::arg("--record", message))?;
     }
-    let pool = command.pool.settings(command.seed, (DEFAULT_PLAYER_RAIN, tidepool::values::DEFAULT_BREEZE))?;
-    let default_view = OceanView::default();
-    let ocean = OceanSettings {
-        sea: command.sea.shape().params(
-            command.wind.speed_m_s(),
-            command.direction.unwrap_or(DEFAULT_WIND_FROM_DEG),
-            command.seed,
-        )?,
-        view: OceanView {
-            sun_azimuth_deg: command.pool.sun.map_or(default_view.sun_azimuth_deg, |s| s.azimuth_deg()),
-            sun_elevation_deg: command.pool.sun.map_or(default_view.sun_elevation_deg, |s| s.elevation_deg()),
-            ssaa: 1,
-            ..default_view
-        },
-        ..OceanSettings::default()
-    };
-    let mut lake = lake_settings(command.seed);
-    if command.wind.wind.is_some() || command.wind.beaufort.is_some() {
-        lake.lake.wind_m_s = command.wind.speed_m_s().min(MAX_LAKE_WIND_M_S);
-    }
-    // Tab goes through the scenes in their order, starting from the one asked for.
-    let all = [SceneSpec::Pool(pool), SceneSpec::Ocean(ocean), SceneSpec::Lake(lake)];
-    let first = SceneKind::from(command.scene);
-    let start = all.iter().position(|s| s.kind() == first).unwrap_or(0);
-    let scenes: Vec<SceneSpec> = all.iter().cycle().skip(start).take(all.len()).cloned().collect();
+    let scenes = super::scenes::specs(&super::scenes::SceneFlags {
+        first: command.scene,
+        pool: &command.pool,
+        wind: &command.wind,
+        direction: command.direction,
+        shape: &command.sea.shape(),
+        seed: command.seed,
+    })?;
     let quit = Arc::new(AtomicBool::new(false));
     let config = PlayerConfig {
         scenes,

@@ -1,0 +1,394 @@
+//! russh's per-connection `Handler`: authentication policy, the one session channel, its
+//! requests (pty, env, shell, window-change accepted; everything else refused) and key input,
+//! handed as bytes to the player's task.
+//!
+//! Rule for every callback: never await anything that depends on this session making progress
+//! (e.g. `Handle::data`): callbacks run *inside* the session's event loop, which would deadlock.
+//! Replies go through the `&mut Session` argument; bulk output goes through the player task.
+
+use std::net::SocketAddr;
+use std::sync::Arc;
+use std::sync::atomic::Ordering;
+
+use russh::keys::ssh_key::HashAlg;
+use russh::server::{Auth, ChannelOpenHandle, Msg, PublicKeyOffer, Response, Session, VerifiedPublicKey};
+use russh::{Channel, ChannelId, ChannelOpenFailure, ChannelWriteHalf, Pty};
+use tokio::sync::watch;
+use tokio_util::sync::CancellationToken;
+
+use tidepool::terminal::ColorMode;
+use tokio::sync::mpsc;
+
+use super::limits::{self, clamp_size};
+use super::server::Hub;
+use super::viewer::{self, Control, ViewerCtx};
+
+/// Longest TERM / COLORTERM value kept (longer values are refused).
+pub const MAX_TERM_LEN: usize = 64;
+/// Packets of key bytes waiting for the player's task; more are dropped (each is at most the
+/// SSH window we offer, `INPUT_WINDOW_BYTES`).
+const INPUT_QUEUE: usize = 64;
+
+/// One connection's handler.
+pub struct ClientHandler {
+    hub: Arc<Hub>,
+    id: u64,
+    peer: SocketAddr,
+    kill: CancellationToken,
+    playing: CancellationToken,
+    channel: Option<ChannelId>,
+    write: Option<ChannelWriteHalf<Msg>>,
+    term: Option<String>,
+    colorterm: Option<String>,
+    size: (u16, u16),
+    shell_requested: bool,
+    control: Option<watch::Sender<Control>>,
+    input: Option<mpsc::Sender<Vec<u8>>>,
+}
+
+impl ClientHandler {
+    pub(crate) fn new(
+        hub: Arc<Hub>,
+        id: u64,
+        peer: SocketAddr,
+        kill: CancellationToken,
+        playing: CancellationToken,
+    ) -> Self {
+        Self {
+            hub,
+            id,
+            peer,
+            kill,
+            playing,
+            channel: None,
+            write: None,
+            term: None,
+            colorterm: None,
+            size: (80, 24),
+            shell_requested: false,
+            control: None,
+            input: None,
+        }
+    }
+
+    fn ours(&self, channel: ChannelId) -> bool {
+        self.channel == Some(channel)
+    }
+
+    fn refuse(&self, what: &str) {
+        self.hub.stats.refused_requests.fetch_add(1, Ordering::Relaxed);
+        eprintln!("serve: {} #{} refused {what}", self.peer, self.id);
+    }
+
+    fn refuse_request(&self, what: &str, channel: ChannelId, session: &mut Session) -> Result<(), russh::Error> {
+        self.refuse(what);
+        session.channel_failure(channel)
+    }
+
+    fn public(&self) -> bool {
+        self.hub.allow.is_none()
+    }
+
+    fn listed(&self, key: &russh::keys::PublicKey) -> bool {
+        self.hub.allow.as_ref().is_some_and(|list| list.admits(key))
+    }
+
+    fn closed(&mut self) {
+        // Input that arrived before the EOF is handled first: "q" then EOF (a piped stdin) is
+        // still a quit.
+        self.input = None;
+        if let Some(control) = &self.control {
+            control.send_modify(|c| c.closed = true);
+        }
+    }
+}
+
+impl russh::server::Handler for ClientHandler {
+    type Error = russh::Error;
+
+    async fn auth_none(&mut self, _user: &str) -> Result<Auth, Self::Error> {
+        Ok(if self.public() { Auth::Accept } else { Auth::reject() })
+    }
+
+    async fn auth_password(&mut self, _user: &str, _password: &str) -> Result<Auth, Self::Error> {
+        Ok(Auth::reject())
+    }
+
+    async fn auth_publickey_offered(&mut self, _user: &str, offer: PublicKeyOffer<'_>) -> Result<Auth, Self::Error> {
+        Ok(if self.public() || self.listed(offer.public_key) { Auth::Accept } else { Auth::reject() })
+    }
+
+    async fn auth_publickey(&mut self, _user: &str, key: VerifiedPublicKey<'_>) -> Result<Auth, Self::Error> {
+        let ok = self.public() || self.listed(key.public_key);
+        if ok {
+            eprintln!("serve: {} #{} key {}", self.peer, self.id, key.public_key.fingerprint(HashAlg::Sha256));
+        }
+        Ok(if ok { Auth::Accept } else { Auth::reject() })
+    }
+
+    async fn auth_keyboard_interactive<'a>(
+        &'a mut self,
+        _user: &str,
+        _submethods: &str,
+        _response: Option<Response<'a>>,
+    ) -> Result<Auth, Self::Error> {
+        // Public pool: accept at once, with no prompts.
+        Ok(if self.public() { Auth::Accept } else { Auth::reject() })
+    }
+
+    async fn auth_succeeded(&mut self, _session: &mut Session) -> Result<(), Self::Error> {
+        self.hub.stats.authenticated.fetch_add(1, Ordering::Relaxed);
+        Ok(())
+    }
+
+    async fn channel_open_session(
+        &mut self,
+        channel: Channel<Msg>,
+        reply: ChannelOpenHandle,
+        _session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        if self.channel.is_some() {
+            self.refuse("a second session channel");
+            reply.reject(ChannelOpenFailure::ResourceShortage).await;
+            return Ok(());
+        }
+        self.channel = Some(channel.id());
+        // Keep only the write half. Dropping the read half matters: russh `await`s a send of every
+        // incoming message into it (bounded, channel_buffer_size), so an unread half would stall
+        // the whole session once full. With it dropped those sends fail at once and are ignored.
+        let (_read, write) = channel.split();
+        self.write = Some(write);
+        reply.accept().await;
+        Ok(())
+    }
+
+    async fn channel_open_x11(
+        &mut self,
+        _channel: Channel<Msg>,
+        _addr: &str,
+        _port: u32,
+        reply: ChannelOpenHandle,
+        _session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        self.refuse("an x11 channel");
+        reply.reject(ChannelOpenFailure::AdministrativelyProhibited).await;
+        Ok(())
+    }
+
+    async fn channel_open_direct_tcpip(
+        &mut self,
+        _channel: Channel<Msg>,
+        _host: &str,
+        _port: u32,
+        _orig: &str,
+        _orig_port: u32,
+        reply: ChannelOpenHandle,
+        _session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        self.refuse("direct-tcpip (local port forwarding)");
+        reply.reject(ChannelOpenFailure::AdministrativelyProhibited).await;
+        Ok(())
+    }
+
+    async fn channel_open_forwarded_tcpip(
+        &mut self,
+        _channel: Channel<Msg>,
+        _host: &str,
+        _port: u32,
+        _orig: &str,
+        _orig_port: u32,
+        reply: ChannelOpenHandle,
+        _session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        self.refuse("forwarded-tcpip");
+        reply.reject(ChannelOpenFailure::AdministrativelyProhibited).await;
+        Ok(())
+    }
+
+    async fn channel_open_direct_streamlocal(
+        &mut self,
+        _channel: Channel<Msg>,
+        _path: &str,
+        reply: ChannelOpenHandle,
+        _session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        self.refuse("direct-streamlocal (unix socket forwarding)");
+        reply.reject(ChannelOpenFailure::AdministrativelyProhibited).await;
+        Ok(())
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    async fn pty_request(
+        &mut self,
+        channel: ChannelId,
+        term: &str,
+        cols: u32,
+        rows: u32,
+        _pix_w: u32,
+        _pix_h: u32,
+        _modes: &[(Pty, u32)],
+        session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        if !self.ours(channel) || self.shell_requested || !printable(term) {
+            return self.refuse_request("pty-req", channel, session);
+        }
+        self.term = Some(term.to_string());
+        self.size = clamp_size(cols, rows);
+        session.channel_success(channel)
+    }
+
+    async fn env_request(
+        &mut self,
+        channel: ChannelId,
+        name: &str,
+        value: &str,
+        session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        if self.ours(channel) && !self.shell_requested && name == "COLORTERM" && printable(value) {
+            self.colorterm = Some(value.to_string());
+            return session.channel_success(channel);
+        }
+        // OpenSSH sends LANG/LC_* with SendEnv: refusing them is normal and silent for the user.
+        session.channel_failure(channel)
+    }
+
+    async fn shell_request(&mut self, channel: ChannelId, session: &mut Session) -> Result<(), Self::Error> {
+        if !self.ours(channel) || self.shell_requested {
+            return self.refuse_request("a second shell", channel, session);
+        }
+        self.shell_requested = true;
+        session.channel_success(channel)?;
+        let Some(slot) = self.hub.players.try_take() else {
+            // Queued in order on this session: the line, exit status, EOF, close. The client
+            // hangs up; one that lingers is cut by the handshake deadline (it never started playing).
+            self.hub.stats.pool_full.fetch_add(1, Ordering::Relaxed);
+            session.data(channel, format!("{}\r\n", limits::POOL_FULL_LINE).into_bytes())?;
+            session.exit_status_request(channel, 1)?;
+            session.eof(channel)?;
+            session.close(channel)?;
+            return Ok(());
+        };
+        let Some(write) = self.write.take() else {
+            return Ok(());
+        };
+        self.playing.cancel(); // stops the handshake deadline
+        let (control_tx, control_rx) = watch::channel(Control { size: self.size, closed: false });
+        let (input_tx, input_rx) = mpsc::channel(INPUT_QUEUE);
+        self.control = Some(control_tx);
+        self.input = Some(input_tx);
+        let ctx = ViewerCtx {
+            hub: self.hub.clone(),
+            id: self.id,
+            peer: self.peer,
+            write,
+            control: control_rx,
+            input: input_rx,
+            color: ColorMode::detect(self.colorterm.as_deref(), self.term.as_deref()),
+            kill: self.kill.clone(),
+            slot,
+        };
+        self.hub.tasks.spawn(viewer::run(ctx));
+        Ok(())
+    }
+
+    async fn window_change_request(
+        &mut self,
+        channel: ChannelId,
+        cols: u32,
+        rows: u32,
+        _pix_w: u32,
+        _pix_h: u32,
+        session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        if !self.ours(channel) {
+            return session.channel_failure(channel);
+        }
+        self.size = clamp_size(cols, rows);
+        let size = self.size;
+        if let Some(control) = &self.control {
+            control.send_modify(|c| c.size = size);
+        }
+        session.channel_success(channel)
+    }
+
+    async fn exec_request(
+        &mut self,
+        channel: ChannelId,
+        _cmd: &[u8],
+        session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        self.refuse_request("exec", channel, session)
+    }
+
+    async fn subsystem_request(
+        &mut self,
+        channel: ChannelId,
+        name: &str,
+        session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        let what = format!("subsystem {:?}", name.chars().take(32).collect::<String>());
+        self.refuse_request(&what, channel, session)
+    }
+
+    async fn x11_request(
+        &mut self,
+        channel: ChannelId,
+        _single: bool,
+        _proto: &str,
+        _cookie: &str,
+        _screen: u32,
+        session: &mut Session,
+    ) -> Result<(), Self::Error> {
+        self.refuse_request("x11-req", channel, session)
+    }
+
+    async fn agent_request(&mut self, _channel: ChannelId, _session: &mut Session) -> Result<bool, Self::Error> {
+        self.refuse("auth-agent-req@openssh.com");
+        Ok(false) // russh sends the channel failure
+    }
+
+    async fn tcpip_forward(
+        &mut self,
+        _addr: &str,
+        _port: &mut u32,
+        _session: &mut Session,
+    ) -> Result<bool, Self::Error> {
+        self.refuse("tcpip-forward (remote port forwarding)");
+        Ok(false) // russh sends the request failure
+    }
+
+    async fn streamlocal_forward(&mut self, _path: &str, _session: &mut Session) -> Result<bool, Self::Error> {
+        self.refuse("streamlocal-forward@openssh.com");
+        Ok(false)
+    }
+
+    async fn data(&mut self, channel: ChannelId, data: &[u8], _session: &mut Session) -> Result<(), Self::Error> {
+        if !self.ours(channel) {
+            return Ok(());
+        }
+        if let Some(input) = &self.input
+            && input.try_send(data.to_vec()).is_err()
+        {
+            self.hub.stats.input_dropped.fetch_add(1, Ordering::Relaxed);
+        }
+        Ok(())
+    }
+
+    async fn channel_eof(&mut self, channel: ChannelId, _session: &mut Session) -> Result<(), Self::Error> {
+        if self.ours(channel) {
+            self.closed();
+        }
+        Ok(())
+    }
+
+    async fn channel_close(&mut self, channel: ChannelId, _session: &mut Session) -> Result<(), Self::Error> {
+        if self.ours(channel) {
+            self.closed();
+        }
+        Ok(())
+    }
+}
+
+fn printable(s: &str) -> bool {
+    s.len() <= MAX_TERM_LEN && s.bytes().all(|b| b.is_ascii_graphic())
+}

@@ -1,0 +1,293 @@
+//! Every bound the server enforces, with its unit, and the small accounting types that enforce
+//! the counting ones (connections, connections per address, players, rates).
+
+use std::collections::HashMap;
+use std::net::IpAddr;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+/// Default players in the pool at once (`--max-clients`).
+pub const DEFAULT_MAX_CLIENTS: usize = 64;
+/// Default TCP connections from one IP address at once, handshaking or playing.
+pub const DEFAULT_MAX_PER_ADDRESS: usize = 8;
+/// Connections allowed beyond `max_clients` that are still handshaking (so a full pool can still
+/// tell newcomers it is full, and handshakes cannot exhaust memory).
+pub const HANDSHAKE_SLACK: usize = 16;
+/// Default time from TCP accept until the player's shell is running (banner, key exchange,
+/// authentication, channel, pty, shell).
+pub const DEFAULT_HANDSHAKE_TIMEOUT: Duration = Duration::from_secs(10);
+/// Default time without a key press before a player is sent away.
+pub const DEFAULT_IDLE_TIMEOUT: Duration = Duration::from_secs(10 * 60);
+/// Default time one frame may take to leave for the client before it counts as stalled and is cut.
+pub const DEFAULT_STALL_TIMEOUT: Duration = Duration::from_secs(20);
+/// Default delay before rejecting a failed authentication (russh `auth_rejection_time`).
+pub const DEFAULT_AUTH_REJECTION_TIME: Duration = Duration::from_millis(500);
+/// Largest terminal accepted from pty-req/window-change; larger values are clamped.
+pub const MAX_COLS: u16 = 500;
+/// Largest terminal height accepted; larger values are clamped.
+pub const MAX_ROWS: u16 = 200;
+/// Smallest terminal drawn; smaller values are clamped up.
+pub const MIN_COLS: u16 = 20;
+/// Smallest terminal height drawn.
+pub const MIN_ROWS: u16 = 5;
+/// Default actions (key-press batches) a player may make per second; the rest are dropped.
+pub const DEFAULT_ACTIONS_PER_SECOND: u32 = 30;
+/// Default total outbound frame bytes per second across all clients.
+pub const DEFAULT_OUTBOUND_BYTES_PER_SECOND: u64 = 16_000_000;
+/// Default bytes per second for one client's frames (its rate-controlled encoder's budget).
+pub const DEFAULT_CLIENT_BYTES_PER_SECOND: u64 = 256_000;
+/// Most players `--max-clients` accepts (memory and CPU are planned per client).
+pub const MAX_MAX_CLIENTS: u64 = 10_000;
+/// Most connections per address `--max-per-address` accepts.
+pub const MAX_PER_ADDRESS: u64 = 1_000;
+/// Longest timeout any `--*-timeout-ms` flag accepts (a day).
+pub const MAX_TIMEOUT_MS: u64 = 24 * 3600 * 1000;
+/// Most actions per second `--actions-per-second` accepts.
+pub const MAX_ACTIONS_PER_SECOND: u64 = 1_000;
+/// Send buffer the kernel may hold per client socket: keeps stale frames out of the pipe.
+pub const SOCKET_SEND_BUFFER_BYTES: usize = 64 * 1024;
+/// Messages russh may queue per session from our side (`Config::event_buffer_size`).
+pub const SESSION_EVENT_QUEUE: usize = 4;
+/// Receive window we offer the client for its input (bytes).
+pub const INPUT_WINDOW_BYTES: u32 = 64 * 1024;
+/// Time the farewell (message + terminal reset + channel close) may take per client at exit.
+pub const FAREWELL_TIMEOUT: Duration = Duration::from_millis(300);
+/// Time from a shutdown request until every connection is cut.
+pub const SHUTDOWN_GRACE: Duration = Duration::from_millis(700);
+/// The line a client beyond `max_clients` sees.
+pub const POOL_FULL_LINE: &str = "the pool is full, try again later";
+
+/// All runtime limits (built from flags; tests shorten the timeouts).
+#[derive(Debug, Clone)]
+pub struct Limits {
+    /// Players at once.
+    pub max_clients: usize,
+    /// Connections per IP address at once.
+    pub max_per_address: usize,
+    /// Accept → shell deadline.
+    pub handshake_timeout: Duration,
+    /// No-input deadline for a player.
+    pub idle_timeout: Duration,
+    /// Per-frame send deadline before a client is considered stalled and cut.
+    pub stall_timeout: Duration,
+    /// Delay on each failed authentication.
+    pub auth_rejection_time: Duration,
+    /// Per-player input rate.
+    pub actions_per_second: u32,
+    /// Server-wide frame byte rate.
+    pub outbound_bytes_per_second: u64,
+    /// One client's frame byte rate.
+    pub client_bytes_per_second: u64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Self {
+            max_clients: DEFAULT_MAX_CLIENTS,
+            max_per_address: DEFAULT_MAX_PER_ADDRESS,
+            handshake_timeout: DEFAULT_HANDSHAKE_TIMEOUT,
+            idle_timeout: DEFAULT_IDLE_TIMEOUT,
+            stall_timeout: DEFAULT_STALL_TIMEOUT,
+            auth_rejection_time: DEFAULT_AUTH_REJECTION_TIME,
+            actions_per_second: DEFAULT_ACTIONS_PER_SECOND,
+            outbound_bytes_per_second: DEFAULT_OUTBOUND_BYTES_PER_SECOND,
+            client_bytes_per_second: DEFAULT_CLIENT_BYTES_PER_SECOND,
+        }
+    }
+}
+
+/// Counts open TCP connections, in total and per IP address; enforced at accept.
+#[derive(Debug)]
+pub struct ConnTracker {
+    max_total: usize,
+    max_per_address: usize,
+    inner: Mutex<TrackerInner>,
+}
+
+#[derive(Debug, Default)]
+struct TrackerInner {
+    total: usize,
+    per_address: HashMap<IpAddr, usize>,
+}
+
+/// Why a connection was refused at accept.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Refusal {
+    /// `max_clients + HANDSHAKE_SLACK` connections are open.
+    TooManyConnections,
+    /// This address has `max_per_address` connections open.
+    TooManyFromAddress,
+}
+
+impl ConnTracker {
+    /// A tracker for `limits`.
+    pub fn new(limits: &Limits) -> Arc<Self> {
+        Arc::new(Self {
+            max_total: limits.max_clients + HANDSHAKE_SLACK,
+            max_per_address: limits.max_per_address,
+            inner: Mutex::new(TrackerInner::default()),
+        })
+    }
+
+    /// Counts a new connection from `ip`, or says why it is refused.
+    pub fn admit(self: &Arc<Self>, ip: IpAddr) -> Result<ConnGuard, Refusal> {
+        let mut inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
+        if inner.total >= self.max_total {
+            return Err(Refusal::TooManyConnections);
+        }
+        let count = inner.per_address.entry(ip).or_insert(0);
+        if *count >= self.max_per_address {
+            return Err(Refusal::TooManyFromAddress);
+        }
+        *count += 1;
+        inner.total += 1;
+        Ok(ConnGuard { tracker: self.clone(), ip })
+    }
+}
+
+/// Releases the connection's place when dropped.
+#[derive(Debug)]
+pub struct ConnGuard {
+    tracker: Arc<ConnTracker>,
+    ip: IpAddr,
+}
+
+impl Drop for ConnGuard {
+    fn drop(&mut self) {
+        let mut inner = self.tracker.inner.lock().unwrap_or_else(|p| p.into_inner());
+        inner.total -= 1;
+        if let Some(count) = inner.per_address.get_mut(&self.ip) {
+            *count -= 1;
+            if *count == 0 {
+                inner.per_address.remove(&self.ip);
+            }
+        }
+    }
+}
+
+/// Player places in the pool (`max_clients`); a place is taken when a shell starts.
+#[derive(Debug)]
+pub struct PlayerSlots {
+    max: usize,
+    taken: AtomicUsize,
+}
+
+impl PlayerSlots {
+    /// Up to `max` players.
+    pub fn new(max: usize) -> Arc<Self> {
+        Arc::new(Self { max, taken: AtomicUsize::new(0) })
+    }
+
+    /// Takes a place, or None when the pool is full.
+    pub fn try_take(self: &Arc<Self>) -> Option<PlayerSlot> {
+        self.taken
+            .fetch_update(Ordering::AcqRel, Ordering::Acquire, |n| (n < self.max).then_some(n + 1))
+            .ok()
+            .map(|_| PlayerSlot { slots: self.clone() })
+    }
+
+    /// Players now.
+    pub fn count(&self) -> usize {
+        self.taken.load(Ordering::Acquire)
+    }
+}
+
+/// A taken place; dropping it frees the place.
+#[derive(Debug)]
+pub struct PlayerSlot {
+    slots: Arc<PlayerSlots>,
+}
+
+impl Drop for PlayerSlot {
+    fn drop(&mut self) {
+        self.slots.taken.fetch_sub(1, Ordering::AcqRel);
+    }
+}
+
+/// A token bucket: `rate` tokens per second, holding at most one second's worth.
+#[derive(Debug)]
+pub struct TokenBucket {
+    rate: f64,
+    tokens: f64,
+    last: Instant,
+}
+
+impl TokenBucket {
+    /// A full bucket refilling at `rate` per second.
+    pub fn new(rate: f64) -> Self {
+        Self { rate, tokens: rate, last: Instant::now() }
+    }
+
+    fn refill(&mut self) {
+        let now = Instant::now();
+        self.tokens = (self.tokens + now.duration_since(self.last).as_secs_f64() * self.rate).min(self.rate);
+        self.last = now;
+    }
+
+    /// Takes `n` tokens if available.
+    pub fn try_take(&mut self, n: f64) -> bool {
+        self.refill();
+        if self.tokens >= n {
+            self.tokens -= n;
+            true
+        } else {
+            false
+        }
+    }
+}
+
+impl TokenBucket {
+    /// Takes `n` tokens whether or not they are there (a frame already encoded is sent); the
+    /// debt, at most a second's worth, is paid before [`TokenBucket::try_take`] succeeds again.
+    pub fn spend(&mut self, n: f64) {
+        self.refill();
+        self.tokens = (self.tokens - n).max(-self.rate);
+    }
+}
+
+/// Clamps a client-reported terminal size to what we draw.
+pub fn clamp_size(cols: u32, rows: u32) -> (u16, u16) {
+    let c = cols.clamp(MIN_COLS as u32, MAX_COLS as u32) as u16;
+    let r = rows.clamp(MIN_ROWS as u32, MAX_ROWS as u32) as u16;
+    (c, r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn per_address_and_total_limits() {
+        let limits = Limits { max_clients: 1, max_per_address: 2, ..Limits::default() };
+        let t = ConnTracker::new(&limits);
+        let a: IpAddr = "127.0.0.1".parse().unwrap();
+        let b: IpAddr = "127.0.0.2".parse().unwrap();
+        let g1 = t.admit(a).unwrap();
+        let _g2 = t.admit(a).unwrap();
+        assert_eq!(t.admit(a).unwrap_err(), Refusal::TooManyFromAddress);
+        drop(g1);
+        let _g3 = t.admit(a).unwrap();
+        let mut held = Vec::new();
+        for i in 0..HANDSHAKE_SLACK - 1 {
+            held.push(t.admit(IpAddr::from([10, 0, 0, i as u8])).unwrap());
+        }
+        assert_eq!(t.admit(b).unwrap_err(), Refusal::TooManyConnections);
+    }
+
+    #[test]
+    fn player_slots_are_bounded_and_freed() {
+        let s = PlayerSlots::new(1);
+        let p = s.try_take().unwrap();
+        assert!(s.try_take().is_none());
+        drop(p);
+        assert!(s.try_take().is_some());
+    }
+
+    #[test]
+    fn sizes_are_clamped() {
+        assert_eq!(clamp_size(0, 0), (MIN_COLS, MIN_ROWS));
+        assert_eq!(clamp_size(u32::MAX, u32::MAX), (MAX_COLS, MAX_ROWS));
+        assert_eq!(clamp_size(80, 24), (80, 24));
+    }
+}

@@ -1,0 +1,326 @@
+//! The SSH server: binds, accepts with per-address and total limits, runs each connection under
+//! a handshake deadline and a kill switch, and shuts down within a second.
+
+use std::collections::HashMap;
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::Duration;
+
+use russh::keys::PrivateKey;
+use russh::server::Config;
+use russh::{MethodKind, MethodSet, SshId};
+use tokio::net::{TcpListener, TcpStream};
+use tokio::sync::{mpsc, watch};
+use tokio::task::JoinHandle;
+use tokio_util::sync::CancellationToken;
+use tokio_util::task::TaskTracker;
+
+use super::authorized_keys::AllowList;
+use super::game::{self, GameLinks, GameOptions, GameStats, Pictures, Shared, Sizes};
+use super::handler::ClientHandler;
+use super::killable::Killable;
+use super::limits::{self, ConnGuard, ConnTracker, Limits, PlayerSlots, TokenBucket};
+
+/// Identification string sent to clients (no library version, nothing to fingerprint).
+pub const SERVER_ID: &str = "SSH-2.0-tidepool";
+/// Pause after a failed accept (e.g. out of file descriptors) before accepting again.
+const ACCEPT_ERROR_PAUSE: Duration = Duration::from_millis(100);
+/// Time between keepalives to a quiet client (at most half the stall timeout).
+const KEEPALIVE_INTERVAL: Duration = Duration::from_secs(15);
+/// Time the last step of shutdown waits for cut connections to finish.
+const CUT_WAIT: Duration = Duration::from_millis(150);
+
+/// What `start` needs.
+pub struct ServerOptions {
+    /// Address to listen on.
+    pub listen: SocketAddr,
+    /// Host key (see `host_key`).
+    pub host_key: PrivateKey,
+    /// `None`: anyone may play. `Some`: only these keys.
+    pub allow: Option<AllowList>,
+    /// Limits and timeouts.
+    pub limits: Limits,
+    /// The shared scene.
+    pub game: GameOptions,
+}
+
+/// Counters for tests, logs and the load report.
+#[derive(Debug, Default)]
+pub struct Stats {
+    /// TCP connections accepted and handed to SSH.
+    pub accepted: AtomicU64,
+    /// Connections closed at accept (total or per-address limit).
+    pub refused_at_accept: AtomicU64,
+    /// Connections cut by the handshake deadline.
+    pub handshake_timeouts: AtomicU64,
+    /// Successful authentications.
+    pub authenticated: AtomicU64,
+    /// Clients told the pool is full.
+    pub pool_full: AtomicU64,
+    /// Requests and channel opens refused (exec, subsystem, forwarding, agent, X11, …).
+    pub refused_requests: AtomicU64,
+    /// Frames sent to clients.
+    pub frames_sent: AtomicU64,
+    /// Pictures a client skipped because it had not taken the previous one yet.
+    pub frames_skipped: AtomicU64,
+    /// Frames skipped by the server-wide outbound byte rate.
+    pub frames_dropped_rate: AtomicU64,
+    /// Players sent away for idling.
+    pub idle_kicks: AtomicU64,
+    /// Players cut for not taking a frame within the stall timeout.
+    pub stall_kicks: AtomicU64,
+    /// Shared actions dropped by the per-player rate or a full queue.
+    pub actions_dropped: AtomicU64,
+    /// Packets of key bytes dropped because the player's task was behind.
+    pub input_dropped: AtomicU64,
+}
+
+impl Stats {
+    /// One line for the log at exit.
+    pub fn summary(&self, game: &GameStats) -> String {
+        let get = |c: &AtomicU64| c.load(Ordering::Relaxed);
+        format!(
+            "{} connections ({} refused at accept, {} handshake timeouts), {} players, {} told the pool is full, \
+             {} requests refused, {} frames published, {} sent, {} skipped, {} idle, {} stalled",
+            get(&self.accepted),
+            get(&self.refused_at_accept),
+            get(&self.handshake_timeouts),
+            get(&self.authenticated),
+            get(&self.pool_full),
+            get(&self.refused_requests),
+            get(&game.frames),
+            get(&self.frames_sent),
+            get(&self.frames_skipped),
+            get(&self.idle_kicks),
+            get(&self.stall_kicks),
+        )
+    }
+}
+
+/// State shared by the accept loop, every connection and every player.
+pub(crate) struct Hub {
+    pub limits: Limits,
+    pub allow: Option<AllowList>,
+    pub config: Arc<Config>,
+    pub tracker: Arc<ConnTracker>,
+    pub players: Arc<PlayerSlots>,
+    /// "Please leave": players say goodbye and close.
+    pub shutdown: CancellationToken,
+    /// Parent of every connection's kill switch.
+    pub cut_all: CancellationToken,
+    pub frames: watch::Receiver<Arc<Pictures>>,
+    pub sizes: Sizes,
+    pub actions: mpsc::Sender<Shared>,
+    /// All players' frames together, bytes a second.
+    pub outbound: Mutex<TokenBucket>,
+    pub stats: Arc<Stats>,
+    pub tasks: TaskTracker,
+    pub next_id: AtomicU64,
+    /// The shared scene's size in pixels.
+    pub scene_size: (u32, u32),
+}
+
+/// A running server.
+pub struct Running {
+    /// Bound address (useful with port 0).
+    pub local_addr: SocketAddr,
+    /// Counters.
+    pub stats: Arc<Stats>,
+    /// The shared scene's counters.
+    pub game_stats: Arc<GameStats>,
+    shutdown: CancellationToken,
+    join: JoinHandle<()>,
+}
+
+impl Running {
+    /// Asks every player to leave and stops accepting; `wait` returns within about a second.
+    pub fn shutdown(&self) {
+        self.shutdown.cancel();
+    }
+
+    /// Waits until the server has stopped (after `shutdown`).
+    pub async fn wait(self) {
+        let _ = self.join.await;
+    }
+}
+
+/// Builds russh's configuration. Public mode offers none, publickey and keyboard-interactive;
+/// private mode (authorized_keys) offers publickey only. Password is never offered: a public
+/// pool must not invite people to type their real password.
+pub fn russh_config(host_key: PrivateKey, private: bool, limits: &Limits) -> Config {
+    let methods: &[MethodKind] = if private {
+        &[MethodKind::PublicKey]
+    } else {
+        &[MethodKind::None, MethodKind::PublicKey, MethodKind::KeyboardInteractive]
+    };
+    Config {
+        server_id: SshId::Standard(SERVER_ID.into()),
+        methods: MethodSet::from(methods),
+        auth_rejection_time: limits.auth_rejection_time,
+        // OpenSSH always probes with "none" first: do not make every private-mode login wait.
+        auth_rejection_time_initial: Some(Duration::ZERO),
+        keys: vec![host_key],
+        // russh resets this timer on every loop turn, including our own frames, so it is not an
+        // idle timeout; it bounds the banner read and a write blocked on a full socket.
+        inactivity_timeout: Some(limits.stall_timeout),
+        // Keepalives also keep a player watching still water from counting as inactive.
+        keepalive_interval: Some(KEEPALIVE_INTERVAL.min(limits.stall_timeout / 2)),
+        keepalive_max: 3,
+        window_size: limits::INPUT_WINDOW_BYTES,
+        event_buffer_size: limits::SESSION_EVENT_QUEUE,
+        max_auth_attempts: 6,
+        // run_stream ignores `nodelay` (only run_on_socket applies it); we set it on accept.
+        nodelay: true,
+        ..Config::default()
+    }
+}
+
+/// Binds and starts serving. Errors only for the bind (e.g. port in use) and the first scene.
+pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
+    let scene = game::first_scene(&opts.game).map_err(StartError::Scene)?;
+    let listener = TcpListener::bind(opts.listen).await.map_err(StartError::Bind)?;
+    let local_addr = listener.local_addr().map_err(StartError::Bind)?;
+    let config = Arc::new(russh_config(opts.host_key, opts.allow.is_some(), &opts.limits));
+    let stats = Arc::new(Stats::default());
+    let game_stats = Arc::new(GameStats::default());
+    let players = PlayerSlots::new(opts.limits.max_clients);
+    let tracker = ConnTracker::new(&opts.limits);
+    let info = tidepool::player::SceneInfo::of(scene.as_ref());
+    let (frames_tx, frames_rx) = watch::channel(game::nothing_yet(info));
+    let (actions_tx, actions_rx) = mpsc::channel(game::ACTION_QUEUE);
+    let sizes: Sizes = Arc::new(Mutex::new(HashMap::new()));
+    let shutdown = CancellationToken::new();
+    let hub = Arc::new(Hub {
+        outbound: Mutex::new(TokenBucket::new(opts.limits.outbound_bytes_per_second as f64)),
+        limits: opts.limits,
+        allow: opts.allow,
+        config,
+        tracker,
+        players: players.clone(),
+        shutdown: shutdown.clone(),
+        cut_all: CancellationToken::new(),
+        frames: frames_rx,
+        sizes: sizes.clone(),
+        actions: actions_tx,
+        stats: stats.clone(),
+        tasks: TaskTracker::new(),
+        next_id: AtomicU64::new(1),
+        scene_size: opts.game.size,
+    });
+    let stop = Arc::new(AtomicBool::new(false));
+    let links = GameLinks {
+        actions: actions_rx,
+        sizes,
+        players: players.clone(),
+        publish: frames_tx,
+        stats: game_stats.clone(),
+        stop: stop.clone(),
+    };
+    // The simulation and rendering are CPU work on their own thread, off the async workers.
+    let game = std::thread::Builder::new()
+        .name("tidepool-game".into())
+        .spawn(move || game::run(opts.game, scene, links))
+        .map_err(StartError::Bind)?;
+    let join = tokio::spawn(async move {
+        accept_loop(&hub, listener).await;
+        finish(&hub).await;
+        stop.store(true, Ordering::Relaxed);
+        let _ = tokio::task::spawn_blocking(move || game.join()).await;
+    });
+    Ok(Running { local_addr, stats, game_stats, shutdown, join })
+}
+
+/// Why the server could not start.
+#[derive(Debug)]
+pub enum StartError {
+    /// The address could not be bound (in use, not ours, no permission).
+    Bind(std::io::Error),
+    /// The first scene could not be built.
+    Scene(tidepool::Error),
+}
+
+async fn accept_loop(hub: &Arc<Hub>, listener: TcpListener) {
+    loop {
+        let accepted = tokio::select! {
+            _ = hub.shutdown.cancelled() => return,
+            r = listener.accept() => r,
+        };
+        let (stream, peer) = match accepted {
+            Ok(x) => x,
+            Err(e) => {
+                eprintln!("serve: accept failed: {e}");
+                tokio::time::sleep(ACCEPT_ERROR_PAUSE).await;
+                continue;
+            }
+        };
+        match hub.tracker.admit(peer.ip()) {
+            Ok(guard) => {
+                hub.stats.accepted.fetch_add(1, Ordering::Relaxed);
+                hub.tasks.spawn(connection(hub.clone(), stream, peer, guard));
+            }
+            Err(refusal) => {
+                hub.stats.refused_at_accept.fetch_add(1, Ordering::Relaxed);
+                eprintln!("serve: {peer} refused at accept: {refusal:?}");
+                drop(stream);
+            }
+        }
+    }
+}
+
+/// Shutdown: players already got `shutdown` and say goodbye; give them SHUTDOWN_GRACE, then cut
+/// whatever is left (stalled clients, handshakes) and wait briefly for the tasks to notice.
+async fn finish(hub: &Arc<Hub>) {
+    hub.tasks.close();
+    if tokio::time::timeout(limits::SHUTDOWN_GRACE, hub.tasks.wait()).await.is_err() {
+        hub.cut_all.cancel();
+        let _ = tokio::time::timeout(CUT_WAIT, hub.tasks.wait()).await;
+    }
+    hub.cut_all.cancel();
+}
+
+async fn connection(hub: Arc<Hub>, stream: TcpStream, peer: SocketAddr, guard: ConnGuard) {
+    let _ = stream.set_nodelay(true);
+    // Small kernel send buffer: a slow client's backlog stays small, so frames are dropped
+    // upstream (latest-wins) instead of aging in the socket.
+    let _ = socket2::SockRef::from(&stream).set_send_buffer_size(limits::SOCKET_SEND_BUFFER_BYTES);
+    let id = hub.next_id.fetch_add(1, Ordering::Relaxed);
+    let kill = hub.cut_all.child_token();
+    let playing = CancellationToken::new();
+    let handler = ClientHandler::new(hub.clone(), id, peer, kill.clone(), playing.clone());
+    let stream = Killable::new(stream, kill.clone());
+
+    let deadline = {
+        let (kill, playing, stats) = (kill.clone(), playing.clone(), hub.stats.clone());
+        let (timeout, shutdown) = (hub.limits.handshake_timeout, hub.shutdown.clone());
+        async move {
+            tokio::select! {
+                _ = playing.cancelled() => {}
+                _ = kill.cancelled() => {}
+                // Nothing to say goodbye to before the game starts: cut handshakes at once.
+                _ = shutdown.cancelled() => kill.cancel(),
+                _ = tokio::time::sleep(timeout) => {
+                    stats.handshake_timeouts.fetch_add(1, Ordering::Relaxed);
+                    kill.cancel();
+                }
+            }
+        }
+    };
+    let session = {
+        let config = hub.config.clone();
+        let kill = kill.clone();
+        async move {
+            let result = match russh::server::run_stream(config, stream, handler).await {
+                Ok(running) => running.await,
+                Err(e) => Err(e),
+            };
+            kill.cancel(); // ends the deadline task and the player's writer
+            result
+        }
+    };
+    let ((), result) = tokio::join!(deadline, session);
+    if let Err(e) = result {
+        eprintln!("serve: {peer} #{id} ended: {e}");
+    }
+    drop(guard);
+}

@@ -1,0 +1,108 @@
+//! The real OpenSSH client in a pseudo-terminal (skipped with a notice where `ssh` is absent).
+//! HOME is an empty temporary folder and `-F /dev/null` ignores any config, so the client has
+//! no keys: it gets in with "none", as `ssh -o BatchMode=yes` would.
+
+use std::io::{Read, Write};
+use std::path::Path;
+use std::sync::mpsc;
+use std::time::{Duration, Instant};
+
+use portable_pty::{CommandBuilder, PtySize, native_pty_system};
+
+use crate::common::{HANG_GUARD, Server, TEST_FLAGS};
+
+fn ssh_available() -> bool {
+    std::process::Command::new("ssh").arg("-V").output().is_ok()
+}
+
+/// A running `ssh` in a pty with a reader thread.
+struct Ssh {
+    child: Box<dyn portable_pty::Child + Send + Sync>,
+    writer: Box<dyn Write + Send>,
+    rx: mpsc::Receiver<Vec<u8>>,
+    seen: Vec<u8>,
+    _master: Box<dyn portable_pty::MasterPty + Send>,
+}
+
+impl Ssh {
+    fn spawn(port: u16, home: &Path, extra: &[&str]) -> Ssh {
+        let pair =
+            native_pty_system().openpty(PtySize { rows: 24, cols: 80, pixel_width: 0, pixel_height: 0 }).unwrap();
+        let mut cmd = CommandBuilder::new("ssh");
+        cmd.env("HOME", home);
+        cmd.env("TERM", "xterm-256color");
+        cmd.env("COLORTERM", "truecolor");
+        cmd.env_remove("SSH_AUTH_SOCK");
+        let port = port.to_string();
+        cmd.args(["-F", "/dev/null", "-p", &port, "-o", "StrictHostKeyChecking=no"]);
+        cmd.args(["-o", "UserKnownHostsFile=/dev/null", "-o", "BatchMode=yes", "-o", "SendEnv=COLORTERM", "-v"]);
+        cmd.args(extra);
+        let child = pair.slave.spawn_command(cmd).unwrap();
+        drop(pair.slave);
+        let mut reader = pair.master.try_clone_reader().unwrap();
+        let writer = pair.master.take_writer().unwrap();
+        let (tx, rx) = mpsc::channel();
+        std::thread::spawn(move || {
+            let mut buf = [0u8; 8192];
+            while let Ok(n) = reader.read(&mut buf) {
+                if n == 0 || tx.send(buf[..n].to_vec()).is_err() {
+                    break;
+                }
+            }
+        });
+        Ssh { child, writer, rx, seen: Vec::new(), _master: pair.master }
+    }
+
+    fn text(&self) -> String {
+        String::from_utf8_lossy(&self.seen).into_owned()
+    }
+
+    fn wait_for(&mut self, needle: &str) {
+        let deadline = Instant::now() + HANG_GUARD;
+        while !self.text().contains(needle) {
+            match self.rx.recv_timeout(deadline.saturating_duration_since(Instant::now())) {
+                Ok(chunk) => self.seen.extend_from_slice(&chunk),
+                Err(_) => panic!("ssh never printed {needle:?}"),
+            }
+        }
+    }
+
+    fn finish(&mut self) -> u32 {
+        let status = self.child.wait().unwrap();
+        while let Ok(chunk) = self.rx.recv_timeout(Duration::from_millis(300)) {
+            self.seen.extend_from_slice(&chunk);
+        }
+        status.exit_code()
+    }
+}
+
+#[test]
+fn openssh_without_keys_sees_the_pool_drops_a_stone_and_q_restores_its_terminal() {
+    if !ssh_available() {
+        eprintln!("NOTICE: ssh not found; skipped the OpenSSH test");
+        return;
+    }
+    let s = Server::start(TEST_FLAGS);
+    let home = tempfile::tempdir().unwrap();
+    let mut ssh = Ssh::spawn(s.port, home.path(), &["localhost"]);
+    ssh.wait_for("\x1b[?1049h");
+    ssh.wait_for("1 playing");
+    ssh.writer.write_all(b" ").unwrap();
+    ssh.writer.flush().unwrap();
+    // The stone reaches the shared scene: the game logs each applied action at exit.
+    ssh.wait_for("\x1b[?2026h");
+    ssh.writer.write_all(b"q").unwrap();
+    ssh.writer.flush().unwrap();
+    let code = ssh.finish();
+    let text = ssh.text();
+    let auth = text.lines().find(|l| l.contains("Authenticated to")).unwrap_or("").trim().to_string();
+    assert!(auth.contains("using \"none\""), "auth line: {auth:?}");
+    assert!(text.contains("bye from the pool"));
+    let restore = text.rfind("\x1b[?1049l").expect("left the alternate screen");
+    assert!(restore > text.rfind("\x1b[?1049h").unwrap(), "restored after the last frame");
+    assert!(text[restore..].contains("bye from the pool"));
+    assert_eq!(code, 0);
+    let (_, log) = s.stop(15);
+    let summary = log.iter().find(|l| l.contains("stopped in")).unwrap();
+    assert!(summary.contains("1 players"), "{summary}");
+}
