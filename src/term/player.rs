@@ -19,13 +19,16 @@ use tiny_skia::Pixmap;
 use super::input::{Input, InputParser, coalesce};
 use super::link::{self, Change, LinkControl};
 use super::pacing::{FramePacer, Meter, SimClock};
+use super::picture::{self, Picture};
+use super::probe::{self, GraphicsRequest, GraphicsSupport};
 use super::screen::{FrameBuilder, Overlay, big_enough};
 use super::ui;
 use super::writer::FrameWriter;
 use crate::error::{Error, Result};
 use crate::output::bucket::ByteBucket;
 use crate::output::color::ColorMode;
-use crate::output::diff::{EncodeOptions, Shown};
+use crate::output::cursor::Cursor;
+use crate::output::diff::{EncodeOptions, SYNC_BEGIN, SYNC_END, Shown};
 use crate::output::frame::Frame;
 use crate::output::rate::{RateEncoder, RateOptions, Target};
 use crate::replay::{FORMAT, Header, PoolOptions, Recorder};
@@ -101,6 +104,20 @@ pub struct PlayerConfig {
     pub greeting: Option<String>,
     /// Set from outside (a signal handler) to end the session as if the user quit.
     pub quit: Arc<AtomicBool>,
+    /// How the picture is drawn (`--graphics`): `Force(Cells)` is the half-block picture.
+    /// Without a probe (see [`run_probed`]) `Auto` means cells and a forced mode is used as
+    /// asked.
+    pub graphics: GraphicsRequest,
+}
+
+/// What the terminal answered to the graphics probe (`term/probe.rs`) before the player started.
+#[derive(Clone, Debug, Default)]
+pub struct Probed {
+    /// What it can show.
+    pub support: GraphicsSupport,
+    /// Bytes that arrived during the probe and were not answers (keys typed meanwhile): the
+    /// player reads them first, so they are not lost.
+    pub leftover: Vec<u8>,
 }
 
 impl std::fmt::Debug for PlayerConfig {
@@ -110,6 +127,7 @@ impl std::fmt::Debug for PlayerConfig {
             .field("fps", &self.fps)
             .field("bandwidth", &self.bandwidth)
             .field("color", &self.color)
+            .field("graphics", &self.graphics)
             .finish_non_exhaustive()
     }
 }
@@ -142,17 +160,50 @@ struct Player {
     drag: Option<(i32, i32)>,
     radius: u32,
     rng: ChaCha8Rng,
+    /// The picture in real pixels; `None` in cells mode.
+    picture: Option<Picture>,
+    /// Mouse reports are in pixels (SGR-pixels mode 1016 is on).
+    mouse_pixels: bool,
+    /// Input that arrived before the loop started (during the probe).
+    leftover: Vec<u8>,
 }
 
 /// Runs the player until the user quits (or the input closes, or `config.quit` is set),
-/// reading `input` and writing frames to `output`.
+/// reading `input` and writing frames to `output`. No probe was made: `--graphics auto` means
+/// cells.
 pub fn run(
     input: &mut dyn TerminalInput,
     output: impl std::io::Write + Send + 'static,
     config: PlayerConfig,
 ) -> Result<()> {
+    run_probed(input, output, config, None)
+}
+
+/// [`run`], after the terminal answered the graphics probe: the mode is chosen from its
+/// answers, and the bytes read during the probe are the first input.
+pub fn run_probed(
+    input: &mut dyn TerminalInput,
+    output: impl std::io::Write + Send + 'static,
+    mut config: PlayerConfig,
+    probed: Option<Probed>,
+) -> Result<()> {
     let term = input.size().map_err(|source| Error::Terminal { action: "cannot read the terminal size", source })?;
-    let (w, h) = picture_size(term.0, term.1);
+    let (support, leftover) = probed.map_or((None, Vec::new()), |p| (Some(p.support), p.leftover));
+    let choice = probe::choose(config.graphics, support.as_ref());
+    let support = support.unwrap_or_default();
+    let picture = Picture::new(&choice, &support, term);
+    let mouse_pixels = picture::pixel_mouse(&choice, &support);
+    if let Some(hint) = choice.hint {
+        // The hint says how to get pictures: it goes first, the colour greeting after it.
+        config.greeting = Some(match config.greeting.take() {
+            Some(g) => format!("{hint}; {g}"),
+            None => hint.to_owned(),
+        });
+    }
+    let (w, h) = match &picture {
+        Some(p) => p.layout().picture,
+        None => picture_size(term.0, term.1),
+    };
     let first = config
         .scenes
         .first()
@@ -195,6 +246,9 @@ pub fn run(
         message,
         drag: None,
         radius: DEFAULT_STONE_RADIUS,
+        picture,
+        mouse_pixels,
+        leftover,
     };
     // The loop runs on a rayon worker: the parallel parts of a frame (simulation bands,
     // picture rows) then go to the worker's own queue instead of rayon's global injector,
@@ -235,6 +289,10 @@ impl Player {
         let mut builder = FrameBuilder::default();
         // A buffer kept back from a frame that had nothing to send, so it is not lost.
         let mut unused: Option<Vec<u8>> = None;
+        // The picture's bytes of this frame, and whether the help was open at the last frame
+        // (text over sixel or iTerm2 pixels erases them: the picture is resent when it closes).
+        let mut picture_bytes = Vec::new();
+        let mut help_was_open = false;
         let read_error = |source| Error::Terminal { action: "cannot read the terminal", source };
         'play: loop {
             if self.config.quit.load(Ordering::SeqCst) {
@@ -247,6 +305,8 @@ impl Player {
             }
             let timeout = deadline.saturating_duration_since(now).min(MAX_WAIT);
             bytes_in.clear();
+            bytes_in.append(&mut self.leftover);
+            let timeout = if bytes_in.is_empty() { timeout } else { Duration::ZERO };
             if !input.read(&mut bytes_in, timeout).map_err(read_error)? {
                 return Ok(());
             }
@@ -322,8 +382,30 @@ impl Player {
                 ..RateOptions::from(self.config.encode)
             };
             let mut bytes = unused.take().unwrap_or_else(|| writer.buffer());
+            let resized = shown.frame.is_none();
             let report = encoder.encode_into(&mut shown, target, bucket.budget(), options, &mut bytes);
             bucket.spend(report.bytes);
+            if let Some(picture) = &mut self.picture {
+                let help_open = self.help.is_some();
+                if resized || (help_was_open && !help_open && picture.text_erases_pixels()) {
+                    // The screen was cleared, or the help's text erased sixel / iTerm2 pixels.
+                    picture.invalidate();
+                }
+                help_was_open = help_open;
+                // Sixel and iTerm2 would paint over the help: the picture waits while it is open.
+                let paused_by_help = help_open && picture.text_erases_pixels();
+                if !paused_by_help && !bucket.in_debt() && big_enough(self.term) {
+                    picture_bytes.clear();
+                    picture.encode(&pixmap, &mut picture_bytes).map_err(Error::Output)?;
+                    if !picture_bytes.is_empty() {
+                        // A picture cannot be cut to the budget: it is sent whole and owed, so
+                        // the next one waits until the rate has paid for it (see bucket.rs).
+                        bucket.owe(picture_bytes.len());
+                        splice_picture(&mut bytes, &picture_bytes, options.sync);
+                        shown.cursor = Cursor::Unknown;
+                    }
+                }
+            }
             if auto && report.bytes > 0 && link.probe_due() {
                 // The question goes after the frame: its answer says the frame has arrived.
                 bytes.extend_from_slice(link::PROBE);
@@ -375,7 +457,15 @@ impl Player {
         now: Instant,
     ) -> &'b Frame {
         let overlay = Overlay {
-            aim: self.aim_until.is_some_and(|t| now < t).then_some((self.aim.0 as u32, self.aim.1 as u32)),
+            aim: self.aim_until.is_some_and(|t| now < t).then(|| {
+                let (x, y) = (self.aim.0 as u32, self.aim.1 as u32);
+                // The marker is a text cell: with real pixels, the cell over the aimed pixel
+                // (in the cell frame's coordinates, two pixel rows a cell).
+                self.picture.as_ref().map_or((x, y), |p| {
+                    let (col, row) = p.cell_of(x, y);
+                    (col, 2 * row)
+                })
+            }),
             help: self.help.as_deref(),
             message: self.message.as_ref().filter(|(_, until)| now < *until).map(|(m, _)| m.as_str()),
             fps: meter.fps,
@@ -383,6 +473,7 @@ impl Player {
             bandwidth: bandwidth.map(|b| b as u64),
             stone: self.radius,
             paused: self.sim.paused(),
+            pixels_elsewhere: self.picture.is_some(),
         };
         builder.build(self.term, self.scene.as_mut(), pixmap, self.config.color, &overlay)
     }
@@ -405,9 +496,29 @@ impl Player {
         self.message = Some((message, Instant::now() + MESSAGE_VISIBLE));
     }
 
-    /// The picture pixel under terminal cell (col, row): its upper half.
+    /// The picture pixel under a mouse report at (col, row): in cells mode the cell's upper
+    /// half; with real pixels the pixel under the cell's centre, or with SGR-pixels reports
+    /// (then `col`, `row` are screen pixels) the pixel under the pointer.
     fn pixel_at(&self, col: u16, row: u16) -> Option<(i32, i32)> {
-        (big_enough(self.term) && row + 1 < self.term.1).then_some((i32::from(col), 2 * i32::from(row)))
+        if !big_enough(self.term) {
+            return None;
+        }
+        match &self.picture {
+            Some(p) => p.pixel_at((col, row), self.mouse_pixels),
+            None => (row + 1 < self.term.1).then_some((i32::from(col), 2 * i32::from(row))),
+        }
+    }
+
+    /// How far one aim step moves, in picture pixels (x, y): in cells mode two pixels each
+    /// way (two columns, one row: a square step), with real pixels one cell.
+    fn aim_step(&self) -> (i32, i32) {
+        match &self.picture {
+            Some(p) => {
+                let (x, y) = p.pixels_per_cell();
+                (x as i32, y as i32)
+            }
+            None => (2, 2),
+        }
     }
 
     fn handle(&mut self, input: Input) -> Result<Flow> {
@@ -428,8 +539,9 @@ impl Player {
                 self.act(Action::Stone { x, y, radius: self.radius, big: false });
             }
             Input::Aim(dx, dy) => {
-                self.aim.0 = (self.aim.0 + 2 * dx).clamp(0, w as i32 - 1);
-                self.aim.1 = (self.aim.1 + 2 * dy).clamp(0, (h as i32 - 1) & !1);
+                let (sx, sy) = self.aim_step();
+                self.aim.0 = (self.aim.0 + sx * dx).clamp(0, w as i32 - 1);
+                self.aim.1 = (self.aim.1 + sy * dy).clamp(0, (h as i32 - 1) & !1);
                 self.aim_until = Some(now + AIM_VISIBLE);
             }
             Input::DropAtAim => {
@@ -466,7 +578,13 @@ impl Player {
             Input::Release => self.drag = None,
             Input::Resize(cols, rows) => {
                 self.term = (cols, rows);
-                let size = picture_size(cols, rows);
+                let size = match &mut self.picture {
+                    Some(p) => {
+                        p.resize((cols, rows));
+                        p.layout().picture
+                    }
+                    None => picture_size(cols, rows),
+                };
                 if big_enough(self.term) && size != self.scene.size() {
                     self.apply(Event::Resize([size.0, size.1]));
                     self.aim = (self.aim.0.min(size.0 as i32 - 1), self.aim.1.min((size.1 as i32 - 1) & !1));
@@ -519,5 +637,21 @@ impl Player {
         }
         self.sim = SimClock::new(self.scene.steps_per_second(), Instant::now());
         Ok(())
+    }
+}
+
+/// Puts a picture's bytes into the frame's synchronized update (before its end marker), so the
+/// picture and the status line change together; a frame without markers gets them.
+fn splice_picture(frame: &mut Vec<u8>, picture: &[u8], sync: bool) {
+    if !sync {
+        frame.extend_from_slice(picture);
+    } else if frame.ends_with(SYNC_END) {
+        frame.truncate(frame.len() - SYNC_END.len());
+        frame.extend_from_slice(picture);
+        frame.extend_from_slice(SYNC_END);
+    } else {
+        frame.splice(0..0, SYNC_BEGIN.iter().copied());
+        frame.extend_from_slice(picture);
+        frame.extend_from_slice(SYNC_END);
     }
 }

@@ -162,6 +162,41 @@ pub struct PlayCommand {
     /// Record the session as JSON lines, for `tidepool render pool --replay FILE` (the pool only).
     #[arg(long, value_name = "FILE")]
     pub record: Option<PathBuf>,
+
+    /// How the picture is drawn: real pixels with the kitty graphics protocol, sixel or iTerm2
+    /// inline images, or half-block cells (two pixels a cell, any terminal). `auto` asks the
+    /// terminal what it can show (150 ms at most) and falls back to cells.
+    #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
+    pub graphics: GraphicsChoice,
+}
+
+/// `--graphics`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GraphicsChoice {
+    /// The best the terminal answers for: kitty, then sixel, then iTerm2, else cells.
+    Auto,
+    /// The kitty graphics protocol (kitty, WezTerm, Ghostty, Konsole).
+    Kitty,
+    /// DEC sixel (xterm -ti vt340, foot, mlterm, WezTerm, Windows Terminal).
+    Sixel,
+    /// iTerm2's inline images (iTerm2, WezTerm).
+    Iterm2,
+    /// Half-block text cells, as before real pixels.
+    Cells,
+}
+
+impl From<GraphicsChoice> for tidepool::player::probe::GraphicsRequest {
+    fn from(choice: GraphicsChoice) -> Self {
+        use tidepool::graphics::GraphicsMode;
+        use tidepool::player::probe::GraphicsRequest::{Auto, Force};
+        match choice {
+            GraphicsChoice::Auto => Auto,
+            GraphicsChoice::Kitty => Force(GraphicsMode::Kitty),
+            GraphicsChoice::Sixel => Force(GraphicsMode::Sixel),
+            GraphicsChoice::Iterm2 => Force(GraphicsMode::Iterm2),
+            GraphicsChoice::Cells => Force(GraphicsMode::Cells),
+        }
+    }
 }
 
 /// The player's default `--damping`.
