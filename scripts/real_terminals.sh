@@ -19,14 +19,17 @@
 # half-block cells at <= $TOLERANCE (two pixels a cell against the full picture: measured
 # 0.04-0.07; a missing or misplaced picture measures > 0.2).
 #
-# STATUS: the player (`tidepool play --graphics ...`) is not wired yet (issue 12 is reshaping
-# it; see INTEGRATION-graphics.md). Once it is, the same runs should start `tidepool play`
-# instead of the demo, press space with `xdotool key`, pause with `p`, save the player's own
-# screenshot with `s`, and compare that PNG with the screen the same way.
+# Then the player itself: `tidepool play --graphics auto` in kitty, in xterm, and inside tmux in
+# each (see `run_player` below): keys through xdotool (space, then `p` to pause and `s` for the
+# player's own screenshot), a screenshot of the screen, and the picture's region compared with
+# the player's PNG. Tolerances (normalized RMSE): kitty $EXACT (pixel for pixel when the
+# picture is not scaled), sixel $SIXEL_TOLERANCE (the fixed palette's ordered dither against
+# the exact picture), cells $TOLERANCE. PLAYER_ONLY=1 skips the demo runs.
 set -u
 OUT=${1:-target/real_terminals}
 TOLERANCE=${TOLERANCE:-0.08}
 EXACT=${EXACT:-0.01}
+SIXEL_TOLERANCE=${SIXEL_TOLERANCE:-0.06}
 mkdir -p "$OUT"
 OUT=$(cd "$OUT" && pwd)
 
@@ -39,7 +42,9 @@ if [ ${#need[@]} -gt 0 ]; then
     || { echo "cannot install ${need[*]}"; exit 2; }
 fi
 
-cargo build --example graphics_demo || exit 2
+if [ -z "${PLAYER_ONLY:-}" ]; then cargo build --example graphics_demo || exit 2; fi
+cargo build --release || exit 2
+TIDEPOOL=$(pwd)/target/release/tidepool
 # How long each demo shows its picture, in seconds.
 SECONDS_SHOWN=10
 # The player waits 150 ms for the terminal's answers. Terminals started under Xvfb with
@@ -115,10 +120,66 @@ S=$SECONDS_SHOWN
 # Inside tmux the demo starts a second late: tmux passes nothing through before its client has
 # attached to the new session (a player started from a running tmux pane never meets this).
 B="sleep 1; env GRAPHICS_DEMO_BUDGET_MS=$GRAPHICS_DEMO_BUDGET_MS"
+if [ -z "${PLAYER_ONLY:-}" ]; then
 run kitty "${KITTY[@]}" "$DEMO" auto "$OUT/kitty.txt" $S
 run kitty-direct "${KITTY[@]}" env SSH_TTY=/dev/pts/fake "$DEMO" auto "$OUT/kitty-direct.txt" $S
 run xterm "${XTERM[@]}" -e "$DEMO" auto "$OUT/xterm.txt" $S
 run kitty-tmux-on "${KITTY[@]}" tmux -L tp-on -f "$OUT/tmux-on.conf" new-session "$B $DEMO auto $OUT/kitty-tmux-on.txt $S"
 run kitty-tmux-off "${KITTY[@]}" tmux -L tp-off -f "$OUT/tmux-off.conf" new-session "$B $DEMO auto $OUT/kitty-tmux-off.txt $S"
 run xterm-tmux "${XTERM[@]}" -e tmux -L tp-x -f "$OUT/tmux-on.conf" new-session "$B $DEMO auto $OUT/xterm-tmux.txt $S"
+fi
+
+# The cell size each terminal reported to the probe (graphics_demo's reports, this setup):
+# where the picture's region starts and how many cells it covers.
+KITTY_CELL=${KITTY_CELL:-9x18}
+XTERM_CELL=${XTERM_CELL:-6x13}
+
+# run_player NAME CELLxSIZE X0 Y0 TERMINAL-COMMAND... : plays in the terminal; the terminal
+# command ends with the shell command to run (given as the last argument, run by `sh -c`).
+run_player() {
+  local name=$1 cell=$2 x0=$3 y0=$4; shift 4
+  local dir="$OUT/play-$name"
+  rm -rf "$dir"; mkdir -p "$dir"
+  # A second's wait first: terminals under Xvfb answer their first query late at window start
+  # (longer than the player's 150 ms), and then the player would rightly choose cells.
+  "$@" "sleep 1; cd $dir && exec $TIDEPOOL play pool --graphics auto --rain 0 --breeze 0 --seed 1 2>$dir/stderr.txt" &
+  local pid=$!
+  sleep 5
+  local win
+  win=$(xdotool search --sync --onlyvisible --pid "$pid" 2>/dev/null | head -1)
+  [ -z "$win" ] && win=$(xdotool search --onlyvisible --name '.' 2>/dev/null | tail -1)
+  xdotool windowfocus "$win" 2>/dev/null
+  for key in space space space; do xdotool key --window "$win" "$key"; sleep 0.3; done
+  sleep 1
+  xdotool key --window "$win" p; sleep 1
+  xdotool key --window "$win" s; sleep 2
+  import -window root "$OUT/play-$name-screen.png"
+  xdotool key --window "$win" q; sleep 1
+  kill "$pid" 2>/dev/null; wait "$pid" 2>/dev/null
+  local shot
+  shot=$(ls "$dir"/tidepool-pool-*.png 2>/dev/null | head -1)
+  if [ -z "$shot" ]; then
+    printf '%-18s no player screenshot (keys did not arrive?)\n' "play-$name" | tee -a "$OUT/summary.txt"
+    return
+  fi
+  local pw ph cw=${cell%x*} ch=${cell#*x}
+  read -r pw ph < <(identify -format '%w %h' "$shot")
+  # The region the picture covers on screen: its pixels one for one (sixel, kitty under the
+  # 1280x800 cap), else the cell area (cells: a half-block picture is one cell a pixel wide).
+  local sw=$pw sh=$ph
+  if [ "$pw" -lt 400 ]; then
+    sw=$(( pw * cw )); sh=$(( ph / 2 * ch ))
+  fi
+  convert "$OUT/play-$name-screen.png" -crop "${sw}x${sh}+${x0}+${y0}" +repage "$OUT/play-$name-region.png"
+  convert "$shot" -resize "${sw}x${sh}!" "$OUT/play-$name-expected.png"
+  local rmse
+  rmse=$(compare -metric RMSE "$OUT/play-$name-region.png" "$OUT/play-$name-expected.png" null: 2>&1 | sed -n 's/^[0-9.e+-]* (\([0-9.e+-]*\))$/\1/p')
+  printf '%-18s picture %sx%s region %sx%s+%s+%s  RMSE %s\n' "play-$name" "$pw" "$ph" "$sw" "$sh" "$x0" "$y0" "${rmse:-?}" \
+    | tee -a "$OUT/summary.txt"
+}
+kx=$(( (960 % ${KITTY_CELL%x*}) / 2 )); ky=$(( (640 % ${KITTY_CELL#*x}) / 2 ))
+run_player kitty "$KITTY_CELL" "$kx" "$ky" "${KITTY[@]}" sh -c
+run_player xterm "$XTERM_CELL" 3 3 "${XTERM[@]}" -e sh -c
+run_player kitty-tmux "$KITTY_CELL" "$kx" "$ky" "${KITTY[@]}" tmux -L tp-pon -f "$OUT/tmux-on.conf" new-session
+run_player xterm-tmux "$XTERM_CELL" 3 3 "${XTERM[@]}" -e tmux -L tp-px -f "$OUT/tmux-on.conf" new-session
 echo "screenshots and reports in $OUT"

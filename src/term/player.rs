@@ -193,6 +193,12 @@ pub fn run_probed(
     let support = support.unwrap_or_default();
     let picture = Picture::new(&choice, &support, term);
     let mouse_pixels = picture::pixel_mouse(&choice, &support);
+    if let Some(p) = &picture {
+        // Say which protocol draws, before any other greeting (the colour greeting is about
+        // cells, which then only draw the status line).
+        let (w, h) = p.layout().picture;
+        config.greeting = Some(format!("{} graphics, {w}x{h} pixels", choice.mode.name()));
+    }
     if let Some(hint) = choice.hint {
         // The hint says how to get pictures: it goes first, the colour greeting after it.
         config.greeting = Some(match config.greeting.take() {
@@ -394,7 +400,9 @@ impl Player {
                 help_was_open = help_open;
                 // Sixel and iTerm2 would paint over the help: the picture waits while it is open.
                 let paused_by_help = help_open && picture.text_erases_pixels();
-                if !paused_by_help && !bucket.in_debt() && big_enough(self.term) {
+                // The status line goes first: a picture only once the cells are all shown (on
+                // a limited link a picture is owed, and would otherwise starve the status line).
+                if !paused_by_help && report.pending == 0 && !bucket.in_debt() && big_enough(self.term) {
                     picture_bytes.clear();
                     picture.encode(&pixmap, &mut picture_bytes).map_err(Error::Output)?;
                     if !picture_bytes.is_empty() {
