@@ -7,5 +7,5 @@ pub use crate::term::player::{
 };
 pub use crate::term::player::{Probed, run_probed};
 pub use crate::term::screen::{FrameBuilder, Overlay};
-pub use crate::term::tty::{ENTER, RESTORE, play, restore, set_restore_prefix};
+pub use crate::term::tty::{ENTER, RESTORE, play, probe_for_picture, restore, set_restore_prefix};
 pub use crate::term::{probe, replies};

@@ -88,6 +88,36 @@ pub fn play(config: PlayerConfig) -> Result<()> {
     result
 }
 
+/// What a picture written once to this process's terminal (`render --out -`) is drawn with:
+/// the terminal is asked (raw mode for at most [`probe::PROBE_BUDGET`], then back to how it
+/// was) unless `request` is `cells` or standard input and output are not both terminals; then
+/// `auto` means cells. The file medium is not offered (the process may end before the terminal
+/// reads a file), nor pixel mouse reports.
+pub fn probe_for_picture(request: GraphicsRequest) -> (probe::GraphicsChoice, probe::GraphicsSupport) {
+    use std::io::IsTerminal;
+    let asks = request != GraphicsRequest::Force(GraphicsMode::Cells)
+        && probe::should_probe(io::stdin().is_terminal(), io::stdout().is_terminal());
+    let support = asks
+        .then(|| {
+            if OUT.get().is_none() {
+                let fd = io::stdout().as_fd().try_clone_to_owned().ok()?;
+                OUT.get_or_init(|| File::from(fd));
+            }
+            crossterm::terminal::enable_raw_mode().ok()?;
+            let probed = probe_terminal();
+            if probed.as_ref().is_ok_and(|p| !p.support.answered) {
+                drop_late_replies();
+            }
+            let _ = crossterm::terminal::disable_raw_mode();
+            let mut support = probed.ok()?.support;
+            support.kitty_temp_file = false;
+            support.sgr_pixels_mouse = false;
+            Some(support)
+        })
+        .flatten();
+    (probe::choose(request, support.as_ref()), support.unwrap_or_default())
+}
+
 /// Asks the terminal what it can show (see [`super::probe`]); the terminal is in raw mode.
 fn probe_terminal() -> io::Result<Probed> {
     let env = probe::Environment::current();

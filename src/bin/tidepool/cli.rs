@@ -368,6 +368,12 @@ pub struct OutputArgs {
     /// standard error, with throughput or triangle counts.
     #[arg(long)]
     pub stats: bool,
+
+    /// With --out - to a terminal: draw the picture in real pixels (kitty graphics, sixel,
+    /// iTerm2) or half-block cells. `auto` asks the terminal (150 ms at most); into a pipe or a
+    /// file it means cells and nothing is asked.
+    #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
+    pub graphics: GraphicsChoice,
 }
 
 /// Flags of the ripple pool, shared by `render pool` and the player.
