@@ -19,6 +19,14 @@ use crate::output::graphics::sixel::{SixelEncoder, SixelPalette};
 use crate::output::graphics::{GraphicsMode, push_rgb};
 use crate::term::probe::{DEFAULT_SIXEL_REGISTERS, GraphicsChoice, GraphicsSupport};
 
+/// The largest picture a scene renders at in a pixel mode, in pixels. The pool's simulation
+/// grid is its picture, and its breeze costs about 33 ns a cell a step (`tidepool render pool
+/// --breeze 1 --stats`): at the full 1280x752 of a 160x48 window, 60 steps a second would need
+/// two cores. Within this size the pool (simulation, picture, encoding) stays near half a core
+/// (`scripts/measure_graphics.py`); kitty and iTerm2 scale the picture up to the cell area
+/// themselves, sixel pictures are scaled up here.
+pub const SCENE_CAP: (u32, u32) = (480, 300);
+
 /// The kitty image's stacking order: under text glyphs, so the help overlay and the aim marker
 /// (text cells over the picture) stay readable.
 pub const KITTY_Z_INDEX: i32 = -1;
@@ -32,6 +40,10 @@ pub struct Picture {
     encoder: Encoder,
     /// The picture as RGB, reused from frame to frame.
     rgb: Vec<u8>,
+    /// The size the scene renders at: `layout.picture` within [`SCENE_CAP`].
+    scene: (u32, u32),
+    /// For sixel, the scene's picture scaled up to `layout.picture` (one pixel a pixel).
+    scaled: Option<Pixmap>,
 }
 
 #[derive(Debug)]
@@ -59,18 +71,34 @@ impl Picture {
             }
             GraphicsMode::Iterm2 => Encoder::Iterm2(Iterm2Encoder::new(layout.origin, layout.cells, choice.tmux_wrap)),
         };
-        Some(Picture { choice: choice.clone(), support: support.clone(), layout, encoder, rgb: Vec::new() })
+        let scene = fit(layout.picture, SCENE_CAP);
+        Some(Picture {
+            choice: choice.clone(),
+            support: support.clone(),
+            layout,
+            encoder,
+            rgb: Vec::new(),
+            scene,
+            scaled: None,
+        })
     }
 
     /// Where the picture goes and its size in pixels (the size the scene renders at).
+    #[cfg(test)]
     pub fn layout(&self) -> &Layout {
         &self.layout
+    }
+
+    /// The size the scene renders at (the picture within [`SCENE_CAP`]).
+    pub fn scene_size(&self) -> (u32, u32) {
+        self.scene
     }
 
     /// A new terminal size: a new layout, and the next picture is sent whole (the caller clears
     /// the screen in the same frame).
     pub fn resize(&mut self, term: (u16, u16)) {
         self.layout = layout_for(self.choice.mode, &self.support, term);
+        self.scene = fit(self.layout.picture, SCENE_CAP);
         match &mut self.encoder {
             Encoder::Kitty(k) => k.set_options(kitty_options(&self.choice, &self.support, &self.layout)),
             Encoder::Sixel(s) => {
@@ -99,6 +127,25 @@ impl Picture {
     /// Appends the bytes that show `pixmap` (nothing when the terminal already shows it).
     /// Fails only when kitty's temporary file cannot be written; then nothing is appended.
     pub fn encode(&mut self, pixmap: &Pixmap, out: &mut Vec<u8>) -> io::Result<()> {
+        let pixmap = match &self.encoder {
+            // Sixel is drawn one pixel a pixel: the scene's picture is scaled up to the area.
+            Encoder::Sixel(_) if (pixmap.width(), pixmap.height()) != self.layout.picture => {
+                let (w, h) = self.layout.picture;
+                let scaled = match self.scaled.take() {
+                    Some(p) if (p.width(), p.height()) == (w, h) => p,
+                    _ => Pixmap::new(w, h).ok_or_else(|| io::Error::other("cannot allocate the sixel picture"))?,
+                };
+                let scaled = self.scaled.insert(scaled);
+                let transform = tiny_skia::Transform::from_scale(
+                    w as f32 / pixmap.width() as f32,
+                    h as f32 / pixmap.height() as f32,
+                );
+                let paint = tiny_skia::PixmapPaint { quality: tiny_skia::FilterQuality::Bilinear, ..Default::default() };
+                scaled.draw_pixmap(0, 0, pixmap.as_ref(), &paint, transform, None);
+                &*scaled
+            }
+            _ => pixmap,
+        };
         let (w, h) = (pixmap.width(), pixmap.height());
         match &mut self.encoder {
             Encoder::Kitty(k) => {
@@ -122,12 +169,16 @@ impl Picture {
     /// terminal reports pixels (SGR-pixels mode), else a cell whose centre is taken.
     pub fn pixel_at(&self, (x, y): (u16, u16), pixels: bool) -> Option<(i32, i32)> {
         let p = if pixels { self.layout.pixel_at(u32::from(x), u32::from(y)) } else { self.layout.pixel_at_cell(x, y) };
-        p.map(|(x, y)| (x as i32, y as i32))
+        p.map(|(x, y)| {
+            let (sx, sy) = self.to_scene(x, y);
+            (sx as i32, sy as i32)
+        })
     }
 
     /// The cell over picture pixel (`x`, `y`), for the aim marker.
     pub fn cell_of(&self, x: u32, y: u32) -> (u32, u32) {
         let l = &self.layout;
+        let (x, y) = (scale(x, self.scene.0, l.picture.0), scale(y, self.scene.1, l.picture.1));
         let col = u64::from(x) * u64::from(l.cells.0) / u64::from(l.picture.0.max(1));
         let row = u64::from(y) * u64::from(l.cells.1) / u64::from(l.picture.1.max(1));
         (col as u32, row as u32)
@@ -136,8 +187,28 @@ impl Picture {
     /// Picture pixels per cell (columns, rows), at least 1: how far one aim step moves.
     pub fn pixels_per_cell(&self) -> (u32, u32) {
         let l = &self.layout;
-        ((l.picture.0 / u32::from(l.cells.0.max(1))).max(1), (l.picture.1 / u32::from(l.cells.1.max(1))).max(1))
+        ((self.scene.0 / u32::from(l.cells.0.max(1))).max(1), (self.scene.1 / u32::from(l.cells.1.max(1))).max(1))
     }
+
+    /// The scene pixel of picture pixel (`x`, `y`).
+    fn to_scene(&self, x: u32, y: u32) -> (u32, u32) {
+        let l = &self.layout;
+        (scale(x, l.picture.0, self.scene.0), scale(y, l.picture.1, self.scene.1))
+    }
+}
+
+/// `v` of a length `from` mapped onto a length `to`.
+fn scale(v: u32, from: u32, to: u32) -> u32 {
+    (u64::from(v) * u64::from(to) / u64::from(from.max(1))) as u32
+}
+
+/// `size` shrunk (aspect kept) to fit within `cap`, at least 1x1.
+fn fit(size: (u32, u32), cap: (u32, u32)) -> (u32, u32) {
+    let k = (f64::from(cap.0) / f64::from(size.0.max(1))).min(f64::from(cap.1) / f64::from(size.1.max(1))).min(1.0);
+    (((f64::from(size.0) * k).round() as u32).max(1), ((f64::from(size.1) * k).round() as u32).max(1))
+}
+
+impl Picture {
 }
 
 /// Whether mouse reports come in pixels: SGR-pixels mode (1016) is turned on when the terminal
@@ -214,6 +285,22 @@ mod tests {
         assert_eq!(out.len(), sent, "an unchanged picture sends nothing");
         let deleted = kitty_decode::decode(&restore_bytes(&choice(GraphicsMode::Kitty), false)).unwrap();
         assert!(deleted.images.is_empty() && deleted.commands[0][&'a'] == "d", "kitty's image is deleted on exit");
+    }
+
+    #[test]
+    fn big_pictures_render_within_the_scene_cap_and_sixel_scales_them_up() {
+        let support = GraphicsSupport { cell_px: Some((8, 16)), ..Default::default() };
+        let mut p = Picture::new(&choice(GraphicsMode::Sixel), &support, (160, 48)).unwrap();
+        assert_eq!((p.layout().picture, p.scene_size()), ((1280, 750), (480, 281)));
+        let mut pixmap = Pixmap::new(480, 281).unwrap();
+        pixmap.fill(tiny_skia::Color::from_rgba8(0, 0, 255, 255));
+        let mut out = Vec::new();
+        p.encode(&pixmap, &mut out).unwrap();
+        let raster: &[u8] = b"\"1;1;1280;750";
+        assert!(out.windows(raster.len()).any(|w| w == raster), "one pixel a screen pixel");
+        // The centre of cell (80, 23) is screen pixel (644, 376): scene pixel (241, 140).
+        assert_eq!(p.pixel_at((80, 23), false), Some((241, 140)));
+        assert_eq!(p.cell_of(241, 140), (80, 23));
     }
 
     #[test]

@@ -196,7 +196,7 @@ pub fn run_probed(
     if let Some(p) = &picture {
         // Say which protocol draws, before any other greeting (the colour greeting is about
         // cells, which then only draw the status line).
-        let (w, h) = p.layout().picture;
+        let (w, h) = p.scene_size();
         config.greeting = Some(format!("{} graphics, {w}x{h} pixels", choice.mode.name()));
     }
     if let Some(hint) = choice.hint {
@@ -207,7 +207,7 @@ pub fn run_probed(
         });
     }
     let (w, h) = match &picture {
-        Some(p) => p.layout().picture,
+        Some(p) => p.scene_size(),
         None => picture_size(term.0, term.1),
     };
     let first = config
@@ -589,7 +589,7 @@ impl Player {
                 let size = match &mut self.picture {
                     Some(p) => {
                         p.resize((cols, rows));
-                        p.layout().picture
+                        p.scene_size()
                     }
                     None => picture_size(cols, rows),
                 };

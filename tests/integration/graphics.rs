@@ -80,8 +80,9 @@ fn forced_kitty_frames_decode_into_the_scenes_picture() {
     let frames = &out[find(&out, ENTER).unwrap()..picture_restore_at(&out)];
     let state = kitty_decode::decode(frames).expect("the frames decode");
     let image = &state.images[&kitty::IMAGE_ID];
-    // 100x12 cells of the assumed 8x16 pixels, less the status row: 800x176, over 100x11 cells.
-    assert_eq!((image.width, image.height), (800, 176));
+    // 100x12 cells of the assumed 8x16 pixels, less the status row: 800x176 over 100x11 cells,
+    // rendered within the scene cap (480x300: 480x106) and scaled up by the terminal.
+    assert_eq!((image.width, image.height), (480, 106));
     assert_eq!((image.keys.get(&'c'), image.keys.get(&'r')), (Some(&"100".to_string()), Some(&"11".to_string())));
     let shot = std::fs::read_dir(&p.dir)
         .unwrap()
@@ -89,7 +90,7 @@ fn forced_kitty_frames_decode_into_the_scenes_picture() {
         .find(|e| e.file_name().to_string_lossy().ends_with(".png"))
         .expect("the `s` screenshot was saved");
     let shot = image::open(shot.path()).unwrap().to_rgb8();
-    assert_eq!((shot.width(), shot.height()), (800, 176), "the scene renders at the picture's size");
+    assert_eq!((shot.width(), shot.height()), (480, 106), "the scene renders at the picture's size");
     assert!(image.rgb == shot.into_raw(), "the last kitty frame is the scene's own picture, pixel for pixel");
     let s = p.screen();
     assert!(s.row_text(s.rows() - 1).contains("pool"), "the status line stays text on the last row");
