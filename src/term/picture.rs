@@ -140,7 +140,8 @@ impl Picture {
                     w as f32 / pixmap.width() as f32,
                     h as f32 / pixmap.height() as f32,
                 );
-                let paint = tiny_skia::PixmapPaint { quality: tiny_skia::FilterQuality::Bilinear, ..Default::default() };
+                let paint =
+                    tiny_skia::PixmapPaint { quality: tiny_skia::FilterQuality::Bilinear, ..Default::default() };
                 scaled.draw_pixmap(0, 0, pixmap.as_ref(), &paint, transform, None);
                 &*scaled
             }
@@ -208,8 +209,7 @@ fn fit(size: (u32, u32), cap: (u32, u32)) -> (u32, u32) {
     (((f64::from(size.0) * k).round() as u32).max(1), ((f64::from(size.1) * k).round() as u32).max(1))
 }
 
-impl Picture {
-}
+impl Picture {}
 
 /// Whether mouse reports come in pixels: SGR-pixels mode (1016) is turned on when the terminal
 /// has it (the probe never says so inside tmux) and the picture is in real pixels, where a
