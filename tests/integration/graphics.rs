@@ -165,3 +165,40 @@ fn cells_sends_no_query() {
     p.send(b"q");
     assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
 }
+
+#[test]
+fn render_to_a_kitty_terminal_draws_the_picture_as_one_image() {
+    let answers: &'static [u8] = KITTY_ANSWERS;
+    let dir = temp_dir("gfx-render");
+    let mut p = Player::spawn_answering(&dir, 100, 12, &["render", "pool", "--out", "-"], &[], move |n| {
+        (n == 0).then(|| answers.to_vec())
+    });
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+    let out = p.output();
+    let state = kitty_decode::decode(&out).expect("the picture decodes");
+    let image = &state.images[&kitty::IMAGE_ID];
+    // The cell area above the prompt's row: 100x11 cells of the assumed 8x16 pixels.
+    assert_eq!((image.width, image.height), (800, 176));
+    assert!(out.ends_with(b"\x1b[12;1H"), "the cursor is left on the last row for the prompt");
+    // The same picture as a PNG file.
+    let png = std::process::Command::new(env!("CARGO_BIN_EXE_tidepool"))
+        .current_dir(&dir)
+        .args(["render", "pool", "--size", "800x176", "--out", "same.png"])
+        .status()
+        .unwrap();
+    assert!(png.success());
+    let want = image::open(dir.join("same.png")).unwrap().to_rgb8().into_raw();
+    assert!(image.rgb == want, "the image is the scene's picture, pixel for pixel");
+}
+
+#[test]
+fn render_into_a_pipe_asks_nothing_and_writes_half_blocks() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_tidepool"))
+        .args(["render", "pool", "--out", "-", "--size", "30x20"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert_eq!(find(&out.stdout, APC_G), None, "no kitty query or image");
+    assert_eq!(find(&out.stdout, b"\x1b[c"), None, "no device attributes question");
+    assert!(String::from_utf8_lossy(&out.stdout).contains('▀'), "half-block text");
+}

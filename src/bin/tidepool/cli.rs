@@ -600,6 +600,15 @@ mod tests {
         assert_eq!((play.scene, play.fps, play.color, play.pool.rain), (PlayScene::Pool, 30, ColorChoice::Auto, None));
         assert_eq!(play.pool.damping.shift(), Some(6), "the player's own damping");
         assert_eq!(play.bandwidth, tidepool::player::Bandwidth::Auto);
+        assert_eq!(play.graphics, GraphicsChoice::Auto, "pictures in real pixels where the terminal answers");
+        for (flag, want) in
+            [("kitty", GraphicsChoice::Kitty), ("sixel", GraphicsChoice::Sixel), ("cells", GraphicsChoice::Cells)]
+        {
+            let cli = Cli::try_parse_from(["tidepool", "play", "--graphics", flag]).unwrap();
+            let Some(Command::Play(play)) = cli.command else { panic!("not play") };
+            assert_eq!(play.graphics, want);
+        }
+        assert!(Cli::try_parse_from(["tidepool", "play", "--graphics", "png"]).is_err());
         let cli = Cli::try_parse_from(["tidepool", "render", "pool"]).unwrap();
         let Some(Command::Render(RenderCommand { scene: RenderScene::Pool(pool) })) = cli.command else { panic!() };
         assert_eq!(pool.pool.damping, Damping::PAPERS);
