@@ -202,3 +202,19 @@ fn render_into_a_pipe_asks_nothing_and_writes_half_blocks() {
     assert_eq!(find(&out.stdout, b"\x1b[c"), None, "no device attributes question");
     assert!(String::from_utf8_lossy(&out.stdout).contains('▀'), "half-block text");
 }
+
+#[test]
+fn a_resize_resends_the_picture_for_the_new_cell_area() {
+    let mut p = spawn("gfx-resize", &["--graphics", "kitty"], Some(DA1_ANSWER));
+    let start = p.wait_for(b"c=100,r=11,", 0, WAIT);
+    p.master.resize(portable_pty::PtySize { rows: 10, cols: 80, pixel_width: 0, pixel_height: 0 }).unwrap();
+    (p.cols, p.rows) = (80, 10);
+    // 80x9 cells of 8x16: 640x144, within the scene cap 480x108, sent whole (a new image
+    // replaces the old one and its placement; every cell of the new size is repainted).
+    let at = p.wait_for(b"s=480,v=108,c=80,r=9,", start, WAIT);
+    p.wait_for(SYNC_END, at, WAIT);
+    let s = p.screen();
+    assert!(s.row_text(9).contains("pool"), "the status line on the new last row");
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+}
