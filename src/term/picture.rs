@@ -12,6 +12,8 @@ use std::io;
 
 use tiny_skia::Pixmap;
 
+use crate::output::bucket::ByteBucket;
+use crate::output::diff::{SYNC_BEGIN, SYNC_END};
 use crate::output::graphics::geometry::{self, Layout};
 use crate::output::graphics::iterm2::Iterm2Encoder;
 use crate::output::graphics::kitty::{self, KittyEncoder, KittyOptions, Medium};
@@ -44,6 +46,11 @@ pub struct Picture {
     scene: (u32, u32),
     /// For sixel, the scene's picture scaled up to `layout.picture` (one pixel a pixel).
     scaled: Option<Pixmap>,
+    /// This frame's picture bytes (reused).
+    bytes: Vec<u8>,
+    /// The help was open at the last frame (its text erases sixel and iTerm2 pixels, so the
+    /// picture is sent whole when it closes).
+    help_was_open: bool,
 }
 
 #[derive(Debug)]
@@ -80,6 +87,8 @@ impl Picture {
             rgb: Vec::new(),
             scene,
             scaled: None,
+            bytes: Vec::new(),
+            help_was_open: false,
         })
     }
 
@@ -195,6 +204,74 @@ impl Picture {
     fn to_scene(&self, x: u32, y: u32) -> (u32, u32) {
         let l = &self.layout;
         (scale(x, l.picture.0, self.scene.0), scale(y, l.picture.1, self.scene.1))
+    }
+}
+
+/// What the player's frame is like, for [`Picture::add_to_frame`].
+#[derive(Clone, Copy, Debug)]
+pub struct Frame {
+    /// The cell frame repaints the whole screen (the first frame, a resize).
+    pub resized: bool,
+    /// The help overlay is open.
+    pub help_open: bool,
+    /// Every cell (the status line) is shown as wanted after this frame's cells.
+    pub cells_shown: bool,
+    /// The terminal is big enough for the picture.
+    pub drawable: bool,
+    /// Frames are wrapped in synchronized output.
+    pub sync: bool,
+}
+
+impl Picture {
+    /// Adds the picture to the frame's `bytes` (inside its synchronized update) when it is due,
+    /// and says whether it did (then the terminal's cursor is somewhere unknown).
+    ///
+    /// The status line goes first: a picture is sent only once the cells are all shown, and
+    /// only while the bucket is not in debt. A picture cannot be cut to a budget: it is sent
+    /// whole and owed (see [`ByteBucket::owe`]), so the next one waits until the rate has paid
+    /// for it; on a limited link the picture rate drops, and nothing queues. Sixel and iTerm2
+    /// would paint over the help, so the picture waits while it is open.
+    pub fn add_to_frame(
+        &mut self,
+        pixmap: &Pixmap,
+        frame: &Frame,
+        bucket: &mut ByteBucket,
+        bytes: &mut Vec<u8>,
+    ) -> io::Result<bool> {
+        let erases = self.text_erases_pixels();
+        if frame.resized || (self.help_was_open && !frame.help_open && erases) {
+            self.invalidate();
+        }
+        self.help_was_open = frame.help_open;
+        if (frame.help_open && erases) || !frame.cells_shown || bucket.in_debt() || !frame.drawable {
+            return Ok(false);
+        }
+        let mut picture = std::mem::take(&mut self.bytes);
+        picture.clear();
+        let result = self.encode(pixmap, &mut picture);
+        let sent = result.is_ok() && !picture.is_empty();
+        if sent {
+            bucket.owe(picture.len());
+            splice_picture(bytes, &picture, frame.sync);
+        }
+        self.bytes = picture;
+        result.map(|()| sent)
+    }
+}
+
+/// Puts a picture's bytes into the frame's synchronized update (before its end marker), so the
+/// picture and the status line change together; a frame without markers gets them.
+fn splice_picture(frame: &mut Vec<u8>, picture: &[u8], sync: bool) {
+    if !sync {
+        frame.extend_from_slice(picture);
+    } else if frame.ends_with(SYNC_END) {
+        frame.truncate(frame.len() - SYNC_END.len());
+        frame.extend_from_slice(picture);
+        frame.extend_from_slice(SYNC_END);
+    } else {
+        frame.splice(0..0, SYNC_BEGIN.iter().copied());
+        frame.extend_from_slice(picture);
+        frame.extend_from_slice(SYNC_END);
     }
 }
 

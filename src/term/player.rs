@@ -28,7 +28,7 @@ use crate::error::{Error, Result};
 use crate::output::bucket::ByteBucket;
 use crate::output::color::ColorMode;
 use crate::output::cursor::Cursor;
-use crate::output::diff::{EncodeOptions, SYNC_BEGIN, SYNC_END, Shown};
+use crate::output::diff::{EncodeOptions, Shown};
 use crate::output::frame::Frame;
 use crate::output::rate::{RateEncoder, RateOptions, Target};
 use crate::replay::{FORMAT, Header, PoolOptions, Recorder};
@@ -295,10 +295,6 @@ impl Player {
         let mut builder = FrameBuilder::default();
         // A buffer kept back from a frame that had nothing to send, so it is not lost.
         let mut unused: Option<Vec<u8>> = None;
-        // The picture's bytes of this frame, and whether the help was open at the last frame
-        // (text over sixel or iTerm2 pixels erases them: the picture is resent when it closes).
-        let mut picture_bytes = Vec::new();
-        let mut help_was_open = false;
         let read_error = |source| Error::Terminal { action: "cannot read the terminal", source };
         'play: loop {
             if self.config.quit.load(Ordering::SeqCst) {
@@ -392,26 +388,15 @@ impl Player {
             let report = encoder.encode_into(&mut shown, target, bucket.budget(), options, &mut bytes);
             bucket.spend(report.bytes);
             if let Some(picture) = &mut self.picture {
-                let help_open = self.help.is_some();
-                if resized || (help_was_open && !help_open && picture.text_erases_pixels()) {
-                    // The screen was cleared, or the help's text erased sixel / iTerm2 pixels.
-                    picture.invalidate();
-                }
-                help_was_open = help_open;
-                // Sixel and iTerm2 would paint over the help: the picture waits while it is open.
-                let paused_by_help = help_open && picture.text_erases_pixels();
-                // The status line goes first: a picture only once the cells are all shown (on
-                // a limited link a picture is owed, and would otherwise starve the status line).
-                if !paused_by_help && report.pending == 0 && !bucket.in_debt() && big_enough(self.term) {
-                    picture_bytes.clear();
-                    picture.encode(&pixmap, &mut picture_bytes).map_err(Error::Output)?;
-                    if !picture_bytes.is_empty() {
-                        // A picture cannot be cut to the budget: it is sent whole and owed, so
-                        // the next one waits until the rate has paid for it (see bucket.rs).
-                        bucket.owe(picture_bytes.len());
-                        splice_picture(&mut bytes, &picture_bytes, options.sync);
-                        shown.cursor = Cursor::Unknown;
-                    }
+                let frame = picture::Frame {
+                    resized,
+                    help_open: self.help.is_some(),
+                    cells_shown: report.pending == 0,
+                    drawable: big_enough(self.term),
+                    sync: options.sync,
+                };
+                if picture.add_to_frame(&pixmap, &frame, &mut bucket, &mut bytes).map_err(Error::Output)? {
+                    shown.cursor = Cursor::Unknown;
                 }
             }
             if auto && report.bytes > 0 && link.probe_due() {
@@ -645,21 +630,5 @@ impl Player {
         }
         self.sim = SimClock::new(self.scene.steps_per_second(), Instant::now());
         Ok(())
-    }
-}
-
-/// Puts a picture's bytes into the frame's synchronized update (before its end marker), so the
-/// picture and the status line change together; a frame without markers gets them.
-fn splice_picture(frame: &mut Vec<u8>, picture: &[u8], sync: bool) {
-    if !sync {
-        frame.extend_from_slice(picture);
-    } else if frame.ends_with(SYNC_END) {
-        frame.truncate(frame.len() - SYNC_END.len());
-        frame.extend_from_slice(picture);
-        frame.extend_from_slice(SYNC_END);
-    } else {
-        frame.splice(0..0, SYNC_BEGIN.iter().copied());
-        frame.extend_from_slice(picture);
-        frame.extend_from_slice(SYNC_END);
     }
 }
