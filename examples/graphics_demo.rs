@@ -117,7 +117,7 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
         placeholders: choice.kitty_placeholders,
         frame_edits: support.kitty_frame_edits,
         medium: if support.kitty_temp_file { Medium::TempFile(kitty::temp_dir()) } else { Medium::Direct },
-        // Under text glyphs, as the player should place it (INTEGRATION-graphics.md).
+        // Under text glyphs, as the player places it (src/term/picture.rs).
         z_index: -1,
         ..KittyOptions::new(l.cells)
     });

@@ -19,14 +19,18 @@
 # half-block cells at <= $TOLERANCE (two pixels a cell against the full picture: measured
 # 0.04-0.07; a missing or misplaced picture measures > 0.2).
 #
-# STATUS: the player (`tidepool play --graphics ...`) is not wired yet (issue 12 is reshaping
-# it; see INTEGRATION-graphics.md). Once it is, the same runs should start `tidepool play`
-# instead of the demo, press space with `xdotool key`, pause with `p`, save the player's own
-# screenshot with `s`, and compare that PNG with the screen the same way.
+# Then the player itself: `tidepool play --graphics auto` in kitty, in xterm, and inside tmux in
+# each (see `run_player` below): keys through xdotool (space, then `p` to pause and `s` for the
+# player's own screenshot), a screenshot of the screen, and the picture's region compared with
+# the player's PNG, scaled to the region (the scene renders within 480x300 and the terminal,
+# or for sixel the player, scales it up, so nothing here is pixel for pixel). A run passes at
+# normalized RMSE <= $PLAYER_TOLERANCE (a missing or misplaced picture measures > 0.2).
+# PLAYER_ONLY=1 skips the demo runs.
 set -u
 OUT=${1:-target/real_terminals}
 TOLERANCE=${TOLERANCE:-0.08}
 EXACT=${EXACT:-0.01}
+PLAYER_TOLERANCE=${PLAYER_TOLERANCE:-0.12}
 mkdir -p "$OUT"
 OUT=$(cd "$OUT" && pwd)
 
@@ -39,7 +43,9 @@ if [ ${#need[@]} -gt 0 ]; then
     || { echo "cannot install ${need[*]}"; exit 2; }
 fi
 
-cargo build --example graphics_demo || exit 2
+if [ -z "${PLAYER_ONLY:-}" ]; then cargo build --example graphics_demo || exit 2; fi
+cargo build --release || exit 2
+TIDEPOOL=$(pwd)/target/release/tidepool
 # How long each demo shows its picture, in seconds.
 SECONDS_SHOWN=10
 # The player waits 150 ms for the terminal's answers. Terminals started under Xvfb with
@@ -115,10 +121,70 @@ S=$SECONDS_SHOWN
 # Inside tmux the demo starts a second late: tmux passes nothing through before its client has
 # attached to the new session (a player started from a running tmux pane never meets this).
 B="sleep 1; env GRAPHICS_DEMO_BUDGET_MS=$GRAPHICS_DEMO_BUDGET_MS"
+if [ -z "${PLAYER_ONLY:-}" ]; then
 run kitty "${KITTY[@]}" "$DEMO" auto "$OUT/kitty.txt" $S
 run kitty-direct "${KITTY[@]}" env SSH_TTY=/dev/pts/fake "$DEMO" auto "$OUT/kitty-direct.txt" $S
 run xterm "${XTERM[@]}" -e "$DEMO" auto "$OUT/xterm.txt" $S
 run kitty-tmux-on "${KITTY[@]}" tmux -L tp-on -f "$OUT/tmux-on.conf" new-session "$B $DEMO auto $OUT/kitty-tmux-on.txt $S"
 run kitty-tmux-off "${KITTY[@]}" tmux -L tp-off -f "$OUT/tmux-off.conf" new-session "$B $DEMO auto $OUT/kitty-tmux-off.txt $S"
 run xterm-tmux "${XTERM[@]}" -e tmux -L tp-x -f "$OUT/tmux-on.conf" new-session "$B $DEMO auto $OUT/xterm-tmux.txt $S"
+fi
+
+# The cell size each terminal reported to the probe (graphics_demo's reports, this setup):
+# where the picture's region starts and how many cells it covers.
+KITTY_CELL=${KITTY_CELL:-9x18}
+XTERM_CELL=${XTERM_CELL:-6x13}
+
+# run_player NAME WxH X0 Y0 TERMINAL-COMMAND... : plays in the terminal and compares the
+# screen's WxH region at (X0, Y0) (where the picture is shown: the cell area above the status
+# row; for sixel its whole 6-pixel bands) with the player's own screenshot scaled to it. The
+# terminal command ends with the shell command to run (the last argument, run by `sh -c`).
+run_player() {
+  local name=$1 region=$2 x0=$3 y0=$4; shift 4
+  local dir="$OUT/play-$name"
+  rm -rf "$dir"; mkdir -p "$dir"
+  # A second's wait first: terminals under Xvfb answer their first query late at window start
+  # (longer than the player's 150 ms), and then the player would rightly choose cells.
+  "$@" "sleep 1; cd $dir && exec $TIDEPOOL play pool --graphics auto --rain 0 --breeze 0 --seed 1 2>$dir/stderr.txt" &
+  local pid=$!
+  sleep 5
+  local win
+  win=$(xdotool search --sync --onlyvisible --pid "$pid" 2>/dev/null | head -1)
+  [ -z "$win" ] && win=$(xdotool search --onlyvisible --name '.' 2>/dev/null | tail -1)
+  xdotool windowfocus "$win" 2>/dev/null
+  for key in space space space; do xdotool key --window "$win" "$key"; sleep 0.3; done
+  sleep 1
+  xdotool key --window "$win" p; sleep 1
+  xdotool key --window "$win" s; sleep 2
+  import -window root "$OUT/play-$name-screen.png"
+  xdotool key --window "$win" q; sleep 1
+  kill "$pid" 2>/dev/null; wait "$pid" 2>/dev/null
+  local shot
+  shot=$(ls "$dir"/tidepool-pool-*.png 2>/dev/null | head -1)
+  if [ -z "$shot" ]; then
+    printf '%-18s no player screenshot (keys did not arrive?)\n' "play-$name" | tee -a "$OUT/summary.txt"
+    return
+  fi
+  local pw ph sw=${region%x*} sh=${region#*x}
+  read -r pw ph < <(identify -format '%w %h' "$shot")
+  convert "$OUT/play-$name-screen.png" -crop "${sw}x${sh}+${x0}+${y0}" +repage "$OUT/play-$name-region.png"
+  convert "$shot" -resize "${sw}x${sh}!" "$OUT/play-$name-expected.png"
+  local rmse
+  rmse=$(compare -metric RMSE "$OUT/play-$name-region.png" "$OUT/play-$name-expected.png" null: 2>&1 | sed -n 's/^[0-9.e+-]* (\([0-9.e+-]*\))$/\1/p')
+  local verdict=FAIL
+  if [ -n "$rmse" ] && awk -v r="$rmse" -v t="$PLAYER_TOLERANCE" 'BEGIN{exit !(r <= t)}'; then verdict=ok; fi
+  printf '%-18s picture %sx%s region %sx%s+%s+%s  RMSE %s  %s\n' "play-$name" "$pw" "$ph" "$sw" "$sh" "$x0" "$y0" "${rmse:-?}" "$verdict" \
+    | tee -a "$OUT/summary.txt"
+}
+kcw=${KITTY_CELL%x*} kch=${KITTY_CELL#*x} xcw=${XTERM_CELL%x*} xch=${XTERM_CELL#*x}
+kx=$(( (960 % kcw) / 2 )); ky=$(( (640 % kch) / 2 ))
+# kitty's 960x640 window: every row but the last; xterm's 120x40 cells: 39 rows, for sixel in
+# whole 6-pixel bands.
+KITTY_AREA=$(( 960 / kcw * kcw ))x$(( (640 / kch - 1) * kch ))
+XTERM_AREA=$(( 120 * xcw ))x$(( 39 * xch ))
+XTERM_SIXEL=$(( 120 * xcw ))x$(( 39 * xch / 6 * 6 ))
+run_player kitty "$KITTY_AREA" "$kx" "$ky" "${KITTY[@]}" sh -c
+run_player xterm "$XTERM_SIXEL" 3 3 "${XTERM[@]}" -e sh -c
+run_player kitty-tmux "$KITTY_AREA" "$kx" "$ky" "${KITTY[@]}" tmux -L tp-pon -f "$OUT/tmux-on.conf" new-session
+run_player xterm-tmux "$XTERM_AREA" 3 3 "${XTERM[@]}" -e tmux -L tp-px -f "$OUT/tmux-on.conf" new-session
 echo "screenshots and reports in $OUT"

@@ -10,6 +10,7 @@ pub use crate::term::pacing::SimClock;
 pub use crate::term::player::{
     Bandwidth, DEFAULT_STONE_RADIUS, PlayerConfig, STONE_RADII, TEST_PANIC_VAR, TerminalInput, picture_size, run,
 };
+pub use crate::term::player::{Probed, run_probed};
 pub use crate::term::screen::{FrameBuilder, Overlay, SceneInfo, big_enough};
-pub use crate::term::tty::{ENTER, RESTORE, play, restore};
+pub use crate::term::tty::{ENTER, RESTORE, play, probe_for_picture, restore, set_restore_prefix};
 pub use crate::term::{probe, replies};

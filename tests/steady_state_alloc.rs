@@ -135,6 +135,7 @@ fn player_frames(scene: SceneSpec) -> usize {
         storage: None,
         greeting: Some("a greeting in the status line".into()),
         quit: Arc::clone(&quit),
+        graphics: tidepool::player::probe::GraphicsRequest::Auto,
     };
     let output = FrameCounter { frames: 0, marks: Arc::clone(&marks), quit };
     tidepool::player::run(&mut FakeTerminal { keys: Some(b"?l") }, output, config).unwrap();

@@ -16,6 +16,8 @@ pub const MAX_BURST: Duration = Duration::from_millis(100);
 /// The smallest capacity, in bytes: room for the costliest cell (a jump, both truecolor codes
 /// and a glyph, about 50 bytes), the screen clear and the synchronized-output markers.
 pub const MIN_CAPACITY: f64 = 256.0;
+/// The most debt a picture frame may leave (see [`ByteBucket::owe`]), in time at the rate.
+pub const MAX_DEBT: Duration = Duration::from_secs(10);
 
 /// A byte bucket refilled at a fixed rate, or an unlimited one.
 #[derive(Clone, Debug)]
@@ -85,9 +87,24 @@ impl ByteBucket {
         }
     }
 
-    /// Empties the bucket (for example when the link is found congested).
+    /// Takes the bytes of a frame bigger than the budget (a picture in real pixels, which
+    /// cannot be cut to fit): the bucket goes into debt, and its budget stays 0 until the rate
+    /// has repaid it. So such frames come as often as the rate allows, and never queue.
+    pub fn owe(&mut self, bytes: usize) {
+        if let Some(rate) = self.rate {
+            // At most ten seconds of debt: a huge picture on a slow link still shows now and then.
+            self.level = (self.level - bytes as f64).max(-rate * MAX_DEBT.as_secs_f64());
+        }
+    }
+
+    /// Whether the bucket is in debt (see [`ByteBucket::owe`]).
+    pub fn in_debt(&self) -> bool {
+        self.rate.is_some() && self.level < 0.0
+    }
+
+    /// Empties the bucket (for example when the link is found congested); a debt stays.
     pub fn drain(&mut self) {
-        self.level = 0.0;
+        self.level = self.level.min(0.0);
     }
 }
 
@@ -136,6 +153,26 @@ mod tests {
         bucket.refill(start - Duration::from_secs(1));
         bucket.refill(start + Duration::from_millis(100));
         assert_eq!(bucket.budget(), 100);
+    }
+
+    #[test]
+    fn a_picture_bigger_than_the_budget_is_owed_and_repaid_before_the_next() {
+        let t0 = Instant::now();
+        let mut b = ByteBucket::new(10_000.0);
+        b.refill(t0);
+        b.owe(5_000);
+        assert!(b.in_debt());
+        b.refill(t0 + Duration::from_millis(400));
+        assert_eq!(b.budget(), 0, "4 000 of 5 000 bytes repaid: still nothing to spend");
+        b.refill(t0 + Duration::from_millis(600));
+        assert!(!b.in_debt());
+        assert_eq!(b.budget(), 1_000);
+        b.owe(10_000_000);
+        b.refill(t0 + Duration::from_millis(600) + MAX_DEBT);
+        assert!(!b.in_debt(), "the debt is capped at {MAX_DEBT:?} of the rate");
+        let mut free = ByteBucket::unlimited();
+        free.owe(1 << 30);
+        assert!(!free.in_debt());
     }
 
     #[test]

@@ -49,7 +49,8 @@ enum Parse {
     Ground,
     Escape,
     Csi(Vec<u8>),
-    /// OSC or DCS string, skipped until ST or BEL.
+    /// OSC, DCS, APC, SOS or PM string (a sixel picture, a kitty graphics command), skipped
+    /// until ST or BEL.
     Text {
         seen_esc: bool,
     },
@@ -155,7 +156,7 @@ impl Screen {
             Parse::Ground => self.ground(b),
             Parse::Escape => match b {
                 b'[' => self.state = Parse::Csi(Vec::new()),
-                b']' | b'P' => self.state = Parse::Text { seen_esc: false },
+                b']' | b'P' | b'_' | b'X' | b'^' => self.state = Parse::Text { seen_esc: false },
                 b'c' => *self = Screen { lf_returns: self.lf_returns, ..Screen::new(self.cols, self.rows) },
                 _ => {} // ESC 7 / ESC 8 / charset selection: not used by tidepool
             },

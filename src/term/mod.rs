@@ -6,6 +6,7 @@
 pub mod input;
 pub mod link;
 pub mod pacing;
+pub mod picture;
 pub mod player;
 pub mod probe;
 pub mod replies;

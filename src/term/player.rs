@@ -19,12 +19,15 @@ use tiny_skia::Pixmap;
 use super::input::{Input, InputParser, coalesce};
 use super::link::{self, Change, LinkControl};
 use super::pacing::{FramePacer, Meter, SimClock};
+use super::picture::{self, Picture};
+use super::probe::{self, GraphicsRequest, GraphicsSupport};
 use super::screen::{FrameBuilder, Overlay, big_enough};
 use super::ui;
 use super::writer::FrameWriter;
 use crate::error::{Error, Result};
 use crate::output::bucket::ByteBucket;
 use crate::output::color::ColorMode;
+use crate::output::cursor::Cursor;
 use crate::output::diff::{EncodeOptions, Shown};
 use crate::output::frame::Frame;
 use crate::output::rate::{RateEncoder, RateOptions, Target};
@@ -101,6 +104,20 @@ pub struct PlayerConfig {
     pub greeting: Option<String>,
     /// Set from outside (a signal handler) to end the session as if the user quit.
     pub quit: Arc<AtomicBool>,
+    /// How the picture is drawn (`--graphics`): `Force(Cells)` is the half-block picture.
+    /// Without a probe (see [`run_probed`]) `Auto` means cells and a forced mode is used as
+    /// asked.
+    pub graphics: GraphicsRequest,
+}
+
+/// What the terminal answered to the graphics probe (`term/probe.rs`) before the player started.
+#[derive(Clone, Debug, Default)]
+pub struct Probed {
+    /// What it can show.
+    pub support: GraphicsSupport,
+    /// Bytes that arrived during the probe and were not answers (keys typed meanwhile): the
+    /// player reads them first, so they are not lost.
+    pub leftover: Vec<u8>,
 }
 
 impl std::fmt::Debug for PlayerConfig {
@@ -110,6 +127,7 @@ impl std::fmt::Debug for PlayerConfig {
             .field("fps", &self.fps)
             .field("bandwidth", &self.bandwidth)
             .field("color", &self.color)
+            .field("graphics", &self.graphics)
             .finish_non_exhaustive()
     }
 }
@@ -142,17 +160,56 @@ struct Player {
     drag: Option<(i32, i32)>,
     radius: u32,
     rng: ChaCha8Rng,
+    /// The picture in real pixels; `None` in cells mode.
+    picture: Option<Picture>,
+    /// Mouse reports are in pixels (SGR-pixels mode 1016 is on).
+    mouse_pixels: bool,
+    /// Input that arrived before the loop started (during the probe).
+    leftover: Vec<u8>,
 }
 
 /// Runs the player until the user quits (or the input closes, or `config.quit` is set),
-/// reading `input` and writing frames to `output`.
+/// reading `input` and writing frames to `output`. No probe was made: `--graphics auto` means
+/// cells.
 pub fn run(
     input: &mut dyn TerminalInput,
     output: impl std::io::Write + Send + 'static,
     config: PlayerConfig,
 ) -> Result<()> {
+    run_probed(input, output, config, None)
+}
+
+/// [`run`], after the terminal answered the graphics probe: the mode is chosen from its
+/// answers, and the bytes read during the probe are the first input.
+pub fn run_probed(
+    input: &mut dyn TerminalInput,
+    output: impl std::io::Write + Send + 'static,
+    mut config: PlayerConfig,
+    probed: Option<Probed>,
+) -> Result<()> {
     let term = input.size().map_err(|source| Error::Terminal { action: "cannot read the terminal size", source })?;
-    let (w, h) = picture_size(term.0, term.1);
+    let (support, leftover) = probed.map_or((None, Vec::new()), |p| (Some(p.support), p.leftover));
+    let choice = probe::choose(config.graphics, support.as_ref());
+    let support = support.unwrap_or_default();
+    let picture = Picture::new(&choice, &support, term);
+    let mouse_pixels = picture::pixel_mouse(&choice, &support);
+    if let Some(p) = &picture {
+        // Say which protocol draws, before any other greeting (the colour greeting is about
+        // cells, which then only draw the status line).
+        let (w, h) = p.scene_size();
+        config.greeting = Some(format!("{} graphics, {w}x{h} pixels", choice.mode.name()));
+    }
+    if let Some(hint) = choice.hint {
+        // The hint says how to get pictures: it goes first, the colour greeting after it.
+        config.greeting = Some(match config.greeting.take() {
+            Some(g) => format!("{hint}; {g}"),
+            None => hint.to_owned(),
+        });
+    }
+    let (w, h) = match &picture {
+        Some(p) => p.scene_size(),
+        None => picture_size(term.0, term.1),
+    };
     let first = config
         .scenes
         .first()
@@ -195,6 +252,9 @@ pub fn run(
         message,
         drag: None,
         radius: DEFAULT_STONE_RADIUS,
+        picture,
+        mouse_pixels,
+        leftover,
     };
     // The loop runs on a rayon worker: the parallel parts of a frame (simulation bands,
     // picture rows) then go to the worker's own queue instead of rayon's global injector,
@@ -253,6 +313,8 @@ impl Player {
                 timeout = timeout.min(Duration::from_millis(1));
             }
             bytes_in.clear();
+            bytes_in.append(&mut self.leftover);
+            let timeout = if bytes_in.is_empty() { timeout } else { Duration::ZERO };
             if !input.read(&mut bytes_in, timeout).map_err(read_error)? {
                 return Ok(());
             }
@@ -336,9 +398,22 @@ impl Player {
             let mut bytes = unused.take().unwrap_or_else(|| writer.buffer());
             // On an auto link the unanswered bytes are capped too (see `link`: the first seconds).
             let budget = if auto { bucket.budget().min(link.window_left(now, bytes_sent)) } else { bucket.budget() };
+            let resized = shown.frame.is_none();
             let report = encoder.encode_into(&mut shown, target, budget, options, &mut bytes);
             bucket.spend(report.bytes);
-            if auto && link.probe_due() && (report.bytes > 0 || link.unasked(bytes_sent)) {
+            if let Some(picture) = &mut self.picture {
+                let frame = picture::Frame {
+                    resized,
+                    help_open: self.help.is_some(),
+                    cells_shown: report.pending == 0,
+                    drawable: big_enough(self.term),
+                    sync: options.sync,
+                };
+                if picture.add_to_frame(&pixmap, &frame, &mut bucket, &mut bytes).map_err(Error::Output)? {
+                    shown.cursor = Cursor::Unknown;
+                }
+            }
+            if auto && link.probe_due() && (!bytes.is_empty() || link.unasked(bytes_sent)) {
                 // The question goes after the frame: its answer says the frame has arrived.
                 bytes.extend_from_slice(link::PROBE);
                 link.probed(now, bytes_sent + bytes.len() as u64);
@@ -389,7 +464,15 @@ impl Player {
         now: Instant,
     ) -> &'b Frame {
         let overlay = Overlay {
-            aim: self.aim_until.is_some_and(|t| now < t).then_some((self.aim.0 as u32, self.aim.1 as u32)),
+            aim: self.aim_until.is_some_and(|t| now < t).then(|| {
+                let (x, y) = (self.aim.0 as u32, self.aim.1 as u32);
+                // The marker is a text cell: with real pixels, the cell over the aimed pixel
+                // (in the cell frame's coordinates, two pixel rows a cell).
+                self.picture.as_ref().map_or((x, y), |p| {
+                    let (col, row) = p.cell_of(x, y);
+                    (col, 2 * row)
+                })
+            }),
             help: self.help.as_deref(),
             message: self.message.as_ref().filter(|(_, until)| now < *until).map(|(m, _)| m.as_str()),
             fps: meter.fps,
@@ -397,6 +480,7 @@ impl Player {
             bandwidth: bandwidth.map(|b| b as u64),
             stone: self.radius,
             paused: self.sim.paused(),
+            pixels_elsewhere: self.picture.is_some(),
         };
         builder.build(self.term, self.scene.as_mut(), pixmap, self.config.color, &overlay)
     }
@@ -419,9 +503,29 @@ impl Player {
         self.message = Some((message, Instant::now() + MESSAGE_VISIBLE));
     }
 
-    /// The picture pixel under terminal cell (col, row): its upper half.
+    /// The picture pixel under a mouse report at (col, row): in cells mode the cell's upper
+    /// half; with real pixels the pixel under the cell's centre, or with SGR-pixels reports
+    /// (then `col`, `row` are screen pixels) the pixel under the pointer.
     fn pixel_at(&self, col: u16, row: u16) -> Option<(i32, i32)> {
-        (big_enough(self.term) && row + 1 < self.term.1).then_some((i32::from(col), 2 * i32::from(row)))
+        if !big_enough(self.term) {
+            return None;
+        }
+        match &self.picture {
+            Some(p) => p.pixel_at((col, row), self.mouse_pixels),
+            None => (row + 1 < self.term.1).then_some((i32::from(col), 2 * i32::from(row))),
+        }
+    }
+
+    /// How far one aim step moves, in picture pixels (x, y): in cells mode two pixels each
+    /// way (two columns, one row: a square step), with real pixels one cell.
+    fn aim_step(&self) -> (i32, i32) {
+        match &self.picture {
+            Some(p) => {
+                let (x, y) = p.pixels_per_cell();
+                (x as i32, y as i32)
+            }
+            None => (2, 2),
+        }
     }
 
     fn handle(&mut self, input: Input) -> Result<Flow> {
@@ -442,8 +546,9 @@ impl Player {
                 self.act(Action::Stone { x, y, radius: self.radius, big: false });
             }
             Input::Aim(dx, dy) => {
-                self.aim.0 = (self.aim.0 + 2 * dx).clamp(0, w as i32 - 1);
-                self.aim.1 = (self.aim.1 + 2 * dy).clamp(0, (h as i32 - 1) & !1);
+                let (sx, sy) = self.aim_step();
+                self.aim.0 = (self.aim.0 + sx * dx).clamp(0, w as i32 - 1);
+                self.aim.1 = (self.aim.1 + sy * dy).clamp(0, (h as i32 - 1) & !1);
                 self.aim_until = Some(now + AIM_VISIBLE);
             }
             Input::DropAtAim => {
@@ -480,7 +585,13 @@ impl Player {
             Input::Release => self.drag = None,
             Input::Resize(cols, rows) => {
                 self.term = (cols, rows);
-                let size = picture_size(cols, rows);
+                let size = match &mut self.picture {
+                    Some(p) => {
+                        p.resize((cols, rows));
+                        p.scene_size()
+                    }
+                    None => picture_size(cols, rows),
+                };
                 if big_enough(self.term) && size != self.scene.size() {
                     self.apply(Event::Resize([size.0, size.1]));
                     self.aim = (self.aim.0.min(size.0 as i32 - 1), self.aim.1.min((size.1 as i32 - 1) & !1));

@@ -29,6 +29,9 @@ pub struct Overlay<'a> {
     pub stone: u32,
     /// Whether the simulation is paused.
     pub paused: bool,
+    /// The picture goes to the terminal in real pixels (kitty, sixel, iTerm2), not in these
+    /// cells: the scene is still rendered, but its rows stay blank cells under it.
+    pub pixels_elsewhere: bool,
 }
 
 /// Bytes reserved for the formatted byte rate.
@@ -114,7 +117,9 @@ impl FrameBuilder {
             ui::too_small(&mut self.frame);
             return &self.frame;
         }
-        self.frame.draw_pixels(pixmap, color);
+        if !overlay.pixels_elsewhere {
+            self.frame.draw_pixels(pixmap, color);
+        }
         if let Some((x, y)) = overlay.aim {
             ui::aim_marker(&mut self.frame, x, y);
         }

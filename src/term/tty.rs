@@ -9,6 +9,13 @@
 //! - [`restore`], which a program calls from its signal handler (the `tidepool` binary does for
 //!   SIGINT, SIGTERM and SIGHUP: the SSH link dropped).
 //!
+//! With `--graphics` other than `cells`, the terminal is first asked what it can show
+//! ([`super::probe`]): in raw mode, before the alternate screen and mouse reporting (a mouse
+//! report during the probe would look like a garbled answer), with the replies read here with a
+//! deadline, so nothing is left blocked on the terminal for the player's own reader. What the
+//! picture needs undone on exit (kitty's image, pixel mouse reports) is written before
+//! [`RESTORE`] on every path, by [`set_restore_prefix`].
+//!
 //! The restore runs at most once. Frames and the restore go through one lock, so the restore
 //! never lands in the middle of a frame; it also starts with CAN (0x18), which aborts an escape
 //! sequence a failed write may have cut in half. Frames are written to a duplicate of stdout's
@@ -22,8 +29,11 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard, Once, OnceLock};
 use std::time::{Duration, Instant};
 
-use super::player::{self, PlayerConfig, TerminalInput};
+use super::picture;
+use super::player::{self, PlayerConfig, Probed, TerminalInput};
+use super::probe::{self, GraphicsRequest, ProbeOptions};
 use crate::error::{Error, Result};
+use crate::output::graphics::{GraphicsMode, kitty};
 
 /// Sent when the player starts: alternate screen, hidden cursor, mouse reporting (buttons and
 /// drags only, mode 1002, not every motion; SGR coordinates, mode 1006), screen cleared.
@@ -37,18 +47,135 @@ static ACTIVE: AtomicBool = AtomicBool::new(false);
 static WRITE_LOCK: Mutex<()> = Mutex::new(());
 static OUT: OnceLock<File> = OnceLock::new();
 static PANIC_HOOK: Once = Once::new();
+/// Written before [`RESTORE`]: what the picture needs undone (see [`set_restore_prefix`]).
+static RESTORE_PREFIX: Mutex<Vec<u8>> = Mutex::new(Vec::new());
+
+/// After a probe the terminal did not answer in time, how long the player waits on exit for
+/// answers still on their way, and drops them, so that none reach the shell as typed text.
+pub const LATE_REPLY_GRACE: Duration = Duration::from_millis(50);
+/// The temporary file of the probe's kitty file-medium query (a number the encoder never
+/// reaches, so the names never collide).
+const PROBE_FILE_NUMBER: u64 = u64::MAX;
 
 /// Plays in this process's terminal (standard input and output) until the user quits; the
 /// terminal is restored on every way out. Standard output must be a terminal.
+///
+/// Unless `config.graphics` is `cells`, the terminal is probed first (at most
+/// [`probe::PROBE_BUDGET`]; only when standard input and output are both terminals, else no
+/// query is sent and `auto` means cells).
 pub fn play(config: PlayerConfig) -> Result<()> {
+    use std::io::IsTerminal;
+    let setup = |source| Error::Terminal { action: "cannot set up the terminal", source };
     let size = crossterm::terminal::size()
         .map_err(|source| Error::Terminal { action: "cannot read the terminal size", source })?;
-    let guard =
-        TerminalGuard::enter().map_err(|source| Error::Terminal { action: "cannot set up the terminal", source })?;
+    let wants_probe = config.graphics != GraphicsRequest::Force(GraphicsMode::Cells)
+        && probe::should_probe(io::stdin().is_terminal(), io::stdout().is_terminal());
+    let guard = TerminalGuard::raw().map_err(setup)?;
+    let probed = if wants_probe { Some(probe_terminal().map_err(setup)?) } else { None };
+    let choice = probe::choose(config.graphics, probed.as_ref().map(|p| &p.support));
+    let pixel_mouse = probed.as_ref().is_some_and(|p| picture::pixel_mouse(&choice, &p.support));
+    set_restore_prefix(picture::restore_bytes(&choice, pixel_mouse));
+    guard.enter_screen(if pixel_mouse { picture::PIXEL_MOUSE_ON } else { b"" }).map_err(setup)?;
+    let unanswered = probed.as_ref().is_some_and(|p| !p.support.answered);
     let mut input = Stdin { size };
-    let result = player::run(&mut input, TtyOut, config);
+    let result = player::run_probed(&mut input, TtyOut, config, probed);
+    if unanswered {
+        drop_late_replies();
+    }
     drop(guard);
+    set_restore_prefix(Vec::new());
+    remove_temp_files();
     result
+}
+
+/// What a picture written once to this process's terminal (`render --out -`) is drawn with:
+/// the terminal is asked (raw mode for at most [`probe::PROBE_BUDGET`], then back to how it
+/// was) unless `request` is `cells` or standard input and output are not both terminals; then
+/// `auto` means cells. The file medium is not offered (the process may end before the terminal
+/// reads a file), nor pixel mouse reports.
+pub fn probe_for_picture(request: GraphicsRequest) -> (probe::GraphicsChoice, probe::GraphicsSupport) {
+    use std::io::IsTerminal;
+    let asks = request != GraphicsRequest::Force(GraphicsMode::Cells)
+        && probe::should_probe(io::stdin().is_terminal(), io::stdout().is_terminal());
+    let support = asks
+        .then(|| {
+            if OUT.get().is_none() {
+                let fd = io::stdout().as_fd().try_clone_to_owned().ok()?;
+                OUT.get_or_init(|| File::from(fd));
+            }
+            crossterm::terminal::enable_raw_mode().ok()?;
+            let probed = probe_terminal();
+            if probed.as_ref().is_ok_and(|p| !p.support.answered) {
+                drop_late_replies();
+            }
+            let _ = crossterm::terminal::disable_raw_mode();
+            let mut support = probed.ok()?.support;
+            support.kitty_temp_file = false;
+            support.sgr_pixels_mouse = false;
+            Some(support)
+        })
+        .flatten();
+    (probe::choose(request, support.as_ref()), support.unwrap_or_default())
+}
+
+/// Asks the terminal what it can show (see [`super::probe`]); the terminal is in raw mode.
+fn probe_terminal() -> io::Result<Probed> {
+    let env = probe::Environment::current();
+    let winsize = probe::WinSize::current()?;
+    let kitty_file =
+        if env.ssh { None } else { kitty::write_temp_file(&kitty::temp_dir(), PROBE_FILE_NUMBER, &[0, 0, 0]).ok() };
+    let options = ProbeOptions { env, winsize, kitty_file: kitty_file.clone() };
+    let stdin = io::stdin();
+    let mut read = |buf: &mut [u8], deadline: Instant| probe::read_fd_with_deadline(stdin.as_fd(), buf, deadline);
+    let mut write = |bytes: &[u8]| {
+        let _lock = lock();
+        match OUT.get() {
+            Some(mut out) => out.write_all(bytes),
+            None => Ok(()),
+        }
+    };
+    let mut outcome = probe::run_probe(&options, &mut write, &mut read, &Instant::now, probe::PROBE_BUDGET)?;
+    if let Some(path) = &kitty_file
+        && path.exists()
+    {
+        // The terminal did not read (and delete) the file: the file medium does not work.
+        outcome.support.kitty_temp_file = false;
+        let _ = std::fs::remove_file(path);
+    }
+    Ok(Probed { support: outcome.support, leftover: outcome.leftover })
+}
+
+/// Reads and drops what arrives within [`LATE_REPLY_GRACE`]: the answers of a probe that timed
+/// out, which would otherwise reach the shell.
+fn drop_late_replies() {
+    let deadline = Instant::now() + LATE_REPLY_GRACE;
+    let mut buf = [0u8; 4096];
+    while Instant::now() < deadline {
+        if !matches!(probe::read_fd_with_deadline(io::stdin().as_fd(), &mut buf, deadline), Ok(n) if n > 0) {
+            break;
+        }
+    }
+}
+
+/// Removes kitty temporary files of this process the terminal did not read (it deletes the
+/// ones it reads).
+fn remove_temp_files() {
+    let prefix = format!("tidepool-{}-", std::process::id());
+    let Ok(entries) = std::fs::read_dir(kitty::temp_dir()) else { return };
+    for entry in entries.flatten() {
+        let name = entry.file_name();
+        let name = name.to_string_lossy();
+        if name.starts_with(&prefix) && name.contains(kitty::TEMP_FILE_MARKER) {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Sets the bytes written before [`RESTORE`] when the terminal is restored (on every path:
+/// the guard, the panic hook, [`restore`] from a signal handler): what the picture needs
+/// undone, such as deleting kitty's image.
+pub fn set_restore_prefix(bytes: Vec<u8>) {
+    *RESTORE_PREFIX.lock().unwrap_or_else(|p| p.into_inner()) = bytes;
 }
 
 /// The terminal in player mode; dropping it restores the terminal.
@@ -58,16 +185,15 @@ pub struct TerminalGuard {
 }
 
 impl TerminalGuard {
-    /// Puts the terminal in raw mode and the alternate screen, hides the cursor and turns on
-    /// mouse reporting. Fails (leaving the terminal as it was) when raw mode cannot be set.
-    pub fn enter() -> io::Result<TerminalGuard> {
-        let out = match OUT.get() {
-            Some(f) => f,
-            None => {
-                let fd = io::stdout().as_fd().try_clone_to_owned()?;
-                OUT.get_or_init(|| File::from(fd))
-            }
-        };
+    /// Puts the terminal in raw mode, with the restore armed (the guard's drop, the panic
+    /// hook, [`restore`]), so the terminal can be asked questions before the screen is taken
+    /// over with [`TerminalGuard::enter_screen`]. Fails (leaving the terminal as it was) when
+    /// raw mode cannot be set.
+    pub fn raw() -> io::Result<TerminalGuard> {
+        if OUT.get().is_none() {
+            let fd = io::stdout().as_fd().try_clone_to_owned()?;
+            OUT.get_or_init(|| File::from(fd));
+        }
         crossterm::terminal::enable_raw_mode()?;
         ACTIVE.store(true, Ordering::SeqCst);
         PANIC_HOOK.call_once(|| {
@@ -77,10 +203,19 @@ impl TerminalGuard {
                 previous(info);
             }));
         });
-        let guard = TerminalGuard { _private: () };
+        Ok(TerminalGuard { _private: () })
+    }
+
+    /// The alternate screen, hidden cursor and mouse reporting ([`ENTER`]), then `extra` (modes
+    /// the picture needs, such as pixel mouse reports).
+    pub fn enter_screen(&self, extra: &[u8]) -> io::Result<()> {
         let _lock = lock();
-        (&*out).write_all(ENTER)?;
-        Ok(guard)
+        let mut out = OUT.get().ok_or_else(|| io::Error::other("the terminal's output is not open"))?;
+        out.write_all(ENTER)?;
+        if !extra.is_empty() {
+            out.write_all(extra)?;
+        }
+        Ok(())
     }
 }
 
@@ -137,6 +272,15 @@ pub fn restore() {
     }
     let _lock = lock();
     if let Some(mut out) = OUT.get() {
+        // CAN first: the prefix must not land inside a sequence a failed write cut in half.
+        let prefix = match RESTORE_PREFIX.try_lock() {
+            Ok(p) => p.clone(),
+            Err(std::sync::TryLockError::Poisoned(p)) => p.into_inner().clone(),
+            Err(std::sync::TryLockError::WouldBlock) => Vec::new(),
+        };
+        if !prefix.is_empty() {
+            let _ = out.write_all(b"\x18").and_then(|()| out.write_all(&prefix));
+        }
         let _ = out.write_all(RESTORE);
     }
     let _ = crossterm::terminal::disable_raw_mode();

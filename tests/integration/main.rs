@@ -9,6 +9,7 @@ mod bytes_per_frame;
 mod cli;
 mod common;
 mod goldens;
+mod graphics;
 mod hostile_input;
 mod lake;
 mod ocean;

@@ -167,6 +167,41 @@ pub struct PlayCommand {
     /// Record the session as JSON lines, for `tidepool render pool --replay FILE` (the pool only).
     #[arg(long, value_name = "FILE")]
     pub record: Option<PathBuf>,
+
+    /// How the picture is drawn: real pixels with the kitty graphics protocol, sixel or iTerm2
+    /// inline images, or half-block cells (two pixels a cell, any terminal). `auto` asks the
+    /// terminal what it can show (150 ms at most) and falls back to cells.
+    #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
+    pub graphics: GraphicsChoice,
+}
+
+/// `--graphics`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum GraphicsChoice {
+    /// The best the terminal answers for: kitty, then sixel, then iTerm2, else cells.
+    Auto,
+    /// The kitty graphics protocol (kitty, WezTerm, Ghostty, Konsole).
+    Kitty,
+    /// DEC sixel (xterm -ti vt340, foot, mlterm, WezTerm, Windows Terminal).
+    Sixel,
+    /// iTerm2's inline images (iTerm2, WezTerm).
+    Iterm2,
+    /// Half-block text cells, as before real pixels.
+    Cells,
+}
+
+impl From<GraphicsChoice> for tidepool::player::probe::GraphicsRequest {
+    fn from(choice: GraphicsChoice) -> Self {
+        use tidepool::graphics::GraphicsMode;
+        use tidepool::player::probe::GraphicsRequest::{Auto, Force};
+        match choice {
+            GraphicsChoice::Auto => Auto,
+            GraphicsChoice::Kitty => Force(GraphicsMode::Kitty),
+            GraphicsChoice::Sixel => Force(GraphicsMode::Sixel),
+            GraphicsChoice::Iterm2 => Force(GraphicsMode::Iterm2),
+            GraphicsChoice::Cells => Force(GraphicsMode::Cells),
+        }
+    }
 }
 
 /// The player's default `--damping`.
@@ -338,6 +373,12 @@ pub struct OutputArgs {
     /// standard error, with throughput or triangle counts.
     #[arg(long)]
     pub stats: bool,
+
+    /// With --out - to a terminal: draw the picture in real pixels (kitty graphics, sixel,
+    /// iTerm2) or half-block cells. `auto` asks the terminal (150 ms at most); into a pipe or a
+    /// file it means cells and nothing is asked.
+    #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
+    pub graphics: GraphicsChoice,
 }
 
 /// Flags of the ripple pool, shared by `render pool` and the player.
@@ -564,6 +605,15 @@ mod tests {
         assert_eq!((play.scene, play.fps, play.color, play.pool.rain), (PlayScene::Pool, 30, ColorChoice::Auto, None));
         assert_eq!(play.pool.damping.shift(), Some(6), "the player's own damping");
         assert_eq!(play.bandwidth, tidepool::player::Bandwidth::Auto);
+        assert_eq!(play.graphics, GraphicsChoice::Auto, "pictures in real pixels where the terminal answers");
+        for (flag, want) in
+            [("kitty", GraphicsChoice::Kitty), ("sixel", GraphicsChoice::Sixel), ("cells", GraphicsChoice::Cells)]
+        {
+            let cli = Cli::try_parse_from(["tidepool", "play", "--graphics", flag]).unwrap();
+            let Some(Command::Play(play)) = cli.command else { panic!("not play") };
+            assert_eq!(play.graphics, want);
+        }
+        assert!(Cli::try_parse_from(["tidepool", "play", "--graphics", "png"]).is_err());
         let cli = Cli::try_parse_from(["tidepool", "render", "pool"]).unwrap();
         let Some(Command::Render(RenderCommand { scene: RenderScene::Pool(pool) })) = cli.command else { panic!() };
         assert_eq!(pool.pool.damping, Damping::PAPERS);

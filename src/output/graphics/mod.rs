@@ -11,8 +11,8 @@
 //! - [`geometry`]: which resolution to render for each protocol, and which picture pixel a
 //!   click lands on.
 //!
-//! How the player is meant to drive these is in `INTEGRATION-graphics.md` at the repository's
-//! root; detection lives in [`crate::term::probe`].
+//! The player drives these through `crate::term::picture`, `render --out -` through the
+//! binary's `commands/inline.rs`; detection lives in [`crate::term::probe`].
 
 pub mod geometry;
 pub mod iterm2;

@@ -12,7 +12,7 @@ use tidepool::terminal::Screen;
 /// The primary device attributes question the player asks after frames, and a VT220-like
 /// answer (as xterm gives).
 const DA1_QUESTION: &[u8] = b"\x1b[c";
-const DA1_ANSWER: &[u8] = b"\x1b[?62;22c";
+pub const DA1_ANSWER: &[u8] = b"\x1b[?62;22c";
 
 /// A player running in a pty.
 pub struct Player {
@@ -40,6 +40,21 @@ pub fn temp_dir(name: &str) -> PathBuf {
 impl Player {
     /// Starts `tidepool ARGS` in a `cols x rows` pty, in folder `dir`, with truecolor and no SSH.
     pub fn spawn(dir: &Path, cols: u16, rows: u16, args: &[&str], env: &[(&str, &str)]) -> Player {
+        Player::spawn_answering(dir, cols, rows, args, env, |_| Some(DA1_ANSWER.to_vec()))
+    }
+
+    /// [`Player::spawn`] with a scripted terminal: `answer(n)` gives the bytes written when the
+    /// `n`-th device attributes question (0-based; the graphics probe's is the first) is seen,
+    /// `None` for silence. A probe's other questions go before its DA1, so the answer to it
+    /// carries the answers to them (a terminal answers in order).
+    pub fn spawn_answering(
+        dir: &Path,
+        cols: u16,
+        rows: u16,
+        args: &[&str],
+        env: &[(&str, &str)],
+        answer: impl Fn(usize) -> Option<Vec<u8>> + Send + 'static,
+    ) -> Player {
         let pty = native_pty_system();
         let pair = pty.openpty(PtySize { rows, cols, pixel_width: 0, pixel_height: 0 }).unwrap();
         let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_tidepool"));
@@ -49,6 +64,10 @@ impl Player {
         cmd.env("COLORTERM", "truecolor");
         cmd.env_remove("SSH_CONNECTION");
         cmd.env_remove("TIDEPOOL_TEST_PANIC");
+        // The probe reads these; the test's terminal is none of them.
+        for name in ["TMUX", "SSH_TTY", "TERM_PROGRAM"] {
+            cmd.env_remove(name);
+        }
         for (k, v) in env {
             cmd.env(k, v);
         }
@@ -62,6 +81,7 @@ impl Player {
         let drained = Arc::new(AtomicBool::new(false));
         let done = Arc::clone(&drained);
         std::thread::spawn(move || {
+            let mut asked = 0;
             let mut buf = [0u8; 65536];
             while let Ok(n) = reader.read(&mut buf) {
                 if n == 0 {
@@ -74,8 +94,11 @@ impl Player {
                 let questions = out[from..].windows(3).filter(|w| *w == DA1_QUESTION).count();
                 drop(out);
                 for _ in 0..questions {
-                    let mut w = answers.lock().unwrap();
-                    let _ = w.write_all(DA1_ANSWER).and_then(|()| w.flush());
+                    if let Some(bytes) = answer(asked) {
+                        let mut w = answers.lock().unwrap();
+                        let _ = w.write_all(&bytes).and_then(|()| w.flush());
+                    }
+                    asked += 1;
                 }
             }
             done.store(true, Ordering::SeqCst);

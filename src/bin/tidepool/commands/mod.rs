@@ -7,6 +7,7 @@
 pub mod animate;
 pub mod bench;
 pub mod docs;
+pub mod inline;
 pub mod lake;
 pub mod maps;
 pub mod ocean;

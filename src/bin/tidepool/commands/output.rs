@@ -38,6 +38,8 @@ pub struct OutputPlan {
     pub size: Size,
     /// Where the heightmap goes, and in which form.
     pub heightmap: Option<(PathBuf, HeightmapKind)>,
+    /// Standard output is a terminal that shows real pixels: the picture goes as one image.
+    pub inline: Option<super::inline::Inline>,
 }
 
 /// The heightmap formats.
@@ -88,8 +90,14 @@ impl OutputPlan {
                 "refusing to write PNG bytes to a terminal; redirect standard output to a file, or use --format ansi",
             ));
         }
+        // Half-block text to a terminal may be real pixels instead (the terminal is asked here,
+        // before the picture's size is chosen: pixels have the size of the terminal's cells).
+        let inline = (target == Target::Stdout && format == Format::Ansi && stdout_is_terminal)
+            .then(|| super::inline::Inline::probe(args.graphics))
+            .flatten();
         let size = match args.size {
             Some(size) => size,
+            None if inline.is_some() => inline.as_ref().map_or(DEFAULT_TEXT_SIZE, super::inline::Inline::size),
             None if format == Format::Png => DEFAULT_PNG_SIZE,
             None if target == Target::Stdout && stdout_is_terminal => terminal_size.unwrap_or(DEFAULT_TEXT_SIZE),
             None => DEFAULT_TEXT_SIZE,
@@ -111,17 +119,22 @@ impl OutputPlan {
                 Some((path.clone(), kind))
             }
         };
-        Ok(OutputPlan { target, format, size, heightmap })
+        Ok(OutputPlan { target, format, size, heightmap, inline })
     }
 
     /// Encodes and writes the picture, then the heightmap, recording how long each took.
     pub fn write_timed(&self, picture: &Pixmap, heights: Option<&Heightmap>, stats: &mut Stats) -> Result<()> {
         let started = Instant::now();
-        let bytes = match self.format {
-            Format::Png => tidepool::encode::png(picture),
-            Format::Ansi => tidepool::encode::halfblock(picture),
+        let bytes = match (self.format, &self.inline) {
+            (Format::Png, _) => tidepool::encode::png(picture),
+            (Format::Ansi, Some(inline)) => inline.encode(picture),
+            (Format::Ansi, None) => tidepool::encode::halfblock(picture),
         };
-        let format = if self.format == Format::Png { "png" } else { "half-block text" };
+        let format = match (self.format, &self.inline) {
+            (Format::Png, _) => "png",
+            (Format::Ansi, Some(inline)) => inline.name(),
+            (Format::Ansi, None) => "half-block text",
+        };
         stats.record("encode", started, format!("{format}, {}", tidepool::encode::human_bytes(bytes.len() as u64)));
         let started = Instant::now();
         let target = match &self.target {
@@ -196,7 +209,15 @@ mod tests {
     use super::*;
 
     fn args(out: Option<&str>, format: Option<Format>, size: Option<Size>) -> OutputArgs {
-        OutputArgs { size, seed: 1, out: out.map(PathBuf::from), format, heightmap: None, stats: false }
+        OutputArgs {
+            size,
+            seed: 1,
+            out: out.map(PathBuf::from),
+            format,
+            heightmap: None,
+            stats: false,
+            graphics: crate::cli::GraphicsChoice::Cells,
+        }
     }
 
     #[test]

@@ -76,6 +76,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
         storage: Some(Arc::new(crate::files::AtomicStorage)),
         greeting: color_hint(command.color, color),
         quit: Arc::clone(&quit),
+        graphics: command.graphics.into(),
     };
     let _stop_on_signal = crate::signals::StopOnSignal::new(quit);
     tidepool::player::play(config).map_err(|e| match e {

@@ -162,8 +162,10 @@ pub fn russh_config(host_key: PrivateKey, private: bool, limits: &Limits) -> Con
         auth_rejection_time_initial: Some(Duration::ZERO),
         keys: vec![host_key],
         // russh resets this timer on every loop turn, including our own frames, so it is not an
-        // idle timeout; it bounds the banner read and a write blocked on a full socket.
-        inactivity_timeout: Some(limits.stall_timeout),
+        // idle timeout; it bounds the banner read and a write blocked on a full socket. Twice
+        // the stall timeout, so a player who stops reading is found stalled by the game (and
+        // told why) before the session is cut under it; the two timers raced at equal lengths.
+        inactivity_timeout: Some(limits.stall_timeout * 2),
         // Keepalives also keep a player watching still water from counting as inactive.
         keepalive_interval: Some(KEEPALIVE_INTERVAL.min(limits.stall_timeout / 2)),
         keepalive_max: 3,

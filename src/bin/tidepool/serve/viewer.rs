@@ -211,6 +211,8 @@ impl Viewer {
             bandwidth: None,
             stone: self.radius,
             paused: set.paused,
+            // Remote players get half-block cells: no image protocol over the shared pool.
+            pixels_elsewhere: false,
         }
     }
 }
