@@ -42,10 +42,10 @@ impl Inline {
         Some(Inline { choice, support, layout, rows })
     }
 
-    /// The picture's size in pixels.
-    pub fn size(&self) -> Size {
+    /// The picture's size in pixels (`fallback` for a layout with no room).
+    pub fn size(&self, fallback: Size) -> Size {
         let (w, h) = self.layout.picture;
-        Size::new(i64::from(w), i64::from(h)).unwrap_or(super::output::DEFAULT_TEXT_SIZE)
+        Size::new(i64::from(w), i64::from(h)).unwrap_or(fallback)
     }
 
     /// The protocol's name, for `--stats`.

@@ -97,7 +97,7 @@ impl OutputPlan {
             .flatten();
         let size = match args.size {
             Some(size) => size,
-            None if inline.is_some() => inline.as_ref().map_or(DEFAULT_TEXT_SIZE, super::inline::Inline::size),
+            None if inline.is_some() => inline.as_ref().map_or(DEFAULT_TEXT_SIZE, |i| i.size(DEFAULT_TEXT_SIZE)),
             None if format == Format::Png => DEFAULT_PNG_SIZE,
             None if target == Target::Stdout && stdout_is_terminal => terminal_size.unwrap_or(DEFAULT_TEXT_SIZE),
             None => DEFAULT_TEXT_SIZE,
