@@ -19,8 +19,8 @@ use tokio_util::sync::CancellationToken;
 use tidepool::terminal::ColorMode;
 use tokio::sync::mpsc;
 
+use super::hub::Hub;
 use super::limits::{self, clamp_size};
-use super::server::Hub;
 use super::viewer::{self, Control, ViewerCtx};
 
 /// Longest TERM / COLORTERM value kept (longer values are refused).

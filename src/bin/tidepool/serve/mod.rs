@@ -14,6 +14,7 @@ pub mod authorized_keys;
 pub mod game;
 pub mod handler;
 pub mod host_key;
+mod hub;
 pub mod killable;
 pub mod letterbox;
 pub mod limits;

@@ -24,9 +24,9 @@ use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
 use super::game::{Cells, Pictures, Shared};
+use super::hub::Hub;
 use super::letterbox::Letterbox;
 use super::limits::{FAREWELL_TIMEOUT, PlayerSlot, TokenBucket};
-use super::server::Hub;
 
 /// Time a player's connection may stay open after its game ended before it is cut.
 pub const LINGER: Duration = Duration::from_secs(1);
