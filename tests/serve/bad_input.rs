@@ -3,9 +3,36 @@
 use std::os::unix::fs::PermissionsExt;
 use std::process::Command;
 
+/// Runs `tidepool serve ARGS`; a server that starts instead of refusing is killed after a
+/// bound (for a hang, not a timing assertion) and reported as such, so a regression fails the
+/// test instead of hanging it.
 fn serve(args: &[&str]) -> (Option<i32>, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_tidepool")).arg("serve").args(args).output().unwrap();
-    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+    use std::io::Read;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_tidepool"))
+        .arg("serve")
+        .args(args)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break Some(status);
+        }
+        if std::time::Instant::now() > deadline {
+            let _ = child.kill();
+            let _ = child.wait();
+            break None;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    };
+    let mut err = String::new();
+    let _ = child.stderr.take().unwrap().read_to_string(&mut err);
+    match status {
+        Some(status) => (status.code(), err),
+        None => (None, format!("the server started and ran for 20 s instead of refusing: {err}")),
+    }
 }
 
 #[test]
