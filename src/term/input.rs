@@ -143,7 +143,7 @@ impl InputParser {
         }
     }
 
-    /// Resolves what is pending once no more bytes have come for [`ESC_WAIT`]: a lone `ESC` is
+    /// Resolves what is pending once no more bytes have come for `ESC_WAIT` (40 ms): a lone `ESC` is
     /// the Escape key, an unfinished sequence is dropped.
     pub fn flush_stale(&mut self, now: Instant, out: &mut Vec<Input>) {
         if self.since.is_some_and(|t| now.saturating_duration_since(t) >= ESC_WAIT) {
