@@ -21,7 +21,7 @@ fi
 
 if command -v tmux >/dev/null; then
   session="tidepool-gallery-$$"
-  tmux new-session -d -s "$session" -x 120 -y 36 "COLORTERM=truecolor $T play --seed 7"
+  tmux new-session -d -s "$session" -x 120 -y 36 "COLORTERM=truecolor $T play --seed 7 --graphics cells"
   sleep 2
   # Three left clicks and a right click, as SGR mouse reports, then a moment for the rings.
   for click in '0;30;10' '0;55;24' '0;75;8' '2;96;20'; do
