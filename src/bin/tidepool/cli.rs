@@ -102,18 +102,11 @@ Examples:
 
 /// `tidepool play [scene]`.
 ///
-/// The player's water is alive at rest: a light breeze, rain you can see, and stones whose
-/// rings cross the pool (damping shift 6, a little less than the papers' 5, because the
-/// breeze's wavelets keep the water moving; the rate-controlled encoder makes that affordable
-/// on any link).
+/// The scene flags a live session takes (`play` and `serve`): every scene is built from them,
+/// so `tab` switches between waters set up by the same command line.
 #[derive(Args, Debug, Clone)]
-#[command(after_help = PLAY_KEYS, mut_arg("damping", |a| a.default_value(PLAYER_DAMPING)))]
-pub struct PlayCommand {
-    /// The scene to start with (`tab` switches while playing).
-    #[arg(value_enum, default_value = "pool")]
-    pub scene: PlayScene,
-
-    /// The water of the pool. [--rain default: 0.02 drops per step]
+pub struct LiveSceneArgs {
+    /// The water of the pool.
     #[command(flatten)]
     pub pool: PoolArgs,
 
@@ -134,6 +127,22 @@ pub struct PlayCommand {
     /// give the same water.
     #[arg(long, value_name = "N", default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]
     pub seed: u64,
+}
+
+/// The player's water is alive at rest: a light breeze, rain you can see, and stones whose
+/// rings cross the pool (damping shift 6, a little less than the papers' 5, because the
+/// breeze's wavelets keep the water moving; the rate-controlled encoder makes that affordable
+/// on any link).
+#[derive(Args, Debug, Clone)]
+#[command(after_help = PLAY_KEYS, mut_arg("damping", |a| a.default_value(PLAYER_DAMPING)))]
+pub struct PlayCommand {
+    /// The scene to start with (`tab` switches while playing).
+    #[arg(value_enum, default_value = "pool")]
+    pub scene: PlayScene,
+
+    /// The scenes' water, wind and seed.
+    #[command(flatten)]
+    pub water: LiveSceneArgs,
 
     /// Display frames per second (1..=240); the simulation runs at its own fixed rate.
     #[arg(long, value_name = "N", default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=240))]
@@ -602,8 +611,11 @@ mod tests {
     fn play_is_the_default_scene_pool() {
         let cli = Cli::try_parse_from(["tidepool", "play"]).unwrap();
         let Some(Command::Play(play)) = cli.command else { panic!("not play") };
-        assert_eq!((play.scene, play.fps, play.color, play.pool.rain), (PlayScene::Pool, 30, ColorChoice::Auto, None));
-        assert_eq!(play.pool.damping.shift(), Some(6), "the player's own damping");
+        assert_eq!(
+            (play.scene, play.fps, play.color, play.water.pool.rain),
+            (PlayScene::Pool, 30, ColorChoice::Auto, None)
+        );
+        assert_eq!(play.water.pool.damping.shift(), Some(6), "the player's own damping");
         assert_eq!(play.bandwidth, tidepool::player::Bandwidth::Auto);
         assert_eq!(play.graphics, GraphicsChoice::Auto, "pictures in real pixels where the terminal answers");
         for (flag, want) in

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use clap::Args;
 use tidepool::Size;
 
-use super::{PLAYER_DAMPING, PlayScene, PoolArgs, ocean, parse_seed, parse_size};
+use super::{PLAYER_DAMPING, PlayScene, parse_size};
 
 const SERVE_HELP: &str = "\
 Everyone who connects plays in the same water: stones, clicks, drags and the scene keys (wind,
@@ -87,23 +87,7 @@ pub struct ServeCommand {
     #[arg(long, value_enum, default_value = "pool")]
     pub scene: PlayScene,
 
-    /// The water of the pool.
+    /// The scenes' water, wind and seed (as for `play`).
     #[command(flatten)]
-    pub pool: PoolArgs,
-
-    /// The wind.
-    #[command(flatten)]
-    pub wind: ocean::WindArgs,
-
-    /// Where the ocean's wind comes FROM, degrees clockwise from north. [default: 330]
-    #[arg(long, value_name = "DEG", value_parser = ocean::parse_degrees, allow_hyphen_values = true)]
-    pub direction: Option<f64>,
-
-    /// The ocean's spectrum and choppiness.
-    #[command(flatten)]
-    pub sea: ocean::PlaySeaArgs,
-
-    /// Seed for everything random (rain, random stones).
-    #[arg(long, value_name = "N", default_value_t = 1, value_parser = parse_seed, allow_negative_numbers = true)]
-    pub seed: u64,
+    pub water: crate::cli::LiveSceneArgs,
 }

@@ -56,14 +56,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
     if let Some(path) = &command.record {
         crate::files::check_writable(path).map_err(|message| Error::arg("--record", message))?;
     }
-    let scenes = super::scenes::specs(&super::scenes::SceneFlags {
-        first: command.scene,
-        pool: &command.pool,
-        wind: &command.wind,
-        direction: command.direction,
-        shape: &command.sea.shape(),
-        seed: command.seed,
-    })?;
+    let scenes = super::scenes::specs(command.scene, &command.water)?;
     let quit = Arc::new(AtomicBool::new(false));
     let config = PlayerConfig {
         scenes,
@@ -71,8 +64,8 @@ pub fn run(command: PlayCommand) -> Result<()> {
         bandwidth: command.max_bps.map_or(command.bandwidth, tidepool::player::Bandwidth::Fixed),
         color,
         encode: EncodeOptions { threshold, sync: !command.no_sync },
-        seed: command.seed,
-        record: command.record.clone().map(|path| (path, command.pool.background.clone())),
+        seed: command.water.seed,
+        record: command.record.clone().map(|path| (path, command.water.pool.background.clone())),
         storage: Some(Arc::new(crate::files::AtomicStorage)),
         greeting: color_hint(command.color, color),
         quit: Arc::clone(&quit),

@@ -4,28 +4,12 @@
 use tidepool::sea::{DEFAULT_WIND_FROM_DEG, MAX_LAKE_WIND_M_S};
 use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneKind, SceneSpec};
 
-use crate::cli::{PlayScene, PoolArgs, ocean};
+use crate::cli::{LiveSceneArgs, PlayScene};
 use crate::error::Result;
 
 /// The player's rain when `--rain` is not given: three drops a second at 60 steps/s, seen as
 /// small rings.
 pub const DEFAULT_PLAYER_RAIN: f64 = 0.05;
-
-/// The scene flags of a live session.
-pub struct SceneFlags<'a> {
-    /// The scene shown first.
-    pub first: PlayScene,
-    /// The pool's water.
-    pub pool: &'a PoolArgs,
-    /// The wind (ocean, and the lake when given).
-    pub wind: &'a ocean::WindArgs,
-    /// Where the ocean's wind comes from, degrees.
-    pub direction: Option<f64>,
-    /// The ocean's spectrum and choppiness.
-    pub shape: &'a ocean::SeaShapeArgs,
-    /// Seed for everything random.
-    pub seed: u64,
-}
 
 /// The lake the player starts with: the default breeze and noise, no supersampling (a
 /// terminal cell is two pixels; the frame budget goes to the water instead).
@@ -33,12 +17,12 @@ pub fn lake_settings(seed: u64) -> LakeSettings {
     LakeSettings { lake: LakeParams { seed, ..LakeParams::default() }, ..LakeSettings::default() }
 }
 
-/// Every scene, in `tab` order, starting from `flags.first`.
-pub fn specs(flags: &SceneFlags<'_>) -> Result<Vec<SceneSpec>> {
+/// Every scene, in `tab` order, starting from `first`.
+pub fn specs(first: PlayScene, flags: &LiveSceneArgs) -> Result<Vec<SceneSpec>> {
     let pool = flags.pool.settings(flags.seed, (DEFAULT_PLAYER_RAIN, tidepool::values::DEFAULT_BREEZE))?;
     let default_view = OceanView::default();
     let ocean = OceanSettings {
-        sea: flags.shape.params(
+        sea: flags.sea.shape().params(
             flags.wind.speed_m_s(),
             flags.direction.unwrap_or(DEFAULT_WIND_FROM_DEG),
             flags.seed,
@@ -57,7 +41,7 @@ pub fn specs(flags: &SceneFlags<'_>) -> Result<Vec<SceneSpec>> {
     }
     // Tab goes through the scenes in their order, starting from the one asked for.
     let all = [SceneSpec::Pool(pool), SceneSpec::Ocean(ocean), SceneSpec::Lake(lake)];
-    let first = SceneKind::from(flags.first);
+    let first = SceneKind::from(first);
     let start = all.iter().position(|s| s.kind() == first).unwrap_or(0);
     Ok(all.iter().cycle().skip(start).take(all.len()).cloned().collect())
 }
