@@ -449,34 +449,8 @@ mod tests {
 
     mod properties {
         use super::*;
+        use crate::output::frame::strategies::frame;
         use proptest::prelude::*;
-
-        fn color() -> impl Strategy<Value = Color> {
-            prop_oneof![
-                // Few distinct values, so neighbouring cells often share colours (the elision paths).
-                (0u8..4, 0u8..4, 0u8..4).prop_map(|(r, g, b)| Color::Rgb([r * 80, g * 80, b * 80])),
-                (0u8..=255).prop_map(Color::Index),
-                Just(Color::Default),
-            ]
-        }
-
-        fn cell() -> impl Strategy<Value = Cell> {
-            prop_oneof![
-                4 => (color(), color()).prop_map(|(top, bottom)| Cell::Pixels { top, bottom }),
-                1 => (prop::sample::select(vec![' ', 'a', '+', '\u{b7}']), color(), color())
-                    .prop_map(|(ch, fg, bg)| Cell::Text { ch, fg, bg }),
-            ]
-        }
-
-        fn frame(cols: usize, rows: usize) -> impl Strategy<Value = Frame> {
-            proptest::collection::vec(cell(), cols * rows).prop_map(move |cells| {
-                let mut f = Frame::new(cols, rows);
-                for (i, c) in cells.into_iter().enumerate() {
-                    f.set(i % cols, i / cols, c);
-                }
-                f
-            })
-        }
 
         proptest! {
             #![proptest_config(ProptestConfig::with_cases(96))]

@@ -147,6 +147,44 @@ impl Frame {
     }
 }
 
+/// Random frames for property tests of the encoders: few distinct colours, so neighbouring
+/// cells often share them (the elision paths), and a text cell now and then.
+#[cfg(test)]
+pub(crate) mod strategies {
+    use super::{Cell, Frame};
+    use crate::output::color::Color;
+    use proptest::prelude::{Just, Strategy, prop, prop_oneof};
+
+    /// A colour of each kind.
+    pub fn color() -> impl Strategy<Value = Color> {
+        prop_oneof![
+            (0u8..4, 0u8..4, 0u8..4).prop_map(|(r, g, b)| Color::Rgb([r * 80, g * 80, b * 80])),
+            (0u8..=255).prop_map(Color::Index),
+            Just(Color::Default),
+        ]
+    }
+
+    /// Mostly pixel cells, sometimes text.
+    pub fn cell() -> impl Strategy<Value = Cell> {
+        prop_oneof![
+            4 => (color(), color()).prop_map(|(top, bottom)| Cell::Pixels { top, bottom }),
+            1 => (prop::sample::select(vec![' ', 'a', '+', '\u{b7}']), color(), color())
+                .prop_map(|(ch, fg, bg)| Cell::Text { ch, fg, bg }),
+        ]
+    }
+
+    /// A `cols` x `rows` frame of such cells.
+    pub fn frame(cols: usize, rows: usize) -> impl Strategy<Value = Frame> {
+        proptest::collection::vec(cell(), cols * rows).prop_map(move |cells| {
+            let mut f = Frame::new(cols, rows);
+            for (i, c) in cells.into_iter().enumerate() {
+                f.set(i % cols, i / cols, c);
+            }
+            f
+        })
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -398,33 +398,8 @@ fn identical_frames_cost_nothing() {
 mod properties {
     use super::super::Strategy as Order;
     use super::*;
-    use proptest::prelude::{Just, ProptestConfig, Strategy, any, prop, prop_assert, prop_oneof, proptest};
-
-    fn color() -> impl Strategy<Value = Color> {
-        prop_oneof![
-            (0u8..4, 0u8..4, 0u8..4).prop_map(|(r, g, b)| Color::Rgb([r * 80, g * 80, b * 80])),
-            (0u8..=255).prop_map(Color::Index),
-            Just(Color::Default),
-        ]
-    }
-
-    fn cell() -> impl Strategy<Value = Cell> {
-        prop_oneof![
-            4 => (color(), color()).prop_map(|(top, bottom)| Cell::Pixels { top, bottom }),
-            1 => (prop::sample::select(vec![' ', 'a', '+', '\u{b7}']), color(), color())
-                .prop_map(|(ch, fg, bg)| Cell::Text { ch, fg, bg }),
-        ]
-    }
-
-    fn frame(cols: usize, rows: usize) -> impl Strategy<Value = Frame> {
-        proptest::collection::vec(cell(), cols * rows).prop_map(move |cells| {
-            let mut f = Frame::new(cols, rows);
-            for (i, c) in cells.into_iter().enumerate() {
-                f.set(i % cols, i / cols, c);
-            }
-            f
-        })
-    }
+    use crate::output::frame::strategies::frame;
+    use proptest::prelude::{Just, ProptestConfig, Strategy, any, prop_assert, prop_oneof, proptest};
 
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(96))]
