@@ -7,6 +7,7 @@
 //! game applies them before the next step.
 
 use std::collections::{BTreeSet, HashMap};
+use std::fmt::Write as _;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -51,8 +52,6 @@ pub struct Pictures {
     pub number: u64,
     /// Whether the shared clock is paused.
     pub paused: bool,
-    /// The scene's size in pixels.
-    pub scene_size: (u32, u32),
     /// The status line's and the help's view of the scene, players counted.
     pub info: Arc<SceneInfo>,
     /// One picture per distinct terminal size, letterboxed to it.
@@ -103,7 +102,7 @@ pub struct GameLinks {
 
 /// The first, empty value of the `watch` slot.
 pub fn nothing_yet(info: SceneInfo) -> Arc<Pictures> {
-    Arc::new(Pictures { number: 0, paused: false, scene_size: (0, 0), info: Arc::new(info), pictures: HashMap::new() })
+    Arc::new(Pictures { number: 0, paused: false, info: Arc::new(info), pictures: HashMap::new() })
 }
 
 /// Builds the first scene (so a bad scene setting fails before the server starts).
@@ -125,6 +124,8 @@ pub fn run(options: GameOptions, mut scene: Box<dyn Playable>, mut links: GameLi
     let mut next_frame = start;
     let mut rng = ChaCha8Rng::seed_from_u64(options.seed ^ STONE_SEED_MIX);
     let mut info = SceneInfo::of(scene.as_ref());
+    // The scene's own status, kept between frames (`Controls::status` rewrites it whole).
+    let mut scene_detail = String::new();
     let mut number = 0u64;
     while !links.stop.load(Ordering::Relaxed) {
         let now = Instant::now();
@@ -165,8 +166,7 @@ pub fn run(options: GameOptions, mut scene: Box<dyn Playable>, mut links: GameLi
             let players = links.players.count();
             // The count first: a passing message may cover the end of a narrow status line.
             info.detail.clear();
-            info.detail.push_str(&format!("{players} playing \u{b7} "));
-            let mut scene_detail = String::new();
+            let _ = write!(info.detail, "{players} playing \u{b7} ");
             scene.status(&mut scene_detail);
             info.detail.push_str(&scene_detail);
             let wanted: BTreeSet<Cells> =
@@ -184,7 +184,6 @@ pub fn run(options: GameOptions, mut scene: Box<dyn Playable>, mut links: GameLi
             links.publish.send_replace(Arc::new(Pictures {
                 number,
                 paused: clock.paused(),
-                scene_size: (w, h),
                 info: Arc::new(info.clone()),
                 pictures,
             }));

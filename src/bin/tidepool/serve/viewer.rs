@@ -114,7 +114,7 @@ struct Viewer {
     radius: u32,
     help: bool,
     drag: Option<(i32, i32)>,
-    message: Option<(String, Instant)>,
+    message: Option<(&'static str, Instant)>,
     actions: TokenBucket,
 }
 
@@ -123,8 +123,8 @@ impl Viewer {
         Letterbox::fit(self.scene_size, picture_size(self.size.0, self.size.1))
     }
 
-    fn say(&mut self, message: &str, how_long: Duration) {
-        self.message = Some((message.to_string(), Instant::now() + how_long));
+    fn say(&mut self, message: &'static str, how_long: Duration) {
+        self.message = Some((message, Instant::now() + how_long));
     }
 
     /// Sends an action to the shared scene, within this player's rate.
@@ -331,7 +331,6 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 skipped += set.number - last_number - 1;
             }
             last_number = set.number;
-            viewer.scene_size = set.scene_size;
             // Just resized: the next frame has this size.
             let Some(picture) = set.pictures.get(&viewer.size).cloned() else { continue };
             let now = Instant::now();
@@ -341,14 +340,15 @@ pub(crate) async fn run(ctx: ViewerCtx) {
             }
             bucket.refill(now);
             let mut overlay = viewer.overlay(&set, now, meter.fps, meter.rate);
-            let message = viewer.message.as_ref().filter(|(_, until)| now < *until).map(|(m, _)| m.clone());
-            overlay.message = message.as_deref();
+            overlay.message = viewer.message.filter(|(_, until)| now < *until).map(|(m, _)| m);
             let frame = builder.compose(viewer.size, &picture, color, &overlay, &set.info);
             let target = match color {
                 ColorMode::TrueColor => Target::new(frame),
                 mode => Target::with_truth(frame, &picture, mode),
             };
-            let mut out = Vec::new();
+            // The frame's bytes go to russh as `Bytes`, so a buffer cannot be kept between
+            // frames; sized for the budget at once instead of doubling up to it.
+            let mut out = Vec::with_capacity(bucket.budget().min(64 << 10));
             let report = encoder.encode_into(&mut shown, target, bucket.budget(), options, &mut out);
             bucket.spend(report.bytes);
             if out.is_empty() {
