@@ -14,7 +14,7 @@
 //! The maps are periodic: texel N is texel 0, so they tile without a seam. DirectX-style
 //! engines (Unreal) want the normal map's green flipped.
 
-use super::heightmap::{Heightmap, encode_map_png, encode_npy, encode_npy_shaped, encode_png16, levels16};
+use super::heightmap::{encode_map_png, encode_npy_shaped, levels16};
 use crate::sim::patch::PatchMaps;
 
 /// PNG levels per metre for heights and displacements: centimetres.
@@ -39,13 +39,12 @@ pub fn file_names(frame: Option<u32>) -> [String; 6] {
 /// Every file of `maps` as (name, bytes), in [`file_names`]' order.
 pub fn encode_maps(maps: &PatchMaps, frame: Option<u32>) -> Vec<(String, Vec<u8>)> {
     let n = maps.size;
-    let height = Heightmap { width: n, height: n, values: maps.height.clone(), png_levels_per_unit: MAP_PNG_SCALE };
-    let flat: Vec<f32> = maps.displacement.iter().flatten().copied().collect();
+    let displacement = maps.displacement.as_flattened();
     let files = [
-        encode_npy(&height),
-        encode_png16(&height),
-        encode_npy_shaped(&[n, n, 3], &flat),
-        encode_map_png(n, n, image::ExtendedColorType::Rgb16, &levels16(&flat, MAP_PNG_SCALE)),
+        encode_npy_shaped(&[n, n], &maps.height),
+        encode_map_png(n, n, image::ExtendedColorType::L16, &levels16(&maps.height, MAP_PNG_SCALE)),
+        encode_npy_shaped(&[n, n, 3], displacement),
+        encode_map_png(n, n, image::ExtendedColorType::Rgb16, &levels16(displacement, MAP_PNG_SCALE)),
         encode_map_png(n, n, image::ExtendedColorType::Rgb8, &normal_bytes(&maps.normal)),
         encode_map_png(n, n, image::ExtendedColorType::L8, &foam_bytes(&maps.foam)),
     ];

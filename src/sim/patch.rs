@@ -242,11 +242,6 @@ impl PatchSea {
         }
     }
 
-    /// Two real fields from one complex transform. `waves(i, w)` gives, for the travelling
-    /// wave w = a·e^(iφ)·e^(-iωt) at lattice point i, its coefficients (c_f, c_g) in the two
-    /// fields f = re Σ c_f·e^(ik·x) and g = re Σ c_g·e^(ik·x). Each real field's spectrum is
-    /// the Hermitian S(k) = (c(k) + conj(c(-k)))/2, and the transform of S_f + i·S_g is
-    /// f + i·g.
     /// Every lattice wave at `time`: a·e^(iφ)·e^(-iωt).
     fn waves(&self, time: SeaTime) -> Vec<Complex32> {
         (0..self.amp.len())
@@ -255,21 +250,24 @@ impl PatchSea {
             .collect()
     }
 
+    /// Two real fields from one complex transform. `coefficients(i, w)` gives, for the travelling
+    /// wave w = a·e^(iφ)·e^(-iωt) at lattice point i, its coefficients (c_f, c_g) in the two
+    /// fields f = re Σ c_f·e^(ik·x) and g = re Σ c_g·e^(ik·x). Each real field's spectrum is
+    /// the Hermitian S(k) = (c(k) + conj(c(-k)))/2, and the transform of S_f + i·S_g is
+    /// f + i·g.
     fn real_fields(
         &self,
         waves: &[Complex32],
         coefficients: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
     ) -> (Vec<f32>, Vec<f32>) {
         let n = self.size;
-        let coefficients: Vec<(Complex32, Complex32)> =
-            (0..n * n).into_par_iter().map(|i| coefficients(i, waves[i])).collect();
         let mut buf: Vec<Complex32> = (0..n * n)
             .into_par_iter()
             .map(|i| {
                 let (r, c) = (i / n, i % n);
                 let mirror = ((n - r) % n) * n + (n - c) % n;
-                let (f, g) = coefficients[i];
-                let (fm, gm) = coefficients[mirror];
+                let (f, g) = coefficients(i, waves[i]);
+                let (fm, gm) = coefficients(mirror, waves[mirror]);
                 let sf = (f + fm.conj()) * 0.5;
                 let sg = (g + gm.conj()) * 0.5;
                 sf + Complex32::new(0.0, 1.0) * sg
@@ -303,13 +301,7 @@ impl PatchSea {
         let n = self.size;
         let mut b: Vec<Complex32> = (0..n * n)
             .into_par_iter()
-            .map(|i| {
-                if self.amp[i].norm_sqr() == 0.0 {
-                    Complex32::new(0.0, 0.0)
-                } else {
-                    self.amp[i] * self.rotation(i, time) * unit(i).2.sqrt()
-                }
-            })
+            .map(|i| if self.amp[i].norm_sqr() == 0.0 { Complex32::new(0.0, 0.0) } else { waves[i] * unit(i).2.sqrt() })
             .collect();
         self.ifft2(&mut b);
         (Lagrangian { h, dx, dy, hx, hy, gxx, gyy, gxy }, b)
