@@ -117,6 +117,9 @@ impl SmoothShader {
         let [dx, dy] = layout.downwind;
         let tile_along = FOAM_TILE_ACROSS_M * FOAM_STREAK;
         let (world, normals, samples) = (&self.world, &self.normals, &self.samples);
+        // Foam colours are read only by faces with a foaming vertex: without foam (a linear or
+        // calm sea) the second shading of every vertex is skipped.
+        let any_foam = foam.iter().any(|&f| f > 0.0);
         self.water.resize(n, [0.0; 3]);
         self.foam_rgb.resize(n, [0.0; 3]);
         self.foam_uv.resize(n, [0.0; 3]);
@@ -141,8 +144,12 @@ impl SmoothShader {
                 };
                 let level = |c: Rgb| to_srgb8(c).map(|v| f32::from(v) + 0.5);
                 *water = level(shade_facet(&shading.look, &shading.light, shading.environment, &facet));
-                let foam_facet = Facet { foam: 1.0, ..facet };
-                *foam_rgb = level(shade_facet(&shading.look, &shading.light, shading.environment, &foam_facet));
+                *foam_rgb = if any_foam {
+                    let foam_facet = Facet { foam: 1.0, ..facet };
+                    level(shade_facet(&shading.look, &shading.light, shading.environment, &foam_facet))
+                } else {
+                    *water
+                };
                 let g = ground[i];
                 let along = g[0] * dx + g[1] * dy - layout.drift_m;
                 let across = -g[0] * dy + g[1] * dx;
