@@ -286,8 +286,6 @@ fn fit(size: (u32, u32), cap: (u32, u32)) -> (u32, u32) {
     (((f64::from(size.0) * k).round() as u32).max(1), ((f64::from(size.1) * k).round() as u32).max(1))
 }
 
-impl Picture {}
-
 /// Whether mouse reports come in pixels: SGR-pixels mode (1016) is turned on when the terminal
 /// has it (the probe never says so inside tmux) and the picture is in real pixels, where a
 /// cell holds many picture pixels. In cells mode a cell is the picture's resolution anyway.

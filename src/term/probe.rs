@@ -36,7 +36,8 @@
 //! ([`PROBE_BUDGET`]), or an escape sequence that is not a reply arrives first, the terminal
 //! gets cells. Bytes that are not replies (keys typed during the probe) are handed back in
 //! [`ProbeOutcome::leftover`] for the input parser. Replies arriving after the probe ended are
-//! dropped by the input parser with [`crate::term::replies::parse_reply`].
+//! dropped by the player's input parser (`term::input`, which frames strings and control
+//! sequences itself).
 //!
 //! **Environment hints** are used only where no query answers: iTerm2 without its cell-size
 //! reply (`TERM_PROGRAM=iTerm.app`), and to skip the file query over SSH.

@@ -1,6 +1,8 @@
 //! Terminal replies in the input stream: recognised at the start of a buffer, so that the
-//! detection ([`crate::term::probe`]) can read them and the player's input parser can drop late
-//! ones instead of turning them into key presses (`ESC _ G i = 3 1 ; O K` would otherwise be
+//! detection ([`crate::term::probe`]) can read them. (During play, the player's own input parser,
+//! `term::input`, frames the same sequences itself and drops late replies, keeping only device
+//! attributes for the link; it does not call this module.) Unrecognised, a reply would turn into
+//! key presses (`ESC _ G i = 3 1 ; O K` would otherwise be
 //! Alt-`_` and then keys, and a late kitty reply's digits would set the ocean's Beaufort
 //! number).
 //!

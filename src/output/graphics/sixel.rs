@@ -163,6 +163,8 @@ impl SixelPalette {
 #[derive(Debug)]
 pub struct SixelEncoder {
     palette: SixelPalette,
+    /// The palette's register definitions (`#i;2;r;g;b` each), the same for every image.
+    registers: Vec<u8>,
     tables: Vec<[[u8; 256]; 64]>,
     /// The picture's top-left cell (column, row), 0-based.
     origin: (u16, u16),
@@ -184,8 +186,15 @@ impl SixelEncoder {
     pub fn new(palette: SixelPalette, origin: (u16, u16), cell_px: Option<(u16, u16)>) -> SixelEncoder {
         let tables = palette.tables();
         let n = palette.len();
+        let registers = (0..n)
+            .flat_map(|i| {
+                let [r, g, b] = palette.percent_rgb(i as u8);
+                format!("#{i};2;{r};{g};{b}").into_bytes()
+            })
+            .collect();
         SixelEncoder {
             palette,
+            registers,
             tables,
             origin,
             cell_px: cell_px.filter(|&(w, h)| w > 0 && h > 0),
@@ -263,10 +272,7 @@ impl SixelEncoder {
     /// (`stride` pixels a row).
     fn push_image(&mut self, out: &mut Vec<u8>, pixels: &[u8], stride: u32, (x0, y0, w, h): (u32, u32, u32, u32)) {
         out.extend_from_slice(format!("\x1bP0;1;0q\"1;1;{w};{h}").as_bytes());
-        for i in 0..self.palette.len() {
-            let [r, g, b] = self.palette.percent_rgb(i as u8);
-            out.extend_from_slice(format!("#{i};2;{r};{g};{b}").as_bytes());
-        }
+        out.extend_from_slice(&self.registers);
         let (w, stride) = (w as usize, stride as usize);
         for band in (0..h as usize).step_by(6) {
             self.used.clear();
