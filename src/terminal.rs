@@ -10,4 +10,5 @@ pub use crate::output::diff::{EncodeOptions, SYNC_BEGIN, SYNC_END, Shown, encode
 pub use crate::output::frame::{Cell, Frame};
 pub use crate::output::quality::{EXACT_PSNR_DB, Quality, measure};
 pub use crate::output::rate::{RateEncoder, RateOptions, Report, Strategy, Target, UNLIMITED};
+pub use crate::output::ssim::{Luma, ssim};
 pub use crate::output::vt::Screen;

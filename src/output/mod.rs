@@ -17,5 +17,6 @@ pub mod oklab;
 pub mod png;
 pub mod quality;
 pub mod rate;
+pub mod ssim;
 pub mod units;
 pub mod vt;
