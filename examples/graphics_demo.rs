@@ -9,11 +9,10 @@
 //! which mode), waits half of `SECONDS` (default 4), paints a red square into the picture and
 //! sends only that change (a kitty frame edit or a sixel cell block where the terminal allows),
 //! writes the picture the terminal should show to `REPORT.png` (for sixel the dithered one), waits the other half and restores the
-//! terminal (kitty's image deleted). Replies are read with `probe::read_fd_with_deadline`, as
-//! the player should.
+//! terminal (kitty's image deleted). The terminal is asked with `tidepool::play::probe_for_picture`,
+//! as `render --out -` asks it.
 
 use std::io::{self, Write};
-use std::os::fd::AsFd;
 use std::time::{Duration, Instant};
 
 use tidepool::graphics::geometry::{SCALED_CAP, layout};
@@ -21,7 +20,7 @@ use tidepool::graphics::iterm2::Iterm2Encoder;
 use tidepool::graphics::kitty::{self, KittyEncoder, KittyOptions, Medium};
 use tidepool::graphics::sixel::{SixelEncoder, SixelPalette, dithered_rgb};
 use tidepool::graphics::{GraphicsMode, push_rgb};
-use tidepool::player::probe::{self, Environment, GraphicsRequest, ProbeOptions, WinSize};
+use tidepool::play::GraphicsRequest;
 use tiny_skia::{Color, FilterQuality, Pixmap, PixmapPaint, Rect, Transform};
 
 const GOLDEN: &[u8] = include_bytes!("../tests/golden/pool_default.png");
@@ -48,49 +47,19 @@ fn main() -> io::Result<()> {
 }
 
 fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
-    let env = Environment::current();
-    let winsize = WinSize::current()?;
-    let kitty_file = if env.ssh { None } else { kitty::write_temp_file(&kitty::temp_dir(), 0, &[0, 0, 0]).ok() };
-    let options = ProbeOptions { env, winsize, kitty_file: kitty_file.clone() };
-
-    // Replies are read from stdin with `poll` and a deadline; each read is logged for the report.
+    // The same question and the same rules as `tidepool render --out -` (at most
+    // 150 ms; the file medium is not offered).
     let started = Instant::now();
-    let log = std::cell::RefCell::new(String::new());
-    let stdin = io::stdin();
-    let mut read = |buf: &mut [u8], deadline: Instant| -> io::Result<usize> {
-        let n = probe::read_fd_with_deadline(stdin.as_fd(), buf, deadline)?;
-        if n > 0 {
-            log.borrow_mut().push_str(&format!("{:?} {:?}\n", started.elapsed(), String::from_utf8_lossy(&buf[..n])));
-        }
-        Ok(n)
-    };
+    let (choice, support) = tidepool::play::probe_for_picture(request);
+    let took = started.elapsed();
+    let support = &support;
+    let mut text = format!("probe took {took:?}\n{support:#?}\n{choice:#?}\n");
+    let (cols, rows) = crossterm::terminal::size()?;
     let mut stdout = io::stdout().lock();
     let mut write = |bytes: &[u8]| {
         stdout.write_all(bytes)?;
         stdout.flush()
     };
-    // GRAPHICS_DEMO_BUDGET_MS: a longer wait, to see what a slow terminal answers.
-    let budget = std::env::var("GRAPHICS_DEMO_BUDGET_MS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .map_or(probe::PROBE_BUDGET, Duration::from_millis);
-    let mut outcome = probe::run_probe(&options, &mut write, &mut read, &Instant::now, budget)?;
-    let took = started.elapsed();
-    if let Some(path) = &kitty_file
-        && path.exists()
-    {
-        outcome.support.kitty_temp_file = false;
-        let _ = std::fs::remove_file(path);
-    }
-    let support = &outcome.support;
-    let choice = probe::choose(request, Some(support));
-    let mut text = format!(
-        "probe took {took:?}\nread:\n{}{support:#?}\n{choice:#?}\nleftover {:?}\n",
-        log.borrow(),
-        outcome.leftover
-    );
-
-    let (cols, rows) = (winsize.cols, winsize.rows);
     let sixel_max = support.sixel.and_then(|s| Some((s.max_w?, s.max_h?)));
     let l = layout(choice.mode, (cols, rows), support.cell_px, sixel_max, SCALED_CAP);
     text.push_str(&format!("{l:#?}\n"));
@@ -121,7 +90,7 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
         z_index: -1,
         ..KittyOptions::new(l.cells)
     });
-    let registers = support.sixel.map_or(probe::DEFAULT_SIXEL_REGISTERS, |s| s.registers);
+    let registers = support.sixel_registers();
     let mut sixel_enc = SixelEncoder::new(SixelPalette::for_registers(registers), (0, 0), Some(l.cell_px));
     let mut iterm2_enc = Iterm2Encoder::new((0, 0), l.cells, choice.tmux_wrap);
     let mut draw = |picture: &Pixmap, out: &mut Vec<u8>, text: &mut String| -> io::Result<()> {

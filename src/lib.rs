@@ -19,8 +19,8 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Features: `cli` (default: the `tidepool` binary), `player` (the interactive terminal player,
-//! `player`), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
+//! Features: `cli` (default: the `tidepool` binary), `player` (the play session and the
+//! interactive terminal player, [`play`]), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
 //! that draws any scene, `widget`).
 #![warn(missing_docs)]
 
@@ -39,7 +39,7 @@ mod term;
 pub mod encode;
 pub mod graphics;
 #[cfg(feature = "player")]
-pub mod player;
+pub mod play;
 pub mod replay;
 pub mod sea;
 pub mod terminal;

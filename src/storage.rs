@@ -10,4 +10,11 @@ use crate::error::Result;
 pub trait Storage: Send + Sync {
     /// Writes `bytes` to `path`, all or nothing.
     fn save(&self, path: &Path, bytes: &[u8]) -> Result<()>;
+
+    /// Whether something is saved at `path` already (screenshots take the first free name).
+    /// A storage that cannot tell says no.
+    fn exists(&self, path: &Path) -> bool {
+        let _ = path;
+        false
+    }
 }

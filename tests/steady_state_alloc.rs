@@ -1,7 +1,7 @@
 //! The interactive loop's steady state must not allocate: a frame (steps, picture, status line
 //! and overlays, diff encoding, the write) reuses every buffer, for the pool and the lake. A
 //! counting allocator checks it, across every thread (rayon's workers and the frame writer).
-//! The player runs for real here, through `tidepool::player::run` on a fake terminal: this is
+//! The player runs for real here, through `tidepool::play::run` on a fake terminal: this is
 //! also the proof that the loop runs on any byte stream.
 //! The ocean is the exception it measures: tiny-skia's `fill_path` builds each triangle's edge
 //! list in a fresh `Vec` (there is no way to hand it a buffer), so an ocean frame allocates
@@ -14,7 +14,7 @@ use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use tidepool::player::{PlayerConfig, TerminalInput};
+use tidepool::play::{Bandwidth, GraphicsRequest, HostConfig, PlayConfig, ScreenConfig, TerminalInput};
 use tidepool::terminal::{ColorMode, EncodeOptions};
 use tidepool::{LakeSettings, OceanSettings, PoolScene, PoolSettings, Scene, SceneSpec, Stone};
 
@@ -124,21 +124,21 @@ impl io::Write for FrameCounter {
 fn player_frames(scene: SceneSpec) -> usize {
     let quit = Arc::new(AtomicBool::new(false));
     let marks = Arc::new(Mutex::new(Vec::with_capacity(2)));
-    let config = PlayerConfig {
-        scenes: vec![scene],
-        fps: 60,
-        bandwidth: tidepool::player::Bandwidth::Unlimited,
-        color: ColorMode::TrueColor,
-        encode: EncodeOptions { threshold: 0, sync: true },
-        seed: 1,
-        record: None,
-        storage: None,
+    let config = PlayConfig {
+        host: HostConfig { scenes: vec![scene], seed: 1, record: None, storage: None },
+        screen: ScreenConfig {
+            fps: 60,
+            bandwidth: Bandwidth::Unlimited,
+            color: ColorMode::TrueColor,
+            encode: EncodeOptions { threshold: 0, sync: true },
+            graphics: GraphicsRequest::Auto,
+            probe: None,
+        },
         greeting: Some("a greeting in the status line".into()),
         quit: Arc::clone(&quit),
-        graphics: tidepool::player::probe::GraphicsRequest::Auto,
     };
     let output = FrameCounter { frames: 0, marks: Arc::clone(&marks), quit };
-    tidepool::player::run(&mut FakeTerminal { keys: Some(b"?l") }, output, config).unwrap();
+    tidepool::play::run(&mut FakeTerminal { keys: Some(b"?l") }, output, config).unwrap();
     let marks = marks.lock().unwrap();
     marks[1] - marks[0]
 }

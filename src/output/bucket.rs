@@ -1,5 +1,6 @@
-//! The byte budget of the rate-controlled encoder: a bucket filled at the link's rate, from
-//! which each frame takes what it sends.
+//! A token bucket: the byte budget of the rate-controlled encoder (filled at the link's rate,
+//! each frame takes what it sends), and with other settings any rate limit (a server's bytes
+//! for all its players, one player's actions a second).
 //!
 //! What a frame does not spend carries over, so a rate smaller than one cell a frame (1 kB/s
 //! is 33 bytes a frame at 30 fps, less than one truecolor cell with its synchronized-output
@@ -19,25 +20,43 @@ pub const MIN_CAPACITY: f64 = 256.0;
 /// The most debt a picture frame may leave (see [`ByteBucket::owe`]), in time at the rate.
 pub const MAX_DEBT: Duration = Duration::from_secs(10);
 
-/// A byte bucket refilled at a fixed rate, or an unlimited one.
+/// A bucket of bytes (or any tokens) refilled at a fixed rate, or an unlimited one.
 #[derive(Clone, Debug)]
 pub struct ByteBucket {
     /// Bytes per second; `None` for no limit.
     rate: Option<f64>,
     level: f64,
     last: Option<Instant>,
+    /// How much of the rate it holds at most.
+    burst: Duration,
+    /// How much of the rate it may owe at most.
+    max_debt: Duration,
 }
 
 impl ByteBucket {
-    /// A bucket filled at `bytes_per_second` (at least 1), starting empty.
+    /// A bucket filled at `bytes_per_second` (at least 1), starting empty, holding at most
+    /// [`MAX_BURST`] of the rate: a frame's budget.
     pub fn new(bytes_per_second: f64) -> ByteBucket {
-        ByteBucket { rate: Some(bytes_per_second.max(1.0)), level: 0.0, last: None }
+        ByteBucket {
+            rate: Some(bytes_per_second.max(1.0)),
+            level: 0.0,
+            last: None,
+            burst: MAX_BURST,
+            max_debt: MAX_DEBT,
+        }
+    }
+
+    /// A rate limit: filled at `per_second`, starting full, holding and owing at most `burst`
+    /// of the rate (a second for a server's limits: a short burst passes, a flood gets the rate).
+    pub fn limit(per_second: f64, burst: Duration) -> ByteBucket {
+        let rate = per_second.max(1e-9);
+        ByteBucket { rate: Some(rate), level: rate * burst.as_secs_f64(), last: None, burst, max_debt: burst }
     }
 
     /// A bucket that never runs dry: [`ByteBucket::budget`] is
     /// [`crate::output::rate::UNLIMITED`].
     pub fn unlimited() -> ByteBucket {
-        ByteBucket { rate: None, level: 0.0, last: None }
+        ByteBucket { rate: None, level: 0.0, last: None, burst: MAX_BURST, max_debt: MAX_DEBT }
     }
 
     /// The rate in bytes per second (`None`: unlimited).
@@ -54,7 +73,8 @@ impl ByteBucket {
     /// The most the bucket holds, in bytes.
     pub fn capacity(&self) -> f64 {
         match self.rate {
-            Some(rate) => (rate * MAX_BURST.as_secs_f64()).max(MIN_CAPACITY),
+            Some(rate) if self.burst == MAX_BURST => (rate * MAX_BURST.as_secs_f64()).max(MIN_CAPACITY),
+            Some(rate) => rate * self.burst.as_secs_f64(),
             None => f64::INFINITY,
         }
     }
@@ -92,8 +112,23 @@ impl ByteBucket {
     /// has repaid it. So such frames come as often as the rate allows, and never queue.
     pub fn owe(&mut self, bytes: usize) {
         if let Some(rate) = self.rate {
-            // At most ten seconds of debt: a huge picture on a slow link still shows now and then.
-            self.level = (self.level - bytes as f64).max(-rate * MAX_DEBT.as_secs_f64());
+            // At most ten seconds of debt (a frame budget's bucket): a huge picture on a slow link
+            // still shows now and then.
+            self.level = (self.level - bytes as f64).max(-rate * self.max_debt.as_secs_f64());
+        }
+    }
+
+    /// Takes `n` tokens at `now` if the bucket holds them (a rate limit: an action, a frame's
+    /// bytes from a shared budget); says whether it did.
+    pub fn try_take(&mut self, n: f64, now: Instant) -> bool {
+        self.refill(now);
+        match self.rate {
+            None => true,
+            Some(_) if self.level >= n => {
+                self.level -= n;
+                true
+            }
+            Some(_) => false,
         }
     }
 
@@ -173,6 +208,21 @@ mod tests {
         let mut free = ByteBucket::unlimited();
         free.owe(1 << 30);
         assert!(!free.in_debt());
+    }
+
+    #[test]
+    fn a_limit_starts_full_lets_a_burst_pass_and_then_the_rate() {
+        let t0 = Instant::now();
+        let mut actions = ByteBucket::limit(30.0, Duration::from_secs(1));
+        let taken = (0..100).filter(|_| actions.try_take(1.0, t0)).count();
+        assert_eq!(taken, 30, "a second's worth at once");
+        assert!(!actions.try_take(1.0, t0 + Duration::from_millis(20)));
+        assert!(actions.try_take(1.0, t0 + Duration::from_millis(40)), "one more after 1/30 s");
+        let mut bytes = ByteBucket::limit(1000.0, Duration::from_secs(1));
+        bytes.refill(t0);
+        bytes.owe(5000);
+        assert!(!bytes.try_take(0.0, t0 + Duration::from_millis(900)), "still owing");
+        assert!(bytes.try_take(0.0, t0 + Duration::from_millis(1100)), "a second of debt at most: repaid after 1 s");
     }
 
     #[test]

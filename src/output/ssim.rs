@@ -94,13 +94,11 @@ pub fn ssim(a: &Luma, b: &Luma) -> f64 {
     let kernel = gaussian();
     let n = w * h;
     let mut planes = [vec![0f64; n], vec![0f64; n], vec![0f64; n], vec![0f64; n], vec![0f64; n]];
-    for i in 0..n {
-        let (x, y) = (f64::from(a.values[i]), f64::from(b.values[i]));
-        planes[0][i] = x;
-        planes[1][i] = y;
-        planes[2][i] = x * x;
-        planes[3][i] = y * y;
-        planes[4][i] = x * y;
+    for (i, (&x, &y)) in a.values.iter().zip(&b.values).enumerate() {
+        let (x, y) = (f64::from(x), f64::from(y));
+        for (plane, v) in planes.iter_mut().zip([x, y, x * x, y * y, x * y]) {
+            plane[i] = v;
+        }
     }
     let mut scratch = vec![0f64; n];
     for plane in &mut planes {

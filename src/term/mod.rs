@@ -1,16 +1,8 @@
-//! The interactive terminal player: the loop that ties a scene to a terminal ([`player`]),
-//! input bytes to inputs ([`input`]), time ([`pacing`]), the frame writer ([`writer`]), what is
-//! drawn over the picture ([`ui`], [`screen`]), and this process's own terminal ([`tty`]). The
-//! bytes themselves come from the pure encoder in [`crate::output::diff`].
+//! The door of this process's own terminal (and of any byte stream that stands for one): the
+//! play session's host, seat and screen driven by one loop ([`door`]), the tty's raw mode and
+//! its restore on every way out ([`tty`]), and the writer thread that never queues frames
+//! ([`writer`]). Everything the session decides lives in [`crate::play`]; this is I/O only.
 
-pub mod input;
-pub mod link;
-pub mod pacing;
-pub mod picture;
-pub mod player;
-pub mod probe;
-pub mod replies;
-pub mod screen;
+pub mod door;
 pub mod tty;
-pub mod ui;
 pub mod writer;

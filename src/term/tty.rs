@@ -9,12 +9,11 @@
 //! - [`restore`], which a program calls from its signal handler (the `tidepool` binary does for
 //!   SIGINT, SIGTERM and SIGHUP: the SSH link dropped).
 //!
-//! With `--graphics` other than `cells`, the terminal is first asked what it can show
-//! ([`super::probe`]): in raw mode, before the alternate screen and mouse reporting (a mouse
-//! report during the probe would look like a garbled answer), with the replies read here with a
-//! deadline, so nothing is left blocked on the terminal for the player's own reader. What the
+//! With `--graphics` other than `cells`, the session's screen first asks the terminal what it
+//! can show (`crate::play`'s probe): in raw mode, before the alternate screen and mouse
+//! reporting (a mouse report during the probe would look like a garbled answer). What the
 //! picture needs undone on exit (kitty's image, pixel mouse reports) is written before
-//! [`RESTORE`] on every path, by [`set_restore_prefix`].
+//! [`Screen::RESTORE`] on every path, by [`set_restore_prefix`].
 //!
 //! The restore runs at most once. Frames and the restore go through one lock, so the restore
 //! never lands in the middle of a frame; it also starts with CAN (0x18), which aborts an escape
@@ -29,59 +28,45 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard, Once, OnceLock};
 use std::time::{Duration, Instant};
 
-use super::picture;
-use super::player::{self, PlayerConfig, Probed, TerminalInput};
-use super::probe::{self, GraphicsRequest, ProbeOptions};
+use super::door::{PlayConfig, TerminalInput, run_door};
 use crate::error::{Error, Result};
 use crate::output::graphics::{GraphicsMode, kitty};
-
-/// Sent when the player starts: alternate screen, hidden cursor, mouse reporting (buttons and
-/// drags only, mode 1002, not every motion; SGR coordinates, mode 1006), screen cleared.
-pub const ENTER: &[u8] = b"\x1b[?1049h\x1b[?25l\x1b[?1000h\x1b[?1002h\x1b[?1006h\x1b[0m\x1b[2J";
-
-/// Sent when the player stops: abort any cut sequence, end synchronized output, reset
-/// colours, mouse off, cursor on, back to the normal screen.
-pub const RESTORE: &[u8] = b"\x18\x1b[?2026l\x1b[0m\x1b[?1006l\x1b[?1002l\x1b[?1000l\x1b[?25h\x1b[?1049l";
+use crate::play::screen::Screen;
+use crate::play::screen::probe::{
+    self, Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize,
+};
 
 static ACTIVE: AtomicBool = AtomicBool::new(false);
 static WRITE_LOCK: Mutex<()> = Mutex::new(());
 static OUT: OnceLock<File> = OnceLock::new();
 static PANIC_HOOK: Once = Once::new();
-/// Written before [`RESTORE`]: what the picture needs undone (see [`set_restore_prefix`]).
+/// Written before [`Screen::RESTORE`]: what the picture needs undone (see [`set_restore_prefix`]).
 static RESTORE_PREFIX: Mutex<Vec<u8>> = Mutex::new(Vec::new());
 
-/// After a probe the terminal did not answer in time, how long the player waits on exit for
-/// answers still on their way, and drops them, so that none reach the shell as typed text.
+/// After a probe the terminal did not answer in time, how long a picture written once waits
+/// for answers still on their way, and drops them, so that none reach the shell as typed text.
 pub const LATE_REPLY_GRACE: Duration = Duration::from_millis(50);
 /// The temporary file of the probe's kitty file-medium query (a number the encoder never
 /// reaches, so the names never collide).
 const PROBE_FILE_NUMBER: u64 = u64::MAX;
 
-/// Plays in this process's terminal (standard input and output) until the user quits; the
+/// Plays in this process's terminal (standard input and output) until the person quits; the
 /// terminal is restored on every way out. Standard output must be a terminal.
 ///
-/// Unless `config.graphics` is `cells`, the terminal is probed first (at most
-/// [`probe::PROBE_BUDGET`]; only when standard input and output are both terminals, else no
-/// query is sent and `auto` means cells).
-pub fn play(config: PlayerConfig) -> Result<()> {
+/// Unless `config.screen.graphics` is `cells`, the terminal is asked what it shows first (only
+/// when standard input and output are both terminals; else no question is sent and `auto`
+/// means cells).
+pub fn play(mut config: PlayConfig) -> Result<()> {
     use std::io::IsTerminal;
     let setup = |source| Error::Terminal { action: "cannot set up the terminal", source };
-    let size = crossterm::terminal::size()
-        .map_err(|source| Error::Terminal { action: "cannot read the terminal size", source })?;
-    let wants_probe = config.graphics != GraphicsRequest::Force(GraphicsMode::Cells)
+    let winsize =
+        window_size().map_err(|source| Error::Terminal { action: "cannot read the terminal size", source })?;
+    let asks = config.screen.graphics != GraphicsRequest::Force(GraphicsMode::Cells)
         && probe::should_probe(io::stdin().is_terminal(), io::stdout().is_terminal());
     let guard = TerminalGuard::raw().map_err(setup)?;
-    let probed = if wants_probe { Some(probe_terminal().map_err(setup)?) } else { None };
-    let choice = probe::choose(config.graphics, probed.as_ref().map(|p| &p.support));
-    let pixel_mouse = probed.as_ref().is_some_and(|p| picture::pixel_mouse(&choice, &p.support));
-    set_restore_prefix(picture::restore_bytes(&choice, pixel_mouse));
-    guard.enter_screen(if pixel_mouse { picture::PIXEL_MOUSE_ON } else { b"" }).map_err(setup)?;
-    let unanswered = probed.as_ref().is_some_and(|p| !p.support.answered);
-    let mut input = Stdin { size };
-    let result = player::run_probed(&mut input, TtyOut, config, probed);
-    if unanswered {
-        drop_late_replies();
-    }
+    config.screen.probe = asks.then(|| probe_options(winsize, true));
+    let mut input = Stdin { size: (winsize.cols, winsize.rows) };
+    let result = run_door(&mut input, TtyOut, config, &mut set_restore_prefix);
     drop(guard);
     set_restore_prefix(Vec::new());
     remove_temp_files();
@@ -93,7 +78,7 @@ pub fn play(config: PlayerConfig) -> Result<()> {
 /// was) unless `request` is `cells` or standard input and output are not both terminals; then
 /// `auto` means cells. The file medium is not offered (the process may end before the terminal
 /// reads a file), nor pixel mouse reports.
-pub fn probe_for_picture(request: GraphicsRequest) -> (probe::GraphicsChoice, probe::GraphicsSupport) {
+pub fn probe_for_picture(request: GraphicsRequest) -> (GraphicsChoice, GraphicsSupport) {
     use std::io::IsTerminal;
     let asks = request != GraphicsRequest::Force(GraphicsMode::Cells)
         && probe::should_probe(io::stdin().is_terminal(), io::stdout().is_terminal());
@@ -104,12 +89,12 @@ pub fn probe_for_picture(request: GraphicsRequest) -> (probe::GraphicsChoice, pr
                 OUT.get_or_init(|| File::from(fd));
             }
             crossterm::terminal::enable_raw_mode().ok()?;
-            let probed = probe_terminal();
-            if probed.as_ref().is_ok_and(|p| !p.support.answered) {
+            let probed = window_size().and_then(|w| ask(&probe_options(w, false)));
+            if probed.as_ref().is_ok_and(|s| !s.answered) {
                 drop_late_replies();
             }
             let _ = crossterm::terminal::disable_raw_mode();
-            let mut support = probed.ok()?.support;
+            let mut support = probed.ok()?;
             support.kitty_temp_file = false;
             support.sgr_pixels_mouse = false;
             Some(support)
@@ -118,15 +103,21 @@ pub fn probe_for_picture(request: GraphicsRequest) -> (probe::GraphicsChoice, pr
     (probe::choose(request, support.as_ref()), support.unwrap_or_default())
 }
 
-/// Asks the terminal what it can show (see [`super::probe`]); the terminal is in raw mode.
-fn probe_terminal() -> io::Result<Probed> {
-    let env = probe::Environment::current();
-    let winsize = probe::WinSize::current()?;
-    let kitty_file =
-        if env.ssh { None } else { kitty::write_temp_file(&kitty::temp_dir(), PROBE_FILE_NUMBER, &[0, 0, 0]).ok() };
-    let options = ProbeOptions { env, winsize, kitty_file: kitty_file.clone() };
+/// The probe's starting point for this process's terminal: its environment and window size,
+/// and (when `file_medium` and not over SSH) a temporary file for the kitty file-medium query.
+fn probe_options(winsize: WinSize, file_medium: bool) -> ProbeOptions {
+    let env = Environment::from_lookup(|name| std::env::var(name).ok());
+    let kitty_file = (file_medium && !env.ssh)
+        .then(|| kitty::write_temp_file(&kitty::temp_dir(), PROBE_FILE_NUMBER, &[0, 0, 0]).ok())
+        .flatten();
+    ProbeOptions { env, winsize, kitty_file }
+}
+
+/// Asks the terminal what it can show, waiting at most [`probe::PROBE_BUDGET`]; the terminal
+/// is in raw mode.
+fn ask(options: &ProbeOptions) -> io::Result<GraphicsSupport> {
     let stdin = io::stdin();
-    let mut read = |buf: &mut [u8], deadline: Instant| probe::read_fd_with_deadline(stdin.as_fd(), buf, deadline);
+    let mut read = |buf: &mut [u8], deadline: Instant| read_fd_with_deadline(stdin.as_fd(), buf, deadline);
     let mut write = |bytes: &[u8]| {
         let _lock = lock();
         match OUT.get() {
@@ -134,15 +125,13 @@ fn probe_terminal() -> io::Result<Probed> {
             None => Ok(()),
         }
     };
-    let mut outcome = probe::run_probe(&options, &mut write, &mut read, &Instant::now, probe::PROBE_BUDGET)?;
-    if let Some(path) = &kitty_file
-        && path.exists()
-    {
-        // The terminal did not read (and delete) the file: the file medium does not work.
-        outcome.support.kitty_temp_file = false;
-        let _ = std::fs::remove_file(path);
-    }
-    Ok(Probed { support: outcome.support, leftover: outcome.leftover })
+    Ok(probe::run_probe(options, &mut write, &mut read, &Instant::now, probe::PROBE_BUDGET)?.support)
+}
+
+/// The window size of the terminal on standard output (TIOCGWINSZ, through crossterm).
+fn window_size() -> io::Result<WinSize> {
+    let w = crossterm::terminal::window_size()?;
+    Ok(WinSize { cols: w.columns, rows: w.rows, x_px: w.width, y_px: w.height })
 }
 
 /// Reads and drops what arrives within [`LATE_REPLY_GRACE`]: the answers of a probe that timed
@@ -151,8 +140,28 @@ fn drop_late_replies() {
     let deadline = Instant::now() + LATE_REPLY_GRACE;
     let mut buf = [0u8; 4096];
     while Instant::now() < deadline {
-        if !matches!(probe::read_fd_with_deadline(io::stdin().as_fd(), &mut buf, deadline), Ok(n) if n > 0) {
+        if !matches!(read_fd_with_deadline(io::stdin().as_fd(), &mut buf, deadline), Ok(n) if n > 0) {
             break;
+        }
+    }
+}
+
+/// A `read_with_deadline` for the probe's [`probe::run_probe`] on a terminal (or any pollable descriptor): waits
+/// until input is there or `deadline` has passed (`poll`), then reads what is there. Returns 0
+/// when the deadline passed with nothing to read. Unlike a reader thread, it leaves nothing
+/// blocked on the terminal for the player's own input reader to compete with.
+#[cfg(unix)]
+pub fn read_fd_with_deadline(fd: std::os::fd::BorrowedFd<'_>, buf: &mut [u8], deadline: Instant) -> io::Result<usize> {
+    use rustix::event::{PollFd, PollFlags, Timespec, poll};
+    loop {
+        let wait = deadline.saturating_duration_since(Instant::now());
+        let timeout = Timespec { tv_sec: wait.as_secs() as i64, tv_nsec: i64::from(wait.subsec_nanos()) };
+        let mut fds = [PollFd::new(&fd, PollFlags::IN)];
+        match poll(&mut fds, Some(&timeout)) {
+            Ok(0) => return Ok(0),
+            Ok(_) => return rustix::io::read(fd, buf).map_err(io::Error::from),
+            Err(rustix::io::Errno::INTR) => continue,
+            Err(e) => return Err(e.into()),
         }
     }
 }
@@ -171,7 +180,7 @@ fn remove_temp_files() {
     }
 }
 
-/// Sets the bytes written before [`RESTORE`] when the terminal is restored (on every path:
+/// Sets the bytes written before [`Screen::RESTORE`] when the terminal is restored (on every path:
 /// the guard, the panic hook, [`restore`] from a signal handler): what the picture needs
 /// undone, such as deleting kitty's image.
 pub fn set_restore_prefix(bytes: Vec<u8>) {
@@ -186,8 +195,8 @@ pub struct TerminalGuard {
 
 impl TerminalGuard {
     /// Puts the terminal in raw mode, with the restore armed (the guard's drop, the panic
-    /// hook, [`restore`]), so the terminal can be asked questions before the screen is taken
-    /// over with [`TerminalGuard::enter_screen`]. Fails (leaving the terminal as it was) when
+    /// hook, [`restore`]), so the terminal can be asked questions before the session's screen
+    /// takes it over ([`Screen::ENTER`]). Fails (leaving the terminal as it was) when
     /// raw mode cannot be set.
     pub fn raw() -> io::Result<TerminalGuard> {
         if OUT.get().is_none() {
@@ -204,18 +213,6 @@ impl TerminalGuard {
             }));
         });
         Ok(TerminalGuard { _private: () })
-    }
-
-    /// The alternate screen, hidden cursor and mouse reporting ([`ENTER`]), then `extra` (modes
-    /// the picture needs, such as pixel mouse reports).
-    pub fn enter_screen(&self, extra: &[u8]) -> io::Result<()> {
-        let _lock = lock();
-        let mut out = OUT.get().ok_or_else(|| io::Error::other("the terminal's output is not open"))?;
-        out.write_all(ENTER)?;
-        if !extra.is_empty() {
-            out.write_all(extra)?;
-        }
-        Ok(())
     }
 }
 
@@ -281,7 +278,7 @@ pub fn restore() {
         if !prefix.is_empty() {
             let _ = out.write_all(b"\x18").and_then(|()| out.write_all(&prefix));
         }
-        let _ = out.write_all(RESTORE);
+        let _ = out.write_all(Screen::RESTORE);
     }
     let _ = crossterm::terminal::disable_raw_mode();
 }
@@ -333,14 +330,41 @@ impl TerminalInput for Stdin {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::vt::Screen;
+    use crate::output::vt::Screen as Vt;
+
+    #[test]
+    fn a_real_descriptor_is_read_until_the_deadline() {
+        use std::os::fd::AsFd;
+        let (reader, mut writer) = std::io::pipe().unwrap();
+        let feeder = std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_millis(20));
+            writer.write_all(b"\x1b_Gi=31;OK\x1b\\\x1b[?62;22c").unwrap();
+            writer
+        });
+        let mut sent = Vec::new();
+        let mut write = |b: &[u8]| {
+            sent.extend_from_slice(b);
+            Ok(())
+        };
+        let mut read = |buf: &mut [u8], deadline: Instant| read_fd_with_deadline(reader.as_fd(), buf, deadline);
+        let options =
+            ProbeOptions { winsize: WinSize { cols: 80, rows: 24, x_px: 0, y_px: 0 }, ..ProbeOptions::default() };
+        let outcome = probe::run_probe(&options, &mut write, &mut read, &Instant::now, Duration::from_secs(5)).unwrap();
+        assert!(outcome.support.answered && outcome.support.kitty);
+        assert!(sent.ends_with(b"\x1b[c"));
+        // Nothing more to read: it returns 0 once the deadline has passed.
+        let _writer = feeder.join().unwrap();
+        let deadline = Instant::now() + Duration::from_millis(30);
+        assert_eq!(read_fd_with_deadline(reader.as_fd(), &mut [0; 16], deadline).unwrap(), 0);
+        assert!(Instant::now() >= deadline, "returned before its deadline");
+    }
 
     #[test]
     fn restore_undoes_every_mode_enter_sets() {
-        let mut s = Screen::new(10, 3);
-        s.feed(ENTER);
+        let mut s = Vt::new(10, 3);
+        s.feed(Screen::ENTER);
         s.feed(b"\x1b[?2026h\x1b[38;2;1;2;3mx\x1b[");
-        s.feed(RESTORE);
+        s.feed(Screen::RESTORE);
         for mode in [1049, 1000, 1002, 1006, 2026] {
             assert_eq!(s.private_mode(mode), Some(false), "mode {mode}");
         }

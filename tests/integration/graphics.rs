@@ -8,7 +8,10 @@ use std::time::Duration;
 
 use crate::common::pty::{DA1_ANSWER, Player, cooked, find, rfind, temp_dir};
 use tidepool::graphics::{kitty, kitty_decode};
-use tidepool::player::{ENTER, RESTORE};
+use tidepool::play::Screen;
+
+const ENTER: &[u8] = Screen::ENTER;
+const RESTORE: &[u8] = Screen::RESTORE;
 use tidepool::terminal::SYNC_END;
 
 const WAIT: Duration = Duration::from_secs(20);

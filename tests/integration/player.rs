@@ -5,7 +5,13 @@
 use std::time::Duration;
 
 use crate::common::pty::{Player, cooked, find, rfind, temp_dir};
-use tidepool::player::{ENTER, RESTORE};
+use tidepool::play::Screen;
+
+const ENTER: &[u8] = Screen::ENTER;
+const RESTORE: &[u8] = Screen::RESTORE;
+/// Makes the player panic after its first frame (a test hook of the terminal door, not a user
+/// feature).
+const TEST_PANIC_VAR: &str = "TIDEPOOL_TEST_PANIC";
 use tidepool::terminal::{SYNC_BEGIN, SYNC_END};
 
 const WAIT: Duration = Duration::from_secs(20);
@@ -60,7 +66,7 @@ fn sigterm_and_sighup_restore() {
 #[test]
 fn a_panic_restores_before_its_message() {
     let dir = temp_dir("panic");
-    let mut p = Player::spawn(&dir, 40, 12, ARGS, &[(tidepool::player::TEST_PANIC_VAR, "1")]);
+    let mut p = Player::spawn(&dir, 40, 12, ARGS, &[(TEST_PANIC_VAR, "1")]);
     let status = p.wait_exit(WAIT);
     assert_eq!(status.exit_code(), 101);
     let out = p.output();

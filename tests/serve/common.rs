@@ -16,6 +16,9 @@ use russh::{Channel, ChannelMsg};
 pub const HANG_GUARD: Duration = Duration::from_secs(30);
 /// Synchronized output begins every frame the server sends.
 pub const SYNC_BEGIN: &[u8] = b"\x1b[?2026h";
+/// The device-attributes question, and the answer a VT220-class terminal gives.
+pub const DA1_QUESTION: &[u8] = b"\x1b[c";
+pub const DA1_ANSWER: &[u8] = b"\x1b[?62;22c";
 
 /// Flags that make a test server quick and quiet: short timeouts, still water, no rain.
 pub const TEST_FLAGS: &[&str] = &["--rain", "0", "--breeze", "0", "--handshake-timeout-ms", "5000"];
@@ -209,6 +212,12 @@ impl Term {
                         self.frames += data.windows(SYNC_BEGIN.len()).filter(|w| *w == SYNC_BEGIN).count();
                         self.screen.feed(&data);
                         self.raw.extend_from_slice(&data);
+                        // A terminal answers device-attributes questions once it has read what
+                        // came before them (the server's link control and probe ask them).
+                        let questions = data.windows(DA1_QUESTION.len()).filter(|w| *w == DA1_QUESTION).count();
+                        for _ in 0..questions {
+                            let _ = self.ch.data(DA1_ANSWER).await;
+                        }
                     }
                     Some(_) => {}
                     None => return false,

@@ -167,7 +167,7 @@ pub struct PlayCommand {
     /// `unlimited` sends every change whole. On a slow link the picture is sent approximately
     /// and refined as the budget allows; frames never queue up.
     #[arg(long, value_name = "BYTES/s|auto|unlimited", default_value = "auto", value_parser = parse_bandwidth)]
-    pub bandwidth: tidepool::player::Bandwidth,
+    pub bandwidth: tidepool::play::Bandwidth,
 
     /// The same as --bandwidth N (kept for scripts written before --bandwidth).
     #[arg(long, value_name = "N", value_parser = parse_bps, conflicts_with = "bandwidth", hide = true)]
@@ -199,10 +199,10 @@ pub enum GraphicsChoice {
     Cells,
 }
 
-impl From<GraphicsChoice> for tidepool::player::probe::GraphicsRequest {
+impl From<GraphicsChoice> for tidepool::play::GraphicsRequest {
     fn from(choice: GraphicsChoice) -> Self {
         use tidepool::graphics::GraphicsMode;
-        use tidepool::player::probe::GraphicsRequest::{Auto, Force};
+        use tidepool::play::GraphicsRequest::{Auto, Force};
         match choice {
             GraphicsChoice::Auto => Auto,
             GraphicsChoice::Kitty => Force(GraphicsMode::Kitty),
@@ -253,8 +253,8 @@ pub enum ColorChoice {
 }
 
 /// Parses `--bandwidth`: `auto`, `unlimited` or a byte rate.
-pub fn parse_bandwidth(text: &str) -> Result<tidepool::player::Bandwidth, String> {
-    use tidepool::player::Bandwidth;
+pub fn parse_bandwidth(text: &str) -> Result<tidepool::play::Bandwidth, String> {
+    use tidepool::play::Bandwidth;
     match text.trim() {
         t if t.eq_ignore_ascii_case("auto") => Ok(Bandwidth::Auto),
         t if t.eq_ignore_ascii_case("unlimited") || t.eq_ignore_ascii_case("off") => Ok(Bandwidth::Unlimited),
@@ -573,7 +573,7 @@ mod tests {
 
     #[test]
     fn bandwidths() {
-        use tidepool::player::Bandwidth;
+        use tidepool::play::Bandwidth;
         assert_eq!(parse_bandwidth("auto"), Ok(Bandwidth::Auto));
         assert_eq!(parse_bandwidth("unlimited"), Ok(Bandwidth::Unlimited));
         assert_eq!(parse_bandwidth("250k"), Ok(Bandwidth::Fixed(250_000)));
@@ -616,7 +616,7 @@ mod tests {
             (PlayScene::Pool, 30, ColorChoice::Auto, None)
         );
         assert_eq!(play.water.pool.damping.shift(), Some(6), "the player's own damping");
-        assert_eq!(play.bandwidth, tidepool::player::Bandwidth::Auto);
+        assert_eq!(play.bandwidth, tidepool::play::Bandwidth::Auto);
         assert_eq!(play.graphics, GraphicsChoice::Auto, "pictures in real pixels where the terminal answers");
         for (flag, want) in
             [("kitty", GraphicsChoice::Kitty), ("sixel", GraphicsChoice::Sixel), ("cells", GraphicsChoice::Cells)]

@@ -57,6 +57,10 @@ impl tidepool::Storage for AtomicStorage {
             other => tidepool::Error::io("cannot write", path, std::io::Error::other(other.to_string())),
         })
     }
+
+    fn exists(&self, path: &Path) -> bool {
+        path.exists()
+    }
 }
 
 /// A file written in pieces (an animation, frame by frame) that appears under its name only

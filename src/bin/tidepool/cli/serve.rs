@@ -65,10 +65,10 @@ pub struct ServeCommand {
     #[arg(long, value_name = "N", default_value_t = 30)]
     pub actions_per_second: u64,
 
-    /// Bytes per second each player's link gets (the rate-controlled encoder spends it where
-    /// the eye sees most; suffixes k and M).
-    #[arg(long, value_name = "BYTES/s", default_value = "256k", value_parser = super::parse_bps)]
-    pub client_bandwidth: u64,
+    /// Bytes per second each player's link gets: auto finds each player's own rate from the
+    /// terminal's answers (as `play` does); a number (suffixes k and M) fixes it; unlimited.
+    #[arg(long, value_name = "BYTES/s|auto|unlimited", default_value = "auto", value_parser = super::parse_bandwidth)]
+    pub client_bandwidth: tidepool::play::Bandwidth,
 
     /// Bytes per second for all players together; beyond it frames are skipped.
     #[arg(long, value_name = "BYTES/s", default_value = "16M", value_parser = super::parse_bps)]

@@ -10,9 +10,10 @@
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
+use tidepool::Action;
 use tidepool::encode::{halfblock, png};
-use tidepool::player::{FrameBuilder, Overlay};
-use tidepool::terminal::{ColorMode, EncodeOptions, Shown, encode_into};
+use tidepool::play::{Bandwidth, GraphicsRequest, Host, HostConfig, Request, Screen, ScreenConfig, Seat};
+use tidepool::terminal::{ColorMode, EncodeOptions};
 use tidepool::{Damping, LakeSettings, OceanSettings, OceanView, PoolSettings, RipplePool, SceneSpec, Simd, Stone};
 use tiny_skia::Pixmap;
 
@@ -125,42 +126,55 @@ pub fn run(args: BenchArgs) -> Result<()> {
         });
     }
 
-    // The player's frame for every scene, at the terminal size.
+    // The player's frame for every scene, at the terminal size: the play session's own host,
+    // seat and screen, on a made-up clock of 30 frames a second (every frame is drawn).
     let (cols, rows_cells) = (args.terminal.width() as u16, (args.terminal.height() / 2 + 1) as u16);
-    let (w, h) = tidepool::player::picture_size(cols, rows_cells);
     let mut verdicts = Vec::new();
     for (name, spec) in scenes(1) {
-        let Ok(mut scene) = spec.build(w, h) else { continue };
-        let steps_per_frame = (scene.steps_per_second() / PLAYER_FPS).round().max(1.0) as u64;
-        let mut pixmap = Pixmap::new(w, h).expect("a terminal-sized picture");
-        let mut builder = FrameBuilder::default();
-        let (mut shown, mut bytes) = (Shown::UNKNOWN, Vec::new());
-        let overlay = Overlay { fps: 30, bytes_per_second: 123_456, stone: 3, ..Overlay::default() };
+        let t0 = Instant::now();
+        let config = ScreenConfig {
+            fps: PLAYER_FPS as u32,
+            bandwidth: Bandwidth::Unlimited,
+            color: ColorMode::TrueColor,
+            encode: EncodeOptions::default(),
+            graphics: GraphicsRequest::Force(tidepool::graphics::GraphicsMode::Cells),
+            probe: None,
+        };
+        let mut screen = Screen::new(config, (cols, rows_cells), t0);
+        let host_config = HostConfig { scenes: vec![spec], seed: 1, record: None, storage: None };
+        let Ok(mut host) = Host::new(host_config, screen.picture_size(), t0) else { continue };
+        let mut seat = Seat::new(screen.fit(host.size()));
+        let (w, h) = host.size();
+        let mut picture = Pixmap::new(w, h).expect("a terminal-sized picture");
+        let mut bytes = Vec::new();
         let mut k = 0u32;
         let mut sent = 0usize;
         let median = median_time(budget, || {
             k = k.wrapping_add(1);
+            let now = t0 + Duration::from_secs_f64(f64::from(k) / PLAYER_FPS);
             if k.is_multiple_of(30) {
                 // A stone a second, as a player drops them.
                 let (x, y) = ((k * 7919 % w) as i32, (k * 104729 % h) as i32);
-                scene.apply(&tidepool::Event::Stone(Stone::clamped(x, y, 3, 48)));
+                host.apply(Request::Act(Action::Stone { x, y, radius: 3, big: false }), now);
             }
-            scene.advance(steps_per_frame);
-            let frame = builder.build((cols, rows_cells), scene.as_mut(), &mut pixmap, ColorMode::TrueColor, &overlay);
+            host.advance(now);
+            host.render(&mut picture);
             bytes.clear();
-            encode_into(&mut shown, frame, EncodeOptions::default(), &mut bytes);
-            sent = bytes.len();
+            let status = host.status();
+            let view = seat.view(now, status);
+            sent = screen.frame(now, &picture, status, &view, &mut bytes).unwrap_or(0);
         });
         black_box(sent);
         let core = median.as_secs_f64() * PLAYER_FPS * 100.0;
         rows.push(Row {
-            stage: format!("player frame, {name}: {steps_per_frame} steps, picture, cells, diff"),
+            stage: format!("player frame, {name}: 1/30 s of steps, picture, cells, diff"),
             size: format!("{cols}x{rows_cells} cells"),
             median,
             rate: format!("{:.0} fps; {core:.1} % of a core at 30 fps", 1.0 / median.as_secs_f64()),
         });
         verdicts.push((name, median, core));
     }
+    let (w, h) = (u32::from(cols), 2 * u32::from(rows_cells - 1));
     // A whole frame of text, for a resize or a first frame.
     let Ok(mut pool) = scenes(1)[0].1.build(w, h) else { return Ok(()) };
     pool.advance(30);

@@ -14,7 +14,7 @@ use tidepool::graphics::iterm2::Iterm2Encoder;
 use tidepool::graphics::kitty::{KittyEncoder, KittyOptions};
 use tidepool::graphics::sixel::{SixelEncoder, SixelPalette};
 use tidepool::graphics::{GraphicsMode, push_rgb};
-use tidepool::player::probe::{DEFAULT_SIXEL_REGISTERS, GraphicsChoice, GraphicsSupport};
+use tidepool::play::{GraphicsChoice, GraphicsSupport};
 use tiny_skia::Pixmap;
 
 use crate::cli::GraphicsChoice as Request;
@@ -30,9 +30,9 @@ pub struct Inline {
 }
 
 impl Inline {
-    /// Asks the terminal (see `tidepool::player::probe_for_picture`); `None` for cells.
+    /// Asks the terminal (see `tidepool::play::probe_for_picture`); `None` for cells.
     pub fn probe(request: Request) -> Option<Inline> {
-        let (choice, support) = tidepool::player::probe_for_picture(request.into());
+        let (choice, support) = tidepool::play::probe_for_picture(request.into());
         if choice.mode == GraphicsMode::Cells {
             return None;
         }
@@ -80,7 +80,7 @@ impl Inline {
             }
             GraphicsMode::Sixel => {
                 push_rgb(picture, &mut rgb);
-                let registers = self.support.sixel.map_or(DEFAULT_SIXEL_REGISTERS, |s| s.registers);
+                let registers = self.support.sixel_registers();
                 SixelEncoder::new(SixelPalette::for_registers(registers), (0, 0), None).encode(&rgb, w, h, &mut out);
             }
             GraphicsMode::Iterm2 => {

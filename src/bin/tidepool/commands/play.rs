@@ -7,7 +7,7 @@ use std::io::IsTerminal;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use tidepool::player::PlayerConfig;
+use tidepool::play::{Bandwidth, HostConfig, PlayConfig, Recording, ScreenConfig};
 use tidepool::terminal::{ColorMode, EncodeOptions};
 
 use crate::cli::{ColorChoice, PlayCommand};
@@ -58,21 +58,27 @@ pub fn run(command: PlayCommand) -> Result<()> {
     }
     let scenes = super::scenes::specs(command.scene, &command.water)?;
     let quit = Arc::new(AtomicBool::new(false));
-    let config = PlayerConfig {
+    let host = HostConfig {
         scenes,
+        seed: command.water.seed,
+        record: command
+            .record
+            .clone()
+            .map(|path| Recording { path, background: command.water.pool.background.clone() }),
+        storage: Some(Arc::new(crate::files::AtomicStorage)),
+    };
+    let screen = ScreenConfig {
         fps: command.fps,
-        bandwidth: command.max_bps.map_or(command.bandwidth, tidepool::player::Bandwidth::Fixed),
+        bandwidth: command.max_bps.map_or(command.bandwidth, Bandwidth::Fixed),
         color,
         encode: EncodeOptions { threshold, sync: !command.no_sync },
-        seed: command.water.seed,
-        record: command.record.clone().map(|path| (path, command.water.pool.background.clone())),
-        storage: Some(Arc::new(crate::files::AtomicStorage)),
-        greeting: color_hint(command.color, color),
-        quit: Arc::clone(&quit),
         graphics: command.graphics.into(),
+        // The door asks the terminal itself when both ends are terminals.
+        probe: None,
     };
+    let config = PlayConfig { host, screen, greeting: color_hint(command.color, color), quit: Arc::clone(&quit) };
     let _stop_on_signal = crate::signals::StopOnSignal::new(quit);
-    tidepool::player::play(config).map_err(|e| match e {
+    tidepool::play::play(config).map_err(|e| match e {
         tidepool::Error::TooLarge { what, width, height } => {
             Error::Usage(format!("cannot allocate a {width}x{height} {what}; use a smaller terminal"))
         }

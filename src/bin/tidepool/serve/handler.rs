@@ -16,15 +16,18 @@ use russh::{Channel, ChannelId, ChannelOpenFailure, ChannelWriteHalf, Pty};
 use tokio::sync::watch;
 use tokio_util::sync::CancellationToken;
 
-use tidepool::terminal::ColorMode;
+use tidepool::play::{Environment, GraphicsRequest, ProbeOptions, ScreenConfig, WinSize};
+use tidepool::terminal::{ColorMode, EncodeOptions};
 use tokio::sync::mpsc;
 
 use super::hub::Hub;
-use super::limits::{self, clamp_size};
-use super::viewer::{self, Control, ViewerCtx};
+use super::limits::{self, clamp_pixels, clamp_size};
+use super::viewer::{self, TerminalState, ViewerCtx};
 
 /// Longest TERM / COLORTERM value kept (longer values are refused).
 pub const MAX_TERM_LEN: usize = 64;
+/// Colour changes of at most this much per channel are not re-sent (as `play` does over SSH).
+const COLOR_THRESHOLD: u8 = 3;
 /// Packets of key bytes waiting for the player's task; more are dropped (each is at most the
 /// SSH window we offer, `INPUT_WINDOW_BYTES`).
 const INPUT_QUEUE: usize = 64;
@@ -41,8 +44,10 @@ pub struct ClientHandler {
     term: Option<String>,
     colorterm: Option<String>,
     size: (u16, u16),
+    /// The terminal's size in pixels as the client reports it (0 when it does not).
+    pixels: (u16, u16),
     shell_requested: bool,
-    control: Option<watch::Sender<Control>>,
+    terminal: Option<watch::Sender<TerminalState>>,
     input: Option<mpsc::Sender<Vec<u8>>>,
 }
 
@@ -65,8 +70,9 @@ impl ClientHandler {
             term: None,
             colorterm: None,
             size: (80, 24),
+            pixels: (0, 0),
             shell_requested: false,
-            control: None,
+            terminal: None,
             input: None,
         }
     }
@@ -97,8 +103,8 @@ impl ClientHandler {
         // Input that arrived before the EOF is handled first: "q" then EOF (a piped stdin) is
         // still a quit.
         self.input = None;
-        if let Some(control) = &self.control {
-            control.send_modify(|c| c.closed = true);
+        if let Some(terminal) = &self.terminal {
+            terminal.send_modify(|c| c.closed = true);
         }
     }
 }
@@ -224,8 +230,8 @@ impl russh::server::Handler for ClientHandler {
         term: &str,
         cols: u32,
         rows: u32,
-        _pix_w: u32,
-        _pix_h: u32,
+        pix_w: u32,
+        pix_h: u32,
         _modes: &[(Pty, u32)],
         session: &mut Session,
     ) -> Result<(), Self::Error> {
@@ -234,6 +240,7 @@ impl russh::server::Handler for ClientHandler {
         }
         self.term = Some(term.to_string());
         self.size = clamp_size(cols, rows);
+        self.pixels = clamp_pixels(pix_w, pix_h);
         session.channel_success(channel)
     }
 
@@ -272,18 +279,32 @@ impl russh::server::Handler for ClientHandler {
             return Ok(());
         };
         self.playing.cancel(); // stops the handshake deadline
-        let (control_tx, control_rx) = watch::channel(Control { size: self.size, closed: false });
+        let (terminal_tx, terminal_rx) = watch::channel(TerminalState { size: self.size, closed: false });
         let (input_tx, input_rx) = mpsc::channel(INPUT_QUEUE);
-        self.control = Some(control_tx);
+        self.terminal = Some(terminal_tx);
         self.input = Some(input_tx);
+        let winsize = WinSize { cols: self.size.0, rows: self.size.1, x_px: self.pixels.0, y_px: self.pixels.1 };
+        let screen = ScreenConfig {
+            fps: self.hub.fps,
+            bandwidth: self.hub.limits.client_bandwidth,
+            color: ColorMode::detect(self.colorterm.as_deref(), self.term.as_deref()),
+            encode: EncodeOptions { threshold: COLOR_THRESHOLD, sync: true },
+            graphics: GraphicsRequest::Auto,
+            // A remote terminal: no file medium; its TMUX is not ours to see.
+            probe: Some(ProbeOptions {
+                env: Environment { ssh: true, ..Environment::default() },
+                winsize,
+                kitty_file: None,
+            }),
+        };
         let ctx = ViewerCtx {
             hub: self.hub.clone(),
             id: self.id,
             peer: self.peer,
             write,
-            control: control_rx,
+            terminal: terminal_rx,
             input: input_rx,
-            color: ColorMode::detect(self.colorterm.as_deref(), self.term.as_deref()),
+            screen,
             kill: self.kill.clone(),
             slot,
         };
@@ -296,17 +317,18 @@ impl russh::server::Handler for ClientHandler {
         channel: ChannelId,
         cols: u32,
         rows: u32,
-        _pix_w: u32,
-        _pix_h: u32,
+        pix_w: u32,
+        pix_h: u32,
         session: &mut Session,
     ) -> Result<(), Self::Error> {
         if !self.ours(channel) {
             return session.channel_failure(channel);
         }
         self.size = clamp_size(cols, rows);
+        self.pixels = clamp_pixels(pix_w, pix_h);
         let size = self.size;
-        if let Some(control) = &self.control {
-            control.send_modify(|c| c.size = size);
+        if let Some(terminal) = &self.terminal {
+            terminal.send_modify(|c| c.size = size);
         }
         session.channel_success(channel)
     }

@@ -12,8 +12,11 @@ use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
 use super::authorized_keys::AllowList;
-use super::game::{GameStats, Pictures, Shared, Sizes};
-use super::limits::{ConnTracker, Limits, PlayerSlots, TokenBucket};
+use tidepool::play::Request;
+use tidepool::terminal::ByteBucket;
+
+use super::game::{Fits, GameStats, SharedFrame};
+use super::limits::{ConnTracker, Limits, PlayerSlots};
 
 /// Counters for tests, logs and the load report.
 #[derive(Debug, Default)]
@@ -40,7 +43,7 @@ pub struct Stats {
     pub idle_kicks: AtomicU64,
     /// Players cut for not taking a frame within the stall timeout.
     pub stall_kicks: AtomicU64,
-    /// Shared actions dropped by the per-player rate or a full queue.
+    /// Requests dropped by the per-player rate or a full queue.
     pub actions_dropped: AtomicU64,
     /// Packets of key bytes dropped because the player's task was behind.
     pub input_dropped: AtomicU64,
@@ -79,14 +82,16 @@ pub(crate) struct Hub {
     pub shutdown: CancellationToken,
     /// Parent of every connection's kill switch.
     pub cut_all: CancellationToken,
-    pub frames: watch::Receiver<Arc<Pictures>>,
-    pub sizes: Sizes,
-    pub actions: mpsc::Sender<Shared>,
+    pub frames: watch::Receiver<Arc<SharedFrame>>,
+    pub fits: Fits,
+    pub requests: mpsc::Sender<Request>,
     /// All players' frames together, bytes a second.
-    pub outbound: Mutex<TokenBucket>,
+    pub outbound: Mutex<ByteBucket>,
     pub stats: Arc<Stats>,
     pub tasks: TaskTracker,
     pub next_id: AtomicU64,
     /// The shared scene's size in pixels.
     pub scene_size: (u32, u32),
+    /// Frames per second of the shared scene (each player's screen draws at most as often).
+    pub fps: u32,
 }

@@ -5,7 +5,10 @@ use std::collections::HashMap;
 use std::net::IpAddr;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::{Duration, Instant};
+use std::time::Duration;
+
+use tidepool::play::Bandwidth;
+use tidepool::terminal::ByteBucket;
 
 /// Default players in the pool at once (`--max-clients`).
 pub const DEFAULT_MAX_CLIENTS: usize = 64;
@@ -35,8 +38,6 @@ pub const MIN_ROWS: u16 = 5;
 pub const DEFAULT_ACTIONS_PER_SECOND: u32 = 30;
 /// Default total outbound frame bytes per second across all clients.
 pub const DEFAULT_OUTBOUND_BYTES_PER_SECOND: u64 = 16_000_000;
-/// Default bytes per second for one client's frames (its rate-controlled encoder's budget).
-pub const DEFAULT_CLIENT_BYTES_PER_SECOND: u64 = 256_000;
 /// Most players `--max-clients` accepts (memory and CPU are planned per client).
 pub const MAX_MAX_CLIENTS: u64 = 10_000;
 /// Most connections per address `--max-per-address` accepts.
@@ -77,8 +78,8 @@ pub struct Limits {
     pub actions_per_second: u32,
     /// Server-wide frame byte rate.
     pub outbound_bytes_per_second: u64,
-    /// One client's frame byte rate.
-    pub client_bytes_per_second: u64,
+    /// One client's link: found from its own round trips, or fixed.
+    pub client_bandwidth: Bandwidth,
 }
 
 impl Default for Limits {
@@ -92,10 +93,25 @@ impl Default for Limits {
             auth_rejection_time: DEFAULT_AUTH_REJECTION_TIME,
             actions_per_second: DEFAULT_ACTIONS_PER_SECOND,
             outbound_bytes_per_second: DEFAULT_OUTBOUND_BYTES_PER_SECOND,
-            client_bytes_per_second: DEFAULT_CLIENT_BYTES_PER_SECOND,
+            client_bandwidth: Bandwidth::Auto,
         }
     }
 }
+
+impl Limits {
+    /// One player's budget of actions: [`Limits::actions_per_second`], a second's burst.
+    pub fn actions_bucket(&self) -> ByteBucket {
+        ByteBucket::limit(f64::from(self.actions_per_second), RATE_BURST)
+    }
+
+    /// All players' bytes together: [`Limits::outbound_bytes_per_second`], a second's burst.
+    pub fn outbound_bucket(&self) -> ByteBucket {
+        ByteBucket::limit(self.outbound_bytes_per_second as f64, RATE_BURST)
+    }
+}
+
+/// How much of a rate limit may be spent at once (and owed).
+pub const RATE_BURST: Duration = Duration::from_secs(1);
 
 /// Counts open TCP connections, in total and per IP address; enforced at accept.
 #[derive(Debug)]
@@ -205,52 +221,20 @@ impl Drop for PlayerSlot {
     }
 }
 
-/// A token bucket: `rate` tokens per second, holding at most one second's worth.
-#[derive(Debug)]
-pub struct TokenBucket {
-    rate: f64,
-    tokens: f64,
-    last: Instant,
-}
-
-impl TokenBucket {
-    /// A full bucket refilling at `rate` per second.
-    pub fn new(rate: f64) -> Self {
-        Self { rate, tokens: rate, last: Instant::now() }
-    }
-
-    fn refill(&mut self) {
-        let now = Instant::now();
-        self.tokens = (self.tokens + now.duration_since(self.last).as_secs_f64() * self.rate).min(self.rate);
-        self.last = now;
-    }
-
-    /// Takes `n` tokens if available.
-    pub fn try_take(&mut self, n: f64) -> bool {
-        self.refill();
-        if self.tokens >= n {
-            self.tokens -= n;
-            true
-        } else {
-            false
-        }
-    }
-}
-
-impl TokenBucket {
-    /// Takes `n` tokens whether or not they are there (a frame already encoded is sent); the
-    /// debt, at most a second's worth, is paid before [`TokenBucket::try_take`] succeeds again.
-    pub fn spend(&mut self, n: f64) {
-        self.refill();
-        self.tokens = (self.tokens - n).max(-self.rate);
-    }
-}
-
 /// Clamps a client-reported terminal size to what we draw.
 pub fn clamp_size(cols: u32, rows: u32) -> (u16, u16) {
     let c = cols.clamp(MIN_COLS as u32, MAX_COLS as u32) as u16;
     let r = rows.clamp(MIN_ROWS as u32, MAX_ROWS as u32) as u16;
     (c, r)
+}
+
+/// The largest terminal size in pixels taken from a client (a 16k screen); larger values are
+/// taken as unknown (0), as are sizes a pixel count cannot describe.
+pub const MAX_PIXELS_SIDE: u32 = 16_384;
+
+/// A client-reported terminal size in pixels, or (0, 0) when it is not believable.
+pub fn clamp_pixels(width: u32, height: u32) -> (u16, u16) {
+    if width > MAX_PIXELS_SIDE || height > MAX_PIXELS_SIDE { (0, 0) } else { (width as u16, height as u16) }
 }
 
 #[cfg(test)]

@@ -3,8 +3,8 @@
 //! Module by module: [`host_key`] (the server's identity), [`authorized_keys`] (who may play),
 //! [`server`] (accept, limits per address, handshake deadline, shutdown), [`handler`] (what an
 //! SSH connection may ask for: a pty and a shell, nothing else), [`viewer`] (one player: keys
-//! in, frames out), [`game`] (the one simulation and its pictures), [`letterbox`] (the shared
-//! picture in each terminal), [`limits`] (every bound, with its unit), [`killable`] (a socket
+//! in, frames out: a seat and a screen of the play session), [`game`] (the one simulation: the
+//! session's host on a thread, and its pictures), [`limits`] (every bound, with its unit), [`killable`] (a socket
 //! the server can cut).
 //!
 //! The library stays free of tokio and russh: this module uses its player pieces (the input
@@ -16,7 +16,6 @@ pub mod handler;
 pub mod host_key;
 mod hub;
 pub mod killable;
-pub mod letterbox;
 pub mod limits;
 pub mod server;
 pub mod viewer;
@@ -76,7 +75,7 @@ pub fn limits(args: &ServeCommand) -> Result<Limits> {
             limits::MAX_ACTIONS_PER_SECOND,
             "actions a second",
         )? as u32,
-        client_bytes_per_second: args.client_bandwidth.max(1),
+        client_bandwidth: args.client_bandwidth,
         outbound_bytes_per_second: args.total_bandwidth.max(1),
         ..Limits::default()
     })

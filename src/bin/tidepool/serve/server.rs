@@ -17,12 +17,12 @@ use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
 use super::authorized_keys::AllowList;
-use super::game::{self, GameLinks, GameOptions, GameStats, Sizes};
+use super::game::{self, Fits, GameLinks, GameOptions, GameStats, SharedFrame};
 use super::handler::ClientHandler;
 use super::hub::Hub;
 pub use super::hub::Stats;
 use super::killable::Killable;
-use super::limits::{self, ConnGuard, ConnTracker, Limits, PlayerSlots, TokenBucket};
+use super::limits::{self, ConnGuard, ConnTracker, Limits, PlayerSlots};
 
 /// Identification string sent to clients (no library version, nothing to fingerprint).
 pub const SERVER_ID: &str = "SSH-2.0-tidepool";
@@ -106,7 +106,7 @@ pub fn russh_config(host_key: PrivateKey, private: bool, limits: &Limits) -> Con
 
 /// Binds and starts serving. Errors only for the bind (e.g. port in use) and the first scene.
 pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
-    let scene = game::first_scene(&opts.game).map_err(StartError::Scene)?;
+    let mut host = opts.game.host().map_err(StartError::Scene)?;
     let listener = TcpListener::bind(opts.listen).await.map_err(StartError::Bind)?;
     let local_addr = listener.local_addr().map_err(StartError::Bind)?;
     let config = Arc::new(russh_config(opts.host_key, opts.allow.is_some(), &opts.limits));
@@ -114,13 +114,13 @@ pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
     let game_stats = Arc::new(GameStats::default());
     let players = PlayerSlots::new(opts.limits.max_clients);
     let tracker = ConnTracker::new(&opts.limits);
-    let info = tidepool::player::SceneInfo::of(scene.as_ref());
-    let (frames_tx, frames_rx) = watch::channel(game::nothing_yet(info));
-    let (actions_tx, actions_rx) = mpsc::channel(game::ACTION_QUEUE);
-    let sizes: Sizes = Arc::new(Mutex::new(HashMap::new()));
+    let first = SharedFrame { status: Arc::new(host.status().clone()), ..SharedFrame::default() };
+    let (frames_tx, frames_rx) = watch::channel(Arc::new(first));
+    let (requests_tx, requests_rx) = mpsc::channel(game::REQUEST_QUEUE);
+    let fits: Fits = Arc::new(Mutex::new(HashMap::new()));
     let shutdown = CancellationToken::new();
     let hub = Arc::new(Hub {
-        outbound: Mutex::new(TokenBucket::new(opts.limits.outbound_bytes_per_second as f64)),
+        outbound: Mutex::new(opts.limits.outbound_bucket()),
         limits: opts.limits,
         allow: opts.allow,
         config,
@@ -129,17 +129,19 @@ pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
         shutdown: shutdown.clone(),
         cut_all: CancellationToken::new(),
         frames: frames_rx,
-        sizes: sizes.clone(),
-        actions: actions_tx,
+        fits: fits.clone(),
+        requests: requests_tx,
         stats: stats.clone(),
         tasks: TaskTracker::new(),
         next_id: AtomicU64::new(1),
         scene_size: opts.game.size,
+        fps: opts.game.fps,
     });
     let stop = Arc::new(AtomicBool::new(false));
+    let fps = opts.game.fps;
     let links = GameLinks {
-        actions: actions_rx,
-        sizes,
+        requests: requests_rx,
+        fits,
         players: players.clone(),
         publish: frames_tx,
         stats: game_stats.clone(),
@@ -148,7 +150,7 @@ pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
     // The simulation and rendering are CPU work on their own thread, off the async workers.
     let game = std::thread::Builder::new()
         .name("tidepool-game".into())
-        .spawn(move || game::run(opts.game, scene, links))
+        .spawn(move || game::run(host, fps, links))
         .map_err(StartError::Bind)?;
     let join = tokio::spawn(async move {
         accept_loop(&hub, listener).await;

@@ -1,22 +1,24 @@
-//! Bytes from the terminal -> the player's inputs.
+//! Bytes from the terminal -> what they mean: the person's [`Input`]s and the terminal's
+//! [`Reply`]s, framed in one place.
 //!
-//! The player reads the terminal's bytes itself instead of through crossterm's event reader, so
-//! it runs the same over a local terminal and an SSH channel, and so it can tell the
-//! terminal's *replies* (device attributes, cursor position reports, kitty graphics answers,
-//! mode reports) from key presses: crossterm turns `ESC _` into Alt-`_` and the rest of an APC
-//! reply into keys, so a late kitty reply's digits would set the ocean's Beaufort number.
-//! Here every reply is recognised and dropped, except cursor position reports, which the
-//! player uses to measure the link's round trip.
+//! The session reads the terminal's bytes itself instead of through crossterm's event reader, so
+//! it runs the same over a local terminal and an SSH channel, and so it can tell the terminal's
+//! *replies* (device attributes, kitty graphics answers, mode and size reports) from key presses:
+//! crossterm turns `ESC _` into Alt-`_` and the rest of an APC reply into keys, so a late kitty
+//! reply's digits would set the ocean's Beaufort number. Every escape sequence is first offered to
+//! [`crate::play::replies::parse_reply`] (the one description of what a reply looks like, which
+//! the graphics probe and the link control read); what is not a reply is read as a key here. So
+//! the two can never disagree on where a sequence ends (`ESC P` + a letter is Alt-P and a letter
+//! to both).
 //!
-//! What is understood: printable characters (UTF-8), Enter, Tab and Shift-Tab, Ctrl-C, Esc,
-//! the arrow keys (`CSI A..D` and `SS3 A..D`), and mouse reports in SGR form (`CSI < b;x;y M/m`,
-//! mode 1006) and the legacy X10 form (`CSI M b x y`). Everything else (function keys,
-//! modified keys, Alt combinations, unknown sequences) is ignored. A lone `ESC` is the Escape key
-//! only once no more bytes follow within [`ESC_WAIT`]; until then it may start a sequence.
+//! Keys understood: printable characters (UTF-8), Enter, Tab and Shift-Tab, Ctrl-C, Esc, the arrow
+//! keys (`CSI A..D` and `SS3 A..D`), and mouse reports in SGR form (`CSI < b;x;y M/m`, mode 1006)
+//! and the legacy X10 form (`CSI M b x y`). Everything else (function keys, modified keys, Alt
+//! combinations, unknown sequences) is [`Received::Unknown`]. A lone `ESC` is the Escape key only
+//! once no more bytes follow within [`ESC_WAIT`]; until then it may start a sequence.
 //!
-//! Mouse motion is reported for button presses and drags only (mode 1002), not for every
-//! motion; [`coalesce`] reduces a burst of drags to the latest position (the stir interpolates
-//! the path).
+//! Mouse motion is reported for button presses and drags only (mode 1002), not for every motion;
+//! [`coalesce`] reduces a burst of drags to the latest position (the stir interpolates the path).
 
 use std::time::{Duration, Instant};
 
@@ -25,7 +27,9 @@ pub const ESC_WAIT: Duration = Duration::from_millis(40);
 /// The longest sequence kept while waiting for its end; longer ones are dropped as garbage.
 pub const MAX_SEQUENCE: usize = 8192;
 
-/// What the user asked for (or the terminal said).
+use super::replies::{Expecting, Reply, parse_reply};
+
+/// What the person asked for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Input {
     /// Leave (`q`, `Ctrl-C`).
@@ -74,13 +78,19 @@ pub enum Input {
     },
     /// The mouse button was released.
     Release,
-    /// The terminal is now (columns, rows).
-    Resize(u16, u16),
-    /// The terminal answered a cursor position request (`CSI 6n`): row and column, from 1.
-    CursorReport(u16, u16),
-    /// The terminal answered a device attributes request (`CSI c`): the player's round-trip
-    /// measurement.
-    DeviceAttributes,
+}
+
+/// One thing read from the terminal.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Received {
+    /// Something the person did.
+    Input(Input),
+    /// The terminal's answer to a question (see [`crate::play::replies`]).
+    Reply(Reply),
+    /// An escape sequence that is neither a key tidepool knows nor a reply (a function key, an
+    /// Alt combination, garbage): ignored in play; during the graphics probe it means the
+    /// terminal answered something else.
+    Unknown,
 }
 
 /// An incremental parser: feed it bytes as they arrive, get inputs out.
@@ -96,8 +106,8 @@ pub struct InputParser {
 
 /// What the start of the buffer holds.
 enum Parsed {
-    /// A complete item of this many bytes, meaning this input (or nothing).
-    Item(usize, Option<Input>),
+    /// A complete item of this many bytes, and what it means (nothing: a control byte).
+    Item(usize, Option<Received>),
     /// The start of a sequence whose end has not arrived.
     Incomplete,
 }
@@ -108,8 +118,8 @@ impl InputParser {
         InputParser::default()
     }
 
-    /// Parses `bytes` that arrived at `now`, appending the inputs to `out`.
-    pub fn feed(&mut self, bytes: &[u8], now: Instant, out: &mut Vec<Input>) {
+    /// Parses `bytes` that arrived at `now`, appending what they mean to `out`.
+    pub fn feed(&mut self, bytes: &[u8], now: Instant, out: &mut Vec<Received>) {
         if bytes.is_empty() {
             return;
         }
@@ -145,7 +155,7 @@ impl InputParser {
 
     /// Resolves what is pending once no more bytes have come for `ESC_WAIT` (40 ms): a lone `ESC` is
     /// the Escape key, an unfinished sequence is dropped.
-    pub fn flush_stale(&mut self, now: Instant, out: &mut Vec<Input>) {
+    pub fn flush_stale(&mut self, now: Instant, out: &mut Vec<Received>) {
         if self.since.is_some_and(|t| now.saturating_duration_since(t) >= ESC_WAIT) {
             self.drain(out, true);
             self.pending.clear();
@@ -159,12 +169,24 @@ impl InputParser {
         self.since.map(|t| t + ESC_WAIT)
     }
 
-    fn drain(&mut self, out: &mut Vec<Input>, stale: bool) {
+    fn drain(&mut self, out: &mut Vec<Received>, stale: bool) {
         let mut at = 0;
         while at < self.pending.len() {
             match parse_one(&self.pending[at..], stale) {
-                Parsed::Item(len, input) => {
-                    out.extend(input);
+                Parsed::Item(len, Some(Received::Reply(Reply::Overlong))) => {
+                    // The rest of an overlong string follows: drop it up to its terminator.
+                    out.push(Received::Unknown);
+                    at += len.max(1);
+                    match self.pending[at..].iter().position(|&b| b == 0x07 || b == b'\\') {
+                        Some(end) => at += end + 1,
+                        None => {
+                            at = self.pending.len();
+                            self.skipping = true;
+                        }
+                    }
+                }
+                Parsed::Item(len, received) => {
+                    out.extend(received);
                     at += len.max(1);
                 }
                 Parsed::Incomplete => break,
@@ -183,42 +205,51 @@ fn parse_one(b: &[u8], stale: bool) -> Parsed {
         if !stale {
             Parsed::Incomplete
         } else if lone_escape {
-            Parsed::Item(1, Some(Input::Escape))
+            Parsed::Item(1, Some(Received::Input(Input::Escape)))
         } else {
-            Parsed::Item(len, None)
+            Parsed::Item(len, Some(Received::Unknown))
         }
     };
+    let input =
+        |len: usize, input: Option<Input>| Parsed::Item(len, Some(input.map_or(Received::Unknown, Received::Input)));
     match b[0] {
         ESC => match b.get(1) {
             None => incomplete(1, true),
-            Some(b'[') => parse_csi(b, stale),
+            // Replies first: the one description of where a reply ends.
+            Some(b'[' | b'_' | b'P' | b']') => match parse_reply(b, Expecting::CURSOR_POSITION) {
+                crate::play::replies::Parsed::Complete(reply, len) => Parsed::Item(len, Some(Received::Reply(reply))),
+                crate::play::replies::Parsed::Incomplete if !stale => Parsed::Incomplete,
+                crate::play::replies::Parsed::Incomplete if b[1] != b'[' => incomplete(b.len(), false),
+                _ if b[1] == b'[' => parse_csi(b, stale),
+                // `ESC P`, `ESC ]`, `ESC _` that cannot be a reply: Alt and a key, ignored.
+                _ => input(2, None),
+            },
             Some(b'O') => match b.get(2) {
                 None => incomplete(2, false),
-                Some(&c) => Parsed::Item(3, arrow(c)),
+                Some(&c) => input(3, arrow(c)),
             },
-            // APC (`ESC _`, kitty graphics replies), DCS (`ESC P`), OSC (`ESC ]`), SOS, PM:
-            // strings up to ST (`ESC \`) or, for OSC, BEL. Replies, never keys.
-            Some(b'_' | b'P' | b']' | b'X' | b'^') => match string_end(b) {
-                Some(len) => Parsed::Item(len, None),
+            // SOS and PM strings, up to ST: never keys, never replies tidepool asks for.
+            Some(b'X' | b'^') => match string_end(b) {
+                Some(len) => input(len, None),
                 None => incomplete(b.len(), false),
             },
             // ESC ESC: the first is a lone Escape key pressed twice, or Alt-Esc.
-            Some(&ESC) => Parsed::Item(1, Some(Input::Escape)),
+            Some(&ESC) => input(1, Some(Input::Escape)),
             // Alt plus a key (or a stray ESC): ignored, with the byte after it.
-            Some(&c) => Parsed::Item((1 + utf8_len(Some(c))).min(b.len()), None),
+            Some(&c) => input((1 + utf8_len(Some(c))).min(b.len()), None),
         },
-        0x03 => Parsed::Item(1, Some(Input::Quit)),
-        b'\r' | b'\n' => Parsed::Item(1, Some(Input::DropAtAim)),
-        b'\t' => Parsed::Item(1, Some(Input::NextScene)),
+        0x03 => input(1, Some(Input::Quit)),
+        b'\r' | b'\n' => input(1, Some(Input::DropAtAim)),
+        b'\t' => input(1, Some(Input::NextScene)),
         c if c < 0x20 || c == 0x7f => Parsed::Item(1, None),
-        c if c < 0x80 => Parsed::Item(1, Some(key(c as char))),
+        c if c < 0x80 => input(1, Some(key(c as char))),
         c => {
             let len = utf8_len(Some(c));
             if b.len() < len {
                 return incomplete(b.len(), false);
             }
             match std::str::from_utf8(&b[..len]).ok().and_then(|s| s.chars().next()) {
-                Some(ch) => Parsed::Item(len, Some(Input::Other(ch))),
+                Some(ch) => input(len, Some(Input::Other(ch))),
                 None => Parsed::Item(1, None),
             }
         }
@@ -255,43 +286,36 @@ fn arrow(c: u8) -> Option<Input> {
     }
 }
 
-/// `ESC [` parameters, intermediates, final byte.
+/// `ESC [` parameters, intermediates, final byte: a key (replies were tried first).
 fn parse_csi(b: &[u8], stale: bool) -> Parsed {
+    let known =
+        |len: usize, input: Option<Input>| Parsed::Item(len, Some(input.map_or(Received::Unknown, Received::Input)));
     // The legacy X10 mouse report: `ESC [ M` and three raw bytes.
     if b.get(2) == Some(&b'M') {
         return match b.get(3..6) {
-            Some(&[cb, cx, cy]) => Parsed::Item(6, x10_mouse(u32::from(cb.wrapping_sub(32)), cx, cy)),
-            _ if stale => Parsed::Item(b.len(), None),
+            Some(&[cb, cx, cy]) => known(6, x10_mouse(u32::from(cb.wrapping_sub(32)), cx, cy)),
+            _ if stale => known(b.len(), None),
             _ => Parsed::Incomplete,
         };
     }
     let Some(end) = (2..b.len()).find(|&i| (0x40..=0x7e).contains(&b[i])) else {
-        return if stale { Parsed::Item(b.len(), None) } else { Parsed::Incomplete };
+        return if stale { known(b.len(), None) } else { Parsed::Incomplete };
     };
     let body = &b[2..end];
     let final_byte = b[end];
     let len = end + 1;
     // A byte that cannot be in a sequence ends it as garbage.
     if body.iter().any(|&c| !(0x20..=0x3f).contains(&c)) {
-        return Parsed::Item(len, None);
+        return known(len, None);
     }
     let input = match (body.first(), final_byte) {
         (None, b'A'..=b'D') => arrow(final_byte),
         (None, b'Z') => Some(Input::NextScene),
         (Some(b'<'), b'M' | b'm') => sgr_mouse(&body[1..], final_byte == b'M'),
-        (Some(b'0'..=b'9'), b'R') => {
-            let mut numbers = params(body);
-            match (numbers.next(), numbers.next(), numbers.next()) {
-                (Some(Some(row)), Some(Some(col)), None) => Some(Input::CursorReport(row, col)),
-                _ => None,
-            }
-        }
-        (Some(b'?'), b'c') => Some(Input::DeviceAttributes),
-        // Other device attributes, mode reports, window reports, graphics attributes, unknown
-        // keys.
+        // Function keys, modified keys, unknown sequences.
         _ => None,
     };
-    Parsed::Item(len, input)
+    known(len, input)
 }
 
 /// The numbers of a `;`-separated parameter list (`None` for an empty or oversized one).
@@ -358,18 +382,15 @@ fn key(c: char) -> Input {
     }
 }
 
-/// Merges runs of drags (and of resizes) into their last event; everything else is kept in
-/// order.
-pub fn coalesce(inputs: impl IntoIterator<Item = Input>) -> Vec<Input> {
-    let mut out: Vec<Input> = Vec::new();
-    for input in inputs {
-        match (out.last_mut(), input) {
-            (Some(last @ Input::Drag { .. }), Input::Drag { .. })
-            | (Some(last @ Input::Resize(..)), Input::Resize(..)) => *last = input,
-            _ => out.push(input),
+/// Merges runs of drags into their last position, in place; everything else is kept in order.
+pub fn coalesce(inputs: &mut Vec<Input>) {
+    inputs.dedup_by(|next, last| {
+        let drags = matches!((&*last, &*next), (Input::Drag { .. }, Input::Drag { .. }));
+        if drags {
+            *last = *next;
         }
-    }
-    out
+        drags
+    });
 }
 
 #[cfg(test)]

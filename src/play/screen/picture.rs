@@ -6,12 +6,14 @@
 //! (which, once sent, cost nothing) and this module sends the picture itself over them, at the
 //! size [`geometry::layout`] gives for the protocol and the terminal's cell size. It owns the
 //! encoder of the protocol chosen (each remembers what the terminal shows, so still water sends
-//! no bytes), the layout, and the mapping of mouse reports to picture pixels.
+//! no bytes) and the layout (mouse reports map to scene pixels through the seat's
+//! [`crate::play::fit::Fit`]).
 
 use std::io;
 
 use tiny_skia::Pixmap;
 
+use super::probe::{GraphicsChoice, GraphicsSupport};
 use crate::output::bucket::ByteBucket;
 use crate::output::diff::{SYNC_BEGIN, SYNC_END};
 use crate::output::graphics::geometry::{self, Layout};
@@ -19,7 +21,6 @@ use crate::output::graphics::iterm2::Iterm2Encoder;
 use crate::output::graphics::kitty::{self, KittyEncoder, KittyOptions, Medium};
 use crate::output::graphics::sixel::{SixelEncoder, SixelPalette};
 use crate::output::graphics::{GraphicsMode, push_rgb};
-use crate::term::probe::{DEFAULT_SIXEL_REGISTERS, GraphicsChoice, GraphicsSupport};
 
 /// The largest picture a scene renders at in a pixel mode, in pixels. The pool's simulation
 /// grid is its picture, and its breeze costs about 33 ns a cell a step (`tidepool render pool
@@ -69,7 +70,7 @@ impl Picture {
             GraphicsMode::Cells => return None,
             GraphicsMode::Kitty => Encoder::Kitty(Box::new(KittyEncoder::new(kitty_options(choice, support, &layout)))),
             GraphicsMode::Sixel => {
-                let registers = support.sixel.map_or(DEFAULT_SIXEL_REGISTERS, |s| s.registers);
+                let registers = support.sixel_registers();
                 Encoder::Sixel(Box::new(SixelEncoder::new(
                     SixelPalette::for_registers(registers),
                     layout.origin,
@@ -92,8 +93,7 @@ impl Picture {
         })
     }
 
-    /// Where the picture goes and its size in pixels (the size the scene renders at).
-    #[cfg(test)]
+    /// Where the picture goes and its size in pixels.
     pub fn layout(&self) -> &Layout {
         &self.layout
     }
@@ -174,37 +174,6 @@ impl Picture {
         }
         Ok(())
     }
-
-    /// The picture pixel under a mouse report: `(x, y)` are screen pixels (0-based) when the
-    /// terminal reports pixels (SGR-pixels mode), else a cell whose centre is taken.
-    pub fn pixel_at(&self, (x, y): (u16, u16), pixels: bool) -> Option<(i32, i32)> {
-        let p = if pixels { self.layout.pixel_at(u32::from(x), u32::from(y)) } else { self.layout.pixel_at_cell(x, y) };
-        p.map(|(x, y)| {
-            let (sx, sy) = self.to_scene(x, y);
-            (sx as i32, sy as i32)
-        })
-    }
-
-    /// The cell over picture pixel (`x`, `y`), for the aim marker.
-    pub fn cell_of(&self, x: u32, y: u32) -> (u32, u32) {
-        let l = &self.layout;
-        let (x, y) = (scale(x, self.scene.0, l.picture.0), scale(y, self.scene.1, l.picture.1));
-        let col = u64::from(x) * u64::from(l.cells.0) / u64::from(l.picture.0.max(1));
-        let row = u64::from(y) * u64::from(l.cells.1) / u64::from(l.picture.1.max(1));
-        (col as u32, row as u32)
-    }
-
-    /// Picture pixels per cell (columns, rows), at least 1: how far one aim step moves.
-    pub fn pixels_per_cell(&self) -> (u32, u32) {
-        let l = &self.layout;
-        ((self.scene.0 / u32::from(l.cells.0.max(1))).max(1), (self.scene.1 / u32::from(l.cells.1.max(1))).max(1))
-    }
-
-    /// The scene pixel of picture pixel (`x`, `y`).
-    fn to_scene(&self, x: u32, y: u32) -> (u32, u32) {
-        let l = &self.layout;
-        (scale(x, l.picture.0, self.scene.0), scale(y, l.picture.1, self.scene.1))
-    }
 }
 
 /// What the player's frame is like, for [`Picture::add_to_frame`].
@@ -273,11 +242,6 @@ fn splice_picture(frame: &mut Vec<u8>, picture: &[u8], sync: bool) {
         frame.extend_from_slice(picture);
         frame.extend_from_slice(SYNC_END);
     }
-}
-
-/// `v` of a length `from` mapped onto a length `to`.
-fn scale(v: u32, from: u32, to: u32) -> u32 {
-    (u64::from(v) * u64::from(to) / u64::from(from.max(1))) as u32
 }
 
 /// `size` shrunk (aspect kept) to fit within `cap`, at least 1x1.
@@ -373,20 +337,5 @@ mod tests {
         p.encode(&pixmap, &mut out).unwrap();
         let raster: &[u8] = b"\"1;1;1280;750";
         assert!(out.windows(raster.len()).any(|w| w == raster), "one pixel a screen pixel");
-        // The centre of cell (80, 23) is screen pixel (644, 376): scene pixel (241, 140).
-        assert_eq!(p.pixel_at((80, 23), false), Some((241, 140)));
-        assert_eq!(p.cell_of(241, 140), (80, 23));
-    }
-
-    #[test]
-    fn clicks_map_to_picture_pixels_by_cell_centre_or_by_pixel() {
-        let support = GraphicsSupport { cell_px: Some((10, 20)), ..Default::default() };
-        let p = Picture::new(&choice(GraphicsMode::Sixel), &support, (20, 6)).unwrap();
-        // 20x5 cells of 10x20: a 200x96 picture (whole sixel bands), one pixel a pixel.
-        assert_eq!(p.layout().picture, (200, 96));
-        assert_eq!(p.pixel_at((3, 2), false), Some((35, 50)), "the centre of cell (3, 2)");
-        assert_eq!(p.pixel_at((37, 51), true), Some((37, 51)), "pixel reports land on that pixel");
-        assert_eq!(p.pixel_at((3, 5), false), None, "the status row is not the picture");
-        assert_eq!(p.cell_of(35, 50), (3, 2));
     }
 }

@@ -1,8 +1,7 @@
-//! Terminal replies in the input stream: recognised at the start of a buffer, so that the
-//! detection ([`crate::term::probe`]) can read them. (During play, the player's own input parser,
-//! `term::input`, frames the same sequences itself and drops late replies, keeping only device
-//! attributes for the link; it does not call this module.) Unrecognised, a reply would turn into
-//! key presses (`ESC _ G i = 3 1 ; O K` would otherwise be
+//! Terminal replies in the input stream: recognised at the start of a buffer. The one input
+//! parser ([`crate::play::input`]) offers every escape sequence here first, so the graphics
+//! probe and the link control read replies framed exactly as the key reader sees them.
+//! Unrecognised, a reply would turn into key presses (`ESC _ G i = 3 1 ; O K` would otherwise be
 //! Alt-`_` and then keys, and a late kitty reply's digits would set the ocean's Beaufort
 //! number).
 //!
@@ -47,6 +46,7 @@ pub struct Expecting {
 
 impl Expecting {
     /// Nothing ambiguous is awaited.
+    #[cfg(test)]
     pub const NOTHING: Expecting = Expecting { cursor_position: false };
     /// A cursor position report is awaited.
     pub const CURSOR_POSITION: Expecting = Expecting { cursor_position: true };

@@ -1,4 +1,4 @@
-//! What the player draws over the picture: the status line, the aim marker, the help overlay
+//! What a screen draws over the picture: the status line, the aim marker, the help overlay
 //! and the "terminal too small" notice. All of it is text cells in a [`Frame`], so it costs
 //! bytes only when it changes.
 
@@ -85,9 +85,8 @@ pub fn status_line(frame: &mut Frame, row: usize, status: &Status<'_>, mode: Col
     frame.text(x, row, scratch, key, bg);
 }
 
-/// Marks the aim at pixel `(x, y)`: a `+` in the cell, over the cell's own colour.
-pub fn aim_marker(frame: &mut Frame, x: u32, y: u32) {
-    let (col, row) = (x as usize, y as usize / 2);
+/// Marks the aim in cell (`col`, `row`): a `+` over the cell's own colour.
+pub fn aim_marker(frame: &mut Frame, col: usize, row: usize) {
     if col >= frame.cols() || row >= frame.rows() {
         return;
     }
@@ -102,32 +101,6 @@ pub fn aim_marker(frame: &mut Frame, x: u32, y: u32) {
         _ => Color::Index(if light { 15 } else { 0 }),
     };
     frame.set(col, row, Cell::Text { ch: '+', fg, bg: under });
-}
-
-/// Every key and mouse action the player knows, with `scene` keys added; the stone keys and
-/// mouse actions only when the scene `takes_stones`.
-pub fn help_lines(scene: &[(&'static str, &'static str)], takes_stones: bool) -> Vec<(&'static str, &'static str)> {
-    let mut lines = Vec::new();
-    if takes_stones {
-        lines.extend_from_slice(&[
-            ("space", "a stone at a random spot"),
-            ("arrows hjkl", "move the aim"),
-            ("enter", "a stone at the aim"),
-            ("left click", "a stone where you click"),
-            ("drag", "stir the water"),
-            ("right click", "a big stone"),
-            ("+ -", "bigger / smaller stones"),
-        ]);
-    }
-    lines.extend_from_slice(scene);
-    lines.extend_from_slice(&[
-        ("p", "pause / resume"),
-        ("s", "save a PNG screenshot"),
-        ("tab", "next scene"),
-        ("?", "this help"),
-        ("q esc ctrl-c", "quit"),
-    ]);
-    lines
 }
 
 /// Draws a centred box listing `lines`, clipped to the frame's picture rows (all but the last).
@@ -226,8 +199,7 @@ mod tests {
 
     #[test]
     fn help_lists_every_key_and_fits() {
-        let lines = help_lines(&[("r", "rain on/off")], true);
-        assert!(!help_lines(&[], false).iter().any(|(k, _)| *k == "space"), "no stones, no stone keys");
+        let lines = crate::play::seat::help_lines(&[("r", "rain on/off")], true);
         let mut f = Frame::new(80, 30);
         help_overlay(&mut f, &lines, ColorMode::TrueColor);
         let all: String = (0..30).map(|y| row(&f, y)).collect();
@@ -239,7 +211,7 @@ mod tests {
     }
 
     #[test]
-    fn aim_marker_sits_in_the_cell_of_its_upper_pixel() {
+    fn aim_marker_sits_in_its_cell_over_its_colour() {
         let mut f = Frame::new(5, 3);
         let dark = Color::Rgb([10, 10, 10]);
         for y in 0..3 {
@@ -247,9 +219,9 @@ mod tests {
                 f.set(x, y, Cell::Pixels { top: dark, bottom: dark });
             }
         }
-        aim_marker(&mut f, 3, 4);
+        aim_marker(&mut f, 3, 2);
         assert_eq!(f.get(3, 2), Cell::Text { ch: '+', fg: Color::Rgb([255, 255, 255]), bg: dark });
-        aim_marker(&mut f, 30, 40);
+        aim_marker(&mut f, 30, 20);
     }
 
     #[test]

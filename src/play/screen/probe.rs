@@ -51,7 +51,8 @@ use base64::engine::general_purpose::STANDARD as BASE64;
 
 use crate::output::graphics::GraphicsMode;
 use crate::output::graphics::{kitty, tmux};
-use crate::term::replies::{Expecting, Parsed, Reply, parse_reply};
+use crate::play::input::{Input, InputParser, Received};
+use crate::play::replies::Reply;
 
 /// The longest the probe waits for the terminal's answers.
 pub const PROBE_BUDGET: Duration = Duration::from_millis(150);
@@ -94,11 +95,6 @@ impl Environment {
             term_program: var("TERM_PROGRAM").filter(|v| !v.is_empty()),
         }
     }
-
-    /// The process's environment.
-    pub fn current() -> Environment {
-        Environment::from_lookup(|name| std::env::var(name).ok())
-    }
 }
 
 /// The terminal's size as TIOCGWINSZ gives it (pixels 0 when the terminal does not say).
@@ -115,12 +111,6 @@ pub struct WinSize {
 }
 
 impl WinSize {
-    /// The window size of the terminal on stdout (crossterm's TIOCGWINSZ).
-    pub fn current() -> io::Result<WinSize> {
-        let w = crossterm::terminal::window_size()?;
-        Ok(WinSize { cols: w.columns, rows: w.rows, x_px: w.width, y_px: w.height })
-    }
-
     /// The cell size in pixels the pixel fields imply, if they are filled in.
     pub fn cell_px(&self) -> Option<(u16, u16)> {
         (self.x_px > 0 && self.y_px > 0 && self.cols > 0 && self.rows > 0)
@@ -190,6 +180,14 @@ pub struct GraphicsSupport {
     pub tmux_passthrough: bool,
 }
 
+impl GraphicsSupport {
+    /// The sixel colour registers to use: what the terminal said, else a VT340's
+    /// ([`DEFAULT_SIXEL_REGISTERS`]).
+    pub fn sixel_registers(&self) -> u16 {
+        self.sixel.map_or(DEFAULT_SIXEL_REGISTERS, |s| s.registers)
+    }
+}
+
 /// The bytes to send (see the module docs), for the options given.
 pub fn queries(options: &ProbeOptions) -> Vec<u8> {
     let mut kitty_queries = format!("\x1b_Gi={KITTY_QUERY_ID},s=1,v=1,a=q,t=d,f=24;{ONE_PIXEL}\x1b\\").into_bytes();
@@ -251,23 +249,23 @@ fn split_sequences(bytes: &[u8]) -> Vec<&[u8]> {
 #[derive(Clone, Debug, Default)]
 pub struct Probe {
     options: ProbeOptions,
-    /// Bytes not yet recognised (a reply may be cut between reads).
-    pending: Vec<u8>,
     replies: Vec<Reply>,
     /// DA1 replies seen.
     da1: u8,
-    /// Replies seen before the first DA1 (tmux's) and before the last.
+    /// Something that is neither a reply nor a key arrived before the answers were complete.
     garbled: bool,
-    leftover: Vec<u8>,
+    /// Bytes read so far (a flood that never ends stops the probe).
+    bytes: usize,
+    leftover: Vec<Input>,
 }
 
-/// What the probe found, and the bytes it read that were not replies.
+/// What the probe found, and the keys that were typed meanwhile.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ProbeOutcome {
     /// The capabilities.
     pub support: GraphicsSupport,
-    /// Input that arrived during the probe (keys), in order, for the input parser.
-    pub leftover: Vec<u8>,
+    /// Keys and clicks that arrived during the probe, in order.
+    pub leftover: Vec<Input>,
 }
 
 impl Probe {
@@ -281,48 +279,67 @@ impl Probe {
         if self.options.env.tmux { 2 } else { 1 }
     }
 
+    /// The DA1 answers the probe can count on (1: outside tmux its own; inside, tmux's own, at
+    /// once; the outer terminal's may never come back). The link control leaves that many
+    /// answers to the probe.
+    pub fn da1_expected(&self) -> u8 {
+        1
+    }
+
     /// Whether every answer has arrived.
     pub fn done(&self) -> bool {
         self.da1 >= self.da1_wanted()
     }
 
-    /// Feeds bytes read from the terminal; returns [`Probe::done`].
-    pub fn feed(&mut self, bytes: &[u8]) -> bool {
-        self.pending.extend_from_slice(bytes);
-        let mut used = 0;
-        while used < self.pending.len() && !self.done() {
-            match parse_reply(&self.pending[used..], Expecting::NOTHING) {
-                Parsed::Complete(reply, n) => {
-                    used += n;
-                    if matches!(reply, Reply::PrimaryAttributes(_)) {
-                        self.da1 += 1;
-                    }
-                    if self.replies.len() < MAX_PROBE_BYTES / 8 {
-                        self.replies.push(reply);
-                    }
-                }
-                Parsed::Incomplete => break,
-                Parsed::NotAReply => {
-                    // A key typed during the probe, or garbage. An escape sequence here is
-                    // taken as garbage (a terminal answering wrongly), since keys with ESC are
-                    // unlikely in the first 150 ms; its bytes still go to the input.
-                    self.garbled |= self.pending[used] == 0x1b;
-                    self.leftover.push(self.pending[used]);
-                    used += 1;
+    /// Counts `n` bytes read from the terminal; a flood beyond [`MAX_PROBE_BYTES`] ends the
+    /// probe as garbled (this is no terminal answering).
+    pub fn count_bytes(&mut self, n: usize) {
+        self.bytes = self.bytes.saturating_add(n);
+        if self.bytes > MAX_PROBE_BYTES && !self.done() {
+            self.garbled = true;
+            self.da1 = self.da1_wanted();
+        }
+    }
+
+    /// Takes one thing read from the terminal (framed by the one input parser,
+    /// [`crate::play::input::InputParser`]); returns [`Probe::done`].
+    pub fn receive(&mut self, received: Received) -> bool {
+        match received {
+            // A key typed during the probe (or just after its last answer, in the same read):
+            // the session handles it once the probe is over.
+            Received::Input(input) => {
+                if self.leftover.len() < MAX_PROBE_BYTES {
+                    self.leftover.push(input);
                 }
             }
-        }
-        self.pending.drain(..used);
-        if self.pending.len() + self.leftover.len() > MAX_PROBE_BYTES {
-            self.garbled = true;
-            self.leftover.append(&mut self.pending);
-            self.da1 = self.da1_wanted(); // stop: this is no terminal answering
+            _ if self.done() => {}
+            Received::Reply(reply) => {
+                if matches!(reply, Reply::PrimaryAttributes(_)) {
+                    self.da1 += 1;
+                }
+                if self.replies.len() < MAX_PROBE_BYTES / 8 {
+                    self.replies.push(reply);
+                }
+            }
+            // An escape sequence that is neither: the terminal answered something else.
+            Received::Unknown => self.garbled = true,
         }
         self.done()
     }
 
+    /// The keys typed during the probe so far, taken.
+    pub fn take_leftover(&mut self) -> Vec<Input> {
+        std::mem::take(&mut self.leftover)
+    }
+
     /// What the replies say. The probe may end early ([`Probe::done`]) or at its deadline.
     pub fn finish(mut self) -> ProbeOutcome {
+        let leftover = self.take_leftover();
+        ProbeOutcome { support: self.support(), leftover }
+    }
+
+    /// What the replies so far say (asked again when a late answer arrives).
+    pub fn support(&self) -> GraphicsSupport {
         let env = &self.options.env;
         let tmux_answered = env.tmux && self.da1 >= 1;
         let answered = !self.garbled && (self.done() || tmux_answered);
@@ -396,9 +413,7 @@ impl Probe {
                 ..Default::default()
             };
         }
-        let mut leftover = std::mem::take(&mut self.leftover);
-        leftover.extend_from_slice(&self.pending);
-        ProbeOutcome { support, leftover }
+        support
     }
 }
 
@@ -416,38 +431,25 @@ pub fn run_probe(
     let deadline = now() + budget;
     write(&queries(options))?;
     let mut probe = Probe::new(options.clone());
+    let mut parser = InputParser::new();
+    let mut received = Vec::new();
     let mut buf = [0u8; 4096];
     while !probe.done() && now() < deadline {
         let n = read_with_deadline(&mut buf, deadline)?;
-        probe.feed(&buf[..n]);
+        probe.count_bytes(n);
+        parser.feed(&buf[..n], now(), &mut received);
+        for r in received.drain(..) {
+            probe.receive(r);
+        }
     }
     Ok(probe.finish())
 }
 
-/// A `read_with_deadline` for [`run_probe`] on a terminal (or any pollable descriptor): waits
-/// until input is there or `deadline` has passed (`poll`), then reads what is there. Returns 0
-/// when the deadline passed with nothing to read. Unlike a reader thread, it leaves nothing
-/// blocked on the terminal for the player's own input reader to compete with.
-#[cfg(unix)]
-pub fn read_fd_with_deadline(fd: std::os::fd::BorrowedFd<'_>, buf: &mut [u8], deadline: Instant) -> io::Result<usize> {
-    use rustix::event::{PollFd, PollFlags, Timespec, poll};
-    loop {
-        let wait = deadline.saturating_duration_since(Instant::now());
-        let timeout = Timespec { tv_sec: wait.as_secs() as i64, tv_nsec: i64::from(wait.subsec_nanos()) };
-        let mut fds = [PollFd::new(&fd, PollFlags::IN)];
-        match poll(&mut fds, Some(&timeout)) {
-            Ok(0) => return Ok(0),
-            Ok(_) => return rustix::io::read(fd, buf).map_err(io::Error::from),
-            Err(rustix::io::Errno::INTR) => continue,
-            Err(e) => return Err(e.into()),
-        }
-    }
-}
-
 /// What `--graphics` asks for.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum GraphicsRequest {
     /// The best the terminal answered for.
+    #[default]
     Auto,
     /// This protocol, whatever the probe said.
     Force(GraphicsMode),

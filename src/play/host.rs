@@ -1,0 +1,299 @@
+//! The host: the only owner of a scene. It holds the scene, its clock, the random source of
+//! random stones, the list `tab` cycles through, and the recorder; [`Host::apply`] resolves a
+//! person's [`Request`] and applies the events in one place, so a key's route is straight:
+//! seat -> host -> scene, and a replay applies the same events through the same `Scene::apply`.
+//!
+//! The local player owns a host next to its seat and screen; `tidepool serve` runs one host on
+//! its own thread for everyone. Time comes in as an argument.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::time::Instant;
+
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use tiny_skia::Pixmap;
+
+use super::clock::SimClock;
+use super::request::Request;
+use crate::error::{Result, ValueError};
+use crate::replay::{FORMAT, Header, PoolOptions, Recorder};
+use crate::scene::{Action, Event, Playable, SceneKind, SceneSpec};
+use crate::storage::Storage;
+
+/// Random stones use their own generator, seeded from the seed xor this, so that pressing
+/// `space` does not change the rain.
+const STONE_SEED_MIX: u64 = 0x5354_4f4e_4553_0001;
+/// Screenshot names tried before giving up on a free one.
+const SCREENSHOT_NAMES: usize = 1000;
+
+/// What the host runs.
+#[derive(Clone)]
+pub struct HostConfig {
+    /// The scenes `tab` cycles through; the first is shown at the start.
+    pub scenes: Vec<SceneSpec>,
+    /// Seed of the random stones.
+    pub seed: u64,
+    /// Record the session (the pool only) to this file.
+    pub record: Option<Recording>,
+    /// Where screenshots and recordings are saved; without one, screenshots are off.
+    pub storage: Option<Arc<dyn Storage>>,
+}
+
+impl std::fmt::Debug for HostConfig {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("HostConfig")
+            .field("scenes", &self.scenes.iter().map(SceneSpec::kind).collect::<Vec<_>>())
+            .field("seed", &self.seed)
+            .field("record", &self.record)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Where a session is recorded.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Recording {
+    /// The replay file.
+    pub path: PathBuf,
+    /// The floor image the pool was started with, for the header (`None`: the built-in one).
+    pub background: Option<PathBuf>,
+}
+
+/// What the status line and the help say about the scene now.
+#[derive(Clone, Debug, Default)]
+pub struct SceneStatus {
+    /// The scene's name (`pool`).
+    pub name: &'static str,
+    /// The scene's own summary (`rain 0.05 · damping 6`), plus whatever a server adds in front
+    /// (`3 playing · `).
+    pub detail: String,
+    /// Whether the scene takes stones.
+    pub takes_stones: bool,
+    /// The status line's key hints, longest first.
+    pub hints: &'static [&'static str],
+    /// The scene's own keys for the help overlay.
+    pub keys: Vec<(&'static str, &'static str)>,
+    /// The simulation is paused.
+    pub paused: bool,
+}
+
+/// The owner of a scene.
+pub struct Host {
+    scene: Box<dyn Playable>,
+    scenes: Vec<SceneSpec>,
+    current: usize,
+    clock: SimClock,
+    rng: ChaCha8Rng,
+    recorder: Option<Recorder>,
+    storage: Option<Arc<dyn Storage>>,
+    step: u64,
+    status: SceneStatus,
+}
+
+impl std::fmt::Debug for Host {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Host")
+            .field("scene", &self.scene.kind())
+            .field("size", &self.scene.size())
+            .field("step", &self.step)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Host {
+    /// The first scene of `config` at `size` pixels, its clock starting at `now`.
+    ///
+    /// Fails when there is no scene, the size cannot be allocated, or a recording is asked for
+    /// a scene other than the pool or without a storage.
+    pub fn new(config: HostConfig, size: (u32, u32), now: Instant) -> Result<Host> {
+        let first =
+            config.scenes.first().ok_or_else(|| ValueError::new("scenes", "a host needs at least one scene"))?;
+        let scene = first.build(size.0, size.1)?;
+        let recorder = match (&config.record, first) {
+            (Some(recording), SceneSpec::Pool(settings)) => {
+                let storage = config
+                    .storage
+                    .clone()
+                    .ok_or_else(|| ValueError::new("record", "recording needs somewhere to save the file"))?;
+                let header = Header {
+                    format: FORMAT,
+                    version: env!("CARGO_PKG_VERSION").into(),
+                    scene: scene.kind(),
+                    seed: config.seed,
+                    size: [size.0, size.1],
+                    options: PoolOptions::of(settings, recording.background.clone()),
+                };
+                Some(Recorder::new(&recording.path, &header, storage))
+            }
+            (Some(_), _) => return Err(ValueError::new("record", "replays hold the pool only").into()),
+            (None, _) => None,
+        };
+        let mut host = Host {
+            clock: SimClock::new(scene.steps_per_second(), now),
+            rng: ChaCha8Rng::seed_from_u64(config.seed ^ STONE_SEED_MIX),
+            scene,
+            scenes: config.scenes,
+            current: 0,
+            recorder,
+            storage: config.storage,
+            step: 0,
+            status: SceneStatus::default(),
+        };
+        host.describe_scene();
+        Ok(host)
+    }
+
+    /// The scene's picture size in pixels.
+    pub fn size(&self) -> (u32, u32) {
+        self.scene.size()
+    }
+
+    /// Which scene is shown.
+    pub fn kind(&self) -> SceneKind {
+        self.scene.kind()
+    }
+
+    /// Simulation steps run so far.
+    pub fn step(&self) -> u64 {
+        self.step
+    }
+
+    /// Resolves `request` with the scene, applies and records its events. Returns a message for
+    /// the person who asked, when there is something to say (a screenshot's name, why `tab`
+    /// did nothing).
+    pub fn apply(&mut self, request: Request, now: Instant) -> Option<String> {
+        match request {
+            Request::Act(action) => self.act(action),
+            Request::RandomStone { radius } => {
+                let (w, h) = self.scene.size();
+                let (x, y) = (self.rng.random_range(0..w) as i32, self.rng.random_range(0..h) as i32);
+                self.act(Action::Stone { x, y, radius, big: false });
+            }
+            Request::TogglePause => {
+                self.clock.set_paused(!self.clock.paused(), now);
+                self.status.paused = self.clock.paused();
+            }
+            Request::NextScene => return self.next_scene(now),
+            Request::Screenshot => return Some(self.screenshot()),
+        }
+        None
+    }
+
+    /// Draws at a new size (the local player's terminal was resized), through the same event
+    /// a replay applies at the same step. A size the scene cannot take leaves it as it was.
+    pub fn resize(&mut self, width: u32, height: u32) {
+        if (width, height) != self.scene.size() {
+            self.apply_event(Event::Resize([width, height]));
+        }
+    }
+
+    /// Runs the steps due by `now` (none while paused); returns how many.
+    pub fn advance(&mut self, now: Instant) -> u64 {
+        let due = self.clock.due(now);
+        self.scene.advance(due);
+        self.step += due;
+        if let Some(r) = &mut self.recorder {
+            r.advance(self.step);
+        }
+        due
+    }
+
+    /// When the next step is due (`None` while paused).
+    pub fn next_due(&self) -> Option<Instant> {
+        self.clock.next_due()
+    }
+
+    /// Draws the scene into `out`, which has the scene's size.
+    pub fn render(&mut self, out: &mut Pixmap) {
+        self.scene.render(out);
+    }
+
+    /// What the status line and the help say now (the scene's summary is refreshed in place:
+    /// no allocation once its text has grown).
+    pub fn status(&mut self) -> &SceneStatus {
+        self.status.detail.clear();
+        self.scene.status(&mut self.status.detail);
+        &self.status
+    }
+
+    /// Ends the session: the recording is saved whole (once; later calls do nothing).
+    pub fn finish(&mut self) -> Result<()> {
+        match &mut self.recorder {
+            Some(r) => r.finish(self.step),
+            None => Ok(()),
+        }
+    }
+
+    fn act(&mut self, action: Action) {
+        for event in self.scene.resolve(action) {
+            self.apply_event(event);
+        }
+    }
+
+    /// Applies an event and records it: the one way the scene changes.
+    fn apply_event(&mut self, event: Event) {
+        self.scene.apply(&event);
+        if let Some(r) = &mut self.recorder {
+            r.record(self.step, event);
+        }
+    }
+
+    fn describe_scene(&mut self) {
+        self.status = SceneStatus {
+            name: self.scene.kind().name(),
+            detail: String::with_capacity(128),
+            takes_stones: self.scene.takes_stones(),
+            hints: self.scene.hints(),
+            keys: self.scene.help(),
+            paused: self.clock.paused(),
+        };
+    }
+
+    /// `tab`: the next scene, at the same size.
+    fn next_scene(&mut self, now: Instant) -> Option<String> {
+        let count = self.scenes.len();
+        if count < 2 {
+            return Some(format!("the {} is the only scene here", self.scene.kind()));
+        }
+        if self.recorder.is_some() {
+            // A replay holds one scene; switching would make it lie.
+            return Some("tab is off while recording (a replay holds one scene)".into());
+        }
+        let (w, h) = self.scene.size();
+        let next = (self.current + 1) % count;
+        match self.scenes[next].build(w, h) {
+            Ok(scene) => {
+                self.scene = scene;
+                self.current = next;
+                self.clock = SimClock::new(self.scene.steps_per_second(), now);
+                self.describe_scene();
+                None
+            }
+            Err(e) => Some(format!("cannot open the {}: {e}", self.scenes[next].kind())),
+        }
+    }
+
+    /// Saves the scene's picture as `tidepool-SCENE-STEP.png` (a free name), and records it.
+    fn screenshot(&mut self) -> String {
+        let Some(storage) = self.storage.clone() else {
+            return "screenshots are off here".into();
+        };
+        let shot = match self.scene.snapshot() {
+            Ok(shot) => shot,
+            Err(e) => return format!("screenshot failed: {e}"),
+        };
+        let base = format!("tidepool-{}-{:06}", self.scene.kind(), self.step);
+        let name = (1..=SCREENSHOT_NAMES)
+            .map(|i| if i == 1 { format!("{base}.png") } else { format!("{base}-{i}.png") })
+            .find(|n| !storage.exists(Path::new(n)))
+            .unwrap_or_else(|| format!("{base}.png"));
+        match storage.save(name.as_ref(), &crate::output::png::encode(&shot)) {
+            Ok(()) => {
+                let message = format!("saved {name}");
+                self.apply_event(Event::Screenshot(name));
+                message
+            }
+            Err(e) => format!("screenshot failed: {e}"),
+        }
+    }
+}

@@ -1,0 +1,77 @@
+//! The play session (feature `player`): a scene that people play in terminals, as a sans-IO
+//! core that any byte stream drives. It does no I/O and reads no clock: bytes and `now` go in,
+//! requests and frame bytes come out.
+//!
+//! - [`Host`]: the only owner of a scene, its clock, its random stones, the scene list and the
+//!   recorder. [`Host::apply`] takes a [`Request`].
+//! - [`Seat`]: one person: aim, stone size, drag, help, messages, and the [`Fit`] between their
+//!   terminal and the scene. [`Seat::handle`] turns an [`Input`] into requests.
+//! - [`Screen`]: one terminal: the graphics probe, the link control and byte budget, the
+//!   rate-controlled cell encoder and the picture encoders. [`Screen::feed`] takes the
+//!   terminal's bytes (replies stay in the screen, inputs come out); [`Screen::frame`] appends a
+//!   frame's bytes.
+//!
+//! Two doors drive them: [`run`] (and [`play`], for this process's own terminal) puts a host,
+//! a seat and a screen on one terminal; `tidepool serve` runs one host on a thread and a seat
+//! and a screen per SSH channel. A key's route is straight: bytes -> [`Screen::feed`] ->
+//! [`Input`] -> [`Seat::handle`] -> [`Request`] -> [`Host::apply`] -> the scene.
+//!
+//! ```
+//! use std::time::{Duration, Instant};
+//! use tidepool::play::{Bandwidth, Host, HostConfig, Screen, ScreenConfig, Seat};
+//! use tidepool::{PoolSettings, SceneSpec};
+//!
+//! let t0 = Instant::now();
+//! let config = ScreenConfig {
+//!     fps: 30,
+//!     bandwidth: Bandwidth::Unlimited,
+//!     color: Default::default(),
+//!     encode: Default::default(),
+//!     graphics: Default::default(),
+//!     probe: None,
+//! };
+//! let mut screen = Screen::new(config, (40, 12), t0);
+//! let scenes = vec![SceneSpec::Pool(PoolSettings::default())];
+//! let host_config = HostConfig { scenes, seed: 1, record: None, storage: None };
+//! let mut host = Host::new(host_config, screen.picture_size(), t0)?;
+//! let mut seat = Seat::new(screen.fit(host.size()));
+//! // The person presses space: a stone.
+//! let (mut inputs, mut requests) = (Vec::new(), Vec::new());
+//! screen.feed(b" ", t0, &mut inputs);
+//! for input in inputs {
+//!     seat.handle(input, t0, host.status(), &mut requests);
+//! }
+//! for request in requests {
+//!     host.apply(request, t0);
+//! }
+//! let now = t0 + Duration::from_millis(100);
+//! host.advance(now);
+//! let mut picture = tiny_skia::Pixmap::new(host.size().0, host.size().1).unwrap();
+//! host.render(&mut picture);
+//! let mut bytes = Vec::new();
+//! let view = seat.view(now, host.status());
+//! // (`view` borrows the seat; the status is taken again for the frame.)
+//! let status = host.status().clone();
+//! screen.frame(now, &picture, &status, &view, &mut bytes)?;
+//! assert!(bytes.starts_with(Screen::ENTER));
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+pub(crate) mod clock;
+pub(crate) mod fit;
+pub(crate) mod host;
+pub(crate) mod input;
+pub(crate) mod replies;
+pub(crate) mod request;
+pub(crate) mod screen;
+pub(crate) mod seat;
+
+pub use crate::term::door::{PlayConfig, TerminalInput, run};
+pub use crate::term::tty::{play, probe_for_picture, restore};
+pub use fit::Fit;
+pub use host::{Host, HostConfig, Recording, SceneStatus};
+pub use input::Input;
+pub use request::Request;
+pub use screen::probe::{Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
+pub use screen::{Bandwidth, Screen, ScreenConfig};
+pub use seat::{Flow, Seat, SeatView};

@@ -1,0 +1,529 @@
+//! A screen: one terminal, bytes in and bytes out. It asks the terminal what it can show (the
+//! graphics probe: questions out, answers fed back as bytes, the same deadline rule everywhere),
+//! finds the link's rate from the terminal's answers (the link control and the byte bucket),
+//! and turns the scene's picture, the seat's overlay and the status line into the frame's
+//! bytes: half-block cells through the rate-controlled encoder, or real pixels (kitty, sixel,
+//! iTerm2) beside a cell frame that carries the status line. It does no I/O and reads no clock:
+//! the door that owns it (this process's terminal, an SSH channel) writes what it appends and
+//! passes the time in.
+//!
+//! The terminal's bytes are framed once ([`InputParser`]): the person's inputs go back to the
+//! door (for the seat), the replies stay here. Device-attributes answers are paired with their
+//! questions in order: the probe's are counted first, so an answer that arrives after the
+//! probe's deadline is still the probe's and never shifts the link's round trips.
+
+mod compose;
+mod link;
+mod picture;
+pub mod probe;
+mod ui;
+
+use std::io;
+use std::time::{Duration, Instant};
+
+use tiny_skia::Pixmap;
+
+use self::compose::{Figures, FrameBuilder, big_enough};
+use self::link::{Change, LinkControl};
+use self::picture::Picture;
+use self::probe::{GraphicsChoice, GraphicsRequest, GraphicsSupport, Probe, ProbeOptions};
+use super::fit::{CellGrid, Fit};
+use super::host::SceneStatus;
+use super::input::{Input, InputParser, Received};
+use super::replies::Reply;
+use super::seat::SeatView;
+use crate::output::bucket::ByteBucket;
+use crate::output::color::ColorMode;
+use crate::output::cursor::Cursor;
+use crate::output::diff::{EncodeOptions, Shown};
+use crate::output::graphics::GraphicsMode;
+use crate::output::rate::{RateEncoder, RateOptions, Target};
+use crate::play::clock::{FramePacer, Meter};
+
+/// How many bytes a second a screen may send.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Bandwidth {
+    /// Found by itself from the terminal's answers (the link control).
+    Auto,
+    /// This many bytes a second.
+    Fixed(u64),
+    /// No limit: every frame is sent whole (what changed of it).
+    Unlimited,
+}
+
+/// How a screen draws.
+#[derive(Clone, Debug)]
+pub struct ScreenConfig {
+    /// Frames per second at most.
+    pub fps: u32,
+    /// What the link carries.
+    pub bandwidth: Bandwidth,
+    /// Terminal colours.
+    pub color: ColorMode,
+    /// Encoder options (colour threshold, synchronized output).
+    pub encode: EncodeOptions,
+    /// How the picture is drawn (`--graphics`).
+    pub graphics: GraphicsRequest,
+    /// Ask the terminal what it shows before the first frame; `None` sends no question (then
+    /// `auto` means cells and a forced mode is used as asked).
+    pub probe: Option<ProbeOptions>,
+}
+
+/// Above this rate approximate cells are not worth their CPU: the link carries exact ones.
+const APPROXIMATE_BELOW: f64 = 1_000_000.0;
+/// After the probe's deadline, how long its answers may still arrive and upgrade the picture
+/// (a far terminal answers a round trip later; a silent one is given up on after this).
+pub const LATE_ANSWERS: Duration = Duration::from_secs(5);
+
+/// The probe's progress.
+#[derive(Debug)]
+enum Asking {
+    /// No question out (never asked, or done).
+    No,
+    /// The questions are out; no frame is drawn until they are answered or the deadline passes.
+    First { probe: Box<Probe>, deadline: Instant },
+    /// Drawing already (cells); the answers may still come until `until`.
+    Late { probe: Box<Probe>, until: Instant },
+}
+
+/// One terminal.
+#[derive(Debug)]
+pub struct Screen {
+    config: ScreenConfig,
+    term: (u16, u16),
+    parser: InputParser,
+    received: Vec<Received>,
+    asking: Asking,
+    /// Device-attributes answers still owed to the probe: they come before any answer to the
+    /// link's questions, which are asked after them.
+    probe_answers: u8,
+    choice: GraphicsChoice,
+    support: GraphicsSupport,
+    picture: Option<Picture>,
+    mouse_pixels: bool,
+    /// The terminal has been set up ([`Screen::ENTER`]).
+    entered: bool,
+    /// Pixel mouse reports must be turned on (a late upgrade to pixels).
+    mouse_pixels_pending: bool,
+    /// The picture's layout changed since [`Screen::take_layout_change`] last said so.
+    layout_changed: bool,
+    notice: Option<String>,
+    pacer: FramePacer,
+    bucket: ByteBucket,
+    link: LinkControl,
+    encoder: RateEncoder,
+    shown: Shown,
+    builder: FrameBuilder,
+    meter: Meter,
+    /// Every byte handed out, for the link's delivery rate.
+    bytes_sent: u64,
+    /// The frame's bytes before they are handed out (a reused buffer).
+    scratch: Vec<u8>,
+}
+
+impl Screen {
+    /// Sent once before the first frame: alternate screen, hidden cursor, mouse reporting
+    /// (buttons and drags only, mode 1002, not every motion; SGR coordinates, mode 1006),
+    /// screen cleared.
+    pub const ENTER: &'static [u8] = b"\x1b[?1049h\x1b[?25l\x1b[?1000h\x1b[?1002h\x1b[?1006h\x1b[0m\x1b[2J";
+    /// Sent when the session ends (after [`Screen::restore_prefix`]): abort any cut sequence,
+    /// end synchronized output, reset colours, mouse off, cursor on, back to the normal screen.
+    pub const RESTORE: &'static [u8] = b"\x18\x1b[?2026l\x1b[0m\x1b[?1006l\x1b[?1002l\x1b[?1000l\x1b[?25h\x1b[?1049l";
+
+    /// A screen for a terminal of `term` cells (columns, rows), its clock starting at `now`.
+    pub fn new(config: ScreenConfig, term: (u16, u16), now: Instant) -> Screen {
+        let asks = config.probe.is_some() && config.graphics != GraphicsRequest::Force(GraphicsMode::Cells);
+        let choice = probe::choose(if asks { GraphicsRequest::Auto } else { config.graphics }, None);
+        let support = GraphicsSupport::default();
+        let bucket = match config.bandwidth {
+            Bandwidth::Auto => ByteBucket::new(link::START_RATE),
+            Bandwidth::Fixed(rate) => ByteBucket::new(rate as f64),
+            Bandwidth::Unlimited => ByteBucket::unlimited(),
+        };
+        Screen {
+            picture: Picture::new(&choice, &support, term),
+            pacer: FramePacer::new(config.fps, now),
+            meter: Meter::new(now),
+            config,
+            term,
+            parser: InputParser::new(),
+            received: Vec::new(),
+            asking: Asking::No,
+            probe_answers: 0,
+            choice,
+            support,
+            mouse_pixels: false,
+            entered: false,
+            mouse_pixels_pending: false,
+            layout_changed: false,
+            notice: None,
+            bucket,
+            link: LinkControl::new(),
+            encoder: RateEncoder::new(),
+            shown: Shown::UNKNOWN,
+            builder: FrameBuilder::default(),
+            bytes_sent: 0,
+            scratch: Vec::new(),
+        }
+    }
+
+    /// Starts the session: appends the probe's questions to `out` when the terminal is to be
+    /// asked (nothing otherwise). No frame is drawn until the answers are in or
+    /// [`probe::PROBE_BUDGET`] has passed.
+    pub fn start(&mut self, now: Instant, out: &mut Vec<u8>) {
+        let Some(options) = self.config.probe.clone().filter(|_| matches!(self.asking, Asking::No)) else {
+            return;
+        };
+        if self.config.graphics == GraphicsRequest::Force(GraphicsMode::Cells) || self.entered {
+            return;
+        }
+        out.extend_from_slice(&probe::queries(&options));
+        let probe = Probe::new(options);
+        self.probe_answers = probe.da1_expected();
+        self.asking = Asking::First { probe: Box::new(probe), deadline: now + probe::PROBE_BUDGET };
+    }
+
+    /// Whether the probe's first answers are still awaited (no frame is drawn meanwhile).
+    pub fn probing(&self) -> bool {
+        matches!(self.asking, Asking::First { .. })
+    }
+
+    /// Takes bytes the terminal sent at `now`: replies are used here, the person's inputs are
+    /// appended to `inputs` (keys typed during the probe come once it is over; a run of drags
+    /// is merged into its last position).
+    pub fn feed(&mut self, bytes: &[u8], now: Instant, inputs: &mut Vec<Input>) {
+        if let Asking::First { probe, .. } = &mut self.asking {
+            probe.count_bytes(bytes.len());
+        }
+        self.parser.feed(bytes, now, &mut self.received);
+        self.route(now, inputs);
+    }
+
+    /// Looks at the clock: a lone Escape that waited long enough, the probe's deadline, the
+    /// link's lost questions.
+    pub fn tick(&mut self, now: Instant, inputs: &mut Vec<Input>) {
+        self.parser.flush_stale(now, &mut self.received);
+        self.route(now, inputs);
+        match &self.asking {
+            Asking::First { deadline, .. } if now >= *deadline => self.end_probe(now, inputs),
+            Asking::Late { until, .. } if now >= *until => {
+                // Never answered: the answers still owed will not come.
+                self.asking = Asking::No;
+                self.probe_answers = 0;
+                if self.config.graphics == GraphicsRequest::Auto {
+                    self.notice = Some("the terminal did not answer: half-block cells".into());
+                }
+            }
+            _ => {}
+        }
+        if self.auto() && !self.probing() {
+            if self.link.tick(now) == Change::Down {
+                self.bucket.drain();
+            }
+            self.bucket.set_rate(self.link.rate());
+        }
+    }
+
+    /// When [`Screen::tick`] must next look at the clock (a lone Escape's wait, the probe's
+    /// deadline), if at all.
+    pub fn next_tick(&self) -> Option<Instant> {
+        let asking = match &self.asking {
+            Asking::First { deadline, .. } => Some(*deadline),
+            Asking::Late { until, .. } => Some(*until),
+            Asking::No => None,
+        };
+        match (asking, self.parser.deadline()) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
+    }
+
+    /// When the next frame is due (frames are drawn at most `fps` a second).
+    pub fn next_frame(&self) -> Instant {
+        self.pacer.next_due()
+    }
+
+    /// The terminal is now `term` cells: the next frame repaints everything.
+    pub fn resize(&mut self, term: (u16, u16)) {
+        if term == self.term {
+            return;
+        }
+        self.term = term;
+        self.shown = Shown::UNKNOWN;
+        if let Some(p) = &mut self.picture {
+            p.resize(term);
+        }
+        self.layout_changed = true;
+    }
+
+    /// The terminal's size in cells.
+    pub fn term(&self) -> (u16, u16) {
+        self.term
+    }
+
+    /// Whether the terminal is big enough for the picture and the status line (a smaller one
+    /// shows a notice, and the scene need not be drawn).
+    pub fn drawable(&self) -> bool {
+        big_enough(self.term)
+    }
+
+    /// Whether the picture's size or place changed (a resize, the probe's answer) since this
+    /// was last asked: the door then makes a new fit (and the local player resizes its scene).
+    pub fn take_layout_change(&mut self) -> bool {
+        std::mem::take(&mut self.layout_changed)
+    }
+
+    /// Something to tell the person (which protocol draws, how to get pictures), once.
+    pub fn take_notice(&mut self) -> Option<String> {
+        self.notice.take()
+    }
+
+    /// The picture [`Screen::frame`] takes, in pixels: the half-block picture (a pixel a
+    /// column, two a row, above the status line), or the real-pixel picture within the scene
+    /// cap (scaled up by the terminal or the sixel encoder).
+    pub fn picture_size(&self) -> (u32, u32) {
+        match &self.picture {
+            Some(p) => p.scene_size(),
+            None => (u32::from(self.term.0).max(3), (2 * u32::from(self.term.1).saturating_sub(1)).max(3)),
+        }
+    }
+
+    /// How a scene of `scene` pixels sits in this terminal's picture.
+    pub fn fit(&self, scene: (u32, u32)) -> Fit {
+        let grid = match &self.picture {
+            _ if !big_enough(self.term) => CellGrid::HalfBlocks { cols: 0, rows: 0 },
+            Some(p) => CellGrid::Pixels { layout: *p.layout(), mouse_pixels: self.mouse_pixels },
+            None => CellGrid::HalfBlocks { cols: self.term.0, rows: self.term.1.saturating_sub(1) },
+        };
+        Fit::new(scene, self.picture_size(), grid)
+    }
+
+    /// Whether a frame should be drawn now: the probe is not holding the screen, and the frame
+    /// is due or `urgent` (a key's frame goes out at once).
+    pub fn ready(&self, now: Instant, urgent: bool) -> bool {
+        !self.probing() && (urgent || self.pacer.ready(now))
+    }
+
+    /// A due frame was not drawn (the door's writer was still busy): the cadence moves on.
+    pub fn skip(&mut self, now: Instant) {
+        self.pacer.sent(now);
+    }
+
+    /// Appends the frame for now to `out`: `picture` (of [`Screen::picture_size`]), the seat's
+    /// overlay, the status line. Returns the bytes appended (0 when nothing changed). Fails only
+    /// when kitty's temporary file cannot be written.
+    pub fn frame(
+        &mut self,
+        now: Instant,
+        picture: &Pixmap,
+        status: &SceneStatus,
+        seat: &SeatView<'_>,
+        out: &mut Vec<u8>,
+    ) -> io::Result<usize> {
+        let start = out.len();
+        if !self.entered {
+            out.extend_from_slice(Self::ENTER);
+            self.entered = true;
+        }
+        if std::mem::take(&mut self.mouse_pixels_pending) {
+            out.extend_from_slice(picture::PIXEL_MOUSE_ON);
+        }
+        if self.auto() {
+            self.bucket.set_rate(self.link.rate());
+        }
+        self.bucket.refill(now);
+        let rate = self.bucket.rate();
+        let figures = Figures {
+            fps: self.meter.fps,
+            bytes_per_second: self.meter.bytes_per_second,
+            bandwidth: rate.map(|r| r as u64),
+            pixels_elsewhere: self.picture.is_some(),
+        };
+        // On an auto link the unanswered bytes are capped too (see `link`: the first seconds).
+        let budget = if self.auto() {
+            self.bucket.budget().min(self.link.window_left(now, self.bytes_sent))
+        } else {
+            self.bucket.budget()
+        };
+        let frame = self.builder.compose(self.term, picture, self.config.color, status, seat, &figures);
+        let target = match self.config.color {
+            ColorMode::TrueColor => Target::new(frame),
+            mode => Target::with_truth(frame, picture, mode),
+        };
+        let options = RateOptions {
+            approximate: rate.is_some_and(|r| r < APPROXIMATE_BELOW),
+            ..RateOptions::from(self.config.encode)
+        };
+        let resized = self.shown.frame.is_none();
+        let mut bytes = std::mem::take(&mut self.scratch);
+        bytes.clear();
+        let report = self.encoder.encode_into(&mut self.shown, target, budget, options, &mut bytes);
+        self.bucket.spend(report.bytes);
+        let mut result = Ok(());
+        if let Some(p) = &mut self.picture {
+            let frame = picture::Frame {
+                resized,
+                help_open: seat.help.is_some(),
+                cells_shown: report.pending == 0,
+                drawable: big_enough(self.term),
+                sync: options.sync,
+            };
+            match p.add_to_frame(picture, &frame, &mut self.bucket, &mut bytes) {
+                Ok(true) => self.shown.cursor = Cursor::Unknown,
+                Ok(false) => {}
+                Err(e) => result = Err(e),
+            }
+        }
+        out.extend_from_slice(&bytes);
+        self.scratch = bytes;
+        let unasked = self.link.unasked(self.bytes_sent + (out.len() - start) as u64);
+        if self.auto() && self.link.probe_due() && (out.len() > start || unasked) {
+            // The question goes after the frame: its answer says the frame has arrived.
+            out.extend_from_slice(link::PROBE);
+            self.link.probed(now, self.bytes_sent + (out.len() - start) as u64);
+        }
+        let len = out.len() - start;
+        self.bytes_sent += len as u64;
+        self.meter.frame(now, len);
+        self.pacer.sent(now);
+        result.map(|()| len)
+    }
+
+    /// Whether link questions are still unanswered (a door that is closing waits a little for
+    /// their answers, so they do not reach the shell as typed text).
+    pub fn awaiting_answers(&self) -> bool {
+        !self.link.probe_due() || matches!(self.asking, Asking::Late { .. })
+    }
+
+    /// What must be undone before [`Screen::RESTORE`] when the session ends: kitty's image
+    /// deleted, pixel mouse reports off. A door writes it on every way out (a signal too).
+    pub fn restore_prefix(&self) -> Vec<u8> {
+        picture::restore_bytes(&self.choice, self.mouse_pixels)
+    }
+
+    /// The bytes that hand the terminal back: [`Screen::restore_prefix`], then
+    /// [`Screen::RESTORE`].
+    pub fn farewell(&self, out: &mut Vec<u8>) {
+        out.extend_from_slice(&self.restore_prefix());
+        out.extend_from_slice(Self::RESTORE);
+    }
+
+    /// Frames and bytes a second over the last whole second.
+    pub fn figures(&self) -> (u32, u64) {
+        (self.meter.fps, self.meter.bytes_per_second)
+    }
+
+    /// The protocol drawing the picture.
+    pub fn mode(&self) -> GraphicsMode {
+        self.choice.mode
+    }
+
+    fn auto(&self) -> bool {
+        self.config.bandwidth == Bandwidth::Auto
+    }
+
+    /// Sends what was read where it belongs.
+    fn route(&mut self, now: Instant, inputs: &mut Vec<Input>) {
+        let (auto, probing) = (self.auto(), self.probing());
+        let mut received = std::mem::take(&mut self.received);
+        for r in received.drain(..) {
+            let probe = match &mut self.asking {
+                Asking::First { probe, .. } | Asking::Late { probe, .. } => Some(probe),
+                Asking::No => None,
+            };
+            match (r, probe) {
+                (Received::Reply(reply @ Reply::PrimaryAttributes(_)), probe) => {
+                    // In order: the probe's answers come before any to the link's questions. An
+                    // extra one (the outer terminal's, inside tmux) goes to the probe while the
+                    // link has asked nothing.
+                    let probes = self.probe_answers > 0 || (probe.is_some() && self.link.probe_due());
+                    match probe {
+                        Some(probe) if probes => {
+                            self.probe_answers = self.probe_answers.saturating_sub(1);
+                            probe.receive(Received::Reply(reply));
+                        }
+                        _ if self.probe_answers > 0 => self.probe_answers -= 1,
+                        _ => {
+                            if auto && self.link.answered(now) == Change::Down {
+                                self.bucket.drain();
+                            }
+                        }
+                    }
+                }
+                (r @ Received::Input(_), Some(probe)) if probing => {
+                    probe.receive(r);
+                }
+                (Received::Input(input), _) => inputs.push(input),
+                (r, Some(probe)) => {
+                    probe.receive(r);
+                }
+                (_, None) => {}
+            }
+        }
+        self.received = received;
+        super::input::coalesce(inputs);
+        let done = match &self.asking {
+            Asking::First { probe, .. } | Asking::Late { probe, .. } => probe.done(),
+            Asking::No => false,
+        };
+        if done {
+            self.end_probe(now, inputs);
+        }
+    }
+
+    /// The probe's answers are in, or its deadline passed: choose how to draw. Before its
+    /// answers are complete the terminal gets cells, and late answers may still upgrade it.
+    fn end_probe(&mut self, now: Instant, inputs: &mut Vec<Input>) {
+        let asking = std::mem::replace(&mut self.asking, Asking::No);
+        let (mut probe, first) = match asking {
+            Asking::First { probe, .. } => (probe, true),
+            Asking::Late { probe, .. } => (probe, false),
+            Asking::No => return,
+        };
+        inputs.extend(probe.take_leftover());
+        let support = probe.support();
+        if !probe.done() {
+            self.asking = Asking::Late { probe, until: now + LATE_ANSWERS };
+            if first {
+                // Draw cells now (or the forced mode), with what is known.
+                self.choose(&support, true);
+            }
+            return;
+        }
+        if first || (self.config.graphics == GraphicsRequest::Auto && self.choice.mode == GraphicsMode::Cells) {
+            self.choose(&support, first);
+        }
+    }
+
+    /// Sets the protocol from what the terminal said (`first`: the first decision, before any
+    /// frame; later only an upgrade from cells to pixels).
+    fn choose(&mut self, support: &GraphicsSupport, first: bool) {
+        let choice = probe::choose(self.config.graphics, Some(support));
+        if !first && choice.mode == GraphicsMode::Cells {
+            return;
+        }
+        self.picture = Picture::new(&choice, support, self.term);
+        let mouse_pixels = picture::pixel_mouse(&choice, support);
+        self.mouse_pixels_pending = mouse_pixels && !self.mouse_pixels;
+        self.mouse_pixels = mouse_pixels;
+        let mut notice = Vec::new();
+        if let Some(hint) = choice.hint {
+            notice.push(hint.to_owned());
+        }
+        if let Some(p) = &self.picture {
+            let (w, h) = p.scene_size();
+            let late = if first { "" } else { " (the terminal answered late)" };
+            notice.push(format!("{} graphics, {w}x{h} pixels{late}", choice.mode.name()));
+        }
+        if !notice.is_empty() {
+            self.notice = Some(notice.join("; "));
+        }
+        self.choice = choice;
+        self.support = support.clone();
+        self.shown = Shown::UNKNOWN;
+        self.layout_changed = true;
+    }
+}
+
+#[cfg(test)]
+mod tests;

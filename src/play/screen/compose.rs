@@ -1,0 +1,102 @@
+//! The cell frame a screen shows: the picture as half-block cells (or blank cells under real
+//! pixels), with the aim marker, the help overlay and the status line on top. Every buffer is
+//! kept from frame to frame, so a steady stream of frames allocates nothing.
+
+use tiny_skia::Pixmap;
+
+use super::ui::{self, MIN_SIZE, Status};
+use crate::output::color::ColorMode;
+use crate::output::frame::Frame;
+use crate::output::units::{write_human_bytes, write_human_rate};
+use crate::play::host::SceneStatus;
+use crate::play::seat::SeatView;
+
+/// What the screen itself adds to the status line.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Figures {
+    /// Frames drawn per second.
+    pub fps: u32,
+    /// Bytes sent per second.
+    pub bytes_per_second: u64,
+    /// The link's rate in effect, bytes per second (`None`: no limit).
+    pub bandwidth: Option<u64>,
+    /// The picture goes to the terminal in real pixels (kitty, sixel, iTerm2), not in these
+    /// cells: the picture's rows stay blank cells under it.
+    pub pixels_elsewhere: bool,
+}
+
+/// Bytes reserved for the formatted byte rate.
+const RATE_ROOM: usize = 40;
+
+/// Whether a `cols x rows` terminal is big enough for the picture and the status line.
+pub fn big_enough((cols, rows): (u16, u16)) -> bool {
+    cols >= MIN_SIZE.0 && rows >= MIN_SIZE.1
+}
+
+/// Builds frames, reusing its buffers.
+#[derive(Debug)]
+pub struct FrameBuilder {
+    frame: Frame,
+    rate: String,
+    line: String,
+}
+
+impl Default for FrameBuilder {
+    fn default() -> Self {
+        FrameBuilder { frame: Frame::new(0, 0), rate: String::new(), line: String::new() }
+    }
+}
+
+impl FrameBuilder {
+    /// The frame for a `term` (columns, rows) terminal: `picture` (the cells' pixel size: one
+    /// pixel a column, two a row, above the status line) with the seat's marker, help and
+    /// message, and the status line of `status` with the screen's `figures`.
+    pub fn compose(
+        &mut self,
+        term: (u16, u16),
+        picture: &Pixmap,
+        color: ColorMode,
+        status: &SceneStatus,
+        seat: &SeatView<'_>,
+        figures: &Figures,
+    ) -> &Frame {
+        let (cols, rows) = (usize::from(term.0), usize::from(term.1));
+        self.frame.reset(cols, rows);
+        // Room for the longest texts once (they grow as the figures do: `0 B/s` becomes
+        // `1.23 MB/s`), so steady frames never reallocate them.
+        self.rate.reserve(RATE_ROOM);
+        self.line.reserve(4 * cols);
+        if !big_enough(term) {
+            ui::too_small(&mut self.frame);
+            return &self.frame;
+        }
+        if !figures.pixels_elsewhere {
+            self.frame.draw_pixels(picture, color);
+        }
+        if let Some((col, row)) = seat.aim {
+            ui::aim_marker(&mut self.frame, usize::from(col), usize::from(row));
+        }
+        if let Some(lines) = seat.help {
+            ui::help_overlay(&mut self.frame, lines, color);
+        }
+        write_human_rate(&mut self.rate, figures.bytes_per_second);
+        if let Some(bandwidth) = figures.bandwidth {
+            // The rate in effect: what the link is found (or told) to carry.
+            self.rate.push_str(" of ");
+            write_human_bytes(&mut self.rate, bandwidth);
+            self.rate.push_str("/s");
+        }
+        let line = Status {
+            scene: status.name,
+            fps: figures.fps,
+            rate: &self.rate,
+            detail: &status.detail,
+            stone: status.takes_stones.then_some(seat.stone),
+            hints: status.hints,
+            paused: status.paused,
+            message: seat.message,
+        };
+        ui::status_line(&mut self.frame, rows - 1, &line, color, &mut self.line);
+        &self.frame
+    }
+}

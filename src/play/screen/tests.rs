@@ -1,0 +1,170 @@
+use super::*;
+use crate::play::fit::Fit;
+use crate::play::host::SceneStatus;
+use crate::play::screen::probe::{Environment, WinSize};
+
+const MS: Duration = Duration::from_millis(1);
+const KITTY_OK: &[u8] = b"\x1b_Gi=31;OK\x1b\\";
+const DA1: &[u8] = b"\x1b[?62;22c";
+
+fn config(bandwidth: Bandwidth, probe: bool) -> ScreenConfig {
+    ScreenConfig {
+        fps: 30,
+        bandwidth,
+        color: ColorMode::TrueColor,
+        encode: EncodeOptions::default(),
+        graphics: GraphicsRequest::Auto,
+        probe: probe.then(|| ProbeOptions {
+            env: Environment { ssh: true, ..Environment::default() },
+            winsize: WinSize { cols: 40, rows: 12, x_px: 320, y_px: 192 },
+            kitty_file: None,
+        }),
+    }
+}
+
+fn status() -> SceneStatus {
+    SceneStatus { name: "pool", takes_stones: true, ..SceneStatus::default() }
+}
+
+/// A frame of a flat picture of the screen's size; the bytes appended.
+fn frame(screen: &mut Screen, now: Instant, shade: u8) -> Vec<u8> {
+    let (w, h) = screen.picture_size();
+    let mut picture = Pixmap::new(w, h).unwrap();
+    picture.fill(tiny_skia::Color::from_rgba8(shade, 90, 160, 255));
+    let mut out = Vec::new();
+    screen.frame(now, &picture, &status(), &SeatView { stone: 3, ..SeatView::default() }, &mut out).unwrap();
+    out
+}
+
+fn contains(hay: &[u8], needle: &[u8]) -> bool {
+    hay.windows(needle.len()).any(|w| w == needle)
+}
+
+#[test]
+fn a_screen_that_asks_nothing_draws_cells_and_sets_the_terminal_up_first() {
+    let t0 = Instant::now();
+    let mut screen = Screen::new(config(Bandwidth::Unlimited, false), (40, 12), t0);
+    let mut asked = Vec::new();
+    screen.start(t0, &mut asked);
+    assert!(asked.is_empty() && !screen.probing());
+    assert_eq!(screen.picture_size(), (40, 22));
+    let first = frame(&mut screen, t0, 10);
+    assert!(first.starts_with(Screen::ENTER));
+    assert_eq!(screen.mode(), GraphicsMode::Cells);
+    let again = frame(&mut screen, t0 + 40 * MS, 10);
+    assert!(!contains(&again, Screen::ENTER), "set up once");
+}
+
+#[test]
+fn the_probe_holds_the_first_frame_until_the_answer_and_keys_typed_meanwhile_come_after() {
+    let t0 = Instant::now();
+    let mut screen = Screen::new(config(Bandwidth::Unlimited, true), (40, 12), t0);
+    let mut asked = Vec::new();
+    screen.start(t0, &mut asked);
+    assert!(asked.ends_with(b"\x1b[c") && screen.probing());
+    assert!(!screen.ready(t0, true), "no frame while the terminal is asked");
+    let mut inputs = Vec::new();
+    let mut answer = b"q".to_vec();
+    answer.extend_from_slice(KITTY_OK);
+    answer.extend_from_slice(DA1);
+    screen.feed(&answer, t0 + 20 * MS, &mut inputs);
+    assert_eq!(inputs, vec![Input::Quit], "the key typed during the probe, once it is over");
+    assert!(!screen.probing() && screen.mode() == GraphicsMode::Kitty);
+    assert!(screen.take_layout_change());
+    assert!(screen.take_notice().unwrap().starts_with("kitty graphics"));
+    let first = frame(&mut screen, t0 + 20 * MS, 10);
+    assert!(first.starts_with(Screen::ENTER) && contains(&first, b"\x1b_G"), "a kitty picture");
+}
+
+#[test]
+fn a_late_answer_upgrades_cells_to_pixels() {
+    let t0 = Instant::now();
+    let mut screen = Screen::new(config(Bandwidth::Unlimited, true), (40, 12), t0);
+    screen.start(t0, &mut Vec::new());
+    let mut inputs = Vec::new();
+    screen.tick(t0 + probe::PROBE_BUDGET, &mut inputs);
+    assert!(!screen.probing() && screen.mode() == GraphicsMode::Cells, "cells after the deadline");
+    assert!(!contains(&frame(&mut screen, t0 + 200 * MS, 10), b"\x1b_G"));
+    let mut answer = KITTY_OK.to_vec();
+    answer.extend_from_slice(DA1);
+    screen.feed(&answer, t0 + 400 * MS, &mut inputs);
+    assert_eq!(screen.mode(), GraphicsMode::Kitty, "upgraded when the answer came");
+    assert!(screen.take_layout_change());
+    assert!(screen.take_notice().unwrap().contains("late"));
+    assert!(contains(&frame(&mut screen, t0 + 450 * MS, 10), b"\x1b_G"), "a kitty picture now");
+    assert!(inputs.is_empty(), "no answer became a key");
+}
+
+#[test]
+fn a_late_probe_answer_is_the_probes_and_never_pairs_with_a_link_question() {
+    let t0 = Instant::now();
+    let mut screen = Screen::new(config(Bandwidth::Auto, true), (40, 12), t0);
+    screen.start(t0, &mut Vec::new());
+    let mut inputs = Vec::new();
+    screen.tick(t0 + probe::PROBE_BUDGET, &mut inputs);
+    // The first frame asks the link's first question at 200 ms.
+    let out = frame(&mut screen, t0 + 200 * MS, 10);
+    assert!(out.ends_with(link::PROBE), "the link's question after the frame");
+    // The probe's answer comes at 300 ms (a slow terminal), the link's at 390 ms.
+    screen.feed(DA1, t0 + 300 * MS, &mut inputs);
+    assert_eq!(screen.link.last_rtt(), None, "the probe's late answer is not a round trip");
+    screen.feed(DA1, t0 + 390 * MS, &mut inputs);
+    assert_eq!(screen.link.last_rtt(), Some(190 * MS), "the link's own answer: 390 - 200 ms");
+    assert!(inputs.is_empty());
+}
+
+#[test]
+fn a_terminal_that_never_answers_keeps_getting_frames() {
+    let t0 = Instant::now();
+    let mut screen = Screen::new(config(Bandwidth::Auto, true), (40, 12), t0);
+    screen.start(t0, &mut Vec::new());
+    let mut inputs = Vec::new();
+    let mut sent = 0;
+    let mut frames = 0;
+    for i in 5..600u32 {
+        let now = t0 + i * 33 * MS / 2;
+        screen.tick(now, &mut inputs);
+        if screen.ready(now, false) {
+            let bytes = frame(&mut screen, now, (i % 200) as u8);
+            sent += bytes.len();
+            frames += usize::from(!bytes.is_empty());
+        }
+    }
+    assert!(!screen.probing());
+    assert!(screen.take_notice().is_some_and(|n| n.contains("did not answer")), "said on the status line");
+    assert!(frames > 200, "drawing all along: {frames} frames in 10 s");
+    assert!(sent > 100_000, "{sent} bytes");
+}
+
+#[test]
+fn a_terminal_that_answers_only_the_probe_gets_a_bounded_rate() {
+    // It answers the probe's questions, then never again (a multiplexer that stopped passing
+    // answers on): the link's questions go unanswered, and the rate falls instead of growing.
+    let t0 = Instant::now();
+    let mut screen = Screen::new(config(Bandwidth::Auto, true), (40, 12), t0);
+    screen.start(t0, &mut Vec::new());
+    let mut inputs = Vec::new();
+    screen.feed(DA1, t0 + 5 * MS, &mut inputs);
+    let mut frames = 0;
+    for i in 1..300u32 {
+        let now = t0 + i * 33 * MS;
+        screen.tick(now, &mut inputs);
+        if screen.ready(now, false) && !frame(&mut screen, now, (i % 200) as u8).is_empty() {
+            frames += 1;
+        }
+    }
+    let rate = screen.bucket.rate().unwrap();
+    assert!(rate <= link::START_RATE, "never above where it started: {rate}");
+    assert!(frames > 100, "still drawing: {frames}");
+}
+
+#[test]
+fn the_fit_follows_the_mode() {
+    let t0 = Instant::now();
+    let screen = Screen::new(config(Bandwidth::Unlimited, false), (40, 12), t0);
+    let fit: Fit = screen.fit((40, 22));
+    assert!(fit.one_to_one());
+    assert_eq!(fit.scene_at(3, 2), Some((3, 4)));
+    let tiny = Screen::new(config(Bandwidth::Unlimited, false), (8, 4), t0);
+    assert_eq!(tiny.fit((8, 6)).scene_at(1, 1), None, "a terminal too small takes no clicks");
+}

@@ -1,0 +1,219 @@
+//! The loop that drives a play session on one terminal: read its bytes, step the host's scene,
+//! draw a frame when the screen says one is due and the writer is free.
+//!
+//! The loop knows nothing of the device: input comes from a [`TerminalInput`] (bytes and the
+//! terminal's size; [`super::tty`] reads this process's terminal, a test a script) and frames go
+//! to any `Write` through a writer thread ([`super::writer`]). Input is waited for with a
+//! timeout that ends at the next due step or frame, so a key press is handled at once.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use tiny_skia::Pixmap;
+
+use super::writer::FrameWriter;
+use crate::error::{Error, Result};
+use crate::play::host::{Host, HostConfig};
+use crate::play::input::Input;
+use crate::play::screen::{Screen, ScreenConfig};
+use crate::play::seat::{Flow, Seat};
+
+/// How long the door waits, when the person quits, for the answers to the screen's last
+/// questions (so that they do not reach the shell).
+const REPLY_GRACE: Duration = Duration::from_millis(300);
+/// The longest the loop waits for input before looking at the clock, the size and the quit flag.
+const MAX_WAIT: Duration = Duration::from_millis(50);
+/// Setting this variable makes the player panic after its first frame: the pty tests use it to
+/// check that a panic restores the terminal. Not a user feature.
+const TEST_PANIC_VAR: &str = "TIDEPOOL_TEST_PANIC";
+
+/// Where a terminal's input comes from.
+pub trait TerminalInput: Send {
+    /// Waits at most `timeout` for input and appends what arrived to `buf`. `Ok(false)` when
+    /// the input is closed for good (the terminal or the client went away).
+    fn read(&mut self, buf: &mut Vec<u8>, timeout: Duration) -> std::io::Result<bool>;
+
+    /// The terminal's size in cells (columns, rows), asked for on every turn of the loop.
+    fn size(&mut self) -> std::io::Result<(u16, u16)>;
+}
+
+/// A session on one terminal.
+#[derive(Clone, Debug)]
+pub struct PlayConfig {
+    /// The scene, its list, its seed, the recording.
+    pub host: HostConfig,
+    /// How the terminal is drawn.
+    pub screen: ScreenConfig,
+    /// A message for the status line's first seconds (e.g. how to get true colour).
+    pub greeting: Option<String>,
+    /// Set from outside (a signal handler) to end the session as if the person quit.
+    pub quit: Arc<AtomicBool>,
+}
+
+/// Runs a session until the person quits (or the input closes, or `config.quit` is set),
+/// reading `input` and writing to `output`. `restore_prefix` is told what the screen needs
+/// undone on exit whenever that changes (this process's terminal writes it from a signal too).
+pub fn run_door(
+    input: &mut dyn TerminalInput,
+    output: impl std::io::Write + Send + 'static,
+    config: PlayConfig,
+    restore_prefix: &mut (dyn FnMut(Vec<u8>) + Send),
+) -> Result<()> {
+    let read_error = |source| Error::Terminal { action: "cannot read the terminal", source };
+    let mut output = output;
+    let writer = FrameWriter::spawn(move |bytes| output.write_all(bytes).and_then(|()| output.flush()))
+        .map_err(Error::Output)?;
+    let now = Instant::now();
+    let mut screen = Screen::new(config.screen, input.size().map_err(read_error)?, now);
+    let mut inputs = Vec::new();
+    let mut bytes = Vec::new();
+    // The probe first: its answer decides the picture's size, so the scene waits for it.
+    let mut asked = writer.buffer();
+    screen.start(now, &mut asked);
+    if !asked.is_empty() {
+        writer.send(asked);
+    }
+    while screen.probing() && !config.quit.load(Ordering::SeqCst) {
+        let now = Instant::now();
+        let wait = screen.next_tick().map_or(MAX_WAIT, |t| t.saturating_duration_since(now).min(MAX_WAIT));
+        bytes.clear();
+        if !input.read(&mut bytes, wait).map_err(read_error)? {
+            return Ok(());
+        }
+        screen.feed(&bytes, Instant::now(), &mut inputs);
+        screen.tick(Instant::now(), &mut inputs);
+    }
+    screen.resize(input.size().map_err(read_error)?);
+    restore_prefix(screen.restore_prefix());
+    let now = Instant::now();
+    let mut host = Host::new(config.host, screen.picture_size(), now)?;
+    let mut seat = Seat::new(screen.fit(host.size()));
+    let greeting = [screen.take_notice(), config.greeting].into_iter().flatten().collect::<Vec<_>>().join("; ");
+    if !greeting.is_empty() {
+        seat.greet(greeting, now);
+    }
+    let (w, h) = host.size();
+    let mut picture = Pixmap::new(w, h).ok_or(Error::TooLarge { what: "picture", width: w, height: h })?;
+    let test_panic = std::env::var_os(TEST_PANIC_VAR).is_some();
+    let mut requests = Vec::new();
+    // A key or click whose frame has not gone out yet.
+    let mut owed = false;
+    // The loop runs on a rayon worker: the parallel parts of a frame (simulation bands,
+    // picture rows) then go to the worker's own queue instead of rayon's global injector,
+    // which allocates a block every 63 jobs. Steady-state frames allocate nothing.
+    let played = rayon::scope(|_| -> Result<()> {
+        'play: loop {
+            if config.quit.load(Ordering::SeqCst) {
+                break 'play;
+            }
+            let now = Instant::now();
+            let mut wake = screen.next_frame();
+            for due in [host.next_due(), screen.next_tick()].into_iter().flatten() {
+                wake = wake.min(due);
+            }
+            let mut timeout = wake.saturating_duration_since(now).min(MAX_WAIT);
+            if owed || !inputs.is_empty() {
+                // A key's frame waits for the writer: look again soon, not at the next tick.
+                timeout = timeout.min(Duration::from_millis(1));
+            }
+            bytes.clear();
+            if !input.read(&mut bytes, timeout).map_err(read_error)? {
+                return Ok(());
+            }
+            let now = Instant::now();
+            screen.feed(&bytes, now, &mut inputs);
+            screen.tick(now, &mut inputs);
+            screen.resize(input.size().map_err(read_error)?);
+            if screen.take_layout_change() {
+                restore_prefix(screen.restore_prefix());
+                let size = screen.picture_size();
+                if screen.drawable() {
+                    host.resize(size.0, size.1);
+                }
+                seat.set_fit(screen.fit(host.size()));
+                // The whole screen is repainted at once, not at the next tick.
+                owed = true;
+            }
+            if let Some(notice) = screen.take_notice() {
+                seat.say(notice, now);
+            }
+            owed |= !inputs.is_empty();
+            for input in inputs.drain(..) {
+                if seat.handle(input, now, host.status(), &mut requests) == Flow::Quit {
+                    break 'play;
+                }
+                for request in requests.drain(..) {
+                    if let Some(message) = host.apply(request, now) {
+                        seat.say(message, now);
+                    }
+                }
+            }
+            host.advance(Instant::now());
+            if let Some(e) = writer.error() {
+                return Err(Error::Output(e));
+            }
+            let now = Instant::now();
+            if !screen.ready(now, owed) {
+                continue;
+            }
+            if !writer.idle() {
+                // The terminal is still busy with the last frame: drop this one (a key's frame
+                // goes as soon as the writer is free).
+                if !owed {
+                    screen.skip(now);
+                }
+                continue;
+            }
+            owed = false;
+            let (w, h) = host.size();
+            if (picture.width(), picture.height()) != (w, h) {
+                picture = Pixmap::new(w, h).ok_or(Error::TooLarge { what: "picture", width: w, height: h })?;
+            }
+            if screen.drawable() {
+                host.render(&mut picture);
+            }
+            let mut out = writer.buffer();
+            let status = host.status();
+            let view = seat.view(now, status);
+            let len = screen.frame(now, &picture, status, &view, &mut out).map_err(Error::Output)?;
+            if len > 0 {
+                writer.send(out);
+            }
+            if test_panic && len > 0 {
+                panic!("{TEST_PANIC_VAR} is set: panicking on purpose to test the terminal restore");
+            }
+        }
+        Ok(())
+    });
+    // A question asked but not yet answered would reach the shell as typed text once the
+    // terminal is restored: wait a little for the answers (and for the last frame, which
+    // carries the question, to be written).
+    let grace = Instant::now() + REPLY_GRACE;
+    while played.is_ok() && screen.awaiting_answers() && Instant::now() < grace {
+        let wait = grace.saturating_duration_since(Instant::now());
+        if !writer.idle() {
+            std::thread::sleep(wait.min(Duration::from_millis(2)));
+            continue;
+        }
+        bytes.clear();
+        if !input.read(&mut bytes, wait.min(MAX_WAIT)).map_err(read_error)? {
+            break;
+        }
+        screen.feed(&bytes, Instant::now(), &mut Vec::<Input>::new());
+    }
+    let finished = host.finish();
+    played.and(finished)
+}
+
+/// Runs a session on any terminal until the person quits (or the input closes, or
+/// `config.quit` is set), reading `input` and writing to `output`: the door an embedding
+/// program (or a test) uses for a byte stream of its own. [`crate::play::play`] is the door of
+/// this process's terminal.
+pub fn run(
+    input: &mut dyn TerminalInput,
+    output: impl std::io::Write + Send + 'static,
+    config: PlayConfig,
+) -> Result<()> {
+    run_door(input, output, config, &mut |_| {})
+}
