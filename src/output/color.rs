@@ -19,9 +19,10 @@ use crate::output::halfblock::Rgb;
 use crate::output::vt::xterm_256;
 
 /// How many colours the terminal shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum ColorMode {
-    /// 24-bit colour: `ESC[38;2;r;g;bm`.
+    /// 24-bit colour: `ESC[38;2;r;g;bm` (what most terminals show today).
+    #[default]
     TrueColor,
     /// The xterm 256-colour palette: `ESC[38;5;nm`.
     Palette256,

@@ -75,3 +75,6 @@ pub use request::Request;
 pub use screen::probe::{Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
 pub use screen::{Bandwidth, Screen, ScreenConfig};
 pub use seat::{Flow, Seat, SeatView};
+
+#[cfg(test)]
+mod tests;

@@ -192,6 +192,22 @@ pub struct Term {
     pub screen: tidepool::terminal::Screen,
     pub frames: usize,
     pub raw: Vec<u8>,
+    /// How it answers device-attributes questions.
+    pub answers: Answers,
+    /// Device-attributes questions seen so far.
+    pub questions: usize,
+}
+
+/// How a test terminal answers the server's questions.
+#[derive(Clone, Copy, Debug)]
+pub enum Answers {
+    /// Every device-attributes question as a VT220-class text terminal does.
+    Text,
+    /// The first (the graphics probe's) with these bytes (a kitty or sixel terminal's answers,
+    /// its DA1 last), later ones as text.
+    Probe(&'static [u8]),
+    /// Never: a terminal that answers nothing.
+    Silent,
 }
 
 impl Term {
@@ -200,7 +216,12 @@ impl Term {
         // The client's terminal is raw (ssh sets it so) and the server has no pty: a line feed
         // moves down only.
         screen.lf_returns = false;
-        Term { ch, screen, frames: 0, raw: Vec::new() }
+        Term { ch, screen, frames: 0, raw: Vec::new(), answers: Answers::Text, questions: 0 }
+    }
+
+    /// A terminal that answers as `answers` says.
+    pub fn answering(ch: Channel<client::Msg>, cols: usize, rows: usize, answers: Answers) -> Term {
+        Term { answers, ..Term::new(ch, cols, rows) }
     }
 
     /// Reads until `done` says so (bounded by [`HANG_GUARD`]).
@@ -216,7 +237,15 @@ impl Term {
                         // came before them (the server's link control and probe ask them).
                         let questions = data.windows(DA1_QUESTION.len()).filter(|w| *w == DA1_QUESTION).count();
                         for _ in 0..questions {
-                            let _ = self.ch.data(DA1_ANSWER).await;
+                            let answer = match (self.answers, self.questions) {
+                                (Answers::Silent, _) => None,
+                                (Answers::Probe(probe), 0) => Some(probe),
+                                _ => Some(DA1_ANSWER),
+                            };
+                            self.questions += 1;
+                            if let Some(answer) = answer {
+                                let _ = self.ch.data(answer).await;
+                            }
                         }
                     }
                     Some(_) => {}

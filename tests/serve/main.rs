@@ -6,4 +6,9 @@ mod common;
 mod limits;
 mod load;
 mod openssh;
+/// The local player in a pseudo-terminal (shared with the integration tests).
+#[allow(dead_code)]
+#[path = "../integration/common/pty.rs"]
+mod pty;
 mod session;
+mod two_doors;
