@@ -1,4 +1,4 @@
-//! Pixels and heights to bytes: PNG, half-block text and heightmaps, and with the `animation`
+//! Pixels to bytes: PNG, half-block text and the sea's maps (a `Heightmap` writes itself), and with the `animation`
 //! feature animated GIF and PNG. Every encoder returns bytes (or writes to any `Write`); where
 //! the bytes go is the caller's choice.
 
@@ -7,7 +7,6 @@ pub use crate::output::apng::ApngWriter;
 #[cfg(feature = "animation")]
 pub use crate::output::gif::{GifPalette, GifWriter};
 pub use crate::output::halfblock::encode as halfblock;
-pub use crate::output::heightmap::{encode_npy as npy, encode_npy_shaped as npy_shaped, encode_png16 as png16};
 pub use crate::output::maps::{MAP_PNG_SCALE, encode_maps as sea_maps, file_names as sea_map_names};
 pub use crate::output::png::encode as png;
 pub use crate::output::units::human_bytes;

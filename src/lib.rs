@@ -48,7 +48,6 @@ pub mod values;
 pub mod widget;
 
 pub use error::{Error, Result, ValueError};
-pub use output::heightmap::Heightmap;
 pub use render::background::{load as load_image, pool_floor};
 pub use render::camera::CameraPose;
 pub use render::caustics::CausticsLook;
@@ -59,7 +58,7 @@ pub use render::texture::SeaTexture;
 pub use scene::lake::{LakeScene, LakeSettings};
 pub use scene::ocean::{OceanScene, OceanSettings};
 pub use scene::pool::{PoolScene, PoolSettings, showcase as pool_showcase};
-pub use scene::{Action, Controls, Event, Playable, Scene, SceneKind, SceneSpec, Script};
+pub use scene::{Action, Controls, Event, Heightmap, Playable, Scene, SceneKind, SceneSpec, Script};
 pub use sim::lake::LakeParams;
 pub use sim::noise::NoiseKind;
 pub use sim::ocean::SeaParams;

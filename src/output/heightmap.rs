@@ -1,27 +1,8 @@
-//! Heightmap export: NPY (float32, for numpy, Blender, game engines) and 16-bit grey PNG.
+//! Heights to bytes: NPY (float32, for numpy, Blender, game engines) and 16-bit grey PNG, from
+//! plain values (a scene's `Heightmap` calls these).
 
 use image::ImageEncoder;
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
-
-/// A grid of heights, row-major, row 0 = the top of the picture (or the north edge).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Heightmap {
-    /// Columns.
-    pub width: usize,
-    /// Rows.
-    pub height: usize,
-    /// `width * height` values in the scene's unit (pool: raw amplitude; ocean/lake: metres).
-    pub values: Vec<f32>,
-    /// 16-bit PNG levels per unit (pool: 1, the raw amplitude; ocean: 100, centimetres; lake:
-    /// 1000, millimetres).
-    pub png_levels_per_unit: f32,
-}
-
-/// Encodes NPY format 1.0: `{'descr': '<f4', 'fortran_order': False, 'shape': (H, W), }`,
-/// space-padded so the data starts at a multiple of 64 bytes, then little-endian float32s.
-pub fn encode_npy(map: &Heightmap) -> Vec<u8> {
-    encode_npy_shaped(&[map.height, map.width], &map.values)
-}
 
 /// NPY 1.0 of float32s in C order with any `shape` (whose product is `values.len()`).
 pub fn encode_npy_shaped(shape: &[usize], values: &[f32]) -> Vec<u8> {
@@ -44,11 +25,11 @@ pub fn encode_npy_shaped(shape: &[usize], values: &[f32]) -> Vec<u8> {
     out
 }
 
-/// Encodes a 16-bit greyscale PNG where a pixel is `round(value · png_levels_per_unit) + 32768`,
-/// clamped to 0..=65535.
-pub fn encode_png16(map: &Heightmap) -> Vec<u8> {
-    let samples = levels16(&map.values, map.png_levels_per_unit);
-    encode_map_png(map.width, map.height, image::ExtendedColorType::L16, &samples)
+/// Encodes `width x height` values as a 16-bit greyscale PNG where a pixel is
+/// `round(value · levels_per_unit) + 32768`, clamped to 0..=65535.
+pub fn encode_png16(width: usize, height: usize, values: &[f32], levels_per_unit: f32) -> Vec<u8> {
+    let samples = levels16(values, levels_per_unit);
+    encode_map_png(width, height, image::ExtendedColorType::L16, &samples)
 }
 
 /// Values to 16-bit PNG levels, `round(v · scale) + 32768` clamped, in native byte order (as
@@ -75,18 +56,11 @@ pub(crate) fn encode_map_png(width: usize, height: usize, colour: image::Extende
 mod tests {
     use super::*;
 
-    fn sample() -> Heightmap {
-        Heightmap {
-            width: 3,
-            height: 2,
-            values: vec![0.0, 1.5, -2.0, 100.0, -32768.0, 40000.0],
-            png_levels_per_unit: 1.0,
-        }
-    }
+    const SAMPLE: [f32; 6] = [0.0, 1.5, -2.0, 100.0, -32768.0, 40000.0];
 
     #[test]
     fn npy_header_is_aligned_and_exact() {
-        let bytes = encode_npy(&sample());
+        let bytes = encode_npy_shaped(&[2, 3], &SAMPLE);
         assert_eq!(&bytes[..8], b"\x93NUMPY\x01\x00");
         let header_len = u16::from_le_bytes([bytes[8], bytes[9]]) as usize;
         assert_eq!((10 + header_len) % 64, 0);
@@ -100,11 +74,11 @@ mod tests {
 
     #[test]
     fn png16_offsets_scales_and_clamps() {
-        let png = encode_png16(&sample());
+        let png = encode_png16(3, 2, &SAMPLE, 1.0);
         let decoded = image::load_from_memory(&png).unwrap();
         let grey = decoded.as_luma16().expect("16-bit grey").as_raw().clone();
         assert_eq!(grey, vec![32768, 32770, 32766, 32868, 0, 65535]);
-        let cm = encode_png16(&Heightmap { width: 1, height: 1, values: vec![0.123], png_levels_per_unit: 100.0 });
+        let cm = encode_png16(1, 1, &[0.123], 100.0);
         assert_eq!(image::load_from_memory(&cm).unwrap().as_luma16().unwrap().as_raw(), &vec![32780]);
     }
 }

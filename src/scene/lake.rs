@@ -2,9 +2,9 @@
 
 use tiny_skia::Pixmap;
 
+use super::Heightmap;
 use super::{Action, Controls, Event, Scene, SceneKind};
 use crate::error::{Error, Result};
-use crate::output::heightmap::Heightmap;
 use crate::render::lake::LakeRenderer;
 use crate::sim::lake::{FAR_SHORE_M, Lake, LakeParams};
 use crate::sim::noise::{MAX_OCTAVES, NoiseKind};

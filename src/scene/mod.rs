@@ -14,6 +14,7 @@
 
 mod controls;
 mod event;
+mod heightmap;
 pub mod lake;
 pub mod ocean;
 #[cfg(test)]
@@ -23,12 +24,12 @@ mod script;
 
 pub use controls::{Action, Controls};
 pub use event::Event;
+pub use heightmap::Heightmap;
 pub use script::Script;
 
 use tiny_skia::Pixmap;
 
 use crate::error::{Error, Result};
-use crate::output::heightmap::Heightmap;
 
 /// A simulation and its renderer: what stills, animations, replays, the player and the
 /// benchmarks all drive.

@@ -2,9 +2,9 @@
 
 use tiny_skia::Pixmap;
 
+use super::Heightmap;
 use super::{Action, Controls, Event, Scene, SceneKind};
 use crate::error::{Error, Result};
-use crate::output::heightmap::Heightmap;
 use crate::render::ocean::{OceanRenderer, OceanView};
 use crate::render::texture::SeaTexture;
 use crate::sim::ocean::{Sea, SeaParams};

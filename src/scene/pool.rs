@@ -2,9 +2,9 @@
 
 use tiny_skia::Pixmap;
 
+use super::Heightmap;
 use super::{Action, Controls, Event, Scene, SceneKind};
 use crate::error::{Error, Result};
-use crate::output::heightmap::Heightmap;
 use crate::render::background;
 use crate::render::pool::{PoolLook, PoolRenderer};
 use crate::sim::breeze::Breeze;

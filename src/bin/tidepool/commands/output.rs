@@ -151,8 +151,8 @@ impl OutputPlan {
         if let (Some((path, kind)), Some(map)) = (&self.heightmap, heights) {
             let started = Instant::now();
             let bytes = match kind {
-                HeightmapKind::Npy => tidepool::encode::npy(map),
-                HeightmapKind::Png16 => tidepool::encode::png16(map),
+                HeightmapKind::Npy => map.to_npy(),
+                HeightmapKind::Png16 => map.to_png16(),
             };
             files::write_file(path, &bytes)?;
             let size = tidepool::encode::human_bytes(bytes.len() as u64);
