@@ -374,6 +374,9 @@ impl Screen {
                 Err(e) => result = Err(e),
             }
         }
+        // Room for the largest frame at once (the scratch buffer has it), so the caller's
+        // buffers stop growing after the first frames: steady frames allocate nothing.
+        out.reserve(bytes.capacity());
         out.extend_from_slice(&bytes);
         self.scratch = bytes;
         let unasked = self.link.unasked(self.bytes_sent + (out.len() - start) as u64);

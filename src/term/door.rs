@@ -15,9 +15,9 @@ use tiny_skia::Pixmap;
 use super::writer::FrameWriter;
 use crate::error::{Error, Result};
 use crate::play::host::{Host, HostConfig};
-use crate::play::input::Input;
+use crate::play::player::Player;
 use crate::play::screen::{Screen, ScreenConfig};
-use crate::play::seat::{Flow, Seat};
+use crate::play::seat::Flow;
 
 /// How long the door waits, when the person quits, for the answers to the screen's last
 /// questions (so that they do not reach the shell).
@@ -66,7 +66,6 @@ pub fn run_door(
         .map_err(Error::Output)?;
     let now = Instant::now();
     let mut screen = Screen::new(config.screen, input.size().map_err(read_error)?, now);
-    let mut inputs = Vec::new();
     let mut bytes = Vec::new();
     // The probe first: its answer decides the picture's size, so the scene waits for it.
     let mut asked = writer.buffer();
@@ -74,94 +73,79 @@ pub fn run_door(
     if !asked.is_empty() {
         writer.send(asked);
     }
-    while screen.probing() && !config.quit.load(Ordering::SeqCst) {
+    let provisional = screen.picture_size();
+    let mut player = Player::new(screen, provisional, config.greeting);
+    while player.screen.probing() && !config.quit.load(Ordering::SeqCst) {
         let now = Instant::now();
-        let wait = screen.next_tick().map_or(MAX_WAIT, |t| t.saturating_duration_since(now).min(MAX_WAIT));
+        let wait = player.screen.next_tick().map_or(MAX_WAIT, |t| t.saturating_duration_since(now).min(MAX_WAIT));
         bytes.clear();
         if !input.read(&mut bytes, wait).map_err(read_error)? {
             return Ok(());
         }
-        screen.feed(&bytes, Instant::now(), &mut inputs);
-        screen.tick(Instant::now(), &mut inputs);
+        player.settle(&bytes, Instant::now());
     }
-    screen.resize(input.size().map_err(read_error)?);
-    restore_prefix(screen.restore_prefix());
-    let now = Instant::now();
-    let mut host = Host::new(config.host, screen.picture_size(), now)?;
-    let mut seat = Seat::new(screen.fit(host.size()));
-    let greeting = [screen.take_notice(), config.greeting].into_iter().flatten().collect::<Vec<_>>().join("; ");
-    if !greeting.is_empty() {
-        seat.greet(greeting, now);
-    }
+    player.screen.resize(input.size().map_err(read_error)?);
+    restore_prefix(player.screen.restore_prefix());
+    let mut host = Host::new(config.host, player.screen.picture_size(), Instant::now())?;
+    player.refit(host.size());
     let (w, h) = host.size();
     let mut picture = Pixmap::new(w, h).ok_or(Error::TooLarge { what: "picture", width: w, height: h })?;
     let test_panic = std::env::var_os(TEST_PANIC_VAR).is_some();
     let mut requests = Vec::new();
     // A key or click whose frame has not gone out yet.
     let mut owed = false;
+    // A buffer kept back from a frame that had nothing to send.
+    let mut unused: Option<Vec<u8>> = None;
     // The loop runs on a rayon worker: the parallel parts of a frame (simulation bands,
     // picture rows) then go to the worker's own queue instead of rayon's global injector,
     // which allocates a block every 63 jobs. Steady-state frames allocate nothing.
     let played = rayon::scope(|_| -> Result<()> {
-        'play: loop {
-            if config.quit.load(Ordering::SeqCst) {
-                break 'play;
-            }
+        while !config.quit.load(Ordering::SeqCst) {
             let now = Instant::now();
-            let mut wake = screen.next_frame();
-            for due in [host.next_due(), screen.next_tick()].into_iter().flatten() {
-                wake = wake.min(due);
-            }
-            let mut timeout = wake.saturating_duration_since(now).min(MAX_WAIT);
-            if owed || !inputs.is_empty() {
-                // A key's frame waits for the writer: look again soon, not at the next tick.
-                timeout = timeout.min(Duration::from_millis(1));
-            }
+            let screen = &player.screen;
+            let wake =
+                [host.next_due(), screen.next_tick()].into_iter().flatten().fold(screen.next_frame(), Instant::min);
+            // A key's frame waits for the writer: look again soon, not at the next tick.
+            let wait = if owed { Duration::from_millis(1) } else { MAX_WAIT };
             bytes.clear();
-            if !input.read(&mut bytes, timeout).map_err(read_error)? {
+            if !input.read(&mut bytes, wake.saturating_duration_since(now).min(wait)).map_err(read_error)? {
                 return Ok(());
             }
             let now = Instant::now();
-            screen.feed(&bytes, now, &mut inputs);
-            screen.tick(now, &mut inputs);
-            screen.resize(input.size().map_err(read_error)?);
-            if screen.take_layout_change() {
-                restore_prefix(screen.restore_prefix());
-                let size = screen.picture_size();
-                if screen.drawable() {
-                    host.resize(size.0, size.1);
-                }
-                seat.set_fit(screen.fit(host.size()));
-                // The whole screen is repainted at once, not at the next tick.
-                owed = true;
+            player.feed(&bytes, now);
+            player.screen.resize(input.size().map_err(read_error)?);
+            let turn = player.turn(now, host.status(), &mut requests);
+            if turn.flow == Flow::Quit {
+                break;
             }
-            if let Some(notice) = screen.take_notice() {
-                seat.say(notice, now);
-            }
-            owed |= !inputs.is_empty();
-            for input in inputs.drain(..) {
-                if seat.handle(input, now, host.status(), &mut requests) == Flow::Quit {
-                    break 'play;
-                }
-                for request in requests.drain(..) {
-                    if let Some(message) = host.apply(request, now) {
-                        seat.say(message, now);
-                    }
+            for request in requests.drain(..) {
+                if let Some(message) = host.apply(request, now) {
+                    player.say(message, now);
                 }
             }
+            if turn.layout_changed {
+                restore_prefix(player.screen.restore_prefix());
+                let (w, h) = player.screen.picture_size();
+                if player.screen.drawable() {
+                    host.resize(w, h);
+                }
+                player.refit(host.size());
+            }
+            // A key's frame (or a repaint) is owed until it is sent, even when the writer is busy.
+            owed |= turn.urgent || turn.layout_changed;
             host.advance(Instant::now());
             if let Some(e) = writer.error() {
                 return Err(Error::Output(e));
             }
             let now = Instant::now();
-            if !screen.ready(now, owed) {
+            if !player.screen.ready(now, owed) {
                 continue;
             }
             if !writer.idle() {
                 // The terminal is still busy with the last frame: drop this one (a key's frame
                 // goes as soon as the writer is free).
                 if !owed {
-                    screen.skip(now);
+                    player.screen.skip(now);
                 }
                 continue;
             }
@@ -170,15 +154,16 @@ pub fn run_door(
             if (picture.width(), picture.height()) != (w, h) {
                 picture = Pixmap::new(w, h).ok_or(Error::TooLarge { what: "picture", width: w, height: h })?;
             }
-            if screen.drawable() {
+            if player.screen.drawable() {
                 host.render(&mut picture);
             }
-            let mut out = writer.buffer();
-            let status = host.status();
-            let view = seat.view(now, status);
-            let len = screen.frame(now, &picture, status, &view, &mut out).map_err(Error::Output)?;
+            let mut out = unused.take().unwrap_or_else(|| writer.buffer());
+            let len = player.frame(now, &picture, host.status(), &mut out).map_err(Error::Output)?;
             if len > 0 {
                 writer.send(out);
+            } else {
+                // Nothing changed: the buffer is kept for the next frame instead of being lost.
+                unused = Some(out);
             }
             if test_panic && len > 0 {
                 panic!("{TEST_PANIC_VAR} is set: panicking on purpose to test the terminal restore");
@@ -190,7 +175,7 @@ pub fn run_door(
     // terminal is restored: wait a little for the answers (and for the last frame, which
     // carries the question, to be written).
     let grace = Instant::now() + REPLY_GRACE;
-    while played.is_ok() && screen.awaiting_answers() && Instant::now() < grace {
+    while played.is_ok() && player.screen.awaiting_answers() && Instant::now() < grace {
         let wait = grace.saturating_duration_since(Instant::now());
         if !writer.idle() {
             std::thread::sleep(wait.min(Duration::from_millis(2)));
@@ -200,7 +185,7 @@ pub fn run_door(
         if !input.read(&mut bytes, wait.min(MAX_WAIT)).map_err(read_error)? {
             break;
         }
-        screen.feed(&bytes, Instant::now(), &mut Vec::<Input>::new());
+        player.feed(&bytes, Instant::now());
     }
     let finished = host.finish();
     played.and(finished)

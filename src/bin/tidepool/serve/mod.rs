@@ -16,6 +16,7 @@ pub mod handler;
 pub mod host_key;
 mod hub;
 pub mod killable;
+pub mod leave;
 pub mod limits;
 pub mod server;
 pub mod viewer;

@@ -12,60 +12,19 @@
 use std::net::SocketAddr;
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 use bytes::Bytes;
 use russh::ChannelWriteHalf;
 use russh::server::Msg;
-use tidepool::play::{Flow, Screen, ScreenConfig, Seat};
+use tidepool::play::{Flow, Player, Screen, ScreenConfig};
 use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
 use super::game::SharedFrame;
 use super::hub::Hub;
-use super::limits::{FAREWELL_TIMEOUT, PlayerSlot};
-
-/// Time a player's connection may stay open after its game ended before it is cut.
-pub const LINGER: Duration = Duration::from_secs(1);
-
-/// Why a player leaves.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Leave {
-    /// Pressed q, Esc or Ctrl-C.
-    Quit,
-    /// Sent EOF or closed the channel.
-    ClientClosed,
-    /// No key for the idle timeout.
-    Idle,
-    /// A frame could not be sent within the stall timeout.
-    Stalled,
-    /// The server is stopping.
-    Shutdown,
-    /// The connection was cut (it ended, or the server cut it).
-    Cut,
-}
-
-impl Leave {
-    fn farewell(self, scene: &str) -> Option<String> {
-        match self {
-            Leave::Quit => Some(format!("bye from the {scene}")),
-            Leave::Idle => Some(format!("you were idle too long; the {scene} sent you home")),
-            Leave::Shutdown => Some(format!("the {scene} is closing (server shutting down); bye")),
-            Leave::Stalled | Leave::ClientClosed | Leave::Cut => None,
-        }
-    }
-
-    fn name(self) -> &'static str {
-        match self {
-            Leave::Quit => "quit",
-            Leave::ClientClosed => "closed",
-            Leave::Idle => "idle",
-            Leave::Stalled => "stalled",
-            Leave::Shutdown => "shutdown",
-            Leave::Cut => "cut",
-        }
-    }
-}
+use super::leave::{self, Leave};
+use super::limits::PlayerSlot;
 
 /// What the connection's handler tells the player task about its terminal.
 #[derive(Debug, Clone, Copy)]
@@ -104,28 +63,27 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     let ViewerCtx { hub, id, peer, write, mut terminal, mut input, screen, kill, slot } = ctx;
     let stats = hub.stats.clone();
     let now = Instant::now();
-    let mut screen = Screen::new(screen, terminal.borrow().size, now);
-    let mut seat = Seat::new(screen.fit(hub.scene_size)).without_screenshots();
-    hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, *seat.fit());
+    let screen = Screen::new(screen, terminal.borrow().size, now);
+    let mut player =
+        Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into())).without_screenshots();
+    hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, *player.seat.fit());
     let mut frames = hub.frames.clone();
     let mut actions = hub.limits.actions_bucket();
-    let (mut inputs, mut requests) = (Vec::new(), Vec::new());
-    let mut last_input = now;
-    let mut owed = false;
-    let mut greeting = Some("shared pool: all see your stones".to_string());
+    let mut requests = Vec::new();
+    let (mut last_input, mut owed) = (now, false);
     let mut tally = Tally::default();
     let mut scene_name = frames.borrow().status.name;
 
     let reason = 'game: {
         let mut asked = Vec::new();
-        screen.start(now, &mut asked);
+        player.screen.start(now, &mut asked);
         if !asked.is_empty() && write.data_bytes(Bytes::from(asked)).await.is_err() {
             break 'game Leave::Cut;
         }
         loop {
             let idle_at = last_input + hub.limits.idle_timeout;
             // The screen's own deadlines only: frames follow the shared pictures.
-            let tick = screen.next_tick();
+            let tick = player.screen.next_tick();
             let mut fresh = false;
             tokio::select! {
                 biased;
@@ -135,14 +93,11 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                     if changed.is_err() { break 'game Leave::Cut; }
                     let state = *terminal.borrow_and_update();
                     if state.closed { break 'game Leave::ClientClosed; }
-                    screen.resize(state.size);
+                    player.screen.resize(state.size);
                 }
                 bytes = input.recv() => {
                     let Some(bytes) = bytes else { break 'game Leave::Cut };
-                    let before = inputs.len();
-                    screen.feed(&bytes, Instant::now(), &mut inputs);
-                    if inputs.len() > before {
-                        // Only the person counts: the terminal's own answers are no sign of life.
+                    if player.feed(&bytes, Instant::now()) {
                         last_input = Instant::now();
                     }
                 }
@@ -159,50 +114,37 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 }
             }
             let now = Instant::now();
-            screen.tick(now, &mut inputs);
-            if screen.take_layout_change() {
-                seat.set_fit(screen.fit(hub.scene_size));
-                hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, *seat.fit());
-                owed = true;
-            }
-            if !screen.probing()
-                && let Some(greeting) = greeting.take()
-            {
-                let notice = screen.take_notice().map_or(String::new(), |n| format!("{n}; "));
-                seat.greet(format!("{notice}{greeting}"), now);
-            } else if let Some(notice) = screen.take_notice() {
-                seat.say(notice, now);
-            }
-            owed |= !inputs.is_empty();
             let shared = frames.borrow().clone();
-            for i in inputs.drain(..) {
-                if seat.handle(i, now, &shared.status, &mut requests) == Flow::Quit {
-                    break 'game Leave::Quit;
-                }
-                for request in requests.drain(..) {
-                    if !actions.try_take(1.0, now) || hub.requests.try_send(request).is_err() {
-                        stats.actions_dropped.fetch_add(1, Ordering::Relaxed);
-                    }
+            scene_name = shared.status.name;
+            let turn = player.turn(now, &shared.status, &mut requests);
+            if turn.flow == Flow::Quit {
+                break 'game Leave::Quit;
+            }
+            for request in requests.drain(..) {
+                if !actions.try_take(1.0, now) || hub.requests.try_send(request).is_err() {
+                    stats.actions_dropped.fetch_add(1, Ordering::Relaxed);
                 }
             }
-            scene_name = shared.status.name;
+            if turn.layout_changed {
+                player.refit(hub.scene_size);
+                hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, *player.seat.fit());
+            }
+            owed |= turn.urgent || turn.layout_changed;
             // A new shared picture or a key's frame: the game's rate paces the frames.
-            if !(fresh || owed) || !screen.ready(now, true) {
+            if !(fresh || owed) || !player.screen.ready(now, true) {
                 continue;
             }
             tally.count(&shared);
             // Just resized: the next shared frame has this size.
-            let Some(picture) = shared.pictures.get(&seat.fit().target()).cloned() else { continue };
+            let Some(picture) = shared.pictures.get(&player.seat.fit().target()).cloned() else { continue };
             if !hub.outbound.lock().unwrap_or_else(|p| p.into_inner()).try_take(0.0, now) {
                 stats.frames_dropped_rate.fetch_add(1, Ordering::Relaxed);
-                screen.skip(now);
                 continue;
             }
             owed = false;
             // The frame's bytes go to russh as `Bytes`, so a buffer cannot be kept between frames.
             let mut out = Vec::new();
-            let view = seat.view(now, &shared.status);
-            let Ok(len) = screen.frame(now, &picture, &shared.status, &view, &mut out) else { continue };
+            let Ok(len) = player.frame(now, &picture, &shared.status, &mut out) else { continue };
             if len == 0 {
                 continue;
             }
@@ -240,41 +182,8 @@ pub(crate) async fn run(ctx: ViewerCtx) {
         tally.bytes
     );
     let mut goodbye = Vec::new();
-    screen.farewell(&mut goodbye);
-    match reason.farewell(scene_name) {
-        Some(message) => {
-            goodbye.extend_from_slice(format!("{message}\r\n").as_bytes());
-            let _ = tokio::time::timeout(FAREWELL_TIMEOUT, async {
-                write.data_bytes(Bytes::from(goodbye)).await.ok()?;
-                write.exit_status(0).await.ok()?;
-                write.eof().await.ok()?;
-                // No DISCONNECT after this: OpenSSH exits on DISCONNECT before writing channel
-                // data it has already received, so the farewell and the restore would be lost.
-                write.close().await.ok()
-            })
-            .await;
-        }
-        None if reason == Leave::ClientClosed => {
-            let _ = tokio::time::timeout(FAREWELL_TIMEOUT, async {
-                write.data_bytes(Bytes::from(goodbye)).await.ok()?;
-                write.close().await.ok()
-            })
-            .await;
-        }
-        None => {}
-    }
-    match reason {
-        Leave::Cut => {}
-        // It is not reading: nothing more will get through, cut now.
-        Leave::Stalled => kill.cancel(),
-        // A client that keeps the connection open after its game ended is cut shortly after.
-        _ => {
-            tokio::select! {
-                _ = kill.cancelled() => {}
-                _ = tokio::time::sleep(LINGER) => kill.cancel(),
-            }
-        }
-    }
+    player.screen.farewell(&mut goodbye);
+    leave::say_goodbye(reason, scene_name, goodbye, &write, &kill).await;
 }
 
 impl Tally {
