@@ -206,11 +206,13 @@ impl Screen {
         self.route(now, inputs);
         match &self.asking {
             Asking::First { deadline, .. } if now >= *deadline => self.end_probe(now, inputs),
-            Asking::Late { until, .. } if now >= *until => {
-                // Never answered: the answers still owed will not come.
+            Asking::Late { probe, until } if now >= *until => {
+                // The answers still owed will not come (inside tmux without passthrough, the
+                // outer terminal's never does).
+                let silent = !probe.heard();
                 self.asking = Asking::No;
                 self.probe_answers = 0;
-                if self.config.graphics == GraphicsRequest::Auto {
+                if silent && self.config.graphics == GraphicsRequest::Auto {
                     self.notice = Some("the terminal did not answer: half-block cells".into());
                 }
             }

@@ -286,6 +286,12 @@ impl Probe {
         1
     }
 
+    /// Whether any device-attributes answer arrived (a terminal that answered something, such
+    /// as tmux itself, is not silent).
+    pub fn heard(&self) -> bool {
+        self.da1 > 0
+    }
+
     /// Whether every answer has arrived.
     pub fn done(&self) -> bool {
         self.da1 >= self.da1_wanted()

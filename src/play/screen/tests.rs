@@ -168,3 +168,22 @@ fn the_fit_follows_the_mode() {
     let tiny = Screen::new(config(Bandwidth::Unlimited, false), (8, 4), t0);
     assert_eq!(tiny.fit((8, 6)).scene_at(1, 1), None, "a terminal too small takes no clicks");
 }
+
+#[test]
+fn inside_tmux_its_own_answer_is_an_answer_and_the_hint_says_how_to_get_pictures() {
+    let t0 = Instant::now();
+    let mut config = config(Bandwidth::Unlimited, true);
+    if let Some(p) = &mut config.probe {
+        p.env.tmux = true;
+    }
+    let mut screen = Screen::new(config, (40, 12), t0);
+    screen.start(t0, &mut Vec::new());
+    let mut inputs = Vec::new();
+    // tmux answers its plain question at once; the outer terminal's answer never comes back.
+    screen.feed(DA1, t0 + 2 * MS, &mut inputs);
+    screen.tick(t0 + probe::PROBE_BUDGET, &mut inputs);
+    assert_eq!(screen.mode(), GraphicsMode::Cells);
+    assert_eq!(screen.take_notice().as_deref(), Some(probe::TMUX_HINT));
+    screen.tick(t0 + probe::PROBE_BUDGET + LATE_ANSWERS, &mut inputs);
+    assert_eq!(screen.take_notice(), None, "tmux answered: not a silent terminal");
+}
