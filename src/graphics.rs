@@ -8,5 +8,6 @@
 pub use crate::output::graphics::geometry::{self, Layout, layout};
 pub use crate::output::graphics::pack::Packing;
 pub use crate::output::graphics::stream::crossover::{AutoSwitch, crossover, truer_mode};
+pub use crate::output::graphics::stream::ladder::resample;
 pub use crate::output::graphics::stream::{Budget, Offer, Part, PictureStream, Protocol, State};
 pub use crate::output::graphics::{GraphicsMode, iterm2, kitty, kitty_decode, push_rgb, rgb, sixel, tmux};
