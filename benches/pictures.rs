@@ -164,8 +164,11 @@ fn stream(mode: &str) -> (PictureStream, Terminal) {
         }
         "sixel" => {
             let l = l(GraphicsMode::Sixel);
-            let protocol =
-                Protocol::Sixel { palette: SixelPalette::for_registers(256), registers: Registers::PerImage, tmux: false };
+            let protocol = Protocol::Sixel {
+                palette: SixelPalette::for_registers(256),
+                registers: Registers::PerImage,
+                tmux: false,
+            };
             let canvas = vec![0u8; l.picture.0 as usize * l.picture.1 as usize * 3];
             (PictureStream::new(protocol, l), Terminal::Sixel(canvas, l.picture))
         }

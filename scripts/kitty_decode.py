@@ -183,6 +183,7 @@ def decode(stream):
             first, data = pending
             data += payload
             if keys.get("m") == "1":
+                pending = (first, data)
                 continue
             keys, payload, pending = first, data, None
         elif keys.get("m") == "1":

@@ -21,10 +21,17 @@ fn decode(name: &str, stream: &[u8]) -> Vec<(u32, u32, u32, Vec<u8>)> {
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("stream.bin");
     std::fs::write(&input, stream).unwrap();
-    let out = Command::new("python3").arg(DECODER).arg(&input).arg(&dir).output().unwrap_or_else(|e| {
-        panic!("this test needs python3 to run the independent decoder ({DECODER}): {e}")
-    });
-    assert!(out.status.success(), "the independent decoder refused the stream: {}", String::from_utf8_lossy(&out.stderr));
+    let out = Command::new("python3")
+        .arg(DECODER)
+        .arg(&input)
+        .arg(&dir)
+        .output()
+        .unwrap_or_else(|e| panic!("this test needs python3 to run the independent decoder ({DECODER}): {e}"));
+    assert!(
+        out.status.success(),
+        "the independent decoder refused the stream: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let images = String::from_utf8(out.stdout)
         .unwrap()
         .lines()
@@ -82,7 +89,9 @@ fn picture_stream_offers_decode_to_the_picture_at_its_rung() {
     let (sw, sh) = (120, 72);
     // PNG wholes and edits on a limited link, zlib wholes without a limit, a slow link's
     // mean-colour base image and strips.
-    for (name, rate, available) in [("unlimited", None, usize::MAX), ("2MBps", Some(2e6), usize::MAX), ("slow", Some(5e3), 400)] {
+    for (name, rate, available) in
+        [("unlimited", None, usize::MAX), ("2MBps", Some(2e6), usize::MAX), ("slow", Some(20e3), 1700)]
+    {
         let mut stream = PictureStream::new(Protocol::Kitty(KittyOptions::new(l.cells)), l);
         let mut wire = Vec::new();
         let mut parts = Vec::new();
