@@ -11,6 +11,7 @@ mod common;
 mod goldens;
 mod graphics;
 mod hostile_input;
+mod kitty_independent;
 mod lake;
 mod ocean;
 mod player;

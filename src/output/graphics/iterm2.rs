@@ -13,6 +13,9 @@ use base64::Engine;
 use base64::engine::general_purpose::STANDARD as BASE64;
 use tiny_skia::Pixmap;
 
+use std::io::Write;
+
+use crate::output::graphics::pack::{Packing, pack};
 use crate::output::graphics::tmux;
 
 /// The encoder, with the picture the terminal shows.
@@ -45,32 +48,39 @@ impl Iterm2Encoder {
         if matches!(&self.shown, Some((sw, sh, data)) if (*sw, *sh) == (w, h) && data == pixmap.data()) {
             return false;
         }
-        let png = crate::output::png::encode(pixmap);
-        out.extend_from_slice(
-            format!("\x1b[{};{}H", u32::from(self.origin.1) + 1, u32::from(self.origin.0) + 1).as_bytes(),
-        );
-        let mut command = format!(
-            "\x1b]1337;File=inline=1;size={};width={};height={};preserveAspectRatio=0;doNotMoveCursor=1:",
-            png.len(),
-            self.cells.0,
-            self.cells.1
-        )
-        .into_bytes();
-        let start = command.len();
-        command.resize(start + png.len().div_ceil(3) * 4, 0);
-        let n = BASE64.encode_slice(&png, &mut command[start..]).expect("sized for the base64");
-        command.truncate(start + n);
-        command.push(0x07);
-        if self.tmux {
-            tmux::push_wrapped(out, &command);
-        } else {
-            out.extend_from_slice(&command);
-        }
+        let mut rgb = Vec::with_capacity(w as usize * h as usize * 3);
+        crate::output::graphics::push_rgb(pixmap, &mut rgb);
+        let mut png = Vec::new();
+        pack(Packing::Png, &rgb, w, h, &mut png);
+        push_file(out, self.origin, self.cells, self.tmux, &png);
         match &mut self.shown {
             Some((sw, sh, data)) if (*sw, *sh) == (w, h) => data.copy_from_slice(pixmap.data()),
             shown => *shown = Some((w, h, pixmap.data().to_vec())),
         }
         true
+    }
+}
+
+/// Appends a cursor move to cell `origin` and the inline file `file` (a PNG or JPEG) filling
+/// `cells` (columns, rows), wrapped for tmux when asked. The base64 goes straight into `out`.
+pub fn push_file(out: &mut Vec<u8>, origin: (u16, u16), cells: (u16, u16), tmux: bool, file: &[u8]) {
+    let _ = write!(out, "\x1b[{};{}H", u32::from(origin.1) + 1, u32::from(origin.0) + 1);
+    let mut command = Vec::new();
+    let to: &mut Vec<u8> = if tmux { &mut command } else { &mut *out };
+    let _ = write!(
+        to,
+        "\x1b]1337;File=inline=1;size={};width={};height={};preserveAspectRatio=0;doNotMoveCursor=1:",
+        file.len(),
+        cells.0,
+        cells.1
+    );
+    let start = to.len();
+    to.resize(start + file.len().div_ceil(3) * 4, 0);
+    let n = BASE64.encode_slice(file, &mut to[start..]).expect("sized for the base64");
+    to.truncate(start + n);
+    to.push(0x07);
+    if tmux {
+        tmux::push_wrapped(out, &command);
     }
 }
 

@@ -33,13 +33,11 @@ pub use super::Update;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
+pub use crate::output::graphics::kitty_placeholder::push_placeholders;
+use crate::output::graphics::pack::{Packing, zlib};
+use crate::output::graphics::{scan, tmux};
 use base64::Engine;
 use base64::engine::general_purpose::STANDARD as BASE64;
-use flate2::Compression;
-use flate2::write::ZlibEncoder;
-
-pub use crate::output::graphics::kitty_placeholder::push_placeholders;
-use crate::output::graphics::tmux;
 
 /// The most base64 bytes in one chunk (the protocol's limit).
 pub const CHUNK_BASE64: usize = 4096;
@@ -190,21 +188,12 @@ impl KittyEncoder {
     }
 
     fn push_full(&mut self, out: &mut Vec<u8>, rgb: &[u8], width: u32, height: u32) -> io::Result<()> {
-        let o = &self.options;
-        let (cols, rows) = o.cells;
-        let mut keys = format!("a=T,i={},f=24,s={width},v={height},c={cols},r={rows},q=2", o.image_id);
-        if o.placeholders {
-            keys.push_str(",U=1");
-        } else {
-            keys.push_str(&format!(",p={PLACEMENT_ID},C=1"));
-            if o.z_index != 0 {
-                keys.push_str(&format!(",z={}", o.z_index));
-            }
-            out.extend_from_slice(
-                format!("\x1b[{};{}H", u32::from(o.origin.1) + 1, u32::from(o.origin.0) + 1).as_bytes(),
-            );
+        let mut keys = Vec::with_capacity(96);
+        image_keys(&mut keys, &self.options, (width, height));
+        if !self.options.placeholders {
+            push_cursor_to(out, self.options.origin);
         }
-        self.push_pixels(out, &keys, "", rgb)?;
+        self.push_pixels(out, &keys, b"", rgb)?;
         if self.options.placeholders && self.placeholders_due {
             let o = &self.options;
             push_placeholders(out, o.image_id, o.origin.0, o.origin.1, o.cells.0, o.cells.1);
@@ -213,27 +202,25 @@ impl KittyEncoder {
         Ok(())
     }
 
-    fn push_edit(&mut self, out: &mut Vec<u8>, rect: &[u8], (x, y, w, h): (u32, u32, u32, u32)) -> io::Result<()> {
-        let keys = format!("a=f,r=1,i={},f=24,x={x},y={y},s={w},v={h},X=1,q=2", self.options.image_id);
-        self.push_pixels(out, &keys, "a=f,", rect)
+    fn push_edit(&mut self, out: &mut Vec<u8>, rect: &[u8], r: (u32, u32, u32, u32)) -> io::Result<()> {
+        let mut keys = Vec::with_capacity(64);
+        edit_keys(&mut keys, self.options.image_id, r);
+        self.push_pixels(out, &keys, b"a=f,", rect)
     }
 
     /// Appends the command(s) carrying `data` by the configured medium. `more_keys` go on
     /// continuation chunks before `m=` (`a=f,` for frame edits, as the protocol requires).
-    fn push_pixels(&mut self, out: &mut Vec<u8>, keys: &str, more_keys: &str, data: &[u8]) -> io::Result<()> {
-        match self.options.medium.clone() {
+    fn push_pixels(&mut self, out: &mut Vec<u8>, keys: &[u8], more_keys: &[u8], data: &[u8]) -> io::Result<()> {
+        match &self.options.medium {
             Medium::TempFile(dir) => {
                 self.files += 1;
-                let path = write_temp_file(&dir, self.files, data)?;
+                let path = write_temp_file(dir, self.files, data)?;
                 let command = temp_file_command(keys, &path);
                 push_command(out, &command, self.options.tmux);
             }
             Medium::Direct => {
-                self.zlib.clear();
-                let mut z = ZlibEncoder::new(std::mem::take(&mut self.zlib), Compression::new(ZLIB_LEVEL));
-                z.write_all(data)?;
-                self.zlib = z.finish()?;
-                push_chunked(out, &format!("{keys},o=z"), more_keys, &self.zlib, self.options.tmux);
+                zlib(data, ZLIB_LEVEL as u8, &mut self.zlib);
+                push_chunks(out, keys, more_keys, Packing::Zlib(ZLIB_LEVEL as u8), &self.zlib, self.options.tmux);
             }
         }
         Ok(())
@@ -263,32 +250,92 @@ fn push_command(out: &mut Vec<u8>, command: &[u8], tmux: bool) {
 /// Appends `data` base64-encoded in chunks: the first with `keys`, the rest with
 /// `more_keys` and `q=2`; `m=1` on all but the last.
 pub fn push_chunked(out: &mut Vec<u8>, keys: &str, more_keys: &str, data: &[u8], tmux: bool) {
+    push_chunked_bytes(out, keys.as_bytes(), more_keys.as_bytes(), data, tmux);
+}
+
+/// [`push_chunked`] for keys as bytes. Without tmux every chunk is written in place (the
+/// base64 straight into `out`); inside tmux each chunk is built once and wrapped.
+fn push_chunked_bytes(out: &mut Vec<u8>, keys: &[u8], more_keys: &[u8], data: &[u8], tmux: bool) {
     let chunks = data.len().div_ceil(CHUNK_RAW).max(1);
-    let mut command = Vec::with_capacity(CHUNK_BASE64 + 64);
-    let mut encoded = [0u8; CHUNK_BASE64];
+    out.reserve(data.len().div_ceil(3) * 4 + chunks * (16 + more_keys.len()) + keys.len() + 16);
+    let mut command = Vec::new();
     for i in 0..chunks {
         let part = &data[(i * CHUNK_RAW).min(data.len())..((i + 1) * CHUNK_RAW).min(data.len())];
-        let more = u8::from(i + 1 < chunks);
-        command.clear();
-        command.extend_from_slice(b"\x1b_G");
-        if i == 0 {
-            command.extend_from_slice(keys.as_bytes());
-            command.extend_from_slice(format!(",m={more};").as_bytes());
+        let more = i + 1 < chunks;
+        let to: &mut Vec<u8> = if tmux {
+            command.clear();
+            &mut command
         } else {
-            command.extend_from_slice(format!("{more_keys}m={more},q=2;").as_bytes());
+            &mut *out
+        };
+        to.extend_from_slice(b"\x1b_G");
+        if i == 0 {
+            to.extend_from_slice(keys);
+            to.extend_from_slice(if more { b",m=1;" } else { b",m=0;" });
+        } else {
+            to.extend_from_slice(more_keys);
+            to.extend_from_slice(if more { b"m=1,q=2;" } else { b"m=0,q=2;" });
         }
-        let n = BASE64.encode_slice(part, &mut encoded).expect("a chunk's base64 fits its buffer");
-        command.extend_from_slice(&encoded[..n]);
-        command.extend_from_slice(b"\x1b\\");
-        push_command(out, &command, tmux);
+        let at = to.len();
+        to.resize(at + part.len().div_ceil(3) * 4, 0);
+        let n = BASE64.encode_slice(part, &mut to[at..]).expect("a chunk's base64 fits its buffer");
+        to.truncate(at + n);
+        to.extend_from_slice(b"\x1b\\");
+        if tmux {
+            tmux::push_wrapped(out, &command);
+        }
     }
+}
+
+/// Appends the chunked command(s) carrying packed pixels: `keys` (without format or
+/// compression) plus the packing's keys (`f=24,o=z` or `f=100`).
+pub fn push_chunks(out: &mut Vec<u8>, keys: &[u8], more_keys: &[u8], packing: Packing, packed: &[u8], tmux: bool) {
+    let mut all = Vec::with_capacity(keys.len() + 12);
+    all.extend_from_slice(keys);
+    all.extend_from_slice(match packing {
+        Packing::Zlib(_) => b",f=24,o=z".as_slice(),
+        Packing::Png => b",f=100".as_slice(),
+        Packing::Jpeg(_) => panic!("kitty decodes no JPEG"),
+    });
+    push_chunked_bytes(out, &all, more_keys, packed, tmux);
+}
+
+/// The keys of a whole-image transmission and display (`a=T`) of a `size` picture under
+/// `options`, without the pixel format: the placement, the cell area, responses off.
+pub fn image_keys(keys: &mut Vec<u8>, o: &KittyOptions, (width, height): (u32, u32)) {
+    let (cols, rows) = o.cells;
+    let _ = write!(keys, "a=T,i={},s={width},v={height},c={cols},r={rows},q=2", o.image_id);
+    if o.placeholders {
+        keys.extend_from_slice(b",U=1");
+    } else {
+        let _ = write!(keys, ",p={PLACEMENT_ID},C=1");
+        if o.z_index != 0 {
+            let _ = write!(keys, ",z={}", o.z_index);
+        }
+    }
+}
+
+/// The keys of an edit of image `id`'s root frame: the rectangle `(x, y, w, h)` replaced.
+pub fn edit_keys(keys: &mut Vec<u8>, id: u32, (x, y, w, h): (u32, u32, u32, u32)) {
+    let _ = write!(keys, "a=f,r=1,i={id},x={x},y={y},s={w},v={h},X=1,q=2");
+}
+
+/// Appends a cursor move to cell `origin` (0-based column, row): a placement is made where
+/// the cursor is.
+pub fn push_cursor_to(out: &mut Vec<u8>, (col, row): (u16, u16)) {
+    let _ = write!(out, "\x1b[{};{}H", u32::from(row) + 1, u32::from(col) + 1);
 }
 
 /// The command that makes the terminal read pixels from `path` (`t=t`): `keys` plus the
 /// medium, the base64-encoded path as payload.
-fn temp_file_command(keys: &str, path: &Path) -> Vec<u8> {
+fn temp_file_command(keys: &[u8], path: &Path) -> Vec<u8> {
     let path = path.as_os_str().as_encoded_bytes();
-    format!("\x1b_G{keys},t=t;{}\x1b\\", BASE64.encode(path)).into_bytes()
+    let mut command = b"\x1b_G".to_vec();
+    command.extend_from_slice(keys);
+    command.extend_from_slice(b",f=24,t=t;");
+    command.extend_from_slice(BASE64.encode(path).as_bytes());
+    command.extend_from_slice(b"\x1b\\");
+    command
 }
 
 /// Where temporary files go: `/dev/shm` when it exists (memory, not disk), else the system's
@@ -317,22 +364,9 @@ pub fn write_temp_file(dir: &Path, n: u64, data: &[u8]) -> io::Result<PathBuf> {
 }
 
 /// The bounding box (x, y, width, height) of the pixels that differ between two RGB pictures of
-/// the same size, or `None` when they are equal.
+/// the same size, or `None` when they are equal (one pass: [`scan::changed_box`]).
 pub fn changed_rect(old: &[u8], new: &[u8], width: u32, height: u32) -> Option<(u32, u32, u32, u32)> {
-    let stride = width as usize * 3;
-    let rows_differ = |y: usize| old[y * stride..(y + 1) * stride] != new[y * stride..(y + 1) * stride];
-    let top = (0..height as usize).find(|&y| rows_differ(y))?;
-    let bottom = (top..height as usize).rev().find(|&y| rows_differ(y)).unwrap_or(top);
-    let (mut left, mut right) = (width as usize, 0);
-    for y in top..=bottom {
-        let (a, b) = (&old[y * stride..(y + 1) * stride], &new[y * stride..(y + 1) * stride]);
-        if let Some(first) = a.iter().zip(b).position(|(p, q)| p != q) {
-            left = left.min(first / 3);
-            let last = a.iter().zip(b).rposition(|(p, q)| p != q).unwrap_or(first);
-            right = right.max(last / 3);
-        }
-    }
-    Some((left as u32, top as u32, (right - left + 1) as u32, (bottom - top + 1) as u32))
+    scan::changed_box(old, new, width, 3, 0..height)
 }
 
 #[cfg(test)]

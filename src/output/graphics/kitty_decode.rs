@@ -173,6 +173,18 @@ fn pixels(keys: &BTreeMap<char, String>, payload: &[u8], w: u32, h: u32) -> Resu
         Some(other) => return Err(format!("compression o={other} is not understood")),
     };
     let bytes_per_pixel = match keys.get(&'f').map_or("32", String::as_str) {
+        "100" => {
+            let mut reader = image::ImageReader::new(std::io::Cursor::new(&data[..]));
+            reader.set_format(image::ImageFormat::Png);
+            let mut limits = image::Limits::default();
+            limits.max_alloc = Some(MAX_PIXELS * 4);
+            reader.limits(limits);
+            let png = reader.decode().map_err(|e| format!("bad PNG: {e}"))?.to_rgb8();
+            if png.dimensions() != (w, h) {
+                return Err(format!("a {:?} PNG for a {w}x{h} image", png.dimensions()));
+            }
+            return Ok(png.into_raw());
+        }
         "24" => 3,
         "32" => 4,
         other => return Err(format!("format f={other} is not understood")),

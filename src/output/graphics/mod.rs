@@ -19,7 +19,10 @@ pub mod iterm2;
 pub mod kitty;
 pub mod kitty_decode;
 pub mod kitty_placeholder;
+pub mod pack;
+pub mod scan;
 pub mod sixel;
+pub mod stream;
 pub mod tmux;
 
 use tiny_skia::Pixmap;

@@ -43,6 +43,9 @@ pub const MAX_REGISTERS: u16 = 256;
 pub const MIN_REGISTERS: u16 = 8;
 /// The side of the Bayer matrix.
 const BAYER_SIDE: usize = 8;
+/// The most bytes tmux (3.3 to 3.6) reads of one escape sequence: a longer sixel image is dropped.
+/// Kept a little under 1 MiB for the passthrough wrapper's doubled escapes and the cursor move.
+pub const TMUX_MAX_IMAGE_BYTES: usize = (1 << 20) - 4096;
 /// A run of this many equal sixels or more is written `!n` (`!4x` is shorter than `xxxx`).
 const MIN_RUN: usize = 4;
 
@@ -159,12 +162,43 @@ impl SixelPalette {
     }
 }
 
+/// When the colour registers are defined.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Registers {
+    /// Each image defines the registers it uses, where it first uses each (`#i;2;r;g;b`
+    /// selects as it defines): works in every terminal, and a small changed block defines only
+    /// its few colours instead of the whole palette (3.7 kB at 256 registers).
+    PerImage,
+    /// Each register is defined once, the first time any image uses it, and kept: only for a
+    /// terminal whose images share their registers ([`SHARED_REGISTERS_ON`] sent first, and the
+    /// terminal said it knows the mode). [`SixelEncoder::forget_registers`] starts over.
+    Shared,
+}
+
+/// Makes xterm's sixel images share one set of colour registers (DEC private mode 1070 off:
+/// "use private color registers for each graphic" is on by default), so registers defined once
+/// stay defined for later images ([`Registers::Shared`]).
+pub const SHARED_REGISTERS_ON: &[u8] = b"\x1b[?1070l";
+/// Undoes [`SHARED_REGISTERS_ON`] (for the terminal's restore).
+pub const SHARED_REGISTERS_OFF: &[u8] = b"\x1b[?1070h";
+
 /// The encoder, with the dithered picture the terminal shows.
 #[derive(Debug)]
 pub struct SixelEncoder {
     palette: SixelPalette,
-    /// The palette's register definitions (`#i;2;r;g;b` each), the same for every image.
-    registers: Vec<u8>,
+    /// Each register's definition (`;2;r;g;b` after `#i`).
+    definitions: Vec<Vec<u8>>,
+    /// When registers are defined, and which are defined now (in this image or this session).
+    registers: Registers,
+    defined: Vec<bool>,
+    /// The most bytes one image may take (tmux's input buffer); `None`: no limit.
+    max_image_bytes: Option<usize>,
+    /// Wrap every image for tmux passthrough.
+    tmux: bool,
+    /// The band being written, when images are split ([`SixelEncoder::set_max_image_bytes`]).
+    band: Vec<u8>,
+    /// The source column of every target column, for [`SixelEncoder::dither_scaled`].
+    x_map: Vec<u32>,
     tables: Vec<[[u8; 256]; 64]>,
     /// The picture's top-left cell (column, row), 0-based.
     origin: (u16, u16),
@@ -186,15 +220,21 @@ impl SixelEncoder {
     pub fn new(palette: SixelPalette, origin: (u16, u16), cell_px: Option<(u16, u16)>) -> SixelEncoder {
         let tables = palette.tables();
         let n = palette.len();
-        let registers = (0..n)
-            .flat_map(|i| {
+        let definitions = (0..n)
+            .map(|i| {
                 let [r, g, b] = palette.percent_rgb(i as u8);
-                format!("#{i};2;{r};{g};{b}").into_bytes()
+                format!(";2;{r};{g};{b}").into_bytes()
             })
             .collect();
         SixelEncoder {
             palette,
-            registers,
+            definitions,
+            registers: Registers::PerImage,
+            defined: vec![false; n],
+            max_image_bytes: None,
+            tmux: false,
+            band: Vec::new(),
+            x_map: Vec::new(),
             tables,
             origin,
             cell_px: cell_px.filter(|&(w, h)| w > 0 && h > 0),
@@ -214,6 +254,96 @@ impl SixelEncoder {
     /// whole.
     pub fn invalidate(&mut self) {
         self.shown = None;
+    }
+
+    /// Chooses when registers are defined (see [`Registers`]); all are undefined after it.
+    pub fn set_registers(&mut self, registers: Registers) {
+        self.registers = registers;
+        self.forget_registers();
+    }
+
+    /// Forgets which registers the terminal holds (a new session, a reset terminal): each is
+    /// defined again at its next use.
+    pub fn forget_registers(&mut self) {
+        self.defined.fill(false);
+    }
+
+    /// Cuts images so that none takes more than `bytes` (tmux buffers at most 1 MiB of one
+    /// sequence and drops a longer one: [`TMUX_MAX_IMAGE_BYTES`]), and wraps them for tmux
+    /// passthrough when `tmux`. An image is cut between bands that start on a text row, so each
+    /// piece starts at a cell.
+    pub fn set_max_image_bytes(&mut self, bytes: Option<usize>, tmux: bool) {
+        self.max_image_bytes = bytes.map(|b| b.max(4096));
+        self.tmux = tmux;
+    }
+
+    /// Dithers `source` (`width x height` pixels of `bpp` bytes, 3 for RGB or 4 for opaque
+    /// RGBA such as a pixmap's data, row-major) scaled to `target` by nearest pixel (each
+    /// source pixel repeated): the register of every target pixel. No RGB copy is made.
+    pub fn dither_scaled(
+        &mut self,
+        source: &[u8],
+        bpp: usize,
+        (width, height): (u32, u32),
+        (tw, th): (u32, u32),
+        out: &mut Vec<u8>,
+    ) {
+        assert!(bpp == 3 || bpp == 4, "3 or 4 bytes a pixel");
+        assert_eq!(source.len(), width as usize * height as usize * bpp, "source does not match {width}x{height}");
+        out.clear();
+        out.reserve(tw as usize * th as usize);
+        self.x_map.clear();
+        self.x_map
+            .extend((0..u64::from(tw)).map(|x| (x * u64::from(width) / u64::from(tw.max(1))) as u32 * bpp as u32));
+        let [tr, tg, tb] = [&self.tables[0], &self.tables[1], &self.tables[2]];
+        let stride = width as usize * bpp;
+        // The threshold follows the source pixel, so a repeated pixel is one flat colour (runs
+        // of equal sixels: a smaller picture costs fewer bytes); at scale 1 it is the target's.
+        for y in 0..th as usize {
+            let sy = (y as u64 * u64::from(height) / u64::from(th.max(1))) as usize;
+            let row = &source[sy * stride..(sy + 1) * stride];
+            let thresholds = &BAYER8[sy % BAYER_SIDE];
+            for &at in &self.x_map {
+                let p = &row[at as usize..at as usize + 3];
+                let t = usize::from(thresholds[(at as usize / bpp) % BAYER_SIDE]);
+                out.push(tr[t][usize::from(p[0])] + tg[t][usize::from(p[1])] + tb[t][usize::from(p[2])]);
+            }
+        }
+    }
+
+    /// Appends the images that show the `(x, y, w, h)` block of the dithered picture `pixels`
+    /// (`width` registers a row, as [`SixelEncoder::dither_into`] makes them), placed at its
+    /// cell: the block starts on a cell boundary (cell size `cell_px`) from cell `origin`.
+    pub fn push_block(
+        &mut self,
+        out: &mut Vec<u8>,
+        pixels: &[u8],
+        width: u32,
+        (x, y, w, h): (u32, u32, u32, u32),
+        origin: (u16, u16),
+        cell_px: (u16, u16),
+    ) {
+        let (cw, ch) = (u32::from(cell_px.0.max(1)), u32::from(cell_px.1.max(1)));
+        let (col, row) = (u32::from(origin.0) + x / cw, u32::from(origin.1) + y / ch);
+        let mut image = std::mem::take(&mut self.band);
+        image.clear();
+        let _ = std::io::Write::write_fmt(&mut image, format_args!("\x1b[{};{}H", row + 1, col + 1));
+        self.push_image(&mut image, pixels, width, (x, y, w, h), (origin, (cw, ch)), out);
+        self.flush(out, &image);
+        self.band = image;
+    }
+
+    /// Moves a finished image (or a cursor move and image) from `image` to `out`, wrapped for
+    /// tmux when asked.
+    fn flush(&self, out: &mut Vec<u8>, image: &[u8]) {
+        if self.tmux {
+            // The cursor move goes as it is (tmux moves its own cursor), the image wrapped.
+            let split = image.windows(2).position(|w| w == b"\x1bP").unwrap_or(0);
+            out.extend_from_slice(&image[..split]);
+            super::tmux::push_wrapped(out, &image[split..]);
+        } else {
+            out.extend_from_slice(image);
+        }
     }
 
     /// The register of every pixel of `rgb` (`width x height`, 3 bytes a pixel), dithered.
@@ -256,10 +386,8 @@ impl SixelEncoder {
             Update::Full => (0, 0, width, height),
             Update::Rect(x, y, w, h) => (x, y, w, h),
         };
-        let (cw, ch) = self.cell_px.map_or((1, 1), |(w, h)| (u32::from(w), u32::from(h)));
-        let (col, row) = (u32::from(self.origin.0) + x / cw, u32::from(self.origin.1) + y / ch);
-        out.extend_from_slice(format!("\x1b[{};{}H", row + 1, col + 1).as_bytes());
-        self.push_image(out, &current, width, (x, y, w, h));
+        let cell_px = self.cell_px.unwrap_or((1, 1));
+        self.push_block(out, &current, width, (x, y, w, h), self.origin, cell_px);
         self.current = match self.shown.take() {
             Some((w, h, old)) if (w, h) == (width, height) => old,
             _ => Vec::new(),
@@ -268,56 +396,133 @@ impl SixelEncoder {
         update
     }
 
-    /// Appends one sixel image of the `(x, y, w, h)` block of the dithered picture `pixels`
-    /// (`stride` pixels a row).
-    fn push_image(&mut self, out: &mut Vec<u8>, pixels: &[u8], stride: u32, (x0, y0, w, h): (u32, u32, u32, u32)) {
-        out.extend_from_slice(format!("\x1bP0;1;0q\"1;1;{w};{h}").as_bytes());
-        out.extend_from_slice(&self.registers);
-        let (w, stride) = (w as usize, stride as usize);
-        for band in (0..h as usize).step_by(6) {
-            self.used.clear();
-            let rows: Vec<&[u8]> = (0..6.min(h as usize - band))
-                .map(|dy| {
-                    let start = (y0 as usize + band + dy) * stride + x0 as usize;
-                    &pixels[start..start + w]
-                })
-                .collect();
-            for x in 0..w {
-                // The (at most six) registers of this column and their sixel bits.
-                let (mut regs, mut bits, mut n) = ([0u8; 6], [0u8; 6], 0);
-                for (dy, row) in rows.iter().enumerate() {
-                    let c = row[x];
-                    match regs[..n].iter().position(|&r| r == c) {
-                        Some(k) => bits[k] |= 1 << dy,
-                        None => {
-                            (regs[n], bits[n]) = (c, 1 << dy);
-                            n += 1;
-                        }
-                    }
-                }
-                for k in 0..n {
-                    let cols = &mut self.columns[usize::from(regs[k])];
-                    if cols.is_empty() {
-                        self.used.push(regs[k]);
-                    }
-                    cols.push((x as u32) << 8 | u32::from(bits[k]));
-                }
-            }
-            self.used.sort_unstable();
-            for (n, &c) in self.used.iter().enumerate() {
-                if n > 0 {
-                    out.push(b'$');
-                }
-                out.push(b'#');
-                push_decimal(out, usize::from(c));
-                let cols = &mut self.columns[usize::from(c)];
-                push_colour_pass(out, cols);
-                cols.clear();
-            }
-            out.push(b'-');
+    /// Writes the sixel image(s) of the `(x0, y0, w, h)` block of `pixels` (`stride` registers a
+    /// row) into `image` (which holds the cursor move to the block's cell), cutting it where
+    /// [`SixelEncoder::set_max_image_bytes`] asks: a finished piece goes to `out` and the next
+    /// starts with its own cursor move, at a band that starts a text row (`place`: the origin
+    /// cell and the cell size).
+    fn push_image(
+        &mut self,
+        image: &mut Vec<u8>,
+        pixels: &[u8],
+        stride: u32,
+        (x0, y0, w, h): (u32, u32, u32, u32),
+        (origin, (cw, ch)): ((u16, u16), (u32, u32)),
+        out: &mut Vec<u8>,
+    ) {
+        let (w_px, stride) = (w as usize, stride as usize);
+        let mut piece_top = 0usize; // the first row of the image being written, within the block
+        let mut header = image.len();
+        push_header(image, w, h);
+        if self.registers == Registers::PerImage {
+            self.defined.fill(false);
         }
-        out.extend_from_slice(b"\x1b\\");
+        // The last band that starts a text row, and where its bytes start.
+        let mut mark: Option<(usize, usize)> = None;
+        let mut band = 0usize;
+        while band < h as usize {
+            let starts_row = (y0 as usize + band).is_multiple_of(ch as usize);
+            if starts_row && band > piece_top {
+                mark = Some((band, image.len()));
+            }
+            self.push_band(image, pixels, stride, (x0 as usize, y0 as usize + band, w_px, 6.min(h as usize - band)));
+            band += 6;
+            let too_big = self.max_image_bytes.is_some_and(|max| image.len() + 2 > max);
+            if let (true, Some((cut, at))) = (too_big, mark) {
+                // Close the piece before the marked band and start the next image there.
+                image.truncate(at);
+                image.extend_from_slice(b"\x1b\\");
+                let mut fixed = Vec::with_capacity(32);
+                push_header(&mut fixed, w, (cut - piece_top) as u32);
+                let old_header_end = header + header_len(&image[header..]);
+                image.splice(header..old_header_end, fixed);
+                self.flush(out, image);
+                image.clear();
+                let row = u32::from(origin.1) + (y0 + cut as u32) / ch;
+                let col = u32::from(origin.0) + x0 / cw;
+                let _ = std::io::Write::write_fmt(image, format_args!("\x1b[{};{}H", row + 1, col + 1));
+                header = image.len();
+                push_header(image, w, h - cut as u32);
+                if self.registers == Registers::PerImage {
+                    self.defined.fill(false);
+                }
+                piece_top = cut;
+                band = cut;
+                mark = None;
+            }
+        }
+        image.extend_from_slice(b"\x1b\\");
     }
+
+    /// Appends one band: `(x0, y, w, rows)` of `pixels`, every register used getting one pass
+    /// (defined where it is first used when it is not defined yet).
+    fn push_band(
+        &mut self,
+        out: &mut Vec<u8>,
+        pixels: &[u8],
+        stride: usize,
+        (x0, y, w, rows): (usize, usize, usize, usize),
+    ) {
+        self.used.clear();
+        let mut lines: [&[u8]; 6] = [&[]; 6];
+        for (dy, line) in lines.iter_mut().enumerate().take(rows) {
+            let start = (y + dy) * stride + x0;
+            *line = &pixels[start..start + w];
+        }
+        let lines = &lines[..rows];
+        for x in 0..w {
+            // The (at most six) registers of this column and their sixel bits.
+            let (mut regs, mut bits, mut n) = ([0u8; 6], [0u8; 6], 0);
+            for (dy, line) in lines.iter().enumerate() {
+                let c = line[x];
+                match regs[..n].iter().position(|&r| r == c) {
+                    Some(k) => bits[k] |= 1 << dy,
+                    None => {
+                        (regs[n], bits[n]) = (c, 1 << dy);
+                        n += 1;
+                    }
+                }
+            }
+            for k in 0..n {
+                let cols = &mut self.columns[usize::from(regs[k])];
+                if cols.is_empty() {
+                    self.used.push(regs[k]);
+                }
+                cols.push((x as u32) << 8 | u32::from(bits[k]));
+            }
+        }
+        self.used.sort_unstable();
+        for (n, &c) in self.used.iter().enumerate() {
+            if n > 0 {
+                out.push(b'$');
+            }
+            out.push(b'#');
+            push_decimal(out, usize::from(c));
+            if !self.defined[usize::from(c)] {
+                out.extend_from_slice(&self.definitions[usize::from(c)]);
+                self.defined[usize::from(c)] = true;
+            }
+            let cols = &mut self.columns[usize::from(c)];
+            push_colour_pass(out, cols);
+            cols.clear();
+        }
+        out.push(b'-');
+    }
+}
+
+/// Appends an image's start: DCS with `P2=1` (uncovered pixels stay as they are) and raster
+/// attributes for square pixels of a `w x h` picture.
+fn push_header(out: &mut Vec<u8>, w: u32, h: u32) {
+    out.extend_from_slice(b"\x1bP0;1;0q\"1;1;");
+    push_decimal(out, w as usize);
+    out.push(b';');
+    push_decimal(out, h as usize);
+}
+
+/// The length of the header [`push_header`] wrote at the start of `bytes`.
+fn header_len(bytes: &[u8]) -> usize {
+    let fixed = b"\x1bP0;1;0q\"1;1;".len();
+    fixed + bytes[fixed..].iter().position(|b| !(b.is_ascii_digit() || *b == b';')).unwrap_or(bytes.len() - fixed)
 }
 
 /// Appends one colour's pass over a band from its covered columns (`column << 8 | sixel bits`,
@@ -374,21 +579,11 @@ fn changed_cells(
     height: u32,
     (cw, ch): (u32, u32),
 ) -> Option<(u32, u32, u32, u32)> {
-    let stride = width as usize;
-    let row = |y: usize| (&old[y * stride..(y + 1) * stride], &new[y * stride..(y + 1) * stride]);
-    let top = (0..height as usize).find(|&y| row(y).0 != row(y).1)?;
-    let bottom = (top..height as usize).rev().find(|&y| row(y).0 != row(y).1).unwrap_or(top);
-    let (mut left, mut right) = (stride, 0);
-    for y in top..=bottom {
-        let (a, b) = row(y);
-        if let Some(first) = a.iter().zip(b).position(|(p, q)| p != q) {
-            left = left.min(first);
-            right = right.max(a.iter().zip(b).rposition(|(p, q)| p != q).unwrap_or(first));
-        }
-    }
-    let (x0, y0) = (left as u32 / cw * cw, top as u32 / ch * ch);
-    let x1 = ((right as u32 + 1).div_ceil(cw) * cw).min(width);
-    let y1 = ((bottom as u32 + 1).div_ceil(ch) * ch).min(height);
+    let (left, top, bw, bh) = super::scan::changed_box(old, new, width, 1, 0..height)?;
+    let (right, bottom) = (left + bw - 1, top + bh - 1);
+    let (x0, y0) = (left / cw * cw, top / ch * ch);
+    let x1 = ((right + 1).div_ceil(cw) * cw).min(width);
+    let y1 = ((bottom + 1).div_ceil(ch) * ch).min(height);
     // Whole bands: a terminal may size an image by its bands; one that ends below the
     // picture could reach the status line.
     let h = (y1 - y0).div_ceil(6) * 6;

@@ -123,7 +123,7 @@ fn runs_are_length_encoded() {
     let mut out = Vec::new();
     SixelEncoder::new(palette, (0, 0), None).encode(&[0; 100 * 6 * 3], 100, 6, &mut out);
     let text = String::from_utf8(out).unwrap();
-    assert!(text.ends_with("#0!100~-\x1b\\"), "{:?}", &text[text.len() - 20..]);
+    assert!(text.ends_with("\"1;1;100;6#0;2;0;0;0!100~-\x1b\\"), "only the register used is defined: {text:?}");
     // A two-row stripe of white over black: passes overlap with `$`, empties are skipped.
     let mut rgb = vec![0u8; 10 * 6 * 3];
     rgb[..10 * 2 * 3].fill(255);
@@ -131,7 +131,71 @@ fn runs_are_length_encoded() {
     SixelEncoder::new(SixelPalette::for_registers(256), (0, 0), None).encode(&rgb, 10, 6, &mut out);
     let text = String::from_utf8(out).unwrap();
     // Black covers rows 2..6 (bits 0b111100 -> '?' + 60 = '{'), white rows 0..2 ('?' + 3 = 'B').
-    assert!(text.ends_with("#0!10{$#251!10B-\x1b\\"), "{:?}", &text[text.len() - 24..]);
+    assert!(text.ends_with("#0;2;0;0;0!10{$#251;2;100;100;100!10B-\x1b\\"), "{text:?}");
+}
+
+#[test]
+fn shared_registers_are_defined_once_per_session() {
+    let mut enc = SixelEncoder::new(SixelPalette::for_registers(256), (0, 0), None);
+    enc.set_registers(Registers::Shared);
+    let mut out = Vec::new();
+    enc.encode(&[0; 12 * 6 * 3], 12, 6, &mut out);
+    assert!(String::from_utf8_lossy(&out).contains("#0;2;0;0;0"), "defined at first use");
+    out.clear();
+    enc.encode(&[255; 12 * 6 * 3], 12, 6, &mut out);
+    enc.encode(&[0; 12 * 6 * 3], 12, 6, &mut out);
+    let text = String::from_utf8(out).unwrap();
+    assert!(text.contains("#251;2;100;100;100") && !text.contains("#0;2;"), "register 0 kept: {text:?}");
+    enc.forget_registers();
+    let mut out = Vec::new();
+    enc.encode(&[255; 12 * 6 * 3], 12, 6, &mut out);
+    assert!(String::from_utf8(out).unwrap().contains("#251;2;"), "defined again after forgetting");
+}
+
+#[test]
+fn images_stay_under_the_tmux_limit_cut_on_text_rows_and_decode_to_the_whole() {
+    let (w, h) = (200u32, 96u32);
+    let rgb = noise(w, h, 5);
+    let palette = SixelPalette::for_registers(256);
+    let mut whole = Vec::new();
+    SixelEncoder::new(palette.clone(), (0, 0), Some((10, 12))).encode(&rgb, w, h, &mut whole);
+    let mut enc = SixelEncoder::new(palette.clone(), (0, 0), Some((10, 12)));
+    let cap = 30_000;
+    enc.set_max_image_bytes(Some(cap), true);
+    let mut out = Vec::new();
+    enc.encode(&rgb, w, h, &mut out);
+    // Each piece: a cursor move to a text row, then one wrapped image under the cap.
+    let mut pieces = Vec::new();
+    let mut rest = &out[..];
+    while !rest.is_empty() {
+        let begin = rest
+            .windows(7)
+            .position(|w| w == crate::output::graphics::tmux::PASSTHROUGH_BEGIN)
+            .expect("a wrapped image");
+        let head = std::str::from_utf8(&rest[..begin]).unwrap();
+        let row: u32 = head.trim_start_matches("\x1b[").split(';').next().unwrap().parse().unwrap();
+        let (inner, len) = crate::output::graphics::tmux::unwrap(&rest[begin..]).expect("whole wrapper");
+        assert!(len <= cap, "a piece of {len} bytes");
+        pieces.push((row, inner));
+        rest = &rest[begin + len..];
+    }
+    assert!(pieces.len() >= 3, "{} pieces of a {}-byte picture", pieces.len(), whole.len());
+    // Decoded and stacked at their rows, the pieces are the whole dithered picture.
+    let want = dithered_rgb(&palette, &rgb, w, h);
+    let mut got = vec![0u8; want.len()];
+    for (row, inner) in &pieces {
+        let image = icy_sixel::SixelImage::decode(inner).expect("each piece decodes");
+        let y0 = (row - 1) as usize * 12;
+        for y in 0..image.height.min(h as usize - y0) {
+            for x in 0..w as usize {
+                let p = &image.pixels[(y * image.width + x) * 4..];
+                if p[3] == 255 {
+                    got[((y0 + y) * w as usize + x) * 3..][..3].copy_from_slice(&p[..3]);
+                }
+            }
+        }
+    }
+    assert!(got == want, "the pieces differ from the whole picture");
 }
 
 #[test]

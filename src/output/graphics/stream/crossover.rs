@@ -1,0 +1,153 @@
+//! `auto`'s choice between real pixels and half-block cells as the link changes.
+//!
+//! The figures come from `cargo bench --bench pictures` (the fixture pool at 160x48 cells of
+//! 8x16 pixels, SSIM over time at the cell area's pixel size; README "Pictures at a rate"):
+//! below a protocol's crossover rate the cell codec shows the truer moving picture, above it
+//! the protocol does. [`crossover`] is the pure function; [`AutoSwitch`] adds the hysteresis
+//! the Screen needs so that a link hovering at the crossover does not flip the mode back and
+//! forth: the rate must stay beyond a margin for a while, and switches are spaced.
+
+use std::time::{Duration, Instant};
+
+use crate::output::graphics::GraphicsMode;
+
+/// The link rate (bytes per second) above which each protocol's pictures score a higher SSIM
+/// over time than the cell codec's, measured by `cargo bench --bench pictures` (see the module
+/// documentation). `None`: the protocol never won below unlimited there.
+pub fn crossover(mode: GraphicsMode) -> Option<f64> {
+    match mode {
+        GraphicsMode::Kitty => Some(KITTY_CROSSOVER),
+        GraphicsMode::Sixel => Some(SIXEL_CROSSOVER),
+        GraphicsMode::Iterm2 => Some(ITERM2_CROSSOVER),
+        GraphicsMode::Cells => None,
+    }
+}
+
+/// kitty's crossover, bytes per second (see [`crossover`]): at 50 kB/s, the lowest rate
+/// measured, kitty already scored SSIM 0.583 against the cells' 0.519 (250 kB/s: 0.603), so the
+/// crossover is at or below it; 50 kB/s is taken until lower rates are measured.
+const KITTY_CROSSOVER: f64 = 50_000.0;
+/// sixel's crossover, bytes per second: sixel lost to cells at 50 kB/s (no picture fitted) and
+/// at 250 kB/s (SSIM 0.197); until the faster rows say otherwise, only a 2 MB/s link keeps it.
+const SIXEL_CROSSOVER: f64 = 2_000_000.0;
+/// iTerm2's crossover, bytes per second: JPEG won at 50 kB/s (0.604 against 0.519) and at
+/// 250 kB/s (0.664).
+const ITERM2_CROSSOVER: f64 = 50_000.0;
+
+/// The mode that shows the truer moving picture at `rate` (bytes per second; `None`: no limit,
+/// the terminal is local) when the terminal can show `pixels`: pictures at or above the
+/// crossover, cells below it.
+pub fn truer_mode(pixels: GraphicsMode, rate: Option<f64>) -> GraphicsMode {
+    match (rate, crossover(pixels)) {
+        (None, _) => pixels,
+        (Some(_), None) => GraphicsMode::Cells,
+        (Some(rate), Some(at)) if rate >= at => pixels,
+        _ => GraphicsMode::Cells,
+    }
+}
+
+/// How far past the crossover the rate must go before the mode switches (a ratio).
+pub const MARGIN: f64 = 1.25;
+/// How long the rate must stay past the margin before the mode switches.
+pub const HOLD: Duration = Duration::from_secs(3);
+/// The least time between two switches.
+pub const MIN_BETWEEN: Duration = Duration::from_secs(10);
+
+/// `auto`'s mode over time: [`truer_mode`] with hysteresis. Clock-injected, so tests run on
+/// made-up time.
+#[derive(Clone, Debug)]
+pub struct AutoSwitch {
+    pixels: GraphicsMode,
+    current: GraphicsMode,
+    /// Since when the rate has been beyond the margin towards the other mode.
+    leaning: Option<Instant>,
+    last_switch: Option<Instant>,
+}
+
+impl AutoSwitch {
+    /// Starts in `pixels` (the protocol the probe found): a local terminal keeps it, and a
+    /// slow link is measured before it is left.
+    pub fn new(pixels: GraphicsMode) -> AutoSwitch {
+        AutoSwitch { pixels, current: pixels, leaning: None, last_switch: None }
+    }
+
+    /// The mode in force.
+    pub fn mode(&self) -> GraphicsMode {
+        self.current
+    }
+
+    /// The mode after the link was measured at `rate` at `now` (`None`: unlimited): it changes
+    /// only when the rate has stayed [`MARGIN`] beyond the crossover for [`HOLD`] and the last
+    /// switch is [`MIN_BETWEEN`] ago. Returns the mode and whether it just changed (the Screen
+    /// says so on the status line for a few seconds).
+    pub fn update(&mut self, rate: Option<f64>, now: Instant) -> (GraphicsMode, bool) {
+        let Some(at) = crossover(self.pixels) else {
+            return (self.current, false);
+        };
+        let other = if self.current == self.pixels { GraphicsMode::Cells } else { self.pixels };
+        let beyond = match (other == self.pixels, rate) {
+            (true, None) => true,
+            (true, Some(r)) => r >= at * MARGIN,
+            (false, None) => false,
+            (false, Some(r)) => r < at / MARGIN,
+        };
+        if !beyond {
+            self.leaning = None;
+            return (self.current, false);
+        }
+        let since = *self.leaning.get_or_insert(now);
+        let spaced = self.last_switch.is_none_or(|t| now.saturating_duration_since(t) >= MIN_BETWEEN);
+        // Back to a local terminal's pixels at once: nothing to wait for.
+        let held = rate.is_none() || now.saturating_duration_since(since) >= HOLD;
+        if held && spaced {
+            self.current = other;
+            self.leaning = None;
+            self.last_switch = Some(now);
+            return (self.current, true);
+        }
+        (self.current, false)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn locally_pixels_and_on_a_slow_link_cells() {
+        for mode in [GraphicsMode::Kitty, GraphicsMode::Sixel, GraphicsMode::Iterm2] {
+            let at = crossover(mode).unwrap();
+            assert_eq!(truer_mode(mode, None), mode);
+            assert_eq!(truer_mode(mode, Some(at * 2.0)), mode);
+            assert_eq!(truer_mode(mode, Some(at / 2.0)), GraphicsMode::Cells);
+        }
+        assert_eq!(truer_mode(GraphicsMode::Cells, None), GraphicsMode::Cells);
+    }
+
+    #[test]
+    fn the_switch_waits_for_a_steady_rate_and_does_not_flap() {
+        let t0 = Instant::now();
+        let at = crossover(GraphicsMode::Kitty).unwrap();
+        let mut auto = AutoSwitch::new(GraphicsMode::Kitty);
+        let s = |secs: f64| t0 + Duration::from_secs_f64(secs);
+        // A rate hovering around the crossover (within the margin) never switches.
+        for i in 0..100 {
+            let rate = if i % 2 == 0 { at * 1.1 } else { at * 0.9 };
+            assert_eq!(auto.update(Some(rate), s(f64::from(i) * 0.5)), (GraphicsMode::Kitty, false), "step {i}");
+        }
+        // A slow link: cells after HOLD, not before.
+        let slow = Some(at / 4.0);
+        assert_eq!(auto.update(slow, s(60.0)).0, GraphicsMode::Kitty);
+        assert_eq!(auto.update(slow, s(62.0)).0, GraphicsMode::Kitty);
+        assert_eq!(auto.update(slow, s(63.0)), (GraphicsMode::Cells, true));
+        // The link recovers at once, but the switch back waits MIN_BETWEEN after the last.
+        let fast = Some(at * 4.0);
+        assert_eq!(auto.update(fast, s(64.0)).0, GraphicsMode::Cells);
+        assert_eq!(auto.update(fast, s(67.5)).0, GraphicsMode::Cells, "held, but too soon after a switch");
+        assert_eq!(auto.update(fast, s(73.0)), (GraphicsMode::Kitty, true));
+        // A dip shorter than HOLD does not switch.
+        assert_eq!(auto.update(slow, s(90.0)).0, GraphicsMode::Kitty);
+        assert_eq!(auto.update(fast, s(92.0)).0, GraphicsMode::Kitty);
+        assert_eq!(auto.update(slow, s(93.0)).0, GraphicsMode::Kitty, "the dip's clock started over");
+    }
+}

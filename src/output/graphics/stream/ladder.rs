@@ -1,0 +1,188 @@
+//! The resolution ladder and the resampler that puts any picture on a rung.
+//!
+//! The top rung is the picture [`crate::output::graphics::geometry::layout`] gives (the cell
+//! area's pixel size, capped for the scaling protocols; for sixel the screen pixels in whole
+//! bands); the bottom rung is half-block resolution (a pixel a column, two a row), below which
+//! cells show as much. Between them the sides shrink by about a quarter a rung, so each rung
+//! costs a bit over half the pixels of the one above.
+
+/// The most rungs (top and bottom included).
+pub const MAX_RUNGS: usize = 8;
+/// Each rung's side is this fraction of the one above (about half the pixels).
+const STEP: f64 = 0.75;
+
+/// The rungs from `top` down to `bottom` (pixels), largest first, each at least 1x1; `bottom`
+/// is clamped to `top`.
+pub fn rungs(top: (u32, u32), bottom: (u32, u32)) -> Vec<(u32, u32)> {
+    let top = (top.0.max(1), top.1.max(1));
+    let bottom = (bottom.0.clamp(1, top.0), bottom.1.clamp(1, top.1));
+    let mut out = vec![top];
+    let mut scale = 1.0;
+    loop {
+        scale *= STEP;
+        let w = (f64::from(top.0) * scale).round() as u32;
+        let h = (f64::from(top.1) * scale).round() as u32;
+        if w <= bottom.0 || h <= bottom.1 || out.len() + 1 >= MAX_RUNGS {
+            break;
+        }
+        out.push((w, h));
+    }
+    if *out.last().expect("the top rung") != bottom {
+        out.push(bottom);
+    }
+    out
+}
+
+/// The smallest rung that holds every pixel of a `source`-sized picture (a rung above it would
+/// only interpolate): where the ladder starts for that picture.
+pub fn top_useful(rungs: &[(u32, u32)], source: (u32, u32)) -> usize {
+    rungs.iter().rposition(|&(w, h)| w >= source.0 && h >= source.1).unwrap_or(0)
+}
+
+/// A separable resampler from one size to another: a tent filter whose radius is one source
+/// pixel when enlarging (bilinear) and the scale when shrinking (an area-like average), so
+/// water neither aliases when shrunk nor blocks when enlarged. Weights are computed once per
+/// pair of sizes.
+#[derive(Debug, Default)]
+pub struct Resampler {
+    sizes: Option<((u32, u32), (u32, u32))>,
+    columns: Axis,
+    rows: Axis,
+    /// One horizontally resampled row per source row, 3 floats a pixel.
+    rows_buf: Vec<f32>,
+}
+
+#[derive(Debug, Default)]
+struct Axis {
+    /// For each target pixel: the first source pixel and how many follow.
+    spans: Vec<(u32, u32)>,
+    /// The weights of every span, one after another.
+    weights: Vec<f32>,
+}
+
+impl Axis {
+    fn new(source: u32, target: u32) -> Axis {
+        let scale = f64::from(source) / f64::from(target);
+        let radius = scale.max(1.0);
+        let mut axis = Axis::default();
+        for i in 0..target {
+            let centre = (f64::from(i) + 0.5) * scale - 0.5;
+            let lo = ((centre - radius).floor() + 1.0).max(0.0) as u32;
+            let hi = ((centre + radius).ceil() - 1.0).min(f64::from(source) - 1.0).max(f64::from(lo)) as u32;
+            let start = axis.weights.len();
+            for j in lo..=hi {
+                axis.weights.push((1.0 - (f64::from(j) - centre).abs() / radius).max(0.0) as f32);
+            }
+            let sum: f32 = axis.weights[start..].iter().sum();
+            if sum > 0.0 {
+                axis.weights[start..].iter_mut().for_each(|w| *w /= sum);
+            } else {
+                // Cannot happen for a tent of radius >= 1 around a point inside the source;
+                // kept safe: the nearest pixel.
+                axis.weights[start..].fill(0.0);
+                axis.weights[start] = 1.0;
+            }
+            axis.spans.push((lo, hi - lo + 1));
+        }
+        axis
+    }
+}
+
+impl Resampler {
+    /// Writes `source` (`from` pixels of `bpp` bytes, 3 or 4; the first three are taken as RGB)
+    /// resampled to `to` as RGB into `out` (cleared first). Equal sizes copy the pixels.
+    pub fn resample(&mut self, source: &[u8], bpp: usize, from: (u32, u32), to: (u32, u32), out: &mut Vec<u8>) {
+        assert_eq!(source.len(), from.0 as usize * from.1 as usize * bpp, "source does not match {from:?}");
+        out.clear();
+        if from == to {
+            out.reserve(source.len() / bpp * 3);
+            for p in source.chunks_exact(bpp) {
+                out.extend_from_slice(&p[..3]);
+            }
+            return;
+        }
+        if self.sizes != Some((from, to)) {
+            self.columns = Axis::new(from.0, to.0);
+            self.rows = Axis::new(from.1, to.1);
+            self.sizes = Some((from, to));
+        }
+        let (tw, sw) = (to.0 as usize, from.0 as usize);
+        self.rows_buf.clear();
+        self.rows_buf.resize(from.1 as usize * tw * 3, 0.0);
+        for (y, row) in source.chunks_exact(sw * bpp).enumerate() {
+            let dst = &mut self.rows_buf[y * tw * 3..(y + 1) * tw * 3];
+            let mut w_at = 0;
+            for (x, &(lo, n)) in self.columns.spans.iter().enumerate() {
+                let mut acc = [0f32; 3];
+                for k in 0..n as usize {
+                    let w = self.columns.weights[w_at + k];
+                    let p = &row[(lo as usize + k) * bpp..];
+                    acc[0] += w * f32::from(p[0]);
+                    acc[1] += w * f32::from(p[1]);
+                    acc[2] += w * f32::from(p[2]);
+                }
+                w_at += n as usize;
+                dst[x * 3..x * 3 + 3].copy_from_slice(&acc);
+            }
+        }
+        out.resize(tw * to.1 as usize * 3, 0);
+        let mut w_at = 0;
+        for (y, &(lo, n)) in self.rows.spans.iter().enumerate() {
+            let dst = &mut out[y * tw * 3..(y + 1) * tw * 3];
+            let weights = &self.rows.weights[w_at..w_at + n as usize];
+            w_at += n as usize;
+            for (i, d) in dst.iter_mut().enumerate() {
+                let mut acc = 0f32;
+                for (k, &w) in weights.iter().enumerate() {
+                    acc += w * self.rows_buf[(lo as usize + k) * tw * 3 + i];
+                }
+                *d = (acc + 0.5).clamp(0.0, 255.0) as u8;
+            }
+        }
+    }
+}
+
+/// `source` resampled to `to` as RGB into `out` ([`Resampler::resample`] without keeping its
+/// weights): for measurements that scale a picture the way a terminal does.
+pub fn resample(source: &[u8], bpp: usize, from: (u32, u32), to: (u32, u32), out: &mut Vec<u8>) {
+    Resampler::default().resample(source, bpp, from, to, out);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_ladder_runs_from_the_area_to_half_blocks() {
+        let r = rungs((1280, 752), (160, 94));
+        assert_eq!(r[0], (1280, 752));
+        assert_eq!(*r.last().unwrap(), (160, 94));
+        assert!(r.len() <= MAX_RUNGS && r.len() >= 5, "{r:?}");
+        assert!(r.windows(2).all(|p| p[1].0 < p[0].0 && p[1].1 < p[0].1), "strictly shrinking: {r:?}");
+        assert_eq!(rungs((100, 40), (100, 40)), vec![(100, 40)], "a tiny area has one rung");
+        assert_eq!(rungs((10, 10), (50, 50)), vec![(10, 10)], "the bottom never exceeds the top");
+        // The scene renders 480x281: the rung that holds it is where the ladder starts.
+        let top = top_useful(&r, (480, 281));
+        assert!(r[top].0 >= 480 && r[top].1 >= 281 && (top + 1 == r.len() || r[top + 1].0 < 480), "{r:?} {top}");
+    }
+
+    #[test]
+    fn resampling_keeps_flat_colours_and_averages_when_shrinking() {
+        let mut rs = Resampler::default();
+        let flat: Vec<u8> = [10u8, 200, 30, 255].repeat(7 * 5);
+        let mut out = Vec::new();
+        for to in [(3, 2), (7, 5), (20, 13)] {
+            rs.resample(&flat, 4, (7, 5), to, &mut out);
+            assert_eq!(out.len(), (to.0 * to.1 * 3) as usize);
+            assert!(out.chunks_exact(3).all(|p| p == [10, 200, 30]), "{to:?}");
+        }
+        // A 1-pixel checkerboard shrunk by 2 is its mean grey.
+        let checker: Vec<u8> =
+            (0..8 * 8).flat_map(|i| if (i % 8 + i / 8) % 2 == 0 { [0u8; 3] } else { [200; 3] }).collect();
+        rs.resample(&checker, 3, (8, 8), (4, 4), &mut out);
+        assert!(out.iter().all(|&v| (90..=110).contains(&v)), "{out:?}");
+        // Enlarging interpolates between neighbours.
+        rs.resample(&[0, 0, 0, 100, 100, 100], 3, (2, 1), (4, 1), &mut out);
+        assert_eq!(out.chunks_exact(3).map(|p| p[0]).collect::<Vec<_>>(), vec![0, 25, 75, 100]);
+    }
+}

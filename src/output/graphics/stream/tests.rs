@@ -1,0 +1,134 @@
+use super::*;
+use crate::output::bucket::ByteBucket;
+use crate::output::graphics::geometry::{SCALED_CAP, layout};
+use crate::output::graphics::kitty_decode;
+use crate::output::graphics::test_pictures::golden_pool;
+
+const FRAME: Duration = Duration::from_nanos(1_000_000_000 / 30);
+
+/// The golden pool picture (640x360) shifted `k` pixels: a picture that moves every frame.
+fn moving(k: u32) -> Pixmap {
+    let (w, h, rgb) = golden_pool();
+    let mut p = Pixmap::new(w, h).unwrap();
+    for (i, px) in p.pixels_mut().iter_mut().enumerate() {
+        let (x, y) = (i as u32 % w, i as u32 / w);
+        let at = ((y * w + (x + 3 * k) % w) * 3) as usize;
+        *px = tiny_skia::ColorU8::from_rgba(rgb[at], rgb[at + 1], rgb[at + 2], 255).premultiply();
+    }
+    p
+}
+
+fn kitty_stream() -> PictureStream {
+    let l = layout(GraphicsMode::Kitty, (160, 48), Some((8, 16)), None, SCALED_CAP);
+    PictureStream::new(Protocol::Kitty(KittyOptions::new(l.cells)), l)
+}
+
+fn sixel_stream() -> PictureStream {
+    let l = layout(GraphicsMode::Sixel, (160, 48), Some((8, 16)), Some((4096, 4096)), SCALED_CAP);
+    let protocol =
+        Protocol::Sixel { palette: SixelPalette::for_registers(256), registers: Registers::PerImage, tmux: false };
+    PictureStream::new(protocol, l)
+}
+
+fn iterm2_stream() -> PictureStream {
+    let l = layout(GraphicsMode::Iterm2, (160, 48), Some((8, 16)), None, SCALED_CAP);
+    PictureStream::new(Protocol::Iterm2 { tmux: false }, l)
+}
+
+/// Plays `frames` moving frames at 30 fps through `stream` with a bucket of `rate` bytes a
+/// second, committing every offer; returns (pictures, bytes, the largest overshoot of what
+/// was available).
+fn play(stream: &mut PictureStream, rate: f64, frames: u32) -> (u32, usize, isize) {
+    let t0 = Instant::now();
+    let mut bucket = ByteBucket::new(rate);
+    bucket.refill(t0);
+    let (mut pictures, mut bytes, mut over) = (0, 0, isize::MIN);
+    for n in 1..=frames {
+        let now = t0 + FRAME * n;
+        bucket.refill(now);
+        let budget = Budget { available: bucket.budget(), rate: Some(rate), frame_interval: FRAME };
+        let picture = moving(n);
+        if let Some(offer) = stream.prepare(&picture, budget, now) {
+            let len = offer.bytes.len();
+            over = over.max(len as isize - budget.available as isize);
+            bucket.spend(len);
+            stream.commit();
+            pictures += 1;
+            bytes += len;
+        }
+    }
+    (pictures, bytes, over)
+}
+
+#[test]
+fn at_250_kb_a_second_every_mode_moves_at_10_fps_or_more_within_the_budget() {
+    for (name, mut stream) in [("kitty", kitty_stream()), ("sixel", sixel_stream()), ("iterm2", iterm2_stream())] {
+        let frames = 60;
+        let (pictures, bytes, over) = play(&mut stream, 250e3, frames);
+        let seconds = f64::from(frames) / 30.0;
+        assert!(over <= 0, "{name}: an offer exceeded the bytes available by {over}");
+        assert!(
+            f64::from(pictures) / seconds >= 10.0,
+            "{name}: {pictures} pictures in {seconds} s ({:?})",
+            stream.state()
+        );
+        assert!(bytes as f64 / seconds <= 250e3 * 1.05, "{name}: {bytes} bytes in {seconds} s");
+    }
+}
+
+#[test]
+fn a_slow_link_gets_smaller_pictures_and_never_more_than_it_has() {
+    let mut fast = kitty_stream();
+    let mut slow = kitty_stream();
+    play(&mut fast, 2e6, 30);
+    let (pictures, _, over) = play(&mut slow, 50e3, 60);
+    assert!(over <= 0, "overshoot {over}");
+    assert!(pictures > 0);
+    let (f, s) = (fast.state().size, slow.state().size);
+    assert!(s.0 < f.0 && s.1 < f.1, "2 MB/s sends {f:?}, 50 kB/s {s:?}");
+}
+
+#[test]
+fn an_uncommitted_offer_is_not_believed_shown() {
+    let mut stream = kitty_stream();
+    let picture = moving(0);
+    let budget = Budget::unlimited(FRAME);
+    let t0 = Instant::now();
+    let first = stream.prepare(&picture, budget, t0).expect("a first picture").state.part;
+    assert_eq!(first, Part::Whole);
+    // Not committed: the same picture is offered again, whole.
+    let again = stream.prepare(&picture, budget, t0 + FRAME).expect("offered again").state.part;
+    assert_eq!(again, Part::Whole);
+    stream.commit();
+    assert!(stream.prepare(&picture, budget, t0 + FRAME * 2).is_none(), "shown: an unchanged picture sends nothing");
+}
+
+#[test]
+fn kitty_offers_decode_to_the_picture_on_the_wire_and_edits_apply_to_it() {
+    let mut stream = kitty_stream();
+    let t0 = Instant::now();
+    let mut wire = Vec::new();
+    let mut picture = moving(0);
+    for (n, rate) in [(0u32, None), (1, Some(2e6)), (2, Some(2e6))] {
+        if n == 2 {
+            // A small change: a frame edit.
+            for px in picture.pixels_mut()[..640 * 4].iter_mut() {
+                *px = tiny_skia::ColorU8::from_rgba(255, 0, 0, 255).premultiply();
+            }
+        }
+        let budget = Budget { available: usize::MAX, rate, frame_interval: FRAME };
+        let offer = stream.prepare(&picture, budget, t0 + FRAME * (10 * n)).expect("an offer");
+        let part = offer.state.part;
+        wire.extend_from_slice(offer.bytes);
+        stream.commit();
+        let image = &kitty_decode::decode(&wire).unwrap().images[&kitty::IMAGE_ID];
+        let size = stream.state().size;
+        assert_eq!((image.width, image.height), size);
+        let mut want = Vec::new();
+        Resampler::default().resample(picture.data(), 4, (640, 360), size, &mut want);
+        assert!(image.rgb == want, "step {n} ({part:?}): the decoded image is not the picture at {size:?}");
+        if n == 2 {
+            assert!(matches!(part, Part::Changed(..)), "{part:?}");
+        }
+    }
+}
