@@ -17,7 +17,7 @@ use crate::error::{Error, Result};
 use crate::play::host::{Host, HostConfig};
 use crate::play::player::Player;
 use crate::play::screen::{Screen, ScreenConfig};
-use crate::play::seat::Flow;
+use crate::play::seat::{Flow, Seat};
 
 /// How long the door waits, when the person quits, for the answers to the screen's last
 /// questions (so that they do not reach the shell).
@@ -87,7 +87,8 @@ pub fn run_door(
     player.screen.resize(input.size().map_err(read_error)?);
     restore_prefix(player.screen.restore_prefix());
     let mut host = Host::new(config.host, player.screen.picture_size(), Instant::now())?;
-    player.refit(host.size());
+    // The seat starts on the scene as the probe's answer sized it (the aim in its middle).
+    player.seat = Seat::new(player.screen.fit(host.size()));
     let (w, h) = host.size();
     let mut picture = Pixmap::new(w, h).ok_or(Error::TooLarge { what: "picture", width: w, height: h })?;
     let test_panic = std::env::var_os(TEST_PANIC_VAR).is_some();
