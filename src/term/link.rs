@@ -88,6 +88,8 @@ pub const DECREASE: f64 = 0.7;
 /// After a fall the rate is this share of the rate the terminal was seen to take, so the
 /// standing queue drains.
 pub const DRAIN_SHARE: f64 = 0.85;
+/// The share a queue of more than twice the high mark drains to.
+pub const DEEP_DRAIN_SHARE: f64 = 0.6;
 /// The longest wait for an answer before it counts as congestion (at least four base round
 /// trips).
 pub const PROBE_TIMEOUT: Duration = Duration::from_millis(1000);
@@ -412,7 +414,9 @@ impl LinkControl {
         let (low, high) = queue_marks(base);
         if let Some(took) = took {
             self.capacity = Some(match self.capacity {
-                Some(c) if queue <= low => c.max(took),
+                // Only a standing queue says the link was the limit; a few late reads of an
+                // answer on a busy machine must not shrink the window to one frame's take.
+                Some(c) if queue <= high => c.max(took),
                 _ => took,
             });
         }
@@ -443,7 +447,9 @@ impl LinkControl {
         // queue that stands and is not draining.
         let standing = last_queue.is_some_and(|last| last > high && queue >= last);
         if queue > high && standing {
-            self.fall(now);
+            // A queue of several marks drains faster: at 15 % under the link, a second of
+            // queue would take six to go.
+            self.fall(now, if queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE });
             Change::Down
         } else if queue < low && self.rate < self.ceiling {
             let growth = if self.fell { INCREASE_AFTER_LIMIT } else { INCREASE };
@@ -455,11 +461,11 @@ impl LinkControl {
         }
     }
 
-    fn fall(&mut self, now: Instant) {
+    fn fall(&mut self, now: Instant, share: f64) {
         let target = match self.delivered {
             // Under what the link was seen to carry (an estimate from two answers, so never
             // below half the rate in one fall), and never up.
-            Some(delivered) => (delivered * DRAIN_SHARE).max(self.rate * 0.5).min(self.rate * DRAIN_SHARE),
+            Some(delivered) => (delivered * share).max(self.rate * 0.5).min(self.rate * DRAIN_SHARE),
             None => self.rate * DECREASE,
         };
         self.rate = target.max(MIN_RATE);
@@ -533,7 +539,7 @@ impl LinkControl {
             return Change::Down;
         }
         if lost {
-            self.fall(now);
+            self.fall(now, DRAIN_SHARE);
             Change::Down
         } else {
             Change::Hold
