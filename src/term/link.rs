@@ -431,8 +431,10 @@ impl LinkControl {
             // link). Starting from it drains what the first frames queued, so the next round
             // trips show the link's own delay: a base taken from a queue would hide every
             // later queue.
-            // (A question after a few bytes says little: then the rate stays.)
-            let shown = took.filter(|_| bytes >= MIN_WINDOW).map_or(self.rate, |t| t * DRAIN_SHARE).max(MIN_RATE);
+            // A question after a few bytes says little of the link: never below the safe rate
+            // then (measured on the real 256 kbit/s link: the player's first question followed
+            // 4 kB, and 400 kB/s ran on for seconds of falls).
+            let shown = took.map_or(self.rate, |t| (t * DRAIN_SHARE).max(SAFE_RATE)).max(MIN_RATE);
             if shown < self.rate {
                 self.rate = shown.min(self.ceiling);
                 self.decided_at = Some(now);
@@ -464,8 +466,9 @@ impl LinkControl {
     fn fall(&mut self, now: Instant, share: f64) {
         let target = match self.delivered {
             // Under what the link was seen to carry (an estimate from two answers, so never
-            // below half the rate in one fall), and never up.
-            Some(delivered) => (delivered * share).max(self.rate * 0.5).min(self.rate * DRAIN_SHARE),
+            // below a quarter of the rate in one fall: a rate far over the link comes down in
+            // one or two round trips), and never up.
+            Some(delivered) => (delivered * share).max(self.rate * 0.25).min(self.rate * DRAIN_SHARE),
             None => self.rate * DECREASE,
         };
         self.rate = target.max(MIN_RATE);

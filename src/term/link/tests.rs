@@ -457,3 +457,17 @@ fn a_multiplexer_whose_ssh_socket_is_read_fills_the_link() {
         assert_eq!(run.link.as_ref().unwrap().hint(), None, "measured: no hint");
     }
 }
+
+#[test]
+fn a_small_first_frame_on_a_slow_far_link_does_not_run_the_rate_away() {
+    // Measured on the real 256 kbit/s link with 300 ms: the first question followed 4 kB, its
+    // answer said little, and 400 kB/s ran on through seconds of halving falls while the window
+    // held the queue near a second.
+    let first_frame_small = |t: f64| if t < 0.02 { 3_500.0 } else { f64::INFINITY };
+    let run = simulate(Path::Direct, Link::far(32_000.0, ms(300)), 20.0, first_frame_small);
+    let p90 = run.queue_quantile(2.0, 0.9);
+    println!("small first frame: queue p90 after 2 s {:.0} ms", p90 * 1e3);
+    assert!(p90 <= 0.3 + 2.0 / FPS, "the queue's p90 after 2 s is {:.0} ms", p90 * 1e3);
+    let used = run.throughput(32_000.0, 5.0, 20.0) / 32_000.0;
+    assert!(used >= 0.8, "only {:.0} % of the link used", used * 100.0);
+}
