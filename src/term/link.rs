@@ -445,10 +445,12 @@ impl LinkControl {
             // Asked before the last change: it measures the queue that change is acting on.
             return Change::Hold;
         }
-        // Two answers in a row over the high mark, the second no lower than the first: a
-        // queue that stands and is not draining.
-        let standing = last_queue.is_some_and(|last| last > high && queue >= last);
-        if queue > high && standing {
+        // A queue that is not draining, over the high mark twice in a row, or once when it
+        // is beyond what a busy machine's late reads of an answer make (a long link then
+        // falls a round trip sooner).
+        let not_draining = last_queue.is_none_or(|last| queue >= last);
+        let confirmed = last_queue.is_some_and(|last| last > high) || queue > 2 * QUEUE_HIGH_MIN;
+        if queue > high && not_draining && confirmed {
             // A queue of several marks drains faster: at 15 % under the link, a second of
             // queue would take six to go.
             self.fall(now, if queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE });
