@@ -9,14 +9,18 @@
 //!
 //! **The rate** follows that queue like a delay-based congestion controller, one decision per
 //! round trip: while the queue stays under the low mark the rate grows by [`INCREASE`] (by
-//! [`INCREASE_AFTER_LIMIT`] once the link has shown its limit; not at all while the frames use
-//! under half of it, as still water does); over the high mark it falls to a little under what
-//! the terminal was seen to take (the bytes between two answers over the time between them:
-//! while a queue stands, that is the link's own rate), or by [`DECREASE`] when that is not
-//! known yet, and the byte bucket is emptied, so the backlog drains; in between it holds. The
-//! marks scale with the shortest round trip ([`queue_marks`]): a queue of one round trip, never
-//! more than [`QUEUE_HIGH`], so a key's frame waits behind at most that. An answer that does not
-//! come within [`PROBE_TIMEOUT`] (or four base round trips) counts as congestion too.
+//! [`INCREASE_AFTER_LIMIT`] once the link has shown its limit); over the high mark, and not
+//! draining (twice in a row, or once past [`QUEUE_HIGH_MIN`] twice over, beyond what a busy
+//! machine's late reads of an answer make), it falls to a little under what the terminal was
+//! seen to take (the bytes between two answers over the time between them: while a queue
+//! stands, that is the link's own rate; [`DEEP_DRAIN_SHARE`] of it for a deep queue), or by
+//! [`DECREASE`] when that is not known yet, and the byte bucket is emptied, so the backlog
+//! drains; in between it holds. The marks scale with the shortest round trip
+//! ([`queue_marks`]): a queue of one round trip, never more than [`QUEUE_HIGH`], so a key's frame
+//! waits behind at most that. The first answer starts the rate from what the first frame was
+//! seen to take (never under [`SAFE_RATE`]): a base round trip taken while the start rate's
+//! queue stood would hide every later queue. An answer that does not come within
+//! [`PROBE_TIMEOUT`] (or four base round trips) counts as congestion too.
 //!
 //! **The window.** A rate alone cannot keep the first seconds short on a very slow link: the
 //! first answer comes back only once the first frame has crossed the link, and until then the
