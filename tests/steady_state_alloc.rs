@@ -133,6 +133,7 @@ fn player_frames(scene: SceneSpec) -> usize {
             encode: EncodeOptions { threshold: 0, sync: true },
             graphics: GraphicsRequest::Auto,
             probe: None,
+            link_path: tidepool::play::LinkPath::Direct,
         },
         greeting: Some("a greeting in the status line".into()),
         quit: Arc::clone(&quit),

@@ -29,6 +29,7 @@
 //!     encode: Default::default(),
 //!     graphics: Default::default(),
 //!     probe: None,
+//!     link_path: Default::default(),
 //! };
 //! let mut screen = Screen::new(config, (40, 12), t0);
 //! let scenes = vec![SceneSpec::Pool(PoolSettings::default())];
@@ -75,7 +76,7 @@ pub use input::Input;
 pub use player::{Player, Turn};
 pub use request::Request;
 pub use screen::probe::{Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
-pub use screen::{Bandwidth, Screen, ScreenConfig};
+pub use screen::{Bandwidth, LinkPath, Screen, ScreenConfig};
 pub use seat::{Flow, Seat, SeatView};
 
 #[cfg(test)]

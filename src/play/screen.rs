@@ -13,7 +13,7 @@
 //! probe's deadline is still the probe's and never shifts the link's round trips.
 
 mod compose;
-mod link;
+pub(crate) mod link;
 mod picture;
 pub mod probe;
 mod ui;
@@ -24,6 +24,7 @@ use std::time::{Duration, Instant};
 use tiny_skia::Pixmap;
 
 use self::compose::{Figures, FrameBuilder, big_enough};
+pub use self::link::LinkPath;
 use self::link::{Change, LinkControl};
 use self::picture::Picture;
 use self::probe::{GraphicsChoice, GraphicsRequest, GraphicsSupport, Probe, ProbeOptions};
@@ -67,6 +68,10 @@ pub struct ScreenConfig {
     /// Ask the terminal what it shows before the first frame; `None` sends no question (then
     /// `auto` means cells and a forced mode is used as asked).
     pub probe: Option<ProbeOptions>,
+    /// What sits between the program and the terminal (a multiplexer over SSH, mosh answer the
+    /// link's questions themselves: the rate is held safe there). A door that cannot tell says
+    /// [`LinkPath::Direct`].
+    pub link_path: LinkPath,
 }
 
 /// Above this rate approximate cells are not worth their CPU: the link carries exact ones.
@@ -135,8 +140,9 @@ impl Screen {
         let asks = config.probe.is_some() && config.graphics != GraphicsRequest::Force(GraphicsMode::Cells);
         let choice = probe::choose(if asks { GraphicsRequest::Auto } else { config.graphics }, None);
         let support = GraphicsSupport::default();
+        let link = LinkControl::on(config.link_path);
         let bucket = match config.bandwidth {
-            Bandwidth::Auto => ByteBucket::new(link::START_RATE),
+            Bandwidth::Auto => ByteBucket::new(link.rate().unwrap_or(link::START_RATE)),
             Bandwidth::Fixed(rate) => ByteBucket::new(rate as f64),
             Bandwidth::Unlimited => ByteBucket::unlimited(),
         };
@@ -158,7 +164,7 @@ impl Screen {
             layout_changed: false,
             notice: None,
             bucket,
-            link: LinkControl::new(),
+            link,
             encoder: RateEncoder::new(),
             shown: Shown::UNKNOWN,
             builder: FrameBuilder::default(),
@@ -180,6 +186,8 @@ impl Screen {
         out.extend_from_slice(&probe::queries(&options));
         let probe = Probe::new(options);
         self.probe_answers = probe.da1_expected();
+        // The link asks nothing until the probe's answers are in (or given up on).
+        self.link.expect_foreign(now, usize::from(self.probe_answers));
         self.asking = Asking::First { probe: Box::new(probe), deadline: now + probe::PROBE_BUDGET };
     }
 
@@ -340,6 +348,7 @@ impl Screen {
             bytes_per_second: self.meter.bytes_per_second,
             bandwidth: rate.map(|r| r as u64),
             pixels_elsewhere: self.picture.is_some(),
+            note: if self.auto() { self.link.hint() } else { None },
         };
         // On an auto link the unanswered bytes are capped too (see `link`: the first seconds).
         let budget = if self.auto() {
@@ -397,7 +406,21 @@ impl Screen {
     /// Whether link questions are still unanswered (a door that is closing waits a little for
     /// their answers, so they do not reach the shell as typed text).
     pub fn awaiting_answers(&self) -> bool {
-        !self.link.probe_due() || matches!(self.asking, Asking::Late { .. })
+        self.link.awaiting() > 0 || matches!(self.asking, Asking::Late { .. })
+    }
+
+    /// What sits between the program and the terminal, as the door said.
+    pub fn link_path(&self) -> LinkPath {
+        self.config.link_path
+    }
+
+    /// Inside a multiplexer over SSH: what sshd's socket holds for this connection now
+    /// (`queued` bytes, read by the door from the kernel's socket table every
+    /// [`link::OUTER_INTERVAL`]): the link's only signal there. Ignored on other paths.
+    pub fn outer_queue(&mut self, now: Instant, queued: u64) {
+        if self.auto() && self.link.outer_queue(now, self.bytes_sent, queued) == Change::Down {
+            self.bucket.drain();
+        }
     }
 
     /// What must be undone before [`Screen::RESTORE`] when the session ends: kitty's image
@@ -441,7 +464,11 @@ impl Screen {
                     // In order: the probe's answers come before any to the link's questions. An
                     // extra one (the outer terminal's, inside tmux) goes to the probe while the
                     // link has asked nothing.
-                    let probes = self.probe_answers > 0 || (probe.is_some() && self.link.probe_due());
+                    let probes = self.probe_answers > 0 || (probe.is_some() && !self.link.asking());
+                    if probes && self.link.foreign_due() {
+                        // The link's queue drops the place it kept for the probe's answer.
+                        self.link.answered(now);
+                    }
                     match probe {
                         Some(probe) if probes => {
                             self.probe_answers = self.probe_answers.saturating_sub(1);

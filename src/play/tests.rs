@@ -21,6 +21,7 @@ fn session(t0: Instant, script: &[(u32, &[u8])], frames: u32) -> Vec<u8> {
         encode: Default::default(),
         graphics: GraphicsRequest::Auto,
         probe: None,
+        link_path: crate::play::LinkPath::Direct,
     };
     let mut screen = Screen::new(config, (100, 20), t0);
     let pool = PoolSettings { rain_rate: 0.05, breeze: 1.0, seed: 3, ..PoolSettings::default() };

@@ -31,10 +31,11 @@ use std::time::{Duration, Instant};
 use super::door::{PlayConfig, TerminalInput, run_door};
 use crate::error::{Error, Result};
 use crate::output::graphics::{GraphicsMode, kitty};
-use crate::play::screen::Screen;
+use crate::play::screen::link::ssh_send_queue;
 use crate::play::screen::probe::{
     self, Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize,
 };
+use crate::play::screen::{LinkPath, Screen};
 
 static ACTIVE: AtomicBool = AtomicBool::new(false);
 static WRITE_LOCK: Mutex<()> = Mutex::new(());
@@ -65,7 +66,10 @@ pub fn play(mut config: PlayConfig) -> Result<()> {
         && probe::should_probe(io::stdin().is_terminal(), io::stdout().is_terminal());
     let guard = TerminalGuard::raw().map_err(setup)?;
     config.screen.probe = asks.then(|| probe_options(winsize, true));
-    let mut input = Stdin { size: (winsize.cols, winsize.rows) };
+    config.screen.link_path = link_path();
+    let ssh_connection =
+        std::env::var("SSH_CONNECTION").ok().filter(|_| matches!(config.screen.link_path, LinkPath::Multiplexer(_)));
+    let mut input = Stdin { size: (winsize.cols, winsize.rows), ssh_connection };
     let result = run_door(&mut input, TtyOut, config, &mut set_restore_prefix);
     drop(guard);
     set_restore_prefix(Vec::new());
@@ -127,6 +131,45 @@ fn ask(options: &ProbeOptions) -> io::Result<GraphicsSupport> {
     };
     Ok(probe::run_probe(options, &mut write, &mut read, &Instant::now, probe::PROBE_BUDGET)?.support)
 }
+
+/// What sits between this process and the terminal: the environment (a multiplexer over SSH)
+/// and the names of the process's ancestors (mosh-server), read from `/proc`.
+fn link_path() -> LinkPath {
+    let mut names = Vec::new();
+    let mut pid = std::os::unix::process::parent_id();
+    // At most a few generations: a shell, a multiplexer, sshd or mosh-server, init.
+    for _ in 0..16 {
+        if pid <= 1 {
+            break;
+        }
+        let Ok(comm) = std::fs::read_to_string(format!("/proc/{pid}/comm")) else { break };
+        names.push(comm.trim().to_owned());
+        let Some(parent) = std::fs::read_to_string(format!("/proc/{pid}/stat")).ok().and_then(|stat| {
+            // `pid (comm) state ppid ...`: the parent after the last ')' (comm may hold spaces).
+            stat.rsplit_once(')')?.1.split_whitespace().nth(1)?.parse().ok()
+        }) else {
+            break;
+        };
+        pid = parent;
+    }
+    LinkPath::detect(|name| std::env::var(name).ok(), names.iter().map(String::as_str))
+}
+
+/// The kernel's table of TCP sockets (`/proc/net/tcp` and `tcp6`), at most [`MAX_SOCKET_TABLE`]
+/// bytes of each: where the SSH connection's send queue is read inside a multiplexer.
+fn socket_table() -> String {
+    use std::io::Read;
+    let mut text = String::new();
+    for path in ["/proc/net/tcp", "/proc/net/tcp6"] {
+        if let Ok(file) = File::open(path) {
+            let _ = file.take(MAX_SOCKET_TABLE).read_to_string(&mut text);
+        }
+    }
+    text
+}
+
+/// The most bytes read of each socket table (a busy machine's table is tens of kilobytes).
+const MAX_SOCKET_TABLE: u64 = 1 << 20;
 
 /// The window size of the terminal on standard output (TIOCGWINSZ, through crossterm).
 fn window_size() -> io::Result<WinSize> {
@@ -286,6 +329,8 @@ pub fn restore() {
 /// Standard input, read without blocking past the player's deadline.
 struct Stdin {
     size: (u16, u16),
+    /// `SSH_CONNECTION`, inside a multiplexer over SSH (where its socket's queue is watched).
+    ssh_connection: Option<String>,
 }
 
 impl TerminalInput for Stdin {
@@ -324,6 +369,11 @@ impl TerminalInput for Stdin {
             self.size = size;
         }
         Ok(self.size)
+    }
+
+    fn outer_queue(&mut self) -> Option<u64> {
+        let connection = self.ssh_connection.as_deref()?;
+        ssh_send_queue(&socket_table(), connection)
     }
 }
 

@@ -9,7 +9,7 @@ use std::time::{Duration, Instant};
 
 use portable_pty::{CommandBuilder, PtySize, native_pty_system};
 
-use crate::common::{HANG_GUARD, Server, TEST_FLAGS};
+use crate::common::{DA1_ANSWER, DA1_QUESTION, HANG_GUARD, Server, TEST_FLAGS};
 
 fn ssh_available() -> bool {
     std::process::Command::new("ssh").arg("-V").output().is_ok()
@@ -18,7 +18,7 @@ fn ssh_available() -> bool {
 /// A running `ssh` in a pty with a reader thread.
 struct Ssh {
     child: Box<dyn portable_pty::Child + Send + Sync>,
-    writer: Box<dyn Write + Send>,
+    writer: std::sync::Arc<std::sync::Mutex<Box<dyn Write + Send>>>,
     rx: mpsc::Receiver<Vec<u8>>,
     seen: Vec<u8>,
     _master: Box<dyn portable_pty::MasterPty + Send>,
@@ -40,13 +40,24 @@ impl Ssh {
         let child = pair.slave.spawn_command(cmd).unwrap();
         drop(pair.slave);
         let mut reader = pair.master.try_clone_reader().unwrap();
-        let writer = pair.master.take_writer().unwrap();
+        let writer = std::sync::Arc::new(std::sync::Mutex::new(pair.master.take_writer().unwrap()));
+        let answers = std::sync::Arc::clone(&writer);
         let (tx, rx) = mpsc::channel();
         std::thread::spawn(move || {
             let mut buf = [0u8; 8192];
+            let mut tail = Vec::new();
             while let Ok(n) = reader.read(&mut buf) {
                 if n == 0 || tx.send(buf[..n].to_vec()).is_err() {
                     break;
+                }
+                // The terminal answers device-attributes questions, as every terminal does (the
+                // server's probe and link control ask them); a question may straddle reads.
+                tail.extend_from_slice(&buf[..n]);
+                let questions = tail.windows(DA1_QUESTION.len()).filter(|w| *w == DA1_QUESTION).count();
+                tail.drain(..tail.len().saturating_sub(DA1_QUESTION.len() - 1));
+                for _ in 0..questions {
+                    let mut w = answers.lock().unwrap();
+                    let _ = w.write_all(DA1_ANSWER).and_then(|()| w.flush());
                 }
             }
         });
@@ -87,12 +98,12 @@ fn openssh_without_keys_sees_the_pool_drops_a_stone_and_q_restores_its_terminal(
     let mut ssh = Ssh::spawn(s.port, home.path(), &["localhost"]);
     ssh.wait_for("\x1b[?1049h");
     ssh.wait_for("1 playing");
-    ssh.writer.write_all(b" ").unwrap();
-    ssh.writer.flush().unwrap();
+    ssh.writer.lock().unwrap().write_all(b" ").unwrap();
+    ssh.writer.lock().unwrap().flush().unwrap();
     // The stone reaches the shared scene: the game logs each applied action at exit.
     ssh.wait_for("\x1b[?2026h");
-    ssh.writer.write_all(b"q").unwrap();
-    ssh.writer.flush().unwrap();
+    ssh.writer.lock().unwrap().write_all(b"q").unwrap();
+    ssh.writer.lock().unwrap().flush().unwrap();
     let code = ssh.finish();
     let text = ssh.text();
     let auth = text.lines().find(|l| l.contains("Authenticated to")).unwrap_or("").trim().to_string();

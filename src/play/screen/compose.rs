@@ -23,6 +23,9 @@ pub struct Figures {
     /// The picture goes to the terminal in real pixels (kitty, sixel, iTerm2), not in these
     /// cells: the picture's rows stay blank cells under it.
     pub pixels_elsewhere: bool,
+    /// A standing note of the screen's (how to set the link's rate where it cannot be
+    /// measured), shown when the seat has no message.
+    pub note: Option<&'static str>,
 }
 
 /// Bytes reserved for the formatted byte rate.
@@ -94,7 +97,7 @@ impl FrameBuilder {
             stone: status.takes_stones.then_some(seat.stone),
             hints: status.hints,
             paused: status.paused,
-            message: seat.message,
+            message: seat.message.or(figures.note),
         };
         ui::status_line(&mut self.frame, rows - 1, &line, color, &mut self.line);
         &self.frame

@@ -19,6 +19,7 @@ fn config(bandwidth: Bandwidth, probe: bool) -> ScreenConfig {
             winsize: WinSize { cols: 40, rows: 12, x_px: 320, y_px: 192 },
             kitty_file: None,
         }),
+        link_path: LinkPath::Direct,
     }
 }
 
@@ -102,14 +103,18 @@ fn a_late_probe_answer_is_the_probes_and_never_pairs_with_a_link_question() {
     screen.start(t0, &mut Vec::new());
     let mut inputs = Vec::new();
     screen.tick(t0 + probe::PROBE_BUDGET, &mut inputs);
-    // The first frame asks the link's first question at 200 ms.
+    // The link asks nothing while the probe's answer is due (at most a second)...
     let out = frame(&mut screen, t0 + 200 * MS, 10);
+    assert!(!out.ends_with(link::PROBE), "no link question while the probe's answer is due");
+    // ...then its first question goes out after a frame, at 1.2 s.
+    screen.tick(t0 + 1200 * MS, &mut inputs);
+    let out = frame(&mut screen, t0 + 1200 * MS, 20);
     assert!(out.ends_with(link::PROBE), "the link's question after the frame");
-    // The probe's answer comes at 300 ms (a slow terminal), the link's at 390 ms.
-    screen.feed(DA1, t0 + 300 * MS, &mut inputs);
+    // The probe's answer comes at 1.5 s (a slow terminal), the link's at 1.6 s.
+    screen.feed(DA1, t0 + 1500 * MS, &mut inputs);
     assert_eq!(screen.link.last_rtt(), None, "the probe's late answer is not a round trip");
-    screen.feed(DA1, t0 + 390 * MS, &mut inputs);
-    assert_eq!(screen.link.last_rtt(), Some(190 * MS), "the link's own answer: 390 - 200 ms");
+    screen.feed(DA1, t0 + 1600 * MS, &mut inputs);
+    assert_eq!(screen.link.last_rtt(), Some(400 * MS), "the link's own answer: 1.6 - 1.2 s");
     assert!(inputs.is_empty());
 }
 

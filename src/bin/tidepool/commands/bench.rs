@@ -139,6 +139,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             encode: EncodeOptions::default(),
             graphics: GraphicsRequest::Force(tidepool::graphics::GraphicsMode::Cells),
             probe: None,
+            link_path: tidepool::play::LinkPath::Direct,
         };
         let mut screen = Screen::new(config, (cols, rows_cells), t0);
         let host_config = HostConfig { scenes: vec![spec], seed: 1, record: None, storage: None };

@@ -73,8 +73,10 @@ pub fn run(command: PlayCommand) -> Result<()> {
         color,
         encode: EncodeOptions { threshold, sync: !command.no_sync },
         graphics: command.graphics.into(),
-        // The door asks the terminal itself when both ends are terminals.
+        // The door asks the terminal itself when both ends are terminals, and finds what sits
+        // between (a multiplexer over SSH, mosh).
         probe: None,
+        link_path: tidepool::play::LinkPath::Direct,
     };
     let config = PlayConfig { host, screen, greeting: color_hint(command.color, color), quit: Arc::clone(&quit) };
     let _stop_on_signal = crate::signals::StopOnSignal::new(quit);

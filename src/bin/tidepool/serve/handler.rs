@@ -296,6 +296,8 @@ impl russh::server::Handler for ClientHandler {
                 winsize,
                 kitty_file: None,
             }),
+            // The far terminal answers for itself: whatever runs there, the round trip is real.
+            link_path: tidepool::play::LinkPath::Direct,
         };
         let ctx = ViewerCtx {
             hub: self.hub.clone(),
