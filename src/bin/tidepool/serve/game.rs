@@ -12,8 +12,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use tidepool::SceneSpec;
-use tidepool::play::{Fit, Host, HostConfig, Request, SceneStatus};
+use tidepool::play::{Fit, Host, Request, SceneStatus};
 use tiny_skia::Pixmap;
 use tokio::sync::{mpsc, watch};
 
@@ -47,27 +46,6 @@ pub struct GameStats {
     pub pictures: AtomicU64,
     /// Requests applied.
     pub requests: AtomicU64,
-}
-
-/// How the game runs.
-pub struct GameOptions {
-    /// The scenes `tab` cycles through; the first is shown at the start.
-    pub scenes: Vec<SceneSpec>,
-    /// The shared scene's size in pixels.
-    pub size: (u32, u32),
-    /// Frames per second.
-    pub fps: u32,
-    /// Seed of the random stones.
-    pub seed: u64,
-}
-
-impl GameOptions {
-    /// The host of the first scene (so a bad scene setting fails before the server starts).
-    /// Nothing is recorded and no file is saved on a player's behalf.
-    pub fn host(&self) -> tidepool::Result<Host> {
-        let config = HostConfig { scenes: self.scenes.clone(), seed: self.seed, record: None, storage: None };
-        Host::new(config, self.size, Instant::now())
-    }
 }
 
 /// What the game thread reads and writes.

@@ -119,7 +119,7 @@ pub fn run(args: ServeCommand) -> Result<()> {
     let (key, origin) = host_key::load_or_create(&key_path).map_err(|e| Error::Usage(e.0))?;
     let fingerprint = host_key::fingerprint_line(&key);
     let scenes = specs(args.scene, &args.water)?;
-    let game = game::GameOptions { scenes, size, fps: args.fps, seed: args.water.seed };
+    let game = server::GameOptions { scenes, size, fps: args.fps, seed: args.water.seed };
     let runtime =
         tokio::runtime::Builder::new_multi_thread().enable_all().thread_name("tidepool-serve").build().map_err(
             |e| Error::Usage(format!("cannot start the server's threads ({e}); free some memory and try again")),

@@ -5,11 +5,13 @@ use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use russh::keys::PrivateKey;
 use russh::server::Config;
 use russh::{MethodKind, MethodSet, SshId};
+use tidepool::SceneSpec;
+use tidepool::play::{Host, HostConfig};
 use tokio::net::{TcpListener, TcpStream};
 use tokio::sync::{mpsc, watch};
 use tokio::task::JoinHandle;
@@ -17,7 +19,7 @@ use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
 use super::authorized_keys::AllowList;
-use super::game::{self, Fits, GameLinks, GameOptions, GameStats, SharedFrame};
+use super::game::{self, Fits, GameLinks, GameStats, SharedFrame};
 use super::handler::ClientHandler;
 use super::hub::Hub;
 pub use super::hub::Stats;
@@ -101,6 +103,27 @@ pub fn russh_config(host_key: PrivateKey, private: bool, limits: &Limits) -> Con
         // run_stream ignores `nodelay` (only run_on_socket applies it); we set it on accept.
         nodelay: true,
         ..Config::default()
+    }
+}
+
+/// How the game runs.
+pub struct GameOptions {
+    /// The scenes `tab` cycles through; the first is shown at the start.
+    pub scenes: Vec<SceneSpec>,
+    /// The shared scene's size in pixels.
+    pub size: (u32, u32),
+    /// Frames per second.
+    pub fps: u32,
+    /// Seed of the random stones.
+    pub seed: u64,
+}
+
+impl GameOptions {
+    /// The host of the first scene (so a bad scene setting fails before the server starts).
+    /// Nothing is recorded and no file is saved on a player's behalf.
+    pub fn host(&self) -> tidepool::Result<Host> {
+        let config = HostConfig { scenes: self.scenes.clone(), seed: self.seed, record: None, storage: None };
+        Host::new(config, self.size, Instant::now())
     }
 }
 
