@@ -46,13 +46,6 @@ pub fn truer_mode(pixels: GraphicsMode, rate: Option<f64>) -> GraphicsMode {
     }
 }
 
-/// How far past the crossover the rate must go before the mode switches (a ratio).
-pub const MARGIN: f64 = 1.25;
-/// How long the rate must stay past the margin before the mode switches.
-pub const HOLD: Duration = Duration::from_secs(3);
-/// The least time between two switches.
-pub const MIN_BETWEEN: Duration = Duration::from_secs(10);
-
 /// `auto`'s mode over time: [`truer_mode`] with hysteresis. Clock-injected, so tests run on
 /// made-up time.
 #[derive(Clone, Debug)]
@@ -65,10 +58,19 @@ pub struct AutoSwitch {
 }
 
 impl AutoSwitch {
-    /// Starts in `pixels` (the protocol the probe found): a local terminal keeps it, and a
-    /// slow link is measured before it is left.
-    pub fn new(pixels: GraphicsMode) -> AutoSwitch {
-        AutoSwitch { pixels, current: pixels, leaning: None, last_switch: None }
+    /// How far past the crossover the rate must go before the mode switches (a ratio).
+    pub const MARGIN: f64 = 1.25;
+    /// How long the rate must stay past the margin before the mode switches.
+    pub const HOLD: Duration = Duration::from_secs(3);
+    /// The least time between two switches.
+    pub const MIN_BETWEEN: Duration = Duration::from_secs(10);
+
+    /// Starts in the truer mode at `rate` when the rate is known (a fixed `--bandwidth`),
+    /// else in `pixels` (the protocol the probe found): a local terminal keeps it, and a slow
+    /// link is measured before it is left.
+    pub fn new(pixels: GraphicsMode, rate: Option<f64>) -> AutoSwitch {
+        let current = rate.map_or(pixels, |r| truer_mode(pixels, Some(r)));
+        AutoSwitch { pixels, current, leaning: None, last_switch: None }
     }
 
     /// The mode in force.
@@ -77,8 +79,8 @@ impl AutoSwitch {
     }
 
     /// The mode after the link was measured at `rate` at `now` (`None`: unlimited): it changes
-    /// only when the rate has stayed [`MARGIN`] beyond the crossover for [`HOLD`] and the last
-    /// switch is [`MIN_BETWEEN`] ago. Returns the mode and whether it just changed (the Screen
+    /// only when the rate has stayed [`AutoSwitch::MARGIN`] beyond the crossover for
+    /// [`AutoSwitch::HOLD`] and the last switch is [`AutoSwitch::MIN_BETWEEN`] ago. Returns the mode and whether it just changed (the Screen
     /// says so on the status line for a few seconds).
     pub fn update(&mut self, rate: Option<f64>, now: Instant) -> (GraphicsMode, bool) {
         let Some(at) = crossover(self.pixels) else {
@@ -87,18 +89,18 @@ impl AutoSwitch {
         let other = if self.current == self.pixels { GraphicsMode::Cells } else { self.pixels };
         let beyond = match (other == self.pixels, rate) {
             (true, None) => true,
-            (true, Some(r)) => r >= at * MARGIN,
+            (true, Some(r)) => r >= at * Self::MARGIN,
             (false, None) => false,
-            (false, Some(r)) => r < at / MARGIN,
+            (false, Some(r)) => r < at / Self::MARGIN,
         };
         if !beyond {
             self.leaning = None;
             return (self.current, false);
         }
         let since = *self.leaning.get_or_insert(now);
-        let spaced = self.last_switch.is_none_or(|t| now.saturating_duration_since(t) >= MIN_BETWEEN);
+        let spaced = self.last_switch.is_none_or(|t| now.saturating_duration_since(t) >= Self::MIN_BETWEEN);
         // Back to a local terminal's pixels at once: nothing to wait for.
-        let held = rate.is_none() || now.saturating_duration_since(since) >= HOLD;
+        let held = rate.is_none() || now.saturating_duration_since(since) >= Self::HOLD;
         if held && spaced {
             self.current = other;
             self.leaning = None;
@@ -128,7 +130,7 @@ mod tests {
     fn the_switch_waits_for_a_steady_rate_and_does_not_flap() {
         let t0 = Instant::now();
         let at = crossover(GraphicsMode::Kitty).unwrap();
-        let mut auto = AutoSwitch::new(GraphicsMode::Kitty);
+        let mut auto = AutoSwitch::new(GraphicsMode::Kitty, None);
         let s = |secs: f64| t0 + Duration::from_secs_f64(secs);
         // A rate hovering around the crossover (within the margin) never switches.
         for i in 0..100 {
