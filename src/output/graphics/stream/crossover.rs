@@ -17,7 +17,7 @@ use crate::output::graphics::GraphicsMode;
 pub fn crossover(mode: GraphicsMode) -> Option<f64> {
     match mode {
         GraphicsMode::Kitty => Some(KITTY_CROSSOVER),
-        GraphicsMode::Sixel => Some(SIXEL_CROSSOVER),
+        GraphicsMode::Sixel => SIXEL_CROSSOVER,
         GraphicsMode::Iterm2 => Some(ITERM2_CROSSOVER),
         GraphicsMode::Cells => None,
     }
@@ -27,9 +27,12 @@ pub fn crossover(mode: GraphicsMode) -> Option<f64> {
 /// measured, kitty already scored SSIM 0.583 against the cells' 0.519 (250 kB/s: 0.603), so the
 /// crossover is at or below it; 50 kB/s is taken until lower rates are measured.
 const KITTY_CROSSOVER: f64 = 50_000.0;
-/// sixel's crossover, bytes per second: sixel lost to cells at 50 kB/s (no picture fitted) and
-/// at 250 kB/s (SSIM 0.197); until the faster rows say otherwise, only a 2 MB/s link keeps it.
-const SIXEL_CROSSOVER: f64 = 2_000_000.0;
+/// sixel has no crossover: in `cargo bench --bench pictures` it lost to cells at every rate
+/// (SSIM 0.38 against 0.52 at 50 kB/s, 0.44/0.58 at 250 kB/s, 0.39/0.63 at 2 MB/s), and even
+/// unlimited (0.17/0.67): a fixed 6x7x6 cube's ordered dither moves each pixel by about half a
+/// level step (a mean luma error of 20 against kitty's 4), more than the water's own local
+/// contrast. A local terminal keeps it (no rate: the person asked for pixels by having them).
+const SIXEL_CROSSOVER: Option<f64> = None;
 /// iTerm2's crossover, bytes per second: JPEG won at 50 kB/s (0.604 against 0.519) and at
 /// 250 kB/s (0.664).
 const ITERM2_CROSSOVER: f64 = 50_000.0;
@@ -83,9 +86,8 @@ impl AutoSwitch {
     /// [`AutoSwitch::HOLD`] and the last switch is [`AutoSwitch::MIN_BETWEEN`] ago. Returns the mode and whether it just changed (the Screen
     /// says so on the status line for a few seconds).
     pub fn update(&mut self, rate: Option<f64>, now: Instant) -> (GraphicsMode, bool) {
-        let Some(at) = crossover(self.pixels) else {
-            return (self.current, false);
-        };
+        // No crossover: cells win at any limited rate, pixels only without a limit.
+        let at = crossover(self.pixels).unwrap_or(f64::INFINITY);
         let other = if self.current == self.pixels { GraphicsMode::Cells } else { self.pixels };
         let beyond = match (other == self.pixels, rate) {
             (true, None) => true,
@@ -117,7 +119,9 @@ mod tests {
 
     #[test]
     fn locally_pixels_and_on_a_slow_link_cells() {
-        for mode in [GraphicsMode::Kitty, GraphicsMode::Sixel, GraphicsMode::Iterm2] {
+        assert_eq!(truer_mode(GraphicsMode::Sixel, Some(100e6)), GraphicsMode::Cells, "sixel never won under a rate");
+        assert_eq!(truer_mode(GraphicsMode::Sixel, None), GraphicsMode::Sixel, "locally pixels");
+        for mode in [GraphicsMode::Kitty, GraphicsMode::Iterm2] {
             let at = crossover(mode).unwrap();
             assert_eq!(truer_mode(mode, None), mode);
             assert_eq!(truer_mode(mode, Some(at * 2.0)), mode);

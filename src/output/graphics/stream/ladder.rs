@@ -1,8 +1,9 @@
 //! The resolution ladder and the resampler that puts any picture on a rung.
 //!
 //! The top rung is the source picture (the scene as rendered, within the layout's picture:
-//! a rung above it would only interpolate); the bottom rung is half-block resolution (a pixel
-//! a column, two a row), below which cells show as much. Between them the sides shrink by
+//! a rung above it would only interpolate); the bottom rung is given (the stream takes a
+//! quarter of half-block resolution: a whole picture there moves truer than tiles of a finer
+//! one on a slow link). Between them the sides shrink by
 //! about a sixth a rung, so each rung has about 70% of the pixels of the one above and costs
 //! about three quarters of its bytes: fine enough that the rung chosen for a link uses most
 //! of what the link carries.

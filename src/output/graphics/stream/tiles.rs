@@ -72,7 +72,7 @@ impl PictureStream {
                     self.push_part(tile, rung, packing);
                 }
                 if self.bytes.len() <= room {
-                    self.next_tile = index;
+                    self.next_tile = (index + 1) % count;
                     return Some(tile);
                 }
                 if width <= ux {
