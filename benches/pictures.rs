@@ -255,17 +255,20 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
         }
         if sample(n) {
             let truth = &truths[n];
-            if std::env::var("PICTURES_DEBUG").is_ok() && n == 59 {
-                if let Some(shown) = terminal.luma() {
-                    let (w, h) = (shown.width().min(truth.width()), shown.height().min(truth.height()));
-                    let mut sum = 0.0;
-                    for y in 0..h {
-                        for x in 0..w {
-                            sum += f64::from((shown.get(x, y) - truth.get(x, y)).abs());
-                        }
+            // PICTURES_DEBUG: the mean luma error two seconds in (a misplaced or missing picture
+            // shows as tens of levels; sixel's dither alone is about 20, kitty's PNG 4).
+            if std::env::var("PICTURES_DEBUG").is_ok()
+                && n == 59
+                && let Some(shown) = terminal.luma()
+            {
+                let (w, h) = (shown.width().min(truth.width()), shown.height().min(truth.height()));
+                let mut sum = 0.0;
+                for y in 0..h {
+                    for x in 0..w {
+                        sum += f64::from((shown.get(x, y) - truth.get(x, y)).abs());
                     }
-                    eprintln!("{mode} {rate:?}: mean luma error {:.2} over {w}x{h}", sum / (w * h) as f64);
                 }
+                eprintln!("{mode} {rate:?}: mean luma error {:.2} over {w}x{h}", sum / (w * h) as f64);
             }
             let s = match terminal.luma() {
                 None => 0.0,
