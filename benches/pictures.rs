@@ -22,6 +22,7 @@
 //!
 //!     cargo bench --bench pictures               # the table, then the CPU figures
 //!     PICTURES=table cargo bench --bench pictures
+//!     PICTURES=table PICTURES_MODES=sixel,cells cargo bench --bench pictures   # some modes
 //!     PICTURES=cpu cargo bench --bench pictures
 
 use std::hint::black_box;
@@ -160,7 +161,8 @@ fn stream(mode: &str) -> (PictureStream, Terminal) {
     match mode {
         "kitty" => {
             let l = l(GraphicsMode::Kitty);
-            (PictureStream::new(Protocol::Kitty(KittyOptions::new(l.cells)), l), Terminal::Kitty(Default::default()))
+            let options = KittyOptions { frame_edits: true, ..KittyOptions::new(l.cells) };
+            (PictureStream::new(Protocol::Kitty(options), l), Terminal::Kitty(Default::default()))
         }
         "sixel" => {
             let l = l(GraphicsMode::Sixel);
@@ -180,6 +182,8 @@ fn stream(mode: &str) -> (PictureStream, Terminal) {
 }
 
 struct Row {
+    /// The rung the run ended on.
+    rung: String,
     pictures: usize,
     bytes: usize,
     ssim: Vec<f64>,
@@ -191,7 +195,7 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
     let frame = Duration::from_nanos(1_000_000_000 / u64::from(FPS));
     let mut bucket = rate.map_or_else(ByteBucket::unlimited, ByteBucket::new);
     bucket.refill(t0);
-    let mut row = Row { pictures: 0, bytes: 0, ssim: Vec::new(), times: Vec::new() };
+    let mut row = Row { rung: "160x94 cells".into(), pictures: 0, bytes: 0, ssim: Vec::new(), times: Vec::new() };
     let sample = |i: usize| i % SAMPLE_EVERY == SAMPLE_EVERY - 1;
     if mode == "cells" {
         let (cols, rows) = (usize::from(TERM.0), usize::from(TERM.1));
@@ -228,7 +232,7 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
                     .flat_map(|(x, y)| screen.pixel(x, y).unwrap_or([0, 0, 0]))
                     .collect();
                 let shown = luma_at(&rgb, (pw, ph), AREA, true);
-                row.ssim.push(tidepool::terminal::ssim(&shown, &truths[n]));
+                row.ssim.push(view_ssim(&shown, &truths[n]));
             }
         }
         return row;
@@ -251,22 +255,61 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
         }
         if sample(n) {
             let truth = &truths[n];
+            // PICTURES_DEBUG: the mean luma error two seconds in (a misplaced or missing picture
+            // shows as tens of levels; sixel's dither alone is about 20, kitty's PNG 4).
+            if std::env::var("PICTURES_DEBUG").is_ok()
+                && n == 59
+                && let Some(shown) = terminal.luma()
+            {
+                let (w, h) = (shown.width().min(truth.width()), shown.height().min(truth.height()));
+                let mut sum = 0.0;
+                for y in 0..h {
+                    for x in 0..w {
+                        sum += f64::from((shown.get(x, y) - truth.get(x, y)).abs());
+                    }
+                }
+                eprintln!("{mode} {rate:?}: mean luma error {:.2} over {w}x{h}", sum / (w * h) as f64);
+            }
             let s = match terminal.luma() {
                 None => 0.0,
-                Some(shown) if shown.height() == truth.height() => tidepool::terminal::ssim(&shown, truth),
+                Some(shown) if shown.height() == truth.height() => view_ssim(&shown, truth),
                 // Sixel's whole bands end 2 rows above the area: the truth cut to them.
                 Some(shown) => {
                     let cut = Luma::from_fn(shown.width(), shown.height(), |x, y| {
                         let v = truth.get(x, y).round() as u8;
                         [v, v, v]
                     });
-                    tidepool::terminal::ssim(&shown, &cut)
+                    view_ssim(&shown, &cut)
                 }
             };
             row.ssim.push(s);
         }
     }
+    let state = stream.state();
+    row.rung = format!("{}x{} {}", state.size.0, state.size.1, state.packing.map_or("-".into(), |p| p.name()));
     row
+}
+
+/// SSIM of `a` against `b`, both first averaged over `PICTURES_VIEW`-pixel squares when that
+/// is set (a viewing distance at which single screen pixels blur: dither patterns average out).
+fn view_ssim(a: &Luma, b: &Luma) -> f64 {
+    let k: usize = std::env::var("PICTURES_VIEW").ok().and_then(|v| v.parse().ok()).unwrap_or(1).max(1);
+    if k == 1 {
+        return tidepool::terminal::ssim(a, b);
+    }
+    let shrink = |l: &Luma| {
+        Luma::from_fn(l.width() / k, l.height() / k, |x, y| {
+            let mut sum = 0.0;
+            for dy in 0..k {
+                for dx in 0..k {
+                    sum += f64::from(l.get(x * k + dx, y * k + dy));
+                }
+            }
+            let v = (sum / (k * k) as f64).round().clamp(0.0, 255.0) as u8;
+            [v, v, v]
+        })
+    };
+    tidepool::terminal::ssim(&shrink(a), &shrink(b))
 }
 
 fn percentile(values: &[f64], p: f64) -> f64 {
@@ -304,21 +347,18 @@ fn table() {
     println!();
     println!("| rate | mode | pictures/s | sent kB/s | mean SSIM | 5th pct SSIM | median ms/frame | last rung |");
     println!("|---|---|---|---|---|---|---|---|");
+    let mut picks = Vec::new();
     for rate in RATES {
+        let mut means = Vec::new();
         let label = rate.map_or("unlimited".to_string(), |r| format!("{:.0} kB/s", r / 1000.0));
-        for mode in MODES {
+        let only = std::env::var("PICTURES_MODES").unwrap_or_default();
+        for mode in MODES.into_iter().filter(|m| only.is_empty() || only.split(',').any(|o| o == *m)) {
             let r = run(mode, rate, &shots, &truths);
             let mut times = r.times.clone();
             times.sort();
             let mean = r.ssim.iter().sum::<f64>() / r.ssim.len() as f64;
-            let rung = if mode == "cells" {
-                "160x94 cells".to_string()
-            } else {
-                let (mut s, _) = stream(mode);
-                // The rung the run ended on is not kept; the stream's first offer at this rate is.
-                let budget = Budget { available: usize::MAX, rate, frame_interval: Duration::from_millis(33) };
-                s.prepare(&shots[0], budget, Instant::now()).map_or("-".into(), |o| format!("{:?}", o.state.size))
-            };
+            let rung = &r.rung;
+            means.push((mode, mean));
             println!(
                 "| {label} | {mode} | {:.1} | {:.1} | {mean:.4} | {:.4} | {:.2} | {rung} |",
                 r.pictures as f64 / seconds,
@@ -327,6 +367,18 @@ fn table() {
                 times[times.len() / 2].as_secs_f64() * 1000.0,
             );
         }
+        let cells = means.iter().find(|(m, _)| *m == "cells").map_or(0.0, |(_, v)| *v);
+        let choice: Vec<String> = means
+            .iter()
+            .filter(|(m, _)| *m != "cells")
+            .map(|(m, v)| format!("{m}: {}", if *v > cells { *m } else { "cells" }))
+            .collect();
+        picks.push(format!("{label}: {}", choice.join(", ")));
+    }
+    println!();
+    println!("the truer mode at each rate (what `auto` should pick for a terminal of each protocol):");
+    for p in picks {
+        println!("- {p}");
     }
     println!();
     println!("table made in {:.1} s", t.elapsed().as_secs_f64());

@@ -38,6 +38,8 @@ use crate::output::color::ColorMode;
 use crate::output::cursor::Cursor;
 use crate::output::diff::{EncodeOptions, Shown};
 use crate::output::graphics::GraphicsMode;
+use crate::output::graphics::stream::Budget;
+use crate::output::graphics::stream::crossover::AutoSwitch;
 use crate::output::rate::{RateEncoder, RateOptions, Target};
 use crate::play::clock::{FramePacer, Meter};
 
@@ -105,6 +107,9 @@ pub struct Screen {
     choice: GraphicsChoice,
     support: GraphicsSupport,
     picture: Option<Picture>,
+    /// `auto` with a terminal that shows pixels: when to draw them instead of cells (the link's
+    /// rate against the protocol's crossover), and the pixel choice to come back to.
+    auto_pixels: Option<(AutoSwitch, GraphicsChoice)>,
     mouse_pixels: bool,
     /// The terminal has been set up ([`Screen::ENTER`]).
     entered: bool,
@@ -158,6 +163,7 @@ impl Screen {
             probe_answers: 0,
             choice,
             support,
+            auto_pixels: None,
             mouse_pixels: false,
             entered: false,
             mouse_pixels_pending: false,
@@ -320,8 +326,9 @@ impl Screen {
     }
 
     /// Appends the frame for now to `out`: `picture` (of [`Screen::picture_size`]), the seat's
-    /// overlay, the status line. Returns the bytes appended (0 when nothing changed). Fails only
-    /// when kitty's temporary file cannot be written.
+    /// overlay, the status line. Returns the bytes appended (0 when nothing changed). Nothing
+    /// in it fails today (a kitty temporary file that cannot be written falls back to direct
+    /// transmission); the `Result` is the doors' contract.
     pub fn frame(
         &mut self,
         now: Instant,
@@ -342,6 +349,7 @@ impl Screen {
             self.bucket.set_rate(self.link.rate());
         }
         self.bucket.refill(now);
+        self.follow_link(now, out);
         let rate = self.bucket.rate();
         let figures = Figures {
             fps: self.meter.fps,
@@ -370,7 +378,6 @@ impl Screen {
         bytes.clear();
         let report = self.encoder.encode_into(&mut self.shown, target, budget, options, &mut bytes);
         self.bucket.spend(report.bytes);
-        let mut result = Ok(());
         if let Some(p) = &mut self.picture {
             let frame = picture::Frame {
                 resized,
@@ -379,10 +386,16 @@ impl Screen {
                 drawable: big_enough(self.term),
                 sync: options.sync,
             };
-            match p.add_to_frame(picture, &frame, &mut self.bucket, &mut bytes) {
-                Ok(true) => self.shown.cursor = Cursor::Unknown,
-                Ok(false) => {}
-                Err(e) => result = Err(e),
+            // What the cells left of this frame's budget: the picture is never owed.
+            let left = Budget {
+                available: budget.saturating_sub(report.bytes),
+                rate,
+                frame_interval: Duration::from_secs(1) / self.config.fps.max(1),
+            };
+            let sent = p.add_to_frame(picture, &frame, left, now, &mut bytes);
+            if sent > 0 {
+                self.bucket.spend(sent);
+                self.shown.cursor = Cursor::Unknown;
             }
         }
         // Room for the largest frame at once (the scratch buffer has it), so the caller's
@@ -400,7 +413,7 @@ impl Screen {
         self.bytes_sent += len as u64;
         self.meter.frame(now, len);
         self.pacer.sent(now);
-        result.map(|()| len)
+        Ok(len)
     }
 
     /// Whether link questions are still unanswered (a door that is closing waits a little for
@@ -528,30 +541,70 @@ impl Screen {
     }
 
     /// Sets the protocol from what the terminal said (`first`: the first decision, before any
-    /// frame; later only an upgrade from cells to pixels).
+    /// frame; later only an upgrade from cells to pixels). With `auto`, pixels are drawn only
+    /// where they show the truer moving picture at the link's rate (a fixed rate is known now;
+    /// a measured one starts with pixels and [`Screen::follow_link`] switches).
     fn choose(&mut self, support: &GraphicsSupport, first: bool) {
         let choice = probe::choose(self.config.graphics, Some(support));
         if !first && choice.mode == GraphicsMode::Cells {
             return;
         }
-        self.picture = Picture::new(&choice, support, self.term);
-        let mouse_pixels = picture::pixel_mouse(&choice, support);
+        self.support = support.clone();
+        let mut notice: Vec<String> = choice.hint.map(str::to_owned).into_iter().collect();
+        self.auto_pixels = None;
+        let mut drawn = choice.clone();
+        if self.config.graphics == GraphicsRequest::Auto && choice.mode != GraphicsMode::Cells {
+            let known = match self.config.bandwidth {
+                Bandwidth::Fixed(rate) => Some(rate as f64),
+                Bandwidth::Auto | Bandwidth::Unlimited => None,
+            };
+            let switch = AutoSwitch::new(choice.mode, known);
+            if switch.mode() == GraphicsMode::Cells {
+                notice.push(picture::switch_notice(choice.mode, GraphicsMode::Cells, known));
+                drawn = probe::choose(GraphicsRequest::Force(GraphicsMode::Cells), None);
+            }
+            self.auto_pixels = Some((switch, choice));
+        }
+        let late = if first { "" } else { " (the terminal answered late)" };
+        self.draw_with(drawn, notice, late);
+    }
+
+    /// `auto` between pixels and cells as the link's rate crosses the protocol's crossover
+    /// (with the switch's hysteresis); a switch is said on the status line. Leaving kitty deletes
+    /// its image (in `out`, before the frame).
+    fn follow_link(&mut self, now: Instant, out: &mut Vec<u8>) {
+        let rate = self.bucket.rate();
+        let Some((switch, pixels)) = &mut self.auto_pixels else { return };
+        let (mode, changed) = switch.update(rate, now);
+        if !changed {
+            return;
+        }
+        let choice = if mode == GraphicsMode::Cells {
+            probe::choose(GraphicsRequest::Force(GraphicsMode::Cells), None)
+        } else {
+            pixels.clone()
+        };
+        let notice = picture::switch_notice(pixels.mode, mode, rate);
+        out.extend_from_slice(&picture::restore_bytes(&self.choice, self.mouse_pixels));
+        self.mouse_pixels = false;
+        self.draw_with(choice, vec![notice], "");
+    }
+
+    /// Draws with `choice` from the next frame on (a repaint), telling `notice` and which
+    /// protocol draws.
+    fn draw_with(&mut self, choice: GraphicsChoice, mut notice: Vec<String>, late: &str) {
+        self.picture = Picture::new(&choice, &self.support, self.term);
+        let mouse_pixels = picture::pixel_mouse(&choice, &self.support);
         self.mouse_pixels_pending = mouse_pixels && !self.mouse_pixels;
         self.mouse_pixels = mouse_pixels;
-        let mut notice = Vec::new();
-        if let Some(hint) = choice.hint {
-            notice.push(hint.to_owned());
-        }
         if let Some(p) = &self.picture {
             let (w, h) = p.scene_size();
-            let late = if first { "" } else { " (the terminal answered late)" };
             notice.push(format!("{} graphics, {w}x{h} pixels{late}", choice.mode.name()));
         }
         if !notice.is_empty() {
             self.notice = Some(notice.join("; "));
         }
         self.choice = choice;
-        self.support = support.clone();
         self.shown = Shown::UNKNOWN;
         self.layout_changed = true;
     }

@@ -221,3 +221,39 @@ fn a_resize_resends_the_picture_for_the_new_cell_area() {
     p.send(b"q");
     assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
 }
+
+#[test]
+fn inside_tmux_with_passthrough_kitty_draws_through_unicode_placeholders() {
+    // tmux answers its own DA1 at once (no sixel); the outer kitty answers the wrapped queries:
+    // the graphics query, frame edits and the virtual placement (Unicode placeholders), then DA1.
+    const OUTER: &[u8] = b"\x1b_Gi=31;OK\x1b\\\x1b_Gi=7627890;OK\x1b\\\x1b_Gi=7627891;OK\x1b\\\x1b[?62;22c";
+    let dir = temp_dir("gfx-tmux-kitty");
+    let args: Vec<&str> = ARGS.to_vec();
+    let mut p = Player::spawn_answering(&dir, 100, 12, &args, &[("TMUX", "/tmp/tmux-0/default,1,0")], move |n| {
+        Some(if n == 1 { OUTER.to_vec() } else { DA1_ANSWER.to_vec() })
+    });
+    let start = find(&p.output(), ENTER).map_or(0, |i| i + ENTER.len());
+    // The image goes wrapped for passthrough, with a virtual placement.
+    let at = p.wait_for(b"\x1bPtmux;\x1b\x1b_G", start, WAIT);
+    p.wait_for(SYNC_END, at, WAIT);
+    p.send(b"q");
+    assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
+    let out = p.output();
+    let frames = &out[find(&out, ENTER).unwrap()..picture_restore_at(&out)];
+    let count = |needle: &[u8]| frames.windows(needle.len()).filter(|w| *w == needle).count();
+    assert!(count(b"\x1b_G") > 0, "kitty commands");
+    assert_eq!(count(b"\x1b_G"), count(b"\x1bPtmux;\x1b\x1b_G"), "every kitty command is wrapped for tmux");
+    let state = kitty_decode::decode(frames).expect("the wrapped commands decode");
+    let image = &state.images[&kitty::IMAGE_ID];
+    assert_eq!(image.keys.get(&'U').map(String::as_str), Some("1"), "a virtual placement");
+    assert_eq!((image.width, image.height), (480, 106));
+    // The placeholder text: 100x11 cells of U+10EEEE, the image id in the foreground colour
+    // (0x746470: 116;100;112), row and column in combining marks; tmux moves it as text.
+    let placeholder = "\u{10EEEE}".as_bytes();
+    assert_eq!(frames.windows(4).filter(|w| *w == placeholder).count(), 100 * 11);
+    assert!(find(frames, b"\x1b[38;2;116;100;112m").is_some(), "the image id as the foreground colour");
+    assert!(find(frames, b"\x1b[?1016h").is_none(), "no pixel mouse inside tmux");
+    // The delete on the way out is wrapped too.
+    let restore = &out[picture_restore_at(&out)..];
+    assert!(find(restore, b"\x1bPtmux;\x1b\x1b_Ga=d").is_some(), "the delete reaches the outer terminal");
+}

@@ -179,7 +179,7 @@ pub struct PlayCommand {
 
     /// How the picture is drawn: real pixels with the kitty graphics protocol, sixel or iTerm2
     /// inline images, or half-block cells (two pixels a cell, any terminal). `auto` asks the
-    /// terminal what it can show (150 ms at most) and falls back to cells.
+    /// terminal what it can show (500 ms at most) and falls back to cells.
     #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
     pub graphics: GraphicsChoice,
 }
@@ -384,7 +384,7 @@ pub struct OutputArgs {
     pub stats: bool,
 
     /// With --out - to a terminal: draw the picture in real pixels (kitty graphics, sixel,
-    /// iTerm2) or half-block cells. `auto` asks the terminal (150 ms at most); into a pipe or a
+    /// iTerm2) or half-block cells. `auto` asks the terminal (500 ms at most); into a pipe or a
     /// file it means cells and nothing is asked.
     #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
     pub graphics: GraphicsChoice,

@@ -326,6 +326,12 @@ pub fn push_cursor_to(out: &mut Vec<u8>, (col, row): (u16, u16)) {
     let _ = write!(out, "\x1b[{};{}H", u32::from(row) + 1, u32::from(col) + 1);
 }
 
+/// Appends the command that makes the terminal read raw RGB pixels from the temporary file
+/// `path` (`t=t`, `f=24`) under `keys`, wrapped for tmux if asked.
+pub(crate) fn push_temp_file_command(out: &mut Vec<u8>, keys: &[u8], path: &Path, tmux: bool) {
+    push_command(out, &temp_file_command(keys, path), tmux);
+}
+
 /// The command that makes the terminal read pixels from `path` (`t=t`): `keys` plus the
 /// medium, the base64-encoded path as payload.
 fn temp_file_command(keys: &[u8], path: &Path) -> Vec<u8> {

@@ -280,12 +280,18 @@ impl SixelEncoder {
     /// Dithers `source` (`width x height` pixels of `bpp` bytes, 3 for RGB or 4 for opaque
     /// RGBA such as a pixmap's data, row-major) scaled to `target` by nearest pixel (each
     /// source pixel repeated): the register of every target pixel. No RGB copy is made.
+    ///
+    /// `fine`: the dither's threshold follows the target pixel, so the pattern is the screen's
+    /// finest (8 pixels) and averages out to the eye; otherwise it follows the source pixel, so
+    /// a repeated pixel is one flat colour and costs fewer bytes (runs of equal sixels), at the
+    /// price of a pattern as coarse as the scale (21 screen pixels at 2.7x).
     pub fn dither_scaled(
         &mut self,
         source: &[u8],
         bpp: usize,
         (width, height): (u32, u32),
         (tw, th): (u32, u32),
+        fine: bool,
         out: &mut Vec<u8>,
     ) {
         assert!(bpp == 3 || bpp == 4, "3 or 4 bytes a pixel");
@@ -302,10 +308,10 @@ impl SixelEncoder {
         for y in 0..th as usize {
             let sy = (y as u64 * u64::from(height) / u64::from(th.max(1))) as usize;
             let row = &source[sy * stride..(sy + 1) * stride];
-            let thresholds = &BAYER8[sy % BAYER_SIDE];
-            for &at in &self.x_map {
+            let thresholds = &BAYER8[if fine { y } else { sy } % BAYER_SIDE];
+            for (x, &at) in self.x_map.iter().enumerate() {
                 let p = &row[at as usize..at as usize + 3];
-                let t = usize::from(thresholds[(at as usize / bpp) % BAYER_SIDE]);
+                let t = usize::from(thresholds[if fine { x } else { at as usize / bpp } % BAYER_SIDE]);
                 out.push(tr[t][usize::from(p[0])] + tg[t][usize::from(p[1])] + tb[t][usize::from(p[2])]);
             }
         }

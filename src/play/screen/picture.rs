@@ -2,100 +2,72 @@
 //! that still carries the status line.
 //!
 //! The player keeps its cell frame for every mode: in `cells` mode it holds the half-block
-//! picture (today's output, unchanged); in a pixel mode its picture rows stay blank cells
-//! (which, once sent, cost nothing) and this module sends the picture itself over them, at the
-//! size [`geometry::layout`] gives for the protocol and the terminal's cell size. It owns the
-//! encoder of the protocol chosen (each remembers what the terminal shows, so still water sends
-//! no bytes) and the layout (mouse reports map to scene pixels through the seat's
-//! [`crate::play::fit::Fit`]).
+//! picture; in a pixel mode its picture rows stay blank cells (which, once sent, cost nothing)
+//! and this module sends the picture itself over them through a
+//! [`PictureStream`]: the protocol's encoder under the link's rate (the resolution, the packing
+//! and the picture rate chosen per frame; only what changed is sent, so still water sends no
+//! bytes). The layout says where the picture goes (mouse reports map to scene pixels through
+//! the seat's [`crate::play::fit::Fit`]).
 
-use std::io;
+use std::time::Instant;
 
 use tiny_skia::Pixmap;
 
 use super::probe::{GraphicsChoice, GraphicsSupport};
-use crate::output::bucket::ByteBucket;
 use crate::output::diff::{SYNC_BEGIN, SYNC_END};
+use crate::output::graphics::GraphicsMode;
 use crate::output::graphics::geometry::{self, Layout};
-use crate::output::graphics::iterm2::Iterm2Encoder;
-use crate::output::graphics::kitty::{self, KittyEncoder, KittyOptions, Medium};
-use crate::output::graphics::sixel::{SixelEncoder, SixelPalette};
-use crate::output::graphics::{GraphicsMode, push_rgb};
+use crate::output::graphics::kitty::{self, KittyOptions, Medium};
+use crate::output::graphics::sixel::{Registers, SixelPalette};
+use crate::output::graphics::stream::crossover::crossover;
+use crate::output::graphics::stream::{Budget, PictureStream, Protocol};
+use crate::output::units::write_human_rate;
 
 /// The largest picture a scene renders at in a pixel mode, in pixels. The pool's simulation
 /// grid is its picture, and its breeze costs about 33 ns a cell a step (`tidepool render pool
 /// --breeze 1 --stats`): at the full 1280x752 of a 160x48 window, 60 steps a second would need
 /// two cores. Within this size the pool (simulation, picture, encoding) stays near half a core
 /// (`scripts/measure_graphics.py`); kitty and iTerm2 scale the picture up to the cell area
-/// themselves, sixel pictures are scaled up here.
+/// themselves, the sixel stream repeats its pixels.
 pub const SCENE_CAP: (u32, u32) = (480, 300);
 
 /// The kitty image's stacking order: under text glyphs, so the help overlay and the aim marker
 /// (text cells over the picture) stay readable.
 pub const KITTY_Z_INDEX: i32 = -1;
 
-/// The picture of a pixel mode: its layout and encoder.
+/// The picture of a pixel mode: its stream.
 #[derive(Debug)]
 pub struct Picture {
     choice: GraphicsChoice,
     support: GraphicsSupport,
-    layout: Layout,
-    encoder: Encoder,
-    /// The picture as RGB, reused from frame to frame.
-    rgb: Vec<u8>,
-    /// The size the scene renders at: `layout.picture` within [`SCENE_CAP`].
+    stream: PictureStream,
+    /// The size the scene renders at: the layout's picture within [`SCENE_CAP`].
     scene: (u32, u32),
-    /// For sixel, the scene's picture scaled up to `layout.picture` (one pixel a pixel).
-    scaled: Option<Pixmap>,
-    /// This frame's picture bytes (reused).
-    bytes: Vec<u8>,
     /// The help was open at the last frame (its text erases sixel and iTerm2 pixels, so the
     /// picture is sent whole when it closes).
     help_was_open: bool,
-}
-
-#[derive(Debug)]
-enum Encoder {
-    Kitty(Box<KittyEncoder>),
-    Sixel(Box<SixelEncoder>),
-    Iterm2(Iterm2Encoder),
 }
 
 impl Picture {
     /// The picture for `choice` in a terminal of `term` cells, or `None` for `cells` mode (the
     /// cell frame is the picture then).
     pub fn new(choice: &GraphicsChoice, support: &GraphicsSupport, term: (u16, u16)) -> Option<Picture> {
+        if choice.mode == GraphicsMode::Cells {
+            return None;
+        }
         let layout = layout_for(choice.mode, support, term);
-        let encoder = match choice.mode {
-            GraphicsMode::Cells => return None,
-            GraphicsMode::Kitty => Encoder::Kitty(Box::new(KittyEncoder::new(kitty_options(choice, support, &layout)))),
-            GraphicsMode::Sixel => {
-                let registers = support.sixel_registers();
-                Encoder::Sixel(Box::new(SixelEncoder::new(
-                    SixelPalette::for_registers(registers),
-                    layout.origin,
-                    Some(layout.cell_px),
-                )))
-            }
-            GraphicsMode::Iterm2 => Encoder::Iterm2(Iterm2Encoder::new(layout.origin, layout.cells, choice.tmux_wrap)),
-        };
-        let scene = fit(layout.picture, SCENE_CAP);
         Some(Picture {
+            stream: PictureStream::new(protocol(choice, support, &layout), layout),
+            scene: fit(layout.picture, SCENE_CAP),
             choice: choice.clone(),
             support: support.clone(),
-            layout,
-            encoder,
-            rgb: Vec::new(),
-            scene,
-            scaled: None,
-            bytes: Vec::new(),
             help_was_open: false,
         })
     }
 
     /// Where the picture goes and its size in pixels.
     pub fn layout(&self) -> &Layout {
-        &self.layout
+        self.stream.layout()
     }
 
     /// The size the scene renders at (the picture within [`SCENE_CAP`]).
@@ -103,76 +75,24 @@ impl Picture {
         self.scene
     }
 
+    /// What the stream did last (the rung, packing and picture rate).
+    #[cfg(test)]
+    pub fn state(&self) -> crate::output::graphics::stream::State {
+        self.stream.state()
+    }
+
     /// A new terminal size: a new layout, and the next picture is sent whole (the caller clears
     /// the screen in the same frame).
     pub fn resize(&mut self, term: (u16, u16)) {
-        self.layout = layout_for(self.choice.mode, &self.support, term);
-        self.scene = fit(self.layout.picture, SCENE_CAP);
-        match &mut self.encoder {
-            Encoder::Kitty(k) => k.set_options(kitty_options(&self.choice, &self.support, &self.layout)),
-            Encoder::Sixel(s) => {
-                **s = SixelEncoder::new(s.palette().clone(), self.layout.origin, Some(self.layout.cell_px));
-            }
-            Encoder::Iterm2(i) => *i = Iterm2Encoder::new(self.layout.origin, self.layout.cells, self.choice.tmux_wrap),
-        }
-    }
-
-    /// Forgets what the terminal shows: the next picture is sent whole (text was written over
-    /// sixel or iTerm2 pixels, or the screen was cleared).
-    pub fn invalidate(&mut self) {
-        match &mut self.encoder {
-            Encoder::Kitty(k) => k.invalidate(),
-            Encoder::Sixel(s) => s.invalidate(),
-            Encoder::Iterm2(i) => i.invalidate(),
-        }
+        let layout = layout_for(self.choice.mode, &self.support, term);
+        self.stream = PictureStream::new(protocol(&self.choice, &self.support, &layout), layout);
+        self.scene = fit(layout.picture, SCENE_CAP);
     }
 
     /// Whether text written over the picture erases its pixels (sixel, iTerm2), so the picture
     /// must be resent after the text goes; kitty draws its image under text and keeps it.
-    pub fn text_erases_pixels(&self) -> bool {
-        !matches!(self.encoder, Encoder::Kitty(_))
-    }
-
-    /// Appends the bytes that show `pixmap` (nothing when the terminal already shows it).
-    /// Fails only when kitty's temporary file cannot be written; then nothing is appended.
-    pub fn encode(&mut self, pixmap: &Pixmap, out: &mut Vec<u8>) -> io::Result<()> {
-        let pixmap = match &self.encoder {
-            // Sixel is drawn one pixel a pixel: the scene's picture is scaled up to the area.
-            Encoder::Sixel(_) if (pixmap.width(), pixmap.height()) != self.layout.picture => {
-                let (w, h) = self.layout.picture;
-                let scaled = match self.scaled.take() {
-                    Some(p) if (p.width(), p.height()) == (w, h) => p,
-                    _ => Pixmap::new(w, h).ok_or_else(|| io::Error::other("cannot allocate the sixel picture"))?,
-                };
-                let scaled = self.scaled.insert(scaled);
-                let transform = tiny_skia::Transform::from_scale(
-                    w as f32 / pixmap.width() as f32,
-                    h as f32 / pixmap.height() as f32,
-                );
-                let paint =
-                    tiny_skia::PixmapPaint { quality: tiny_skia::FilterQuality::Bilinear, ..Default::default() };
-                scaled.draw_pixmap(0, 0, pixmap.as_ref(), &paint, transform, None);
-                &*scaled
-            }
-            _ => pixmap,
-        };
-        let (w, h) = (pixmap.width(), pixmap.height());
-        match &mut self.encoder {
-            Encoder::Kitty(k) => {
-                self.rgb.clear();
-                push_rgb(pixmap, &mut self.rgb);
-                k.encode(&self.rgb, w, h, out)?;
-            }
-            Encoder::Sixel(s) => {
-                self.rgb.clear();
-                push_rgb(pixmap, &mut self.rgb);
-                s.encode(&self.rgb, w, h, out);
-            }
-            Encoder::Iterm2(i) => {
-                i.encode(pixmap, out);
-            }
-        }
-        Ok(())
+    fn text_erases_pixels(&self) -> bool {
+        self.choice.mode != GraphicsMode::Kitty
     }
 }
 
@@ -192,39 +112,38 @@ pub struct Frame {
 }
 
 impl Picture {
-    /// Adds the picture to the frame's `bytes` (inside its synchronized update) when it is due,
-    /// and says whether it did (then the terminal's cursor is somewhere unknown).
+    /// Adds the picture to the frame's `bytes` (inside its synchronized update) when one is
+    /// due and fits `budget` (the bytes left after the cells), and returns the bytes added (0:
+    /// none; then the terminal's cursor is where the cells left it).
     ///
-    /// The status line goes first: a picture is sent only once the cells are all shown, and
-    /// only while the bucket is not in debt. A picture cannot be cut to a budget: it is sent
-    /// whole and owed (see [`ByteBucket::owe`]), so the next one waits until the rate has paid
-    /// for it; on a limited link the picture rate drops, and nothing queues. Sixel and iTerm2
-    /// would paint over the help, so the picture waits while it is open.
+    /// The status line goes first: a picture is sent only once the cells are all shown. The
+    /// stream chooses the picture's resolution, packing and rate so that it fits what the link
+    /// has now, or sends nothing (see [`PictureStream`]); nothing is owed and nothing queues.
+    /// Sixel and iTerm2 would paint over the help, so the picture waits while it is open.
     pub fn add_to_frame(
         &mut self,
         pixmap: &Pixmap,
         frame: &Frame,
-        bucket: &mut ByteBucket,
+        budget: Budget,
+        now: Instant,
         bytes: &mut Vec<u8>,
-    ) -> io::Result<bool> {
+    ) -> usize {
         let erases = self.text_erases_pixels();
         if frame.resized || (self.help_was_open && !frame.help_open && erases) {
-            self.invalidate();
+            self.stream.invalidate();
         }
         self.help_was_open = frame.help_open;
-        if (frame.help_open && erases) || !frame.cells_shown || bucket.in_debt() || !frame.drawable {
-            return Ok(false);
+        if (frame.help_open && erases) || !frame.cells_shown || !frame.drawable {
+            return 0;
         }
-        let mut picture = std::mem::take(&mut self.bytes);
-        picture.clear();
-        let result = self.encode(pixmap, &mut picture);
-        let sent = result.is_ok() && !picture.is_empty();
-        if sent {
-            bucket.owe(picture.len());
-            splice_picture(bytes, &picture, frame.sync);
-        }
-        self.bytes = picture;
-        result.map(|()| sent)
+        // The synchronized-output markers a frame without cells needs come out of the budget.
+        let markers = if frame.sync && !bytes.ends_with(SYNC_END) { SYNC_BEGIN.len() + SYNC_END.len() } else { 0 };
+        let budget = Budget { available: budget.available.saturating_sub(markers), ..budget };
+        let Some(offer) = self.stream.prepare(pixmap, budget, now) else { return 0 };
+        let before = bytes.len();
+        splice_picture(bytes, offer.bytes, frame.sync);
+        self.stream.commit();
+        bytes.len() - before
     }
 }
 
@@ -248,6 +167,25 @@ fn splice_picture(frame: &mut Vec<u8>, picture: &[u8], sync: bool) {
 fn fit(size: (u32, u32), cap: (u32, u32)) -> (u32, u32) {
     let k = (f64::from(cap.0) / f64::from(size.0.max(1))).min(f64::from(cap.1) / f64::from(size.1.max(1))).min(1.0);
     (((f64::from(size.0) * k).round() as u32).max(1), ((f64::from(size.1) * k).round() as u32).max(1))
+}
+
+/// What the status line says when `auto` switches to `to` (cells, or back to `pixels`) at the
+/// link's `rate` (`None`: unlimited), which crossed `pixels`' crossover: which mode draws and
+/// why.
+pub fn switch_notice(pixels: GraphicsMode, to: GraphicsMode, rate: Option<f64>) -> String {
+    let mut link = String::new();
+    match rate {
+        Some(r) => write_human_rate(&mut link, r as u64),
+        None => link.push_str("no limit"),
+    }
+    let mut at = String::new();
+    if let Some(c) = crossover(pixels) {
+        write_human_rate(&mut at, c as u64);
+    }
+    match to {
+        GraphicsMode::Cells => format!("link {link}: half-block cells (truer than {} below {at})", pixels.name()),
+        _ => format!("link {link}: pixels again"),
+    }
 }
 
 /// Whether mouse reports come in pixels: SGR-pixels mode (1016) is turned on when the terminal
@@ -281,61 +219,29 @@ fn layout_for(mode: GraphicsMode, support: &GraphicsSupport, term: (u16, u16)) -
     geometry::layout(mode, term, support.cell_px, sixel_max, geometry::SCALED_CAP)
 }
 
-fn kitty_options(choice: &GraphicsChoice, support: &GraphicsSupport, layout: &Layout) -> KittyOptions {
-    KittyOptions {
-        origin: layout.origin,
-        tmux: choice.tmux_wrap,
-        placeholders: choice.kitty_placeholders,
-        frame_edits: support.kitty_frame_edits,
-        medium: if support.kitty_temp_file { Medium::TempFile(kitty::temp_dir()) } else { Medium::Direct },
-        z_index: KITTY_Z_INDEX,
-        ..KittyOptions::new(layout.cells)
+/// The stream's protocol settings for `choice` from what the probe found: kitty with the frame
+/// edits and the temporary-file medium the terminal answered for, sixel with a palette for its
+/// registers (each image defines the registers it uses: that works in every terminal),
+/// iTerm2; each wrapped for tmux when the choice says so.
+fn protocol(choice: &GraphicsChoice, support: &GraphicsSupport, layout: &Layout) -> Protocol {
+    match choice.mode {
+        GraphicsMode::Kitty => Protocol::Kitty(KittyOptions {
+            origin: layout.origin,
+            tmux: choice.tmux_wrap,
+            placeholders: choice.kitty_placeholders,
+            frame_edits: support.kitty_frame_edits,
+            medium: if support.kitty_temp_file { Medium::TempFile(kitty::temp_dir()) } else { Medium::Direct },
+            z_index: KITTY_Z_INDEX,
+            ..KittyOptions::new(layout.cells)
+        }),
+        GraphicsMode::Sixel => Protocol::Sixel {
+            palette: SixelPalette::for_registers(support.sixel_registers()),
+            registers: Registers::PerImage,
+            tmux: choice.tmux_wrap,
+        },
+        GraphicsMode::Iterm2 | GraphicsMode::Cells => Protocol::Iterm2 { tmux: choice.tmux_wrap },
     }
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::output::graphics::kitty_decode;
-
-    fn choice(mode: GraphicsMode) -> GraphicsChoice {
-        GraphicsChoice { mode, tmux_wrap: false, kitty_placeholders: false, hint: None }
-    }
-
-    #[test]
-    fn cells_mode_has_no_picture() {
-        assert!(Picture::new(&choice(GraphicsMode::Cells), &GraphicsSupport::default(), (80, 24)).is_none());
-    }
-
-    #[test]
-    fn kitty_pictures_decode_to_the_pixmap_and_still_pictures_send_nothing() {
-        let support = GraphicsSupport { cell_px: Some((8, 16)), ..Default::default() };
-        let mut p = Picture::new(&choice(GraphicsMode::Kitty), &support, (10, 5)).unwrap();
-        assert_eq!(p.layout().picture, (80, 64));
-        let mut pixmap = Pixmap::new(80, 64).unwrap();
-        pixmap.fill(tiny_skia::Color::from_rgba8(10, 120, 200, 255));
-        let mut out = Vec::new();
-        p.encode(&pixmap, &mut out).unwrap();
-        let image = &kitty_decode::decode(&out).unwrap().images[&kitty::IMAGE_ID];
-        assert_eq!((image.width, image.height), (80, 64));
-        assert_eq!(image.rgb, crate::output::graphics::rgb(&pixmap));
-        let sent = out.len();
-        p.encode(&pixmap, &mut out).unwrap();
-        assert_eq!(out.len(), sent, "an unchanged picture sends nothing");
-        let deleted = kitty_decode::decode(&restore_bytes(&choice(GraphicsMode::Kitty), false)).unwrap();
-        assert!(deleted.images.is_empty() && deleted.commands[0][&'a'] == "d", "kitty's image is deleted on exit");
-    }
-
-    #[test]
-    fn big_pictures_render_within_the_scene_cap_and_sixel_scales_them_up() {
-        let support = GraphicsSupport { cell_px: Some((8, 16)), ..Default::default() };
-        let mut p = Picture::new(&choice(GraphicsMode::Sixel), &support, (160, 48)).unwrap();
-        assert_eq!((p.layout().picture, p.scene_size()), ((1280, 750), (480, 281)));
-        let mut pixmap = Pixmap::new(480, 281).unwrap();
-        pixmap.fill(tiny_skia::Color::from_rgba8(0, 0, 255, 255));
-        let mut out = Vec::new();
-        p.encode(&pixmap, &mut out).unwrap();
-        let raster: &[u8] = b"\"1;1;1280;750";
-        assert!(out.windows(raster.len()).any(|w| w == raster), "one pixel a screen pixel");
-    }
-}
+mod tests;

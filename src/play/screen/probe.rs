@@ -33,11 +33,12 @@
 //! off inside tmux.
 //!
 //! **No answer, a slow answer, garbage.** If the final DA1 does not arrive within the budget
-//! ([`PROBE_BUDGET`]), or an escape sequence that is not a reply arrives first, the terminal
-//! gets cells. Bytes that are not replies (keys typed during the probe) are handed back in
-//! [`ProbeOutcome::leftover`] for the input parser. Replies arriving after the probe ended are
-//! dropped by the player's input parser (`term::input`, which frames strings and control
-//! sequences itself).
+//! ([`PROBE_BUDGET`]), the terminal gets cells first; answers that come later (within the
+//! Screen's `LATE_ANSWERS`) still upgrade it to pixels, and a terminal silent all along is
+//! given up on with a word on the status line. An escape sequence that is not a reply arriving
+//! first means cells. Bytes that are not replies (keys typed during the probe) are handed back
+//! in [`ProbeOutcome::leftover`] for the input parser; a reply never becomes a key (the one
+//! input parser frames every reply, early or late).
 //!
 //! **Environment hints** are used only where no query answers: iTerm2 without its cell-size
 //! reply (`TERM_PROGRAM=iTerm.app`), and to skip the file query over SSH.
@@ -54,8 +55,15 @@ use crate::output::graphics::{kitty, tmux};
 use crate::play::input::{Input, InputParser, Received};
 use crate::play::replies::Reply;
 
-/// The longest the probe waits for the terminal's answers.
-pub const PROBE_BUDGET: Duration = Duration::from_millis(150);
+/// The longest the probe waits for the terminal's answers before the first frame. Every
+/// terminal answers DA1, and DA1 (asked last) ends the wait the moment it arrives, so a longer
+/// deadline costs only a terminal that answers nothing (it sees its first frame this much
+/// later, once). 500 ms covers a round trip to another continent (200-300 ms) and a terminal
+/// starting on a loaded machine (kitty under Xvfb answered after 150-160 ms here): such
+/// terminals get pixels from the first frame instead of cells and a switch. Answers later still
+/// upgrade cells to pixels for a while (the Screen's `LATE_ANSWERS`), after which a silent
+/// terminal is given up on and the status line says so.
+pub const PROBE_BUDGET: Duration = Duration::from_millis(500);
 /// The kitty query's image id (the protocol's example; nothing is stored under it).
 pub const KITTY_QUERY_ID: u32 = 31;
 /// The id of the kitty query through a temporary file.

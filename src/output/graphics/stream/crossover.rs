@@ -17,7 +17,7 @@ use crate::output::graphics::GraphicsMode;
 pub fn crossover(mode: GraphicsMode) -> Option<f64> {
     match mode {
         GraphicsMode::Kitty => Some(KITTY_CROSSOVER),
-        GraphicsMode::Sixel => Some(SIXEL_CROSSOVER),
+        GraphicsMode::Sixel => SIXEL_CROSSOVER,
         GraphicsMode::Iterm2 => Some(ITERM2_CROSSOVER),
         GraphicsMode::Cells => None,
     }
@@ -27,9 +27,12 @@ pub fn crossover(mode: GraphicsMode) -> Option<f64> {
 /// measured, kitty already scored SSIM 0.583 against the cells' 0.519 (250 kB/s: 0.603), so the
 /// crossover is at or below it; 50 kB/s is taken until lower rates are measured.
 const KITTY_CROSSOVER: f64 = 50_000.0;
-/// sixel's crossover, bytes per second: sixel lost to cells at 50 kB/s (no picture fitted) and
-/// at 250 kB/s (SSIM 0.197); until the faster rows say otherwise, only a 2 MB/s link keeps it.
-const SIXEL_CROSSOVER: f64 = 2_000_000.0;
+/// sixel has no crossover: in `cargo bench --bench pictures` it lost to cells at every rate
+/// (SSIM 0.38 against 0.52 at 50 kB/s, 0.44/0.58 at 250 kB/s, 0.39/0.63 at 2 MB/s), and even
+/// unlimited (0.17/0.67): a fixed 6x7x6 cube's ordered dither moves each pixel by about half a
+/// level step (a mean luma error of 20 against kitty's 4), more than the water's own local
+/// contrast. A local terminal keeps it (no rate: the person asked for pixels by having them).
+const SIXEL_CROSSOVER: Option<f64> = None;
 /// iTerm2's crossover, bytes per second: JPEG won at 50 kB/s (0.604 against 0.519) and at
 /// 250 kB/s (0.664).
 const ITERM2_CROSSOVER: f64 = 50_000.0;
@@ -46,13 +49,6 @@ pub fn truer_mode(pixels: GraphicsMode, rate: Option<f64>) -> GraphicsMode {
     }
 }
 
-/// How far past the crossover the rate must go before the mode switches (a ratio).
-pub const MARGIN: f64 = 1.25;
-/// How long the rate must stay past the margin before the mode switches.
-pub const HOLD: Duration = Duration::from_secs(3);
-/// The least time between two switches.
-pub const MIN_BETWEEN: Duration = Duration::from_secs(10);
-
 /// `auto`'s mode over time: [`truer_mode`] with hysteresis. Clock-injected, so tests run on
 /// made-up time.
 #[derive(Clone, Debug)]
@@ -65,10 +61,19 @@ pub struct AutoSwitch {
 }
 
 impl AutoSwitch {
-    /// Starts in `pixels` (the protocol the probe found): a local terminal keeps it, and a
-    /// slow link is measured before it is left.
-    pub fn new(pixels: GraphicsMode) -> AutoSwitch {
-        AutoSwitch { pixels, current: pixels, leaning: None, last_switch: None }
+    /// How far past the crossover the rate must go before the mode switches (a ratio).
+    pub const MARGIN: f64 = 1.25;
+    /// How long the rate must stay past the margin before the mode switches.
+    pub const HOLD: Duration = Duration::from_secs(3);
+    /// The least time between two switches.
+    pub const MIN_BETWEEN: Duration = Duration::from_secs(10);
+
+    /// Starts in the truer mode at `rate` when the rate is known (a fixed `--bandwidth`),
+    /// else in `pixels` (the protocol the probe found): a local terminal keeps it, and a slow
+    /// link is measured before it is left.
+    pub fn new(pixels: GraphicsMode, rate: Option<f64>) -> AutoSwitch {
+        let current = rate.map_or(pixels, |r| truer_mode(pixels, Some(r)));
+        AutoSwitch { pixels, current, leaning: None, last_switch: None }
     }
 
     /// The mode in force.
@@ -77,28 +82,27 @@ impl AutoSwitch {
     }
 
     /// The mode after the link was measured at `rate` at `now` (`None`: unlimited): it changes
-    /// only when the rate has stayed [`MARGIN`] beyond the crossover for [`HOLD`] and the last
-    /// switch is [`MIN_BETWEEN`] ago. Returns the mode and whether it just changed (the Screen
+    /// only when the rate has stayed [`AutoSwitch::MARGIN`] beyond the crossover for
+    /// [`AutoSwitch::HOLD`] and the last switch is [`AutoSwitch::MIN_BETWEEN`] ago. Returns the mode and whether it just changed (the Screen
     /// says so on the status line for a few seconds).
     pub fn update(&mut self, rate: Option<f64>, now: Instant) -> (GraphicsMode, bool) {
-        let Some(at) = crossover(self.pixels) else {
-            return (self.current, false);
-        };
+        // No crossover: cells win at any limited rate, pixels only without a limit.
+        let at = crossover(self.pixels).unwrap_or(f64::INFINITY);
         let other = if self.current == self.pixels { GraphicsMode::Cells } else { self.pixels };
         let beyond = match (other == self.pixels, rate) {
             (true, None) => true,
-            (true, Some(r)) => r >= at * MARGIN,
+            (true, Some(r)) => r >= at * Self::MARGIN,
             (false, None) => false,
-            (false, Some(r)) => r < at / MARGIN,
+            (false, Some(r)) => r < at / Self::MARGIN,
         };
         if !beyond {
             self.leaning = None;
             return (self.current, false);
         }
         let since = *self.leaning.get_or_insert(now);
-        let spaced = self.last_switch.is_none_or(|t| now.saturating_duration_since(t) >= MIN_BETWEEN);
+        let spaced = self.last_switch.is_none_or(|t| now.saturating_duration_since(t) >= Self::MIN_BETWEEN);
         // Back to a local terminal's pixels at once: nothing to wait for.
-        let held = rate.is_none() || now.saturating_duration_since(since) >= HOLD;
+        let held = rate.is_none() || now.saturating_duration_since(since) >= Self::HOLD;
         if held && spaced {
             self.current = other;
             self.leaning = None;
@@ -115,7 +119,9 @@ mod tests {
 
     #[test]
     fn locally_pixels_and_on_a_slow_link_cells() {
-        for mode in [GraphicsMode::Kitty, GraphicsMode::Sixel, GraphicsMode::Iterm2] {
+        assert_eq!(truer_mode(GraphicsMode::Sixel, Some(100e6)), GraphicsMode::Cells, "sixel never won under a rate");
+        assert_eq!(truer_mode(GraphicsMode::Sixel, None), GraphicsMode::Sixel, "locally pixels");
+        for mode in [GraphicsMode::Kitty, GraphicsMode::Iterm2] {
             let at = crossover(mode).unwrap();
             assert_eq!(truer_mode(mode, None), mode);
             assert_eq!(truer_mode(mode, Some(at * 2.0)), mode);
@@ -128,7 +134,7 @@ mod tests {
     fn the_switch_waits_for_a_steady_rate_and_does_not_flap() {
         let t0 = Instant::now();
         let at = crossover(GraphicsMode::Kitty).unwrap();
-        let mut auto = AutoSwitch::new(GraphicsMode::Kitty);
+        let mut auto = AutoSwitch::new(GraphicsMode::Kitty, None);
         let s = |secs: f64| t0 + Duration::from_secs_f64(secs);
         // A rate hovering around the crossover (within the margin) never switches.
         for i in 0..100 {

@@ -1,15 +1,17 @@
 //! The resolution ladder and the resampler that puts any picture on a rung.
 //!
-//! The top rung is the picture [`crate::output::graphics::geometry::layout`] gives (the cell
-//! area's pixel size, capped for the scaling protocols; for sixel the screen pixels in whole
-//! bands); the bottom rung is half-block resolution (a pixel a column, two a row), below which
-//! cells show as much. Between them the sides shrink by about a quarter a rung, so each rung
-//! costs a bit over half the pixels of the one above.
+//! The top rung is the source picture (the scene as rendered, within the layout's picture:
+//! a rung above it would only interpolate); the bottom rung is given (the stream takes a
+//! quarter of half-block resolution: a whole picture there moves truer than tiles of a finer
+//! one on a slow link). Between them the sides shrink by
+//! about a sixth a rung, so each rung has about 70% of the pixels of the one above and costs
+//! about three quarters of its bytes: fine enough that the rung chosen for a link uses most
+//! of what the link carries.
 
 /// The most rungs (top and bottom included).
-pub const MAX_RUNGS: usize = 8;
-/// Each rung's side is this fraction of the one above (about half the pixels).
-const STEP: f64 = 0.75;
+const MAX_RUNGS: usize = 12;
+/// Each rung's side is this fraction of the one above (about 70% of the pixels).
+const STEP: f64 = 0.84;
 
 /// The rungs from `top` down to `bottom` (pixels), largest first, each at least 1x1; `bottom`
 /// is clamped to `top`.
@@ -31,12 +33,6 @@ pub fn rungs(top: (u32, u32), bottom: (u32, u32)) -> Vec<(u32, u32)> {
         out.push(bottom);
     }
     out
-}
-
-/// The smallest rung that holds every pixel of a `source`-sized picture (a rung above it would
-/// only interpolate): where the ladder starts for that picture.
-pub fn top_useful(rungs: &[(u32, u32)], source: (u32, u32)) -> usize {
-    rungs.iter().rposition(|&(w, h)| w >= source.0 && h >= source.1).unwrap_or(0)
 }
 
 /// A separable resampler from one size to another: a tent filter whose radius is one source
@@ -154,16 +150,16 @@ mod tests {
 
     #[test]
     fn the_ladder_runs_from_the_area_to_half_blocks() {
-        let r = rungs((1280, 752), (160, 94));
-        assert_eq!(r[0], (1280, 752));
+        let r = rungs((480, 282), (160, 94));
+        assert_eq!(r[0], (480, 282));
         assert_eq!(*r.last().unwrap(), (160, 94));
-        assert!(r.len() <= MAX_RUNGS && r.len() >= 5, "{r:?}");
+        assert!(r.len() <= MAX_RUNGS && r.len() >= 7, "{r:?}");
+        // Each rung has 60-80% of the pixels of the one above (the bottom may be closer).
+        let pixels = |s: &(u32, u32)| f64::from(s.0 * s.1);
+        assert!(r[..r.len() - 1].windows(2).all(|p| (0.6..0.8).contains(&(pixels(&p[1]) / pixels(&p[0])))), "{r:?}");
         assert!(r.windows(2).all(|p| p[1].0 < p[0].0 && p[1].1 < p[0].1), "strictly shrinking: {r:?}");
         assert_eq!(rungs((100, 40), (100, 40)), vec![(100, 40)], "a tiny area has one rung");
         assert_eq!(rungs((10, 10), (50, 50)), vec![(10, 10)], "the bottom never exceeds the top");
-        // The scene renders 480x281: the rung that holds it is where the ladder starts.
-        let top = top_useful(&r, (480, 281));
-        assert!(r[top].0 >= 480 && r[top].1 >= 281 && (top + 1 == r.len() || r[top + 1].0 < 480), "{r:?} {top}");
     }
 
     #[test]

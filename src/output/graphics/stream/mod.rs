@@ -1,29 +1,30 @@
 //! One terminal's pictures under rate control: a [`PictureStream`] is the picture encoder of a
 //! pixel mode (kitty, sixel, iTerm2) together with the choices that fit it to a link — the
-//! resolution (a [`ladder`] from the cell area's pixel size down to half-block resolution), the
-//! packing (kitty: zlib RGB or PNG, whole images or `a=f` frame edits of changed rectangles;
-//! sixel: changed cell blocks, colour registers defined once; iTerm2: PNG or JPEG) and the
-//! picture rate — so that a picture never costs more than the bytes the caller has now.
+//! resolution (a [`ladder`] from the source picture's size down to half-block resolution), the
+//! packing (kitty: zlib RGB or PNG, whole images or `a=f` frame edits of changed rectangles,
+//! or temporary files for a terminal on this machine; sixel: changed cell blocks; iTerm2: PNG
+//! or JPEG) and the picture rate — so that a picture never costs more than the bytes the caller
+//! has now.
 //!
-//! Pure and clock-injected: no terminal, no clock, no I/O. Time comes in as an argument.
+//! Pure and clock-injected: no terminal, no clock. Time comes in as an argument. (The one
+//! side effect: kitty's temporary files, when the terminal is on this machine.)
 //!
 //! # The contract (how the Screen calls it)
 //!
 //! 1. Make one stream per terminal and mode: [`PictureStream::new`] with the layout
 //!    ([`crate::output::graphics::geometry::layout`]) and the protocol's [`Protocol`] settings
-//!    from the probe. After a resize make a new one (or [`PictureStream::resize`]).
-//! 2. Each frame, after the cells (the status line goes first), ask [`PictureStream::due`]
-//!    (`now`); when it is, render the scene (at [`PictureStream::render_size`] when the scene
-//!    can change size cheaply; the pool cannot — its grid is its picture — so it keeps its size
-//!    and the stream resamples whatever it is given) and call [`PictureStream::prepare`] with
-//!    the picture, the [`Budget`] (the bucket's bytes now, its rate, the frame interval) and
-//!    `now`. The picture is encoded into the stream's own buffer: nothing is committed yet.
+//!    from the probe. After a resize make a new one ([`PictureStream::resize`]).
+//! 2. Each frame, after the cells (the status line goes first), call [`PictureStream::prepare`]
+//!    with the scene's picture (any size up to the layout's picture: the pool renders within
+//!    the player's scene cap, and the stream never sends more pixels than it is given), the
+//!    [`Budget`] (the bucket's bytes now, its rate, the frame interval) and `now`. The picture
+//!    is encoded into the stream's own buffer: nothing is committed yet.
 //! 3. `prepare` returns `None` (nothing to send: not due, unchanged, or nothing fits the bytes
 //!    available now) or an [`Offer`] whose `bytes` are at most `budget.available`. Put them in
-//!    the frame's synchronized update, take them from the bucket (`ByteBucket::spend`, never
-//!    `owe`), and call [`PictureStream::commit`] once they are written. Only then does the
-//!    stream believe the terminal shows the picture; an offer not committed is forgotten at the
-//!    next `prepare`.
+//!    the frame's synchronized update, take them from the bucket (`ByteBucket::spend`), and
+//!    call [`PictureStream::commit`] once they are written. Only then does the stream believe
+//!    the terminal shows the picture; an offer not committed is forgotten at the next
+//!    `prepare`.
 //! 4. Text written over the picture (the help overlay over sixel or iTerm2 pixels) or a cleared
 //!    screen: [`PictureStream::invalidate`]; the next picture is sent whole.
 //! 5. [`PictureStream::state`] says what the stream does (rung, packing, picture rate) for the
@@ -31,21 +32,26 @@
 //!
 //! # Rate control
 //!
-//! With a rate, each picture may cost the bytes the rate brings in one picture interval,
-//! within the bucket's burst (100 ms of the rate: [`crate::output::bucket::MAX_BURST`]), less a
-//! share kept for the status line. The stream learns what each rung costs (bytes a pixel, a
-//! moving average per rung, the first guess scaled from a neighbour), and picks the highest
-//! picture rate (its maximum, then 15, then 10 a second) at which a rung near the top fits;
-//! otherwise 10 a second at the largest rung that fits. The encoded picture's real cost is
-//! known before it is offered: if it exceeds the bytes available now, the next rung down is
-//! tried, and for kitty and sixel, when even the bottom rung is too big, the picture is sent in
-//! horizontal strips, oldest first, each an edit of what is shown. Without a rate the stream
-//! sends every picture at the rung that holds the source picture (no interpolated pixels), in
-//! the packing that costs least CPU.
+//! The rung is the largest whose whole picture is predicted to cost at most the bytes the rate
+//! brings in a tenth of a second ([`MIN_RATE`] pictures a second), within the bucket's burst
+//! and less a share kept for the status line ([`PICTURE_SHARE`]). The stream learns what each
+//! rung costs (bytes a pixel, a moving average per rung, the first guess scaled from a
+//! neighbour). Pictures then go as often as the bucket holds the rung's predicted cost (at most
+//! the protocol's rate and once a frame), so a link's whole rate is used: what a rung leaves
+//! below the allowance becomes a higher picture rate, not idle bytes. While the bucket holds
+//! less than the prediction nothing is encoded (no CPU for pictures that would not fit). The
+//! encoded picture's real cost is known before it is offered: above the allowance the next
+//! rung down is tried. When even the bottom rung is too big, kitty (with frame edits) and sixel
+//! send it in tiles, oldest first, each an edit of what is shown and each within the bytes
+//! available now; iTerm2 and kitty without frame edits send the bottom rung less often, when
+//! the bucket holds it. Without a rate every picture goes at the source's own size (no
+//! interpolated pixels), in the packing that costs least CPU.
 
 pub mod crossover;
 pub mod ladder;
+mod tiles;
 
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 use tiny_skia::Pixmap;
@@ -53,37 +59,33 @@ use tiny_skia::Pixmap;
 use self::ladder::Resampler;
 use crate::output::bucket::{MAX_BURST, MIN_CAPACITY};
 use crate::output::graphics::geometry::Layout;
-use crate::output::graphics::kitty::{self, KittyOptions};
+use crate::output::graphics::kitty::{self, KittyOptions, Medium};
 use crate::output::graphics::pack::{Packing, pack};
 use crate::output::graphics::sixel::{Registers, SixelEncoder, SixelPalette, TMUX_MAX_IMAGE_BYTES};
 use crate::output::graphics::{GraphicsMode, iterm2, scan};
 
 /// The share of a picture interval's bytes a picture may take: the rest is left for the status
 /// line and the cells' own changes.
-pub const PICTURE_SHARE: f64 = 0.85;
-/// The picture rates tried below the protocol's maximum, highest first (pictures a second).
-pub const RATES: [f64; 2] = [15.0, 10.0];
-/// How many rungs below the top useful one still count as "near the top" (see the module
-/// documentation).
-const NEAR_TOP: usize = 2;
+const PICTURE_SHARE: f64 = 0.85;
+/// The picture rate the rung is chosen for: the rung's whole picture fits a tenth of a second
+/// of the rate, so a moving picture keeps at least this many pictures a second.
+const MIN_RATE: f64 = 10.0;
 /// A rung above the current one is taken only when it is predicted to fit this share of the
 /// allowance (hysteresis: no flapping between two rungs).
-const UP_SHARE: f64 = 0.8;
+const UP_SHARE: f64 = 0.85;
 /// The weight of the newest measurement in a rung's cost average.
 const LEARN: f64 = 0.3;
 /// How per-pixel cost grows as a rung shrinks: bytes a pixel scale as (pixels ratio) ^ this.
 const DENSITY_EXPONENT: f64 = 0.2;
-/// The soonest the next picture may follow a base image sent for strips.
+/// The soonest the next picture may follow a base image sent for tiles.
 const FRAME_MIN: Duration = Duration::from_millis(1);
-/// Strips a picture is cut into when even the bottom rung is too big.
-const MAX_STRIPS: u32 = 16;
 
 /// The protocol and its settings, from the probe.
 #[derive(Clone, Debug)]
 pub enum Protocol {
-    /// kitty graphics: image id, placement, tmux wrapping and placeholders, z-index (the cell
-    /// area and origin are taken from the layout). Only direct transmission: temporary files
-    /// are for a local terminal, where the stream has no rate to fit.
+    /// kitty graphics: image id, placement, tmux wrapping and placeholders, frame edits, the
+    /// medium (direct, or temporary files for a terminal on this machine), z-index (the cell
+    /// area and origin are taken from the layout).
     Kitty(KittyOptions),
     /// sixel: the palette for the terminal's registers, when registers are defined, and tmux
     /// (images wrapped for passthrough and kept under tmux's input buffer).
@@ -114,10 +116,20 @@ impl Protocol {
     /// The most pictures a second: kitty and iTerm2 scale in the terminal and keep up with the
     /// player's 30 frames; sixel pictures are drawn pixel for pixel and cost several times more
     /// to encode and to draw, so 15.
-    pub fn max_rate(&self) -> f64 {
+    fn max_rate(&self) -> f64 {
         match self {
             Protocol::Sixel { .. } => 15.0,
             _ => 30.0,
+        }
+    }
+
+    /// Whether part of the shown picture can be replaced (kitty's frame edits, sixel's blocks):
+    /// then a picture too big for the link goes in tiles.
+    fn edits(&self) -> bool {
+        match self {
+            Protocol::Kitty(o) => o.frame_edits,
+            Protocol::Sixel { .. } => true,
+            Protocol::Iterm2 { .. } => false,
         }
     }
 }
@@ -154,11 +166,11 @@ pub struct Offer<'a> {
 pub struct State {
     /// The picture's size on the wire (the rung), pixels.
     pub size: (u32, u32),
-    /// The packing (sixel: `None`).
+    /// The packing (sixel and kitty's temporary files: `None`).
     pub packing: Option<Packing>,
-    /// Pictures a second the stream aims at.
+    /// Pictures a second the link's rate pays for at this rung.
     pub rate: f64,
-    /// The part of the picture the last offer carried: the whole, a changed box or a strip.
+    /// The part of the picture the last offer carried.
     pub part: Part,
 }
 
@@ -170,8 +182,9 @@ pub enum Part {
     /// The box `(x, y, w, h)` holding every change (pixels of the picture on the wire; for
     /// sixel, screen pixels).
     Changed(u32, u32, u32, u32),
-    /// Rows `y0..y1` only (the rest follows in later pictures).
-    Strip(u32, u32),
+    /// The box `(x, y, w, h)` only: a tile of a picture too big for the link (the rest follows
+    /// in later offers).
+    Tile(u32, u32, u32, u32),
 }
 
 /// What is pending until [`PictureStream::commit`].
@@ -186,21 +199,23 @@ struct Pending {
 pub struct PictureStream {
     protocol: Protocol,
     layout: Layout,
+    /// The source picture size the ladder was built for.
+    source: (u32, u32),
     rungs: Vec<(u32, u32)>,
     rung: usize,
     /// Learned bytes a pixel of a whole picture, per rung.
     cost: Vec<Option<f64>>,
-    /// Pictures a second aimed at, and when the next is due.
+    /// Pictures a second the rate pays for, and when the next picture may go.
     rate: f64,
     next_due: Option<Instant>,
     /// What the terminal shows: the rung and its pixels (RGB at the rung; sixel: registers at
     /// screen size), `None` when unknown.
     shown: Option<(usize, Vec<u8>)>,
-    /// The picture being offered (same form as `shown`) and what the offer carries.
+    /// The picture being offered (same form as `shown`).
     candidate: Vec<u8>,
     pending: Option<Pending>,
-    /// The next strip to send when pictures go in strips.
-    next_strip: u32,
+    /// The next tile (its index in raster order) when pictures go in tiles.
+    next_tile: usize,
     /// The last state, for the status line.
     state: State,
     /// Scratch: the offer's bytes, the packed pixels, a box's pixels, the resampled picture.
@@ -212,37 +227,42 @@ pub struct PictureStream {
     sixel: Option<Box<SixelEncoder>>,
     /// kitty's placeholder text must be (re)printed after the next whole image.
     placeholders_due: bool,
+    /// kitty's temporary files: how many were written, and the one the pending offer names
+    /// (removed when the offer is not committed: no terminal will read it).
+    files: u64,
+    pending_file: Option<PathBuf>,
 }
 
 impl PictureStream {
-    /// A stream for `protocol` over `layout` (whose `picture` is the top rung). Nothing is
+    /// A stream for `protocol` over `layout` (whose `picture` bounds the top rung). Nothing is
     /// shown yet.
     pub fn new(protocol: Protocol, layout: Layout) -> PictureStream {
         let sixel = match &protocol {
             Protocol::Sixel { palette, registers, tmux } => {
                 let mut s = SixelEncoder::new(palette.clone(), layout.origin, Some(layout.cell_px));
                 s.set_registers(*registers);
-                s.set_max_image_bytes(tmux.then_some(TMUX_MAX_IMAGE_BYTES), *tmux);
+                // Under tmux's input buffer always: harmless elsewhere (an image that big is
+                // cut at a row of cells), and tmux drawing sixel itself needs it unwrapped.
+                s.set_max_image_bytes(Some(TMUX_MAX_IMAGE_BYTES), *tmux);
                 Some(Box::new(s))
             }
             _ => None,
         };
-        let rungs = ladder::rungs(layout.picture, (u32::from(layout.cells.0), 2 * u32::from(layout.cells.1)));
         let rate = protocol.max_rate();
-        let state = State { size: rungs[0], packing: None, rate, part: Part::Whole };
-        PictureStream {
-            cost: vec![None; rungs.len()],
+        let mut stream = PictureStream {
+            cost: Vec::new(),
             protocol,
             layout,
-            rungs,
+            source: (0, 0),
+            rungs: Vec::new(),
             rung: 0,
             rate,
             next_due: None,
             shown: None,
             candidate: Vec::new(),
             pending: None,
-            next_strip: 0,
-            state,
+            next_tile: 0,
+            state: State { size: layout.picture, packing: None, rate, part: Part::Whole },
             bytes: Vec::new(),
             packed: Vec::new(),
             part_rgb: Vec::new(),
@@ -250,11 +270,16 @@ impl PictureStream {
             resampler: Resampler::default(),
             sixel,
             placeholders_due: true,
-        }
+            files: 0,
+            pending_file: None,
+        };
+        stream.build_ladder(layout.picture);
+        stream
     }
 
     /// A new layout (a resize): the ladder is rebuilt and the next picture is sent whole.
     pub fn resize(&mut self, layout: Layout) {
+        self.forget_pending();
         *self = PictureStream::new(self.protocol.clone(), layout);
     }
 
@@ -263,15 +288,9 @@ impl PictureStream {
         &self.layout
     }
 
-    /// The resolution ladder, largest first.
+    /// The resolution ladder, largest first (built for the last picture's size).
     pub fn rungs(&self) -> &[(u32, u32)] {
         &self.rungs
-    }
-
-    /// The size the next picture goes at: a scene that can change size cheaply renders at this
-    /// size (anything bigger is resampled down; see the module documentation).
-    pub fn render_size(&self) -> (u32, u32) {
-        self.rungs[self.rung]
     }
 
     /// What the stream did last.
@@ -279,78 +298,127 @@ impl PictureStream {
         self.state
     }
 
+    /// The protocol's mode.
+    pub fn mode(&self) -> GraphicsMode {
+        self.protocol.mode()
+    }
+
     /// Forgets what the terminal shows: the next picture is sent whole.
     pub fn invalidate(&mut self) {
+        self.forget_pending();
         self.shown = None;
-        self.pending = None;
         self.next_due = None;
+        self.next_tile = 0;
         self.placeholders_due = true;
     }
 
-    /// Whether a picture is due at `now`.
-    pub fn due(&self, now: Instant) -> bool {
+    /// Whether a picture may go at `now` (the protocol's picture rate; the bucket decides too).
+    fn due(&self, now: Instant) -> bool {
         self.next_due.is_none_or(|t| now >= t)
+    }
+
+    /// The ladder for a `source`-sized picture: from the source within the layout's picture down
+    /// to a quarter of half-block resolution.
+    fn build_ladder(&mut self, source: (u32, u32)) {
+        let area = self.layout.picture;
+        let k = (f64::from(area.0) / f64::from(source.0.max(1)))
+            .min(f64::from(area.1) / f64::from(source.1.max(1)))
+            .min(1.0);
+        let top = (((f64::from(source.0) * k) as u32).max(1), ((f64::from(source.1) * k) as u32).max(1));
+        // A quarter of half-block resolution: below cells' own, but whole pictures there
+        // score better than tiles of a finer rung (`benches/pictures.rs`: kitty at 250 kB/s,
+        // SSIM 0.65 with whole 100x59 pictures against 0.62 with tiles of 160x94).
+        let bottom = (u32::from(self.layout.cells.0) / 2, u32::from(self.layout.cells.1));
+        self.source = source;
+        self.rungs = ladder::rungs(top, bottom);
+        self.cost = vec![None; self.rungs.len()];
+        self.rung = 0;
+        self.shown = None;
+        self.next_tile = 0;
     }
 
     /// The picture `picture` encoded for the terminal within `budget`, or `None` (see the
     /// module documentation). Nothing is believed shown until [`PictureStream::commit`].
     pub fn prepare(&mut self, picture: &Pixmap, budget: Budget, now: Instant) -> Option<Offer<'_>> {
-        self.pending = None;
+        self.forget_pending();
         if !self.due(now) {
             return None;
         }
         let source = (picture.width(), picture.height());
-        let top = ladder::top_useful(&self.rungs, source);
-        let allowance = self.plan(top, budget);
-        // Due half a frame early, so that a picture interval of three frames is three frames
-        // and not four when the clock's ticks fall a nanosecond short.
-        let interval = Duration::from_secs_f64(1.0 / self.rate).max(budget.frame_interval) - budget.frame_interval / 2;
-        // Above its share the rung is too expensive: the next one down is tried.
-        let limit = allowance;
+        if source != self.source {
+            self.build_ladder(source);
+        }
+        // No rate but a bound on the bytes now (the link's window of unanswered bytes while
+        // its rate is still unknown): planned as the rate that pays for those bytes in a
+        // picture interval, so the pictures fit the window as it opens.
+        let budget = Budget {
+            rate: budget.rate.or_else(|| {
+                (budget.available < usize::MAX).then(|| budget.available as f64 * MIN_RATE / PICTURE_SHARE)
+            }),
+            ..budget
+        };
+        let allowance = self.plan(budget);
+        let room = allowance.min(budget.available);
+        let limited = budget.rate.is_some();
+        // The protocol's picture rate; a picture at most once a frame. Due half a frame early,
+        // so that an interval of two frames is two and not three when the clock's ticks fall a
+        // nanosecond short.
+        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
+        let interval = Duration::from_secs_f64(1.0 / most).max(budget.frame_interval) - budget.frame_interval / 2;
+        // The bucket does not hold what this rung costs yet: no picture is encoded for nothing.
+        if limited && self.predict(self.rung).is_some_and(|c| c > room as f64 && c <= allowance as f64) {
+            return None;
+        }
         let mut rung = self.rung;
-        loop {
+        let part = loop {
             // Unchanged: nothing to send, and nothing owed.
-            let Some(part) = self.encode(picture, rung, budget.rate.is_some()) else {
+            let Some(part) = self.encode(picture, rung, limited) else {
                 self.next_due = Some(now + interval);
                 return None;
             };
             self.learn(rung, part);
-            if self.bytes.len() <= limit {
-                // Within its share: sent when the bucket holds it, else the next frame retries.
-                return self.offer(rung, part, budget, now + interval);
+            if self.bytes.len() <= room {
+                return self.offer(rung, part, limited, now + interval);
+            }
+            if self.bytes.len() <= allowance {
+                // Within the rung's allowance but not the bucket's bytes now: a later frame.
+                return None;
             }
             if rung + 1 < self.rungs.len() {
                 rung += 1;
                 continue;
             }
-            // Even the bottom rung is too big: a strip of it, where the protocol edits.
-            let strips_possible = match self.protocol {
-                Protocol::Iterm2 { .. } => false,
-                Protocol::Sixel { .. } => self.shown.is_some(),
-                Protocol::Kitty(_) => self.shown.as_ref().is_some_and(|(r, _)| *r == rung),
-            };
-            if !strips_possible {
-                if self.bytes.len() <= budget.available {
-                    return self.offer(rung, part, budget, now + interval);
+            // The bottom rung of a protocol without tiles: fewer than 10 pictures a second,
+            // each up to what the bucket holds at most.
+            if !self.protocol.edits() && limited {
+                if self.bytes.len() > budget.available {
+                    return None;
                 }
-                match self.protocol {
-                    // No partial update: it waits for a bucket that holds it.
-                    Protocol::Iterm2 { .. } => return None,
-                    // Nothing known shown: every strip differs from "unknown".
-                    Protocol::Sixel { .. } => self.shown = Some((rung, vec![u8::MAX; self.candidate.len()])),
-                    // An image of the picture's mean colour first (a few bytes), which the
-                    // strips then edit.
-                    Protocol::Kitty(_) => {
-                        self.flatten_candidate();
-                        self.bytes.clear();
-                        self.push_part(Part::Whole, rung, Packing::Zlib(6));
-                        return self.offer(rung, Part::Whole, budget, now + FRAME_MIN);
-                    }
-                }
+                return self.offer(rung, part, limited, now + interval);
             }
-            let part = self.encode_strip(rung, allowance.min(budget.available), budget.rate.is_some())?;
-            return self.offer(rung, part, budget, now + interval);
+            break part;
+        };
+        // Even the bottom rung is too big: tiles of it, where the protocol edits.
+        if !self.protocol.edits() {
+            return None;
         }
+        match self.protocol {
+            // Nothing known shown: every tile differs from "unknown".
+            Protocol::Sixel { .. } if self.shown.is_none() => {
+                self.shown = Some((rung, vec![u8::MAX; self.candidate.len()]));
+            }
+            // An image of the picture's mean colour first (a few bytes), which the tiles then
+            // edit.
+            Protocol::Kitty(_) if self.shown.as_ref().is_none_or(|(r, _)| *r != rung) => {
+                self.flatten_candidate();
+                self.bytes.clear();
+                self.push_part(Part::Whole, rung, Some(Packing::Zlib(6)));
+                return self.offer(rung, Part::Whole, limited, now + FRAME_MIN);
+            }
+            _ => {}
+        }
+        let part = self.encode_tile(rung, part, room, limited)?;
+        self.offer(rung, part, limited, now + interval)
     }
 
     /// Fills the candidate with its mean colour.
@@ -366,14 +434,10 @@ impl PictureStream {
         }
     }
 
-    /// Offers `self.bytes` when they fit what is available now.
-    fn offer(&mut self, rung: usize, part: Part, budget: Budget, next: Instant) -> Option<Offer<'_>> {
-        if self.bytes.len() > budget.available {
-            return None;
-        }
+    /// Offers `self.bytes` (the caller has checked they fit).
+    fn offer(&mut self, rung: usize, part: Part, limited: bool, next: Instant) -> Option<Offer<'_>> {
         self.pending = Some(Pending { rung, part });
-        self.state =
-            State { size: self.rungs[rung], packing: self.packing(budget.rate.is_some()), rate: self.rate, part };
+        self.state = State { size: self.rungs[rung], packing: self.packing(limited, rung), rate: self.rate, part };
         self.next_due = Some(next);
         Some(Offer { bytes: &self.bytes, state: self.state })
     }
@@ -381,13 +445,17 @@ impl PictureStream {
     /// The offer was written: the terminal shows it from now on.
     pub fn commit(&mut self) {
         let Some(Pending { rung, part }) = self.pending.take() else { return };
-        let row = self.row_bytes(rung);
+        self.pending_file = None;
         let sixel = matches!(self.protocol, Protocol::Sixel { .. });
+        let (stride, bpp) = self.stride(rung);
         match (part, &mut self.shown) {
-            (Part::Strip(y0, y1), Some((r, shown))) if *r == rung || sixel => {
+            (Part::Tile(x, y, w, h), Some((r, shown))) if *r == rung || sixel => {
                 *r = rung;
-                let (a, b) = (y0 as usize * row, y1 as usize * row);
-                shown[a..b].copy_from_slice(&self.candidate[a..b]);
+                for row in y as usize..(y + h) as usize {
+                    let a = row * stride + x as usize * bpp;
+                    let b = a + w as usize * bpp;
+                    shown[a..b].copy_from_slice(&self.candidate[a..b]);
+                }
             }
             (_, shown) => {
                 let old = shown.take().map(|(_, v)| v).unwrap_or_default();
@@ -400,19 +468,28 @@ impl PictureStream {
         self.rung = rung;
     }
 
-    /// Bytes a row of the shown picture at `rung` takes.
-    fn row_bytes(&self, rung: usize) -> usize {
-        match self.protocol {
-            Protocol::Sixel { .. } => self.layout.picture.0 as usize,
-            _ => self.rungs[rung].0 as usize * 3,
+    /// An offer not committed: its temporary file is removed (no terminal will read it).
+    fn forget_pending(&mut self) {
+        self.pending = None;
+        if let Some(path) = self.pending_file.take() {
+            let _ = std::fs::remove_file(path);
         }
     }
 
-    fn packing(&self, limited: bool) -> Option<Packing> {
+    /// Bytes a row of the shown picture at `rung` takes, and bytes a pixel.
+    fn stride(&self, rung: usize) -> (usize, usize) {
         match self.protocol {
+            Protocol::Sixel { .. } => (self.layout.picture.0 as usize, 1),
+            _ => (self.rungs[rung].0 as usize * 3, 3),
+        }
+    }
+
+    fn packing(&self, limited: bool, rung: usize) -> Option<Packing> {
+        match &self.protocol {
+            Protocol::Kitty(o) if matches!(o.medium, Medium::TempFile(_)) => None,
             Protocol::Kitty(_) if limited => Some(Packing::Png),
             Protocol::Kitty(_) => Some(Packing::Zlib(1)),
-            Protocol::Iterm2 { .. } if limited => Some(Packing::Jpeg(self.jpeg_quality())),
+            Protocol::Iterm2 { .. } if limited => Some(Packing::Jpeg(self.jpeg_quality(rung))),
             Protocol::Iterm2 { .. } => Some(Packing::Png),
             Protocol::Sixel { .. } => None,
         }
@@ -420,43 +497,30 @@ impl PictureStream {
 
     /// iTerm2's JPEG quality: lower on the lower rungs, where each pixel is bigger on screen
     /// and the rung was chosen because bytes are short.
-    fn jpeg_quality(&self) -> u8 {
-        let from_bottom = self.rungs.len() - 1 - self.rung;
-        [50, 65, 75, 80].get(from_bottom).copied().unwrap_or(85)
+    fn jpeg_quality(&self, rung: usize) -> u8 {
+        let from_bottom = self.rungs.len() - 1 - rung;
+        [40, 50, 60, 70, 75, 80].get(from_bottom).copied().unwrap_or(85)
     }
 
-    /// Chooses the picture rate and the rung for `budget` (the top useful rung being `top`) and
-    /// returns the bytes one picture may take.
-    fn plan(&mut self, top: usize, budget: Budget) -> usize {
+    /// Chooses the rung for `budget` and returns the bytes one picture may take.
+    fn plan(&mut self, budget: Budget) -> usize {
+        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
         let Some(rate) = budget.rate else {
-            self.rate = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
-            self.rung = top;
+            self.rate = most;
+            self.rung = 0;
             return usize::MAX;
         };
         let burst = (rate * MAX_BURST.as_secs_f64()).max(MIN_CAPACITY);
-        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
-        let allowance = |fps: f64| (rate / fps).min(burst) * PICTURE_SHARE;
-        let mut choice = None;
-        for fps in std::iter::once(most).chain(RATES.into_iter().filter(|&r| r < most)) {
-            let fit = self.largest_fitting(top, allowance(fps));
-            if fit.is_some_and(|r| r <= top + NEAR_TOP) || fps <= RATES[RATES.len() - 1] {
-                choice = Some((fps, fit.unwrap_or(self.rungs.len() - 1)));
-                break;
-            }
-        }
-        let (fps, mut rung) = choice.unwrap_or((most, self.rungs.len() - 1));
+        let allowance = (rate / MIN_RATE).min(burst) * PICTURE_SHARE;
+        let last = self.rungs.len() - 1;
+        let mut rung = (0..self.rungs.len()).find(|&r| self.predict(r).is_none_or(|c| c <= allowance)).unwrap_or(last);
         // Hysteresis: a bigger rung only when it fits with room to spare.
-        if rung < self.rung && self.predict(rung).is_some_and(|c| c > UP_SHARE * allowance(fps)) {
-            rung = self.rung.min(self.rungs.len() - 1);
+        if rung < self.rung && self.predict(rung).is_some_and(|c| c > UP_SHARE * allowance) {
+            rung = self.rung.min(last);
         }
-        self.rate = fps;
-        self.rung = rung.max(top);
-        allowance(fps) as usize
-    }
-
-    /// The largest rung at or below `top` whose predicted cost fits `allowance`.
-    fn largest_fitting(&self, top: usize, allowance: f64) -> Option<usize> {
-        (top..self.rungs.len()).find(|&r| self.predict(r).is_none_or(|c| c <= allowance))
+        self.rung = rung;
+        self.rate = self.predict(rung).map_or(most, |c| (rate * PICTURE_SHARE / c.max(1.0)).min(most));
+        allowance as usize
     }
 
     /// A whole picture's predicted bytes at `rung`: learned, or scaled from the nearest rung
@@ -488,12 +552,16 @@ impl PictureStream {
             let screen = self.layout.picture;
             let sixel = self.sixel.as_mut().expect("a sixel stream has its encoder");
             // Dithered straight from the pixmap (opaque: its bytes are straight RGB) when the
-            // rung is the picture's size; otherwise resampled to the rung first.
+            // rung is the picture's size; otherwise resampled to the rung first. Each rung
+            // pixel becomes a block of screen pixels.
+            // The top rung (a link that carries whole pictures) gets the fine pattern; the
+            // others the flat blocks that cost fewer bytes.
+            let fine = rung == 0;
             if size == from {
-                sixel.dither_scaled(picture.data(), 4, from, screen, &mut self.candidate);
+                sixel.dither_scaled(picture.data(), 4, from, screen, fine, &mut self.candidate);
             } else {
                 self.resampler.resample(picture.data(), 4, from, size, &mut self.rgb);
-                sixel.dither_scaled(&self.rgb, 3, size, screen, &mut self.candidate);
+                sixel.dither_scaled(&self.rgb, 3, size, screen, fine, &mut self.candidate);
             }
             let part = match &self.shown {
                 Some((_, old)) => sixel_part(old, &self.candidate, screen, self.layout.cell_px)?,
@@ -514,69 +582,21 @@ impl PictureStream {
         let part = match &self.shown {
             Some((r, old)) if *r == rung => match scan::changed_box(old, &self.candidate, size.0, 3, 0..size.1) {
                 None => return None,
-                Some(b) if matches!(self.protocol, Protocol::Kitty(_)) && 2 * b.2 * b.3 <= size.0 * size.1 => {
+                Some(b) if self.protocol.edits() && 2 * b.2 * b.3 <= size.0 * size.1 => {
                     Part::Changed(b.0, b.1, b.2, b.3)
                 }
                 Some(_) => Part::Whole,
             },
             _ => Part::Whole,
         };
-        let packing = self.packing(limited).expect("kitty and iTerm2 pack");
+        let packing = self.packing(limited, rung);
         self.push_part(part, rung, packing);
         Some(part)
     }
 
-    /// Encodes the next strip of the bottom rung that fits `available` bytes (kitty and sixel,
-    /// whose edits replace part of what is shown); `None` when none does or nothing changed.
-    fn encode_strip(&mut self, rung: usize, available: usize, limited: bool) -> Option<Part> {
-        let height = match self.protocol {
-            Protocol::Sixel { .. } => self.layout.picture.1,
-            _ => self.rungs[rung].1,
-        };
-        // Strips of whole sixel bands that start on text rows (lcm of 6 and the cell height).
-        let unit = match self.protocol {
-            Protocol::Sixel { .. } => lcm(6, u32::from(self.layout.cell_px.1.max(1))),
-            _ => 1,
-        };
-        let whole = self.bytes.len().max(1);
-        let strips = (whole.div_ceil(available.max(1)) as u32 + 1).clamp(2, MAX_STRIPS);
-        let strip_h = height.div_ceil(strips).div_ceil(unit) * unit;
-        let count = height.div_ceil(strip_h);
-        for k in 0..count {
-            let s = (self.next_strip + k) % count;
-            let (y0, y1) = (s * strip_h, ((s + 1) * strip_h).min(height));
-            let (_, shown) = self.shown.as_ref()?;
-            let row = self.row_bytes(rung);
-            if shown[y0 as usize * row..y1 as usize * row] == self.candidate[y0 as usize * row..y1 as usize * row] {
-                continue;
-            }
-            let part = Part::Strip(y0, y1);
-            self.bytes.clear();
-            if let Some(sixel) = self.sixel.as_mut() {
-                let screen = self.layout.picture;
-                // Sixel strips must end on a band; the last one may be shorter.
-                sixel.push_block(
-                    &mut self.bytes,
-                    &self.candidate,
-                    screen.0,
-                    (0, y0, screen.0, y1 - y0),
-                    self.layout.origin,
-                    self.layout.cell_px,
-                );
-            } else {
-                let packing = self.packing(limited).expect("kitty packs");
-                self.push_part(part, rung, packing);
-            }
-            if self.bytes.len() <= available {
-                self.next_strip = (s + 1) % count;
-                return Some(part);
-            }
-        }
-        None
-    }
-
-    /// Appends the command(s) for `part` of the candidate at `rung` (kitty and iTerm2).
-    fn push_part(&mut self, part: Part, rung: usize, packing: Packing) {
+    /// Appends the command(s) for `part` of the candidate at `rung` (kitty and iTerm2), packed
+    /// with `packing` (`None`: kitty's raw RGB in a temporary file).
+    fn push_part(&mut self, part: Part, rung: usize, packing: Option<Packing>) {
         let size = self.rungs[rung];
         let (x, y, w, h) = part_box(part, size);
         let pixels: &[u8] = if (w, h) == size {
@@ -589,42 +609,62 @@ impl PictureStream {
             }
             &self.part_rgb
         };
-        pack(packing, pixels, w, h, &mut self.packed);
         match &self.protocol {
             Protocol::Kitty(options) => {
                 let o = KittyOptions { origin: self.layout.origin, cells: self.layout.cells, ..options.clone() };
                 let mut keys = Vec::with_capacity(96);
-                if part == Part::Whole {
+                let whole = part == Part::Whole;
+                if whole {
                     kitty::image_keys(&mut keys, &o, size);
                     if !o.placeholders {
                         kitty::push_cursor_to(&mut self.bytes, o.origin);
                     }
-                    kitty::push_chunks(&mut self.bytes, &keys, b"", packing, &self.packed, o.tmux);
-                    if o.placeholders && self.placeholders_due {
-                        kitty::push_placeholders(
-                            &mut self.bytes,
-                            o.image_id,
-                            o.origin.0,
-                            o.origin.1,
-                            o.cells.0,
-                            o.cells.1,
-                        );
-                    }
                 } else {
                     kitty::edit_keys(&mut keys, o.image_id, (x, y, w, h));
-                    kitty::push_chunks(&mut self.bytes, &keys, b"a=f,", packing, &self.packed, o.tmux);
+                }
+                let through_file = match (&o.medium, packing) {
+                    (Medium::TempFile(dir), None) => {
+                        self.files += 1;
+                        match kitty::write_temp_file(dir, self.files, pixels) {
+                            Ok(path) => {
+                                kitty::push_temp_file_command(&mut self.bytes, &keys, &path, o.tmux);
+                                self.pending_file = Some(path);
+                                true
+                            }
+                            Err(_) => false,
+                        }
+                    }
+                    _ => false,
+                };
+                if !through_file {
+                    if matches!(o.medium, Medium::TempFile(_)) {
+                        // The file could not be written (a full or read-only /dev/shm): direct
+                        // from now on, and this picture directly too.
+                        if let Protocol::Kitty(options) = &mut self.protocol {
+                            options.medium = Medium::Direct;
+                        }
+                    }
+                    let packing = packing.unwrap_or(Packing::Zlib(1));
+                    pack(packing, pixels, w, h, &mut self.packed);
+                    let more: &[u8] = if whole { b"" } else { b"a=f," };
+                    kitty::push_chunks(&mut self.bytes, &keys, more, packing, &self.packed, o.tmux);
+                }
+                if whole && o.placeholders && self.placeholders_due {
+                    kitty::push_placeholders(&mut self.bytes, o.image_id, o.origin.0, o.origin.1, o.cells.0, o.cells.1);
                 }
             }
             Protocol::Iterm2 { tmux } => {
+                pack(packing.unwrap_or(Packing::Png), pixels, w, h, &mut self.packed);
                 iterm2::push_file(&mut self.bytes, self.layout.origin, self.layout.cells, *tmux, &self.packed)
             }
             Protocol::Sixel { .. } => unreachable!("sixel is encoded by its encoder"),
         }
     }
+}
 
-    /// The protocol's mode.
-    pub fn mode(&self) -> GraphicsMode {
-        self.protocol.mode()
+impl Drop for PictureStream {
+    fn drop(&mut self) {
+        self.forget_pending();
     }
 }
 
@@ -632,8 +672,7 @@ impl PictureStream {
 fn part_box(part: Part, size: (u32, u32)) -> (u32, u32, u32, u32) {
     match part {
         Part::Whole => (0, 0, size.0, size.1),
-        Part::Changed(x, y, w, h) => (x, y, w, h),
-        Part::Strip(y0, y1) => (0, y0, size.0, y1 - y0),
+        Part::Changed(x, y, w, h) | Part::Tile(x, y, w, h) => (x, y, w, h),
     }
 }
 
@@ -649,16 +688,6 @@ fn sixel_part(old: &[u8], new: &[u8], screen: (u32, u32), cell_px: (u16, u16)) -
         return Some(Part::Whole);
     }
     Some(Part::Changed(x0, y0, x1 - x0, h))
-}
-
-fn lcm(a: u32, b: u32) -> u32 {
-    let gcd = |mut a: u32, mut b: u32| {
-        while b != 0 {
-            (a, b) = (b, a % b);
-        }
-        a
-    };
-    a / gcd(a, b) * b
 }
 
 #[cfg(test)]

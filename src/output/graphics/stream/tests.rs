@@ -1,6 +1,7 @@
 use super::*;
 use crate::output::bucket::ByteBucket;
 use crate::output::graphics::geometry::{SCALED_CAP, layout};
+use crate::output::graphics::kitty::KittyOptions;
 use crate::output::graphics::kitty_decode;
 use crate::output::graphics::test_pictures::golden_pool;
 
@@ -20,7 +21,7 @@ fn moving(k: u32) -> Pixmap {
 
 fn kitty_stream() -> PictureStream {
     let l = layout(GraphicsMode::Kitty, (160, 48), Some((8, 16)), None, SCALED_CAP);
-    PictureStream::new(Protocol::Kitty(KittyOptions::new(l.cells)), l)
+    PictureStream::new(Protocol::Kitty(KittyOptions { frame_edits: true, ..KittyOptions::new(l.cells) }), l)
 }
 
 fn sixel_stream() -> PictureStream {
@@ -108,10 +109,12 @@ fn kitty_offers_decode_to_the_picture_on_the_wire_and_edits_apply_to_it() {
     let mut stream = kitty_stream();
     let t0 = Instant::now();
     let mut wire = Vec::new();
+    // Unlimited, then 2 MB/s until the rung settles, then a small change: a frame edit.
+    let rates = [None, Some(2e6), Some(2e6), Some(2e6), Some(2e6), Some(2e6)];
     let mut picture = moving(0);
-    for (n, rate) in [(0u32, None), (1, Some(2e6)), (2, Some(2e6))] {
-        if n == 2 {
-            // A small change: a frame edit.
+    for (n, rate) in (0u32..).zip(rates) {
+        picture = if n + 1 < rates.len() as u32 { moving(n) } else { picture };
+        if n + 1 == rates.len() as u32 {
             for px in picture.pixels_mut()[..640 * 4].iter_mut() {
                 *px = tiny_skia::ColorU8::from_rgba(255, 0, 0, 255).premultiply();
             }
@@ -127,7 +130,7 @@ fn kitty_offers_decode_to_the_picture_on_the_wire_and_edits_apply_to_it() {
         let mut want = Vec::new();
         Resampler::default().resample(picture.data(), 4, (640, 360), size, &mut want);
         assert!(image.rgb == want, "step {n} ({part:?}): the decoded image is not the picture at {size:?}");
-        if n == 2 {
+        if n + 1 == rates.len() as u32 {
             assert!(matches!(part, Part::Changed(..)), "{part:?}");
         }
     }

@@ -120,7 +120,8 @@ fn no_answer_means_cells_after_the_budget() {
 #[test]
 fn a_slow_answer_means_cells() {
     let answers = kitty_answers();
-    let run = FakeTerminal::new(&[(20, &answers[..30]), (300, &answers[30..])]).run(&options(false));
+    let late = PROBE_BUDGET.as_millis() as u64 + 150;
+    let run = FakeTerminal::new(&[(20, &answers[..30]), (late, &answers[30..])]).run(&options(false));
     let s = &run.outcome.support;
     assert!(!s.answered && !s.kitty, "a partial answer is not trusted: {s:?}");
     assert_eq!(run.took, PROBE_BUDGET);
@@ -306,4 +307,112 @@ fn no_terminal_no_query() {
         _ => None,
     });
     assert_eq!(env, Environment { tmux: true, ssh: true, term_program: None });
+}
+
+/// Through the Screen, as a player meets its terminal: answers at made-up times.
+mod through_the_screen {
+    use std::time::{Duration, Instant};
+
+    use crate::output::color::ColorMode;
+    use crate::output::diff::EncodeOptions;
+    use crate::output::graphics::GraphicsMode;
+    use crate::play::input::Input;
+    use crate::play::screen::probe::{Environment, GraphicsRequest, PROBE_BUDGET, ProbeOptions, WinSize};
+    use crate::play::screen::{Bandwidth, LATE_ANSWERS, Screen, ScreenConfig};
+
+    const MS: Duration = Duration::from_millis(1);
+    const KITTY: &[u8] = b"\x1b_Gi=31;OK\x1b\\";
+    const DA1: &[u8] = b"\x1b[?62;22c";
+
+    fn screen(t0: Instant) -> Screen {
+        let config = ScreenConfig {
+            fps: 30,
+            bandwidth: Bandwidth::Unlimited,
+            color: ColorMode::TrueColor,
+            encode: EncodeOptions::default(),
+            graphics: GraphicsRequest::Auto,
+            probe: Some(ProbeOptions {
+                env: Environment { ssh: true, ..Environment::default() },
+                winsize: WinSize { cols: 40, rows: 12, x_px: 320, y_px: 192 },
+                kitty_file: None,
+            }),
+            link_path: Default::default(),
+        };
+        let mut s = Screen::new(config, (40, 12), t0);
+        s.start(t0, &mut Vec::new());
+        s
+    }
+
+    /// Feeds `chunks` at their times (ms after t0), ticking the clock every 10 ms up to `until`
+    /// ms; returns every input the screen handed on.
+    fn run(s: &mut Screen, t0: Instant, chunks: &[(u64, &[u8])], until: u64) -> Vec<Input> {
+        let mut inputs = Vec::new();
+        for ms in (0..=until).step_by(10) {
+            for (at, bytes) in chunks.iter().filter(|(at, _)| (ms.saturating_sub(9)..=ms).contains(at)) {
+                s.feed(bytes, t0 + Duration::from_millis(*at), &mut inputs);
+            }
+            s.tick(t0 + Duration::from_millis(ms), &mut inputs);
+        }
+        inputs
+    }
+
+    #[test]
+    fn the_first_deadline_covers_a_far_terminal_and_da1_ends_the_wait_at_once() {
+        // A terminal a 300 ms round trip away (another continent): pixels from the first frame.
+        assert!(PROBE_BUDGET >= Duration::from_millis(400), "{PROBE_BUDGET:?}");
+        let t0 = Instant::now();
+        let mut s = screen(t0);
+        let inputs = run(&mut s, t0, &[(300, &[KITTY, DA1].concat())], 300);
+        assert!(!s.probing() && s.mode() == GraphicsMode::Kitty, "no cells first");
+        assert!(inputs.is_empty());
+        // A near one: the wait ends with its DA1, not at the deadline.
+        let mut near = screen(t0);
+        near.feed(&[KITTY, DA1].concat(), t0 + 3 * MS, &mut Vec::new());
+        assert!(!near.probing() && near.ready(t0 + 3 * MS, true));
+    }
+
+    #[test]
+    fn an_answer_after_the_deadline_upgrades_cells_and_becomes_no_key() {
+        let t0 = Instant::now();
+        let mut s = screen(t0);
+        let late = PROBE_BUDGET.as_millis() as u64 + 400;
+        // `_`, `=` and `?` would be keys if the answer were read as typing.
+        let answer = [&b"\x1b[?1;0;256S\x1b[?2;0;1000;1000S\x1b[6;16;8t"[..], KITTY, DA1].concat();
+        let inputs = run(&mut s, t0, &[(late, &answer)], late + 100);
+        assert_eq!(s.mode(), GraphicsMode::Kitty, "upgraded when the answer came");
+        assert!(s.take_notice().is_some_and(|n| n.contains("answered late")));
+        assert!(inputs.is_empty(), "no answer became a key: {inputs:?}");
+    }
+
+    #[test]
+    fn garbage_before_the_answer_means_cells_and_no_keys() {
+        let t0 = Instant::now();
+        let mut s = screen(t0);
+        let garbage = [&b"\x1b[?62;4\x01c\x1b[[[9~\x1b_Gi=31;O\x1bK\x1b\\"[..], KITTY, DA1].concat();
+        let inputs = run(&mut s, t0, &[(20, &garbage)], 100 + LATE_ANSWERS.as_millis() as u64);
+        assert_eq!(s.mode(), GraphicsMode::Cells);
+        assert!(
+            inputs.iter().all(|i| !matches!(i, Input::Other('_' | '=' | '?') | Input::Help)),
+            "no part of an answer became a key: {inputs:?}"
+        );
+    }
+
+    #[test]
+    fn a_partial_answer_draws_cells_until_the_rest_comes_or_says_the_terminal_did_not_answer() {
+        let t0 = Instant::now();
+        let budget = PROBE_BUDGET.as_millis() as u64;
+        // kitty's OK, then nothing until after the deadline: cells, then the rest upgrades.
+        let mut s = screen(t0);
+        let inputs = run(&mut s, t0, &[(20, KITTY), (budget + 800, DA1)], budget + 900);
+        assert_eq!(s.mode(), GraphicsMode::Kitty);
+        assert!(inputs.is_empty());
+        // Only the sixel registers, and DA1 never: cells, and after the late window the
+        // status line says so.
+        let mut silent = screen(t0);
+        let until = budget + LATE_ANSWERS.as_millis() as u64 + 20;
+        let inputs = run(&mut silent, t0, &[(20, b"\x1b[?1;0;256S")], until);
+        assert_eq!(silent.mode(), GraphicsMode::Cells);
+        assert!(silent.take_notice().is_some_and(|n| n.contains("did not answer")));
+        assert!(inputs.is_empty(), "{inputs:?}");
+    }
 }
