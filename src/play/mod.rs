@@ -18,7 +18,7 @@
 //!
 //! ```
 //! use std::time::{Duration, Instant};
-//! use tidepool::play::{Bandwidth, Host, HostConfig, Screen, ScreenConfig, Seat};
+//! use tidepool::play::{Bandwidth, Flow, Host, HostConfig, Player, Screen, ScreenConfig};
 //! use tidepool::{PoolSettings, SceneSpec};
 //!
 //! let t0 = Instant::now();
@@ -31,17 +31,16 @@
 //!     probe: None,
 //!     link_path: Default::default(),
 //! };
-//! let mut screen = Screen::new(config, (40, 12), t0);
+//! let screen = Screen::new(config, (40, 12), t0);
 //! let scenes = vec![SceneSpec::Pool(PoolSettings::default())];
 //! let host_config = HostConfig { scenes, seed: 1, record: None, storage: None };
 //! let mut host = Host::new(host_config, screen.picture_size(), t0)?;
-//! let mut seat = Seat::new(screen.fit(host.size()));
+//! let mut player = Player::new(screen, host.size(), None);
 //! // The person presses space: a stone.
-//! let (mut inputs, mut requests) = (Vec::new(), Vec::new());
-//! screen.feed(b" ", t0, &mut inputs);
-//! for input in inputs {
-//!     seat.handle(input, t0, host.status(), &mut requests);
-//! }
+//! player.feed(b" ", t0);
+//! let mut requests = Vec::new();
+//! let turn = player.turn(t0, host.status(), &mut requests);
+//! assert_eq!(turn.flow, Flow::Continue);
 //! for request in requests {
 //!     host.apply(request, t0);
 //! }
@@ -50,10 +49,7 @@
 //! let mut picture = tiny_skia::Pixmap::new(host.size().0, host.size().1).unwrap();
 //! host.render(&mut picture);
 //! let mut bytes = Vec::new();
-//! let view = seat.view(now, host.status());
-//! // (`view` borrows the seat; the status is taken again for the frame.)
-//! let status = host.status().clone();
-//! screen.frame(now, &picture, &status, &view, &mut bytes)?;
+//! player.frame(now, &picture, host.status(), &mut bytes)?;
 //! assert!(bytes.starts_with(Screen::ENTER));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -77,7 +73,7 @@ pub use player::{Player, Turn};
 pub use request::Request;
 pub use screen::probe::{Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
 pub use screen::{Bandwidth, LinkPath, Screen, ScreenConfig};
-pub use seat::{Flow, Seat, SeatView};
+pub use seat::{Flow, Seat};
 
 #[cfg(test)]
 mod tests;

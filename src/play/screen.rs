@@ -329,7 +329,7 @@ impl Screen {
     /// overlay, the status line. Returns the bytes appended (0 when nothing changed). Nothing
     /// in it fails today (a kitty temporary file that cannot be written falls back to direct
     /// transmission); the `Result` is the doors' contract.
-    pub fn frame(
+    pub(crate) fn frame(
         &mut self,
         now: Instant,
         picture: &Pixmap,

@@ -33,7 +33,7 @@ pub enum Flow {
 
 /// What a seat shows over the picture this frame.
 #[derive(Clone, Copy, Debug, Default)]
-pub struct SeatView<'a> {
+pub(crate) struct SeatView<'a> {
     /// The aim marker's cell (column, row), while it is visible.
     pub aim: Option<(u16, u16)>,
     /// The help overlay's lines, while it is open.
@@ -156,7 +156,7 @@ impl Seat {
     }
 
     /// What goes over the picture now. An open help follows the scene (`tab` changes its keys).
-    pub fn view(&mut self, now: Instant, status: &SceneStatus) -> SeatView<'_> {
+    pub(crate) fn view(&mut self, now: Instant, status: &SceneStatus) -> SeatView<'_> {
         if let Some((scene, _)) = &self.help
             && *scene != status.name
         {

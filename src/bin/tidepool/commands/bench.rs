@@ -12,7 +12,7 @@ use std::time::{Duration, Instant};
 
 use tidepool::Action;
 use tidepool::encode::{halfblock, png};
-use tidepool::play::{Bandwidth, GraphicsRequest, Host, HostConfig, Request, Screen, ScreenConfig, Seat};
+use tidepool::play::{Bandwidth, GraphicsRequest, Host, HostConfig, Player, Request, Screen, ScreenConfig};
 use tidepool::terminal::{ColorMode, EncodeOptions};
 use tidepool::{Damping, LakeSettings, OceanSettings, OceanView, PoolSettings, RipplePool, SceneSpec, Simd, Stone};
 use tiny_skia::Pixmap;
@@ -141,10 +141,10 @@ pub fn run(args: BenchArgs) -> Result<()> {
             probe: None,
             link_path: tidepool::play::LinkPath::Direct,
         };
-        let mut screen = Screen::new(config, (cols, rows_cells), t0);
+        let screen = Screen::new(config, (cols, rows_cells), t0);
         let host_config = HostConfig { scenes: vec![spec], seed: 1, record: None, storage: None };
         let Ok(mut host) = Host::new(host_config, screen.picture_size(), t0) else { continue };
-        let mut seat = Seat::new(screen.fit(host.size()));
+        let mut player = Player::new(screen, host.size(), None);
         let (w, h) = host.size();
         let mut picture = Pixmap::new(w, h).expect("a terminal-sized picture");
         let mut bytes = Vec::new();
@@ -161,9 +161,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             host.advance(now);
             host.render(&mut picture);
             bytes.clear();
-            let status = host.status();
-            let view = seat.view(now, status);
-            sent = screen.frame(now, &picture, status, &view, &mut bytes).unwrap_or(0);
+            sent = player.frame(now, &picture, host.status(), &mut bytes).unwrap_or(0);
         });
         black_box(sent);
         let core = median.as_secs_f64() * PLAYER_FPS * 100.0;
