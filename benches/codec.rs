@@ -9,7 +9,7 @@
 //! ([`tidepool::terminal::RateEncoder`]) and the naive strategy (changed cells in screen order until the
 //! budget runs out, the same encoder with [`Strategy::ScanOrder`]) encode every frame with a
 //! [`ByteBucket`] at that rate on a simulated 30 fps clock; every emitted frame is fed to the
-//! terminal model ([`tidepool::terminal::Screen`], exactly 160x48, no spare row) and the screen is
+//! terminal model ([`tidepool::terminal::TerminalModel`], exactly 160x48, no spare row) and the screen is
 //! compared with the true frame: bytes/s, mean and 5th-percentile PSNR (8-bit sRGB, both
 //! halves of every picture cell, the status row left out, an exact frame counted as 99 dB) and
 //! the mean OKLab distance per pixel. The unlimited rows also check that every frame is exact
@@ -31,8 +31,8 @@ use std::time::{Duration, Instant};
 use criterion::Criterion;
 use tidepool::Script;
 use tidepool::terminal::{
-    self as quality, ByteBucket, Color, ColorMode, EncodeOptions, Frame, RateEncoder, RateOptions, Screen, Shown,
-    Strategy, Target, UNLIMITED,
+    self as quality, ByteBucket, Color, ColorMode, EncodeOptions, Frame, RateEncoder, RateOptions, Shown, Strategy,
+    Target, TerminalModel, UNLIMITED,
 };
 use tiny_skia::Pixmap;
 
@@ -123,7 +123,7 @@ fn run(shots: &[Shot], mode: ColorMode, rate: Option<f64>, strategy: Strategy, a
     bucket.refill(start);
     let mut encoder = RateEncoder::new();
     let mut shown = Shown::UNKNOWN;
-    let mut screen = Screen::new(COLS, ROWS);
+    let mut screen = TerminalModel::new(COLS, ROWS);
     screen.lf_returns = false;
     let options = RateOptions { strategy, approximate, ..RateOptions::default() };
     let mut out = Vec::new();
@@ -357,7 +357,7 @@ fn stale() {
         let mut psnr = 0.0;
         let mut n = 0;
         for i in (60 + k)..shots.len() {
-            let mut screen = Screen::new(COLS, ROWS);
+            let mut screen = TerminalModel::new(COLS, ROWS);
             screen.lf_returns = false;
             let (bytes, _) = tidepool::terminal::encode(&Shown::UNKNOWN, &shots[i - k].frame, EncodeOptions::default());
             screen.feed(&bytes);

@@ -34,7 +34,9 @@ use tidepool::graphics::geometry::{SCALED_CAP, layout};
 use tidepool::graphics::kitty::KittyOptions;
 use tidepool::graphics::sixel::{Registers, SixelPalette};
 use tidepool::graphics::{Budget, GraphicsMode, PictureStream, Protocol, kitty, kitty_decode};
-use tidepool::terminal::{ByteBucket, Color, ColorMode, Frame, Luma, RateEncoder, RateOptions, Screen, Shown, Target};
+use tidepool::terminal::{
+    ByteBucket, Color, ColorMode, Frame, Luma, RateEncoder, RateOptions, Shown, Target, TerminalModel,
+};
 use tidepool::{Event, Script, Stone};
 use tiny_skia::Pixmap;
 
@@ -201,7 +203,7 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
         let (cols, rows) = (usize::from(TERM.0), usize::from(TERM.1));
         let mut encoder = RateEncoder::new();
         let mut shown = Shown::UNKNOWN;
-        let mut screen = Screen::new(cols, rows);
+        let mut screen = TerminalModel::new(cols, rows);
         screen.lf_returns = false;
         let mut frame_cells = Frame::new(cols, rows);
         let mut small = Vec::new();

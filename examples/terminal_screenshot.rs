@@ -5,7 +5,7 @@
 //! Usage: `cargo run --release --example terminal_screenshot CAPTURE.ans OUT.png COLS ROWS`
 
 use font8x8::UnicodeFonts;
-use tidepool::terminal::Screen;
+use tidepool::terminal::TerminalModel;
 use tiny_skia::{Pixmap, PremultipliedColorU8};
 
 const CELL_W: u32 = 8;
@@ -22,7 +22,7 @@ fn main() {
     let (cols, rows): (usize, usize) = (cols.parse().expect("COLS"), rows.parse().expect("ROWS"));
     let bytes = std::fs::read(capture).expect("a readable capture");
     // One spare row: the capture's last newline must not scroll the first row away.
-    let mut screen = Screen::new(cols, rows + 1);
+    let mut screen = TerminalModel::new(cols, rows + 1);
     screen.feed(&bytes);
     let mut pixmap = Pixmap::new(cols as u32 * CELL_W, rows as u32 * CELL_H).expect("a picture");
     let width = pixmap.width();

@@ -11,4 +11,4 @@ pub use crate::output::frame::{Cell, Frame};
 pub use crate::output::quality::{EXACT_PSNR_DB, Quality, measure};
 pub use crate::output::rate::{RateEncoder, RateOptions, Report, Strategy, Target, UNLIMITED};
 pub use crate::output::ssim::{Luma, ssim};
-pub use crate::output::vt::Screen;
+pub use crate::output::vt::TerminalModel;

@@ -86,7 +86,7 @@ mod tests {
     use ratatui_core::terminal::Terminal;
 
     use super::*;
-    use crate::output::vt::Screen;
+    use crate::output::vt::TerminalModel;
     use crate::scene::pool::{PoolScene, PoolSettings};
     use crate::sim::ripple::Stone;
 
@@ -104,7 +104,7 @@ mod tests {
             terminal.draw(|f| f.render_stateful_widget(SceneWidget::new(&mut pool), f.area(), &mut state)).unwrap();
 
             let text = crate::output::halfblock::encode(&pool.snapshot().unwrap());
-            let mut screen = Screen::new(usize::from(cols), usize::from(rows) + 1);
+            let mut screen = TerminalModel::new(usize::from(cols), usize::from(rows) + 1);
             screen.feed(&text);
             let buffer = terminal.backend().buffer();
             let to_rgb = |c: Color| match c {

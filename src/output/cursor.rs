@@ -212,7 +212,7 @@ pub fn push_move(out: &mut Vec<u8>, from: Cursor, to: (usize, usize)) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::vt::Screen;
+    use crate::output::vt::TerminalModel;
 
     /// Moves in a 200x60 terminal model land where asked, and are never longer than `CUP`.
     #[test]
@@ -225,7 +225,7 @@ mod tests {
         for _ in 0..3000 {
             let from = (next(200), next(60));
             let to = (next(200), next(60));
-            let mut s = Screen::new(200, 60);
+            let mut s = TerminalModel::new(200, 60);
             s.lf_returns = false;
             s.feed(format!("\x1b[{};{}H", from.1 + 1, from.0 + 1).as_bytes());
             let mut out = Vec::new();
@@ -260,7 +260,7 @@ mod tests {
 
     #[test]
     fn wrapped_cursor_in_the_model() {
-        let mut s = Screen::new(4, 3);
+        let mut s = TerminalModel::new(4, 3);
         s.lf_returns = false;
         s.feed("\x1b[2;1Habcd".as_bytes());
         let mut out = Vec::new();

@@ -264,7 +264,7 @@ pub fn encode_into(shown: &mut Shown, next: &Frame, options: EncodeOptions, out:
 mod tests {
     use super::*;
     use crate::output::color::ColorMode;
-    use crate::output::vt::Screen;
+    use crate::output::vt::TerminalModel;
     use tiny_skia::{ColorU8, Pixmap};
 
     fn rgb(v: u8) -> Color {
@@ -288,14 +288,14 @@ mod tests {
         f
     }
 
-    fn model(cols: usize, rows: usize) -> Screen {
-        let mut s = Screen::new(cols, rows);
+    fn model(cols: usize, rows: usize) -> TerminalModel {
+        let mut s = TerminalModel::new(cols, rows);
         s.lf_returns = false;
         s
     }
 
     /// Every pixel the screen shows equals the frame's.
-    fn assert_screen_shows(screen: &Screen, frame: &Frame) {
+    fn assert_screen_shows(screen: &TerminalModel, frame: &Frame) {
         for y in 0..frame.rows() {
             for x in 0..frame.cols() {
                 match frame.get(x, y) {

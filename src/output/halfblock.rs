@@ -65,7 +65,7 @@ pub fn encode(pixmap: &Pixmap) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::vt::Screen;
+    use crate::output::vt::TerminalModel;
     use tiny_skia::ColorU8;
 
     fn pixmap(w: u32, h: u32, f: impl Fn(u32, u32) -> Rgb) -> Pixmap {
@@ -102,7 +102,7 @@ mod tests {
     #[test]
     fn a_terminal_model_reproduces_the_picture() {
         let p = pixmap(17, 9, |x, y| [(x * 15) as u8, (y * 28) as u8, ((x ^ y) * 7) as u8]);
-        let mut screen = Screen::new(17, 6); // one spare row: the last newline would scroll
+        let mut screen = TerminalModel::new(17, 6); // one spare row: the last newline would scroll
         screen.feed(&encode(&p));
         for y in 0..9 {
             for x in 0..17 {

@@ -1,7 +1,7 @@
 //! How close a terminal's screen is to the picture it should show, measured like a codec:
 //! PSNR over 8-bit sRGB and the mean OKLab distance, both halves of every picture cell.
 //!
-//! The screen is a [`crate::output::vt::Screen`] fed the encoder's bytes. A pixel it shows in
+//! The screen is a [`crate::output::vt::TerminalModel`] fed the encoder's bytes. A pixel it shows in
 //! the terminal's default colour, or under a glyph that is not a half block, counts as
 //! [`UNKNOWN_PIXEL`] (black, the usual terminal background): a screen that was never painted
 //! scores as a black picture.
@@ -10,7 +10,7 @@ use tiny_skia::Pixmap;
 
 use crate::output::halfblock::{Rgb, pixel_rgb};
 use crate::output::oklab;
-use crate::output::vt::Screen;
+use crate::output::vt::TerminalModel;
 
 /// What a pixel the screen does not show as a half-block colour counts as.
 pub const UNKNOWN_PIXEL: Rgb = [0, 0, 0];
@@ -43,7 +43,7 @@ pub fn psnr(mse: f64) -> f64 {
 /// Compares the half-block pixels of `screen` with `truth`, drawn from the screen's top-left
 /// corner (two pixel rows a text row). Only the picture's pixels count, so rows below it (the
 /// status line) are left out.
-pub fn measure(screen: &Screen, truth: &Pixmap) -> Quality {
+pub fn measure(screen: &TerminalModel, truth: &Pixmap) -> Quality {
     let (w, h) = (truth.width() as usize, truth.height() as usize);
     let (mut squared, mut distance) = (0f64, 0f64);
     for y in 0..h {
@@ -75,12 +75,12 @@ mod tests {
     #[test]
     fn an_exact_screen_and_a_known_error() {
         let truth = grey(2, 2, 100);
-        let mut screen = Screen::new(2, 2);
+        let mut screen = TerminalModel::new(2, 2);
         screen.feed("\x1b[38;2;100;100;100;48;2;100;100;100m\u{2580}\u{2580}".as_bytes());
         let exact = measure(&screen, &truth);
         assert_eq!((exact.mse, exact.oklab, exact.psnr()), (0.0, 0.0, EXACT_PSNR_DB));
         // One of the four pixels 10 steps off in every channel: MSE 100 / 4 = 25.
-        let mut screen = Screen::new(2, 2);
+        let mut screen = TerminalModel::new(2, 2);
         screen.feed("\x1b[38;2;110;110;110;48;2;100;100;100m\u{2580}\x1b[38;2;100;100;100m\u{2580}".as_bytes());
         let q = measure(&screen, &truth);
         assert_eq!(q.mse, 25.0);
@@ -91,7 +91,7 @@ mod tests {
     #[test]
     fn unpainted_pixels_count_as_black_and_the_status_row_is_left_out() {
         let truth = grey(3, 2, 255);
-        let mut screen = Screen::new(3, 2);
+        let mut screen = TerminalModel::new(3, 2);
         screen.feed(b"\x1b[2;1Hstatus");
         let q = measure(&screen, &truth);
         assert_eq!(q.mse, 255.0 * 255.0);

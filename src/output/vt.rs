@@ -12,7 +12,7 @@ use crate::output::halfblock::Rgb;
 
 /// One character cell.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Cell {
+pub struct ModelCell {
     /// The character shown.
     pub ch: char,
     /// Foreground colour; `None` is the terminal's default.
@@ -21,18 +21,18 @@ pub struct Cell {
     pub bg: Option<Rgb>,
 }
 
-impl Default for Cell {
+impl Default for ModelCell {
     fn default() -> Self {
-        Cell { ch: ' ', fg: None, bg: None }
+        ModelCell { ch: ' ', fg: None, bg: None }
     }
 }
 
 /// A grid of cells with a cursor and the current colours.
 #[derive(Clone, Debug)]
-pub struct Screen {
+pub struct TerminalModel {
     cols: usize,
     rows: usize,
-    cells: Vec<Cell>,
+    cells: Vec<ModelCell>,
     cursor: (usize, usize),
     wrap_pending: bool,
     fg: Option<Rgb>,
@@ -56,13 +56,13 @@ enum Parse {
     },
 }
 
-impl Screen {
+impl TerminalModel {
     /// A blank `cols x rows` screen with the cursor at the top left.
-    pub fn new(cols: usize, rows: usize) -> Screen {
-        Screen {
+    pub fn new(cols: usize, rows: usize) -> TerminalModel {
+        TerminalModel {
             cols,
             rows,
-            cells: vec![Cell::default(); cols * rows],
+            cells: vec![ModelCell::default(); cols * rows],
             cursor: (0, 0),
             wrap_pending: false,
             fg: None,
@@ -85,7 +85,7 @@ impl Screen {
     }
 
     /// The cell at column `x`, row `y`.
-    pub fn cell(&self, x: usize, y: usize) -> Cell {
+    pub fn cell(&self, x: usize, y: usize) -> ModelCell {
         self.cells[y * self.cols + x]
     }
 
@@ -157,7 +157,9 @@ impl Screen {
             Parse::Escape => match b {
                 b'[' => self.state = Parse::Csi(Vec::new()),
                 b']' | b'P' | b'_' | b'X' | b'^' => self.state = Parse::Text { seen_esc: false },
-                b'c' => *self = Screen { lf_returns: self.lf_returns, ..Screen::new(self.cols, self.rows) },
+                b'c' => {
+                    *self = TerminalModel { lf_returns: self.lf_returns, ..TerminalModel::new(self.cols, self.rows) }
+                }
                 _ => {} // ESC 7 / ESC 8 / charset selection: not used by tidepool
             },
             Parse::Csi(mut params) => {
@@ -220,7 +222,7 @@ impl Screen {
         } else if self.rows > 0 {
             self.cells.rotate_left(self.cols);
             let start = (self.rows - 1) * self.cols;
-            self.cells[start..].fill(Cell { bg: self.bg, ..Cell::default() });
+            self.cells[start..].fill(ModelCell { bg: self.bg, ..ModelCell::default() });
         }
     }
 
@@ -233,7 +235,7 @@ impl Screen {
             self.line_feed();
         }
         let (x, y) = self.cursor;
-        self.cells[y * self.cols + x] = Cell { ch, fg: self.fg, bg: self.bg };
+        self.cells[y * self.cols + x] = ModelCell { ch, fg: self.fg, bg: self.bg };
         if x + 1 < self.cols {
             self.cursor.0 += 1;
         } else {
@@ -277,7 +279,7 @@ impl Screen {
     }
 
     fn erase(&mut self, from: usize, to: usize) {
-        let blank = Cell { bg: self.bg, ..Cell::default() };
+        let blank = ModelCell { bg: self.bg, ..ModelCell::default() };
         let to = to.min(self.cells.len());
         if from < to {
             self.cells[from..to].fill(blank);
@@ -379,11 +381,11 @@ mod tests {
 
     #[test]
     fn cursor_moves_and_colours() {
-        let mut s = Screen::new(10, 4);
+        let mut s = TerminalModel::new(10, 4);
         s.feed(b"\x1b[2;3H\x1b[38;2;1;2;3m\x1b[48;5;16mX\x1b[2CY\x1b[0mZ");
-        assert_eq!(s.cell(2, 1), Cell { ch: 'X', fg: Some([1, 2, 3]), bg: Some([0, 0, 0]) });
+        assert_eq!(s.cell(2, 1), ModelCell { ch: 'X', fg: Some([1, 2, 3]), bg: Some([0, 0, 0]) });
         assert_eq!(s.cell(5, 1).ch, 'Y');
-        assert_eq!(s.cell(6, 1), Cell { ch: 'Z', fg: None, bg: None });
+        assert_eq!(s.cell(6, 1), ModelCell { ch: 'Z', fg: None, bg: None });
         assert_eq!(s.cursor(), (7, 1));
         s.feed(b"\x1b[A\x1b[3D\x1b[B\x1b[B\x1b[G\x1b[1dQ");
         assert_eq!(s.cell(0, 0).ch, 'Q');
@@ -391,7 +393,7 @@ mod tests {
 
     #[test]
     fn pending_wrap_and_scroll() {
-        let mut s = Screen::new(3, 2);
+        let mut s = TerminalModel::new(3, 2);
         s.feed("abcdefg".as_bytes());
         assert_eq!(s.row_text(0), "def");
         assert_eq!(s.row_text(1), "g  ");
@@ -402,7 +404,7 @@ mod tests {
 
     #[test]
     fn colour_changes_keep_a_pending_wrap() {
-        let mut s = Screen::new(3, 2);
+        let mut s = TerminalModel::new(3, 2);
         s.feed(b"abc\x1b[31md");
         assert_eq!(s.row_text(1), "d  ", "SGR does not cancel the wrap");
         s.feed(b"\x1b[1;1Habc\x1b[Cx");
@@ -411,7 +413,7 @@ mod tests {
 
     #[test]
     fn private_modes_are_recorded() {
-        let mut s = Screen::new(2, 2);
+        let mut s = TerminalModel::new(2, 2);
         s.feed(b"\x1b[?1049h\x1b[?25l\x1b[?2026h\x1b[?2026l");
         assert_eq!(s.private_mode(1049), Some(true));
         assert_eq!(s.private_mode(25), Some(false));
@@ -421,7 +423,7 @@ mod tests {
 
     #[test]
     fn half_blocks_decode_to_pixels() {
-        let mut s = Screen::new(3, 1);
+        let mut s = TerminalModel::new(3, 1);
         s.feed("\x1b[38;2;1;1;1m\x1b[48;2;2;2;2m\u{2580}\u{2584} ".as_bytes());
         assert_eq!((s.pixel(0, 0), s.pixel(0, 1)), (Some([1, 1, 1]), Some([2, 2, 2])));
         assert_eq!((s.pixel(1, 0), s.pixel(1, 1)), (Some([2, 2, 2]), Some([1, 1, 1])));

@@ -105,7 +105,7 @@ pub struct InputParser {
 }
 
 /// What the start of the buffer holds.
-enum Parsed {
+enum Framed {
     /// A complete item of this many bytes, and what it means (nothing: a control byte).
     Item(usize, Option<Received>),
     /// The start of a sequence whose end has not arrived.
@@ -173,7 +173,7 @@ impl InputParser {
         let mut at = 0;
         while at < self.pending.len() {
             match parse_one(&self.pending[at..], stale) {
-                Parsed::Item(len, Some(Received::Reply(Reply::Overlong))) => {
+                Framed::Item(len, Some(Received::Reply(Reply::Overlong))) => {
                     // The rest of an overlong string follows: drop it up to its terminator.
                     out.push(Received::Unknown);
                     at += len.max(1);
@@ -185,11 +185,11 @@ impl InputParser {
                         }
                     }
                 }
-                Parsed::Item(len, received) => {
+                Framed::Item(len, received) => {
                     out.extend(received);
                     at += len.max(1);
                 }
-                Parsed::Incomplete => break,
+                Framed::Incomplete => break,
             }
         }
         self.pending.drain(..at);
@@ -200,25 +200,25 @@ const ESC: u8 = 0x1b;
 
 /// Parses the item at the start of `b`. With `stale`, an incomplete sequence is taken as what
 /// it is so far: a lone ESC is the Escape key, anything longer is dropped.
-fn parse_one(b: &[u8], stale: bool) -> Parsed {
+fn parse_one(b: &[u8], stale: bool) -> Framed {
     let incomplete = |len: usize, lone_escape: bool| {
         if !stale {
-            Parsed::Incomplete
+            Framed::Incomplete
         } else if lone_escape {
-            Parsed::Item(1, Some(Received::Input(Input::Escape)))
+            Framed::Item(1, Some(Received::Input(Input::Escape)))
         } else {
-            Parsed::Item(len, Some(Received::Unknown))
+            Framed::Item(len, Some(Received::Unknown))
         }
     };
     let input =
-        |len: usize, input: Option<Input>| Parsed::Item(len, Some(input.map_or(Received::Unknown, Received::Input)));
+        |len: usize, input: Option<Input>| Framed::Item(len, Some(input.map_or(Received::Unknown, Received::Input)));
     match b[0] {
         ESC => match b.get(1) {
             None => incomplete(1, true),
             // Replies first: the one description of where a reply ends.
             Some(b'[' | b'_' | b'P' | b']') => match parse_reply(b, Expecting::CURSOR_POSITION) {
-                crate::play::replies::Parsed::Complete(reply, len) => Parsed::Item(len, Some(Received::Reply(reply))),
-                crate::play::replies::Parsed::Incomplete if !stale => Parsed::Incomplete,
+                crate::play::replies::Parsed::Complete(reply, len) => Framed::Item(len, Some(Received::Reply(reply))),
+                crate::play::replies::Parsed::Incomplete if !stale => Framed::Incomplete,
                 crate::play::replies::Parsed::Incomplete if b[1] != b'[' => incomplete(b.len(), false),
                 _ if b[1] == b'[' => parse_csi(b, stale),
                 // `ESC P`, `ESC ]`, `ESC _` that cannot be a reply: Alt and a key, ignored.
@@ -241,7 +241,7 @@ fn parse_one(b: &[u8], stale: bool) -> Parsed {
         0x03 => input(1, Some(Input::Quit)),
         b'\r' | b'\n' => input(1, Some(Input::DropAtAim)),
         b'\t' => input(1, Some(Input::NextScene)),
-        c if c < 0x20 || c == 0x7f => Parsed::Item(1, None),
+        c if c < 0x20 || c == 0x7f => Framed::Item(1, None),
         c if c < 0x80 => input(1, Some(key(c as char))),
         c => {
             let len = utf8_len(Some(c));
@@ -250,7 +250,7 @@ fn parse_one(b: &[u8], stale: bool) -> Parsed {
             }
             match std::str::from_utf8(&b[..len]).ok().and_then(|s| s.chars().next()) {
                 Some(ch) => input(len, Some(Input::Other(ch))),
-                None => Parsed::Item(1, None),
+                None => Framed::Item(1, None),
             }
         }
     }
@@ -287,19 +287,19 @@ fn arrow(c: u8) -> Option<Input> {
 }
 
 /// `ESC [` parameters, intermediates, final byte: a key (replies were tried first).
-fn parse_csi(b: &[u8], stale: bool) -> Parsed {
+fn parse_csi(b: &[u8], stale: bool) -> Framed {
     let known =
-        |len: usize, input: Option<Input>| Parsed::Item(len, Some(input.map_or(Received::Unknown, Received::Input)));
+        |len: usize, input: Option<Input>| Framed::Item(len, Some(input.map_or(Received::Unknown, Received::Input)));
     // The legacy X10 mouse report: `ESC [ M` and three raw bytes.
     if b.get(2) == Some(&b'M') {
         return match b.get(3..6) {
             Some(&[cb, cx, cy]) => known(6, x10_mouse(u32::from(cb.wrapping_sub(32)), cx, cy)),
             _ if stale => known(b.len(), None),
-            _ => Parsed::Incomplete,
+            _ => Framed::Incomplete,
         };
     }
     let Some(end) = (2..b.len()).find(|&i| (0x40..=0x7e).contains(&b[i])) else {
-        return if stale { known(b.len(), None) } else { Parsed::Incomplete };
+        return if stale { known(b.len(), None) } else { Framed::Incomplete };
     };
     let body = &b[2..end];
     let final_byte = b[end];

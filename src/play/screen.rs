@@ -379,7 +379,7 @@ impl Screen {
         let report = self.encoder.encode_into(&mut self.shown, target, budget, options, &mut bytes);
         self.bucket.spend(report.bytes);
         if let Some(p) = &mut self.picture {
-            let frame = picture::Frame {
+            let frame = picture::FrameFacts {
                 resized,
                 help_open: seat.help.is_some(),
                 cells_shown: report.pending == 0,

@@ -6,7 +6,7 @@ use tiny_skia::Pixmap;
 
 use super::*;
 use crate::PoolSettings;
-use crate::output::vt::Screen as Vt;
+use crate::output::vt::TerminalModel as Vt;
 use crate::scene::SceneSpec;
 
 const FRAME: Duration = Duration::from_nanos(1_000_000_000 / 30);

@@ -380,7 +380,7 @@ impl TerminalInput for Stdin {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::output::vt::Screen as Vt;
+    use crate::output::vt::TerminalModel as Vt;
 
     #[test]
     fn a_real_descriptor_is_read_until_the_deadline() {

@@ -21,7 +21,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use portable_pty::{CommandBuilder, PtySize, native_pty_system};
-use tidepool::terminal::Screen;
+use tidepool::terminal::TerminalModel;
 
 const DA1_QUESTION: &[u8] = b"\x1b[c";
 const DA1_ANSWER: &[u8] = b"\x1b[?62;22c";
@@ -68,7 +68,7 @@ fn run(rate: usize, bandwidth: &str, presses: usize) -> (Vec<Duration>, f64, usi
     let (link_seen, link_backlog, answers, link_stop) =
         (Arc::clone(&seen), Arc::clone(&backlog), Arc::clone(&keyboard), Arc::clone(&stop));
     let link = std::thread::spawn(move || {
-        let mut screen = Screen::new(COLS.into(), ROWS.into());
+        let mut screen = TerminalModel::new(COLS.into(), ROWS.into());
         screen.lf_returns = false;
         let slice = Duration::from_millis(1);
         let start = Instant::now();

@@ -181,12 +181,12 @@ pub struct PlayCommand {
     /// inline images, or half-block cells (two pixels a cell, any terminal). `auto` asks the
     /// terminal what it can show (500 ms at most) and falls back to cells.
     #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
-    pub graphics: GraphicsChoice,
+    pub graphics: GraphicsFlag,
 }
 
 /// `--graphics`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
-pub enum GraphicsChoice {
+pub enum GraphicsFlag {
     /// The best the terminal answers for: kitty, then sixel, then iTerm2, else cells.
     Auto,
     /// The kitty graphics protocol (kitty, WezTerm, Ghostty, Konsole).
@@ -199,16 +199,16 @@ pub enum GraphicsChoice {
     Cells,
 }
 
-impl From<GraphicsChoice> for tidepool::play::GraphicsRequest {
-    fn from(choice: GraphicsChoice) -> Self {
+impl From<GraphicsFlag> for tidepool::play::GraphicsRequest {
+    fn from(choice: GraphicsFlag) -> Self {
         use tidepool::graphics::GraphicsMode;
         use tidepool::play::GraphicsRequest::{Auto, Force};
         match choice {
-            GraphicsChoice::Auto => Auto,
-            GraphicsChoice::Kitty => Force(GraphicsMode::Kitty),
-            GraphicsChoice::Sixel => Force(GraphicsMode::Sixel),
-            GraphicsChoice::Iterm2 => Force(GraphicsMode::Iterm2),
-            GraphicsChoice::Cells => Force(GraphicsMode::Cells),
+            GraphicsFlag::Auto => Auto,
+            GraphicsFlag::Kitty => Force(GraphicsMode::Kitty),
+            GraphicsFlag::Sixel => Force(GraphicsMode::Sixel),
+            GraphicsFlag::Iterm2 => Force(GraphicsMode::Iterm2),
+            GraphicsFlag::Cells => Force(GraphicsMode::Cells),
         }
     }
 }
@@ -387,7 +387,7 @@ pub struct OutputArgs {
     /// iTerm2) or half-block cells. `auto` asks the terminal (500 ms at most); into a pipe or a
     /// file it means cells and nothing is asked.
     #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
-    pub graphics: GraphicsChoice,
+    pub graphics: GraphicsFlag,
 }
 
 /// Flags of the ripple pool, shared by `render pool` and the player.
@@ -617,9 +617,9 @@ mod tests {
         );
         assert_eq!(play.water.pool.damping.shift(), Some(6), "the player's own damping");
         assert_eq!(play.bandwidth, tidepool::play::Bandwidth::Auto);
-        assert_eq!(play.graphics, GraphicsChoice::Auto, "pictures in real pixels where the terminal answers");
+        assert_eq!(play.graphics, GraphicsFlag::Auto, "pictures in real pixels where the terminal answers");
         for (flag, want) in
-            [("kitty", GraphicsChoice::Kitty), ("sixel", GraphicsChoice::Sixel), ("cells", GraphicsChoice::Cells)]
+            [("kitty", GraphicsFlag::Kitty), ("sixel", GraphicsFlag::Sixel), ("cells", GraphicsFlag::Cells)]
         {
             let cli = Cli::try_parse_from(["tidepool", "play", "--graphics", flag]).unwrap();
             let Some(Command::Play(play)) = cli.command else { panic!("not play") };

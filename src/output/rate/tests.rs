@@ -6,7 +6,7 @@ use super::*;
 use crate::output::bucket::ByteBucket;
 use crate::output::diff;
 use crate::output::oklab;
-use crate::output::vt::Screen;
+use crate::output::vt::TerminalModel;
 
 fn picture(cols: u32, rows: u32, f: impl Fn(u32, u32) -> [u8; 3]) -> Pixmap {
     let mut p = Pixmap::new(cols, 2 * rows).unwrap();
@@ -26,15 +26,15 @@ fn frame_of(p: &Pixmap, mode: ColorMode) -> Frame {
 }
 
 /// A terminal model of exactly the frame's size (no spare row), in raw mode.
-fn terminal(cols: usize, rows: usize) -> Screen {
-    let mut s = Screen::new(cols, rows);
+fn terminal(cols: usize, rows: usize) -> TerminalModel {
+    let mut s = TerminalModel::new(cols, rows);
     s.lf_returns = false;
     s
 }
 
 /// The terminal shows exactly what the model claims: every pixel of a pixel cell, and a text
 /// cell's glyph, background and (unless it is a space) foreground.
-fn assert_screen_matches(screen: &Screen, model: &Frame) {
+fn assert_screen_matches(screen: &TerminalModel, model: &Frame) {
     for y in 0..model.rows() {
         for x in 0..model.cols() {
             match model.get(x, y) {
@@ -254,7 +254,7 @@ fn frames_to_converge(mode: ColorMode, rate: usize, approximate: bool) -> (usize
     let options = RateOptions { approximate, ..RateOptions::default() };
     let capacity = (3 * rate).max(crate::output::bucket::MIN_CAPACITY as usize);
     let mut level = 0;
-    let mut frame = |shown: &mut Shown, target: Target<'_>, screen: &mut Screen| {
+    let mut frame = |shown: &mut Shown, target: Target<'_>, screen: &mut TerminalModel| {
         level = (level + rate).min(capacity);
         let mut bytes = Vec::new();
         let report = encoder.encode_into(shown, target, level, options, &mut bytes);

@@ -98,7 +98,7 @@ impl Picture {
 
 /// What the player's frame is like, for [`Picture::add_to_frame`].
 #[derive(Clone, Copy, Debug)]
-pub struct Frame {
+pub struct FrameFacts {
     /// The cell frame repaints the whole screen (the first frame, a resize).
     pub resized: bool,
     /// The help overlay is open.
@@ -123,7 +123,7 @@ impl Picture {
     pub fn add_to_frame(
         &mut self,
         pixmap: &Pixmap,
-        frame: &Frame,
+        frame: &FrameFacts,
         budget: Budget,
         now: Instant,
         bytes: &mut Vec<u8>,

@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use portable_pty::{Child, CommandBuilder, ExitStatus, MasterPty, PtySize, native_pty_system};
-use tidepool::terminal::Screen;
+use tidepool::terminal::TerminalModel;
 
 /// The primary device attributes question the player asks after frames, and a VT220-like
 /// answer (as xterm gives).
@@ -137,8 +137,8 @@ impl Player {
     }
 
     /// The screen the output so far draws (raw mode: a line feed keeps the column).
-    pub fn screen(&self) -> Screen {
-        let mut s = Screen::new(self.cols.into(), self.rows.into());
+    pub fn screen(&self) -> TerminalModel {
+        let mut s = TerminalModel::new(self.cols.into(), self.rows.into());
         s.lf_returns = false;
         s.feed(&self.output());
         s
@@ -146,7 +146,7 @@ impl Player {
 
     /// Waits until `ready` holds for the screen the output draws (polled; `what` names it in the
     /// failure). A readiness signal, never an assertion on time: the bound is only for a hang.
-    pub fn wait_until(&self, what: &str, timeout: Duration, ready: impl Fn(&Screen) -> bool) {
+    pub fn wait_until(&self, what: &str, timeout: Duration, ready: impl Fn(&TerminalModel) -> bool) {
         let deadline = Instant::now() + timeout;
         loop {
             if ready(&self.screen()) {

@@ -17,7 +17,7 @@ use tidepool::graphics::{GraphicsMode, push_rgb};
 use tidepool::play::{GraphicsChoice, GraphicsSupport};
 use tiny_skia::Pixmap;
 
-use crate::cli::GraphicsChoice as Request;
+use crate::cli::GraphicsFlag as Request;
 
 /// A picture for this terminal in real pixels.
 #[derive(Clone, Debug, PartialEq)]

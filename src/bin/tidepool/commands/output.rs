@@ -20,7 +20,7 @@ pub const DEFAULT_TEXT_SIZE: Size = Size::of(80, 48);
 
 /// Where the picture goes.
 #[derive(Clone, Debug, PartialEq, Eq)]
-pub enum Target {
+pub enum Destination {
     /// Standard output.
     Stdout,
     /// A file, written atomically.
@@ -31,7 +31,7 @@ pub enum Target {
 #[derive(Clone, Debug, PartialEq)]
 pub struct OutputPlan {
     /// Where the picture goes.
-    pub target: Target,
+    pub target: Destination,
     /// Its format.
     pub format: Format,
     /// Its size in pixels.
@@ -64,9 +64,9 @@ impl OutputPlan {
             None => {
                 let format = args.format.unwrap_or(Format::Png);
                 let ext = if format == Format::Png { "png" } else { "ans" };
-                (Target::File(PathBuf::from(format!("{scene}.{ext}"))), format)
+                (Destination::File(PathBuf::from(format!("{scene}.{ext}"))), format)
             }
-            Some(path) if path.as_os_str() == "-" => (Target::Stdout, args.format.unwrap_or(Format::Ansi)),
+            Some(path) if path.as_os_str() == "-" => (Destination::Stdout, args.format.unwrap_or(Format::Ansi)),
             Some(path) => {
                 let format = match (args.format, format_of(path)) {
                     (Some(format), _) => format,
@@ -81,10 +81,10 @@ impl OutputPlan {
                         ));
                     }
                 };
-                (Target::File(path.clone()), format)
+                (Destination::File(path.clone()), format)
             }
         };
-        if target == Target::Stdout && format == Format::Png && stdout_is_terminal {
+        if target == Destination::Stdout && format == Format::Png && stdout_is_terminal {
             return Err(Error::arg(
                 "--out",
                 "refusing to write PNG bytes to a terminal; redirect standard output to a file, or use --format ansi",
@@ -92,14 +92,14 @@ impl OutputPlan {
         }
         // Half-block text to a terminal may be real pixels instead (the terminal is asked here,
         // before the picture's size is chosen: pixels have the size of the terminal's cells).
-        let inline = (target == Target::Stdout && format == Format::Ansi && stdout_is_terminal)
+        let inline = (target == Destination::Stdout && format == Format::Ansi && stdout_is_terminal)
             .then(|| super::inline::Inline::probe(args.graphics))
             .flatten();
         let size = match args.size {
             Some(size) => size,
             None if inline.is_some() => inline.as_ref().map_or(DEFAULT_TEXT_SIZE, |i| i.size(DEFAULT_TEXT_SIZE)),
             None if format == Format::Png => DEFAULT_PNG_SIZE,
-            None if target == Target::Stdout && stdout_is_terminal => terminal_size.unwrap_or(DEFAULT_TEXT_SIZE),
+            None if target == Destination::Stdout && stdout_is_terminal => terminal_size.unwrap_or(DEFAULT_TEXT_SIZE),
             None => DEFAULT_TEXT_SIZE,
         };
         let heightmap = match &args.heightmap {
@@ -138,11 +138,11 @@ impl OutputPlan {
         stats.record("encode", started, format!("{format}, {}", tidepool::encode::human_bytes(bytes.len() as u64)));
         let started = Instant::now();
         let target = match &self.target {
-            Target::Stdout => {
+            Destination::Stdout => {
                 write_stdout(&bytes)?;
                 "standard output".to_string()
             }
-            Target::File(path) => {
+            Destination::File(path) => {
                 files::write_file(path, &bytes)?;
                 path.display().to_string()
             }
@@ -216,15 +216,15 @@ mod tests {
             format,
             heightmap: None,
             stats: false,
-            graphics: crate::cli::GraphicsChoice::Cells,
+            graphics: crate::cli::GraphicsFlag::Cells,
         }
     }
 
     #[test]
     fn format_follows_the_extension_and_the_flag_overrides_it() {
         let plan = |out, format| OutputPlan::new(&args(out, format, None), "pool", false, None);
-        assert_eq!(plan(None, None).unwrap().target, Target::File("pool.png".into()));
-        assert_eq!(plan(None, Some(Format::Ansi)).unwrap().target, Target::File("pool.ans".into()));
+        assert_eq!(plan(None, None).unwrap().target, Destination::File("pool.png".into()));
+        assert_eq!(plan(None, Some(Format::Ansi)).unwrap().target, Destination::File("pool.ans".into()));
         assert_eq!(plan(Some("a.PNG"), None).unwrap().format, Format::Png);
         assert_eq!(plan(Some("a.txt"), None).unwrap().format, Format::Ansi);
         assert_eq!(plan(Some("a.ans"), Some(Format::Png)).unwrap().format, Format::Png);
