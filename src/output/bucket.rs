@@ -35,7 +35,7 @@ pub struct ByteBucket {
 
 impl ByteBucket {
     /// A bucket filled at `bytes_per_second` (at least 1), starting empty, holding at most
-    /// [`MAX_BURST`] of the rate: a frame's budget.
+    /// `MAX_BURST` of the rate: a frame's budget.
     pub fn new(bytes_per_second: f64) -> ByteBucket {
         ByteBucket {
             rate: Some(bytes_per_second.max(1.0)),

@@ -8,7 +8,7 @@
 //!   terminal and the scene. [`Seat::handle`] turns an [`Input`] into requests.
 //! - [`Screen`]: one terminal: the graphics probe, the link control and byte budget, the
 //!   rate-controlled cell encoder and the picture encoders. [`Screen::feed`] takes the
-//!   terminal's bytes (replies stay in the screen, inputs come out); [`Screen::frame`] appends a
+//!   terminal's bytes (replies stay in the screen, inputs come out); `Screen::frame` appends a
 //!   frame's bytes.
 //!
 //! Two doors drive them: [`run`] (and [`play`], for this process's own terminal) puts a host,

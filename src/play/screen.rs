@@ -181,7 +181,7 @@ impl Screen {
 
     /// Starts the session: appends the probe's questions to `out` when the terminal is to be
     /// asked (nothing otherwise). No frame is drawn until the answers are in or
-    /// [`probe::PROBE_BUDGET`] has passed.
+    /// `PROBE_BUDGET` (500 ms) has passed.
     pub fn start(&mut self, now: Instant, out: &mut Vec<u8>) {
         let Some(options) = self.config.probe.clone().filter(|_| matches!(self.asking, Asking::No)) else {
             return;
@@ -294,7 +294,7 @@ impl Screen {
         self.notice.take()
     }
 
-    /// The picture [`Screen::frame`] takes, in pixels: the half-block picture (a pixel a
+    /// The picture `Screen::frame` takes, in pixels: the half-block picture (a pixel a
     /// column, two a row, above the status line), or the real-pixel picture within the scene
     /// cap (scaled up by the terminal or the sixel encoder).
     pub fn picture_size(&self) -> (u32, u32) {
@@ -429,7 +429,7 @@ impl Screen {
 
     /// Inside a multiplexer over SSH: what sshd's socket holds for this connection now
     /// (`queued` bytes, read by the door from the kernel's socket table every
-    /// [`link::OUTER_INTERVAL`]): the link's only signal there. Ignored on other paths.
+    /// `OUTER_INTERVAL`): the link's only signal there. Ignored on other paths.
     pub fn outer_queue(&mut self, now: Instant, queued: u64) {
         if self.auto() && self.link.outer_queue(now, self.bytes_sent, queued) == Change::Down {
             self.bucket.drain();

@@ -39,7 +39,7 @@ pub trait TerminalInput: Send {
     fn size(&mut self) -> std::io::Result<(u16, u16)>;
 
     /// Inside a multiplexer over SSH, the bytes the SSH connection's socket holds now (the
-    /// link's one visible sign there), asked for every [`OUTER_INTERVAL`]; `None` where it
+    /// link's one visible sign there), asked for every `OUTER_INTERVAL` (50 ms); `None` where it
     /// cannot be seen (the default).
     fn outer_queue(&mut self) -> Option<u64> {
         None

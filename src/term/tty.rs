@@ -78,7 +78,7 @@ pub fn play(mut config: PlayConfig) -> Result<()> {
 }
 
 /// What a picture written once to this process's terminal (`render --out -`) is drawn with:
-/// the terminal is asked (raw mode for at most [`probe::PROBE_BUDGET`], then back to how it
+/// the terminal is asked (raw mode for at most `PROBE_BUDGET` (500 ms), then back to how it
 /// was) unless `request` is `cells` or standard input and output are not both terminals; then
 /// `auto` means cells. The file medium is not offered (the process may end before the terminal
 /// reads a file), nor pixel mouse reports.

@@ -17,7 +17,7 @@
 //! moved (`C=1`), so the caller's idea of the cursor stays right.
 //!
 //! **Changed rectangle.** When only part of the picture changed and the terminal answered the
-//! probe's frame-edit test ([`crate::term::probe`]), the frame is sent as an edit of the image's
+//! probe's frame-edit test (`play::screen::probe`), the frame is sent as an edit of the image's
 //! root frame (`a=f,r=1,x=,y=,s=,v=,X=1`): the animation part of the protocol, which composes a
 //! rectangle of new pixels onto an existing frame with plain replacement. The bounding box of
 //! the changed pixels is sent if it is at most [`EDIT_MAX_FRACTION`] of the picture; otherwise
@@ -370,7 +370,7 @@ pub fn write_temp_file(dir: &Path, n: u64, data: &[u8]) -> io::Result<PathBuf> {
 }
 
 /// The bounding box (x, y, width, height) of the pixels that differ between two RGB pictures of
-/// the same size, or `None` when they are equal (one pass: [`scan::changed_box`]).
+/// the same size, or `None` when they are equal (one pass: `scan::changed_box`).
 pub fn changed_rect(old: &[u8], new: &[u8], width: u32, height: u32) -> Option<(u32, u32, u32, u32)> {
     scan::changed_box(old, new, width, 3, 0..height)
 }

@@ -190,7 +190,7 @@ pub struct GraphicsSupport {
 
 impl GraphicsSupport {
     /// The sixel colour registers to use: what the terminal said, else a VT340's
-    /// ([`DEFAULT_SIXEL_REGISTERS`]).
+    /// (`DEFAULT_SIXEL_REGISTERS`).
     pub fn sixel_registers(&self) -> u16 {
         self.sixel.map_or(DEFAULT_SIXEL_REGISTERS, |s| s.registers)
     }
