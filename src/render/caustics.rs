@@ -96,6 +96,9 @@ pub struct LightMap {
     pub shift: u32,
     /// Rolling row caches, one per parallel task, kept between frames.
     windows: Vec<Window>,
+    /// For a pool finer than its picture: the heights averaged to one value a pixel, and
+    /// their light (see [`LightMap::compute_on_grid`]).
+    coarse: Option<Box<(Vec<i16>, LightMap)>>,
 }
 
 impl LightMap {
@@ -153,6 +156,93 @@ impl LightMap {
         }
     }
 }
+
+impl LightMap {
+    /// The light of a pool of `grid x grid` cells a pixel, `width x height` cells: computed
+    /// on the heights averaged over each pixel's cells (so the caustics have the shapes, the
+    /// smoothing and the depth in pixels they have on a pool of one cell a pixel), then spread
+    /// back over the cells bilinearly. The result has one entry a cell. Grid 1 is
+    /// [`LightMap::compute`].
+    pub fn compute_on_grid(
+        &mut self,
+        heights: &[i16],
+        (width, height): (usize, usize),
+        grid: usize,
+        look: CausticsLook,
+        simd: Simd,
+    ) {
+        if grid <= 1 {
+            self.compute(heights, width, height, look, simd);
+            return;
+        }
+        let (cols, rows) = (width / grid, height / grid);
+        let coarse = self.coarse.get_or_insert_with(Box::default);
+        let (means, light) = &mut **coarse;
+        // The means with a margin of PAD pixels around them, continued by odd reflection
+        // (h(-d) = 2·h(0) - h(d)): a slope runs on past the edge instead of folding back, so
+        // the edge draws no false caustic line (repeating the edge value would bend every
+        // slope that reaches it).
+        let (padded_cols, padded_rows) = (cols + 2 * PAD, rows + 2 * PAD);
+        means.clear();
+        means.resize(padded_cols * padded_rows, 0);
+        let area = (grid * grid) as i32;
+        for cy in 0..rows {
+            for cx in 0..cols {
+                let mut sum = 0i32;
+                for y in cy * grid..(cy + 1) * grid {
+                    let row = &heights[y * width + cx * grid..y * width + (cx + 1) * grid];
+                    sum += row.iter().map(|&v| i32::from(v)).sum::<i32>();
+                }
+                let mean = sum.div_euclid(area) + i32::from(2 * sum.rem_euclid(area) >= area);
+                means[(cy + PAD) * padded_cols + cx + PAD] = mean as i16;
+            }
+        }
+        let reflect =
+            |edge: i16, mirrored: i16| (2 * i32::from(edge) - i32::from(mirrored)).clamp(-32768, 32767) as i16;
+        for y in PAD..PAD + rows {
+            let row = &mut means[y * padded_cols..(y + 1) * padded_cols];
+            for d in 1..=PAD {
+                let (left, right) = (PAD, PAD + cols - 1);
+                row[left - d] = reflect(row[left], row[(left + d).min(right)]);
+                row[right + d] = reflect(row[right], row[right.saturating_sub(d).max(left)]);
+            }
+        }
+        for d in 1..=PAD {
+            let (top, bottom) = (PAD, PAD + rows - 1);
+            for x in 0..padded_cols {
+                let at = |means: &[i16], y: usize| means[y * padded_cols + x];
+                means[(top - d) * padded_cols + x] = reflect(at(means, top), at(means, (top + d).min(bottom)));
+                means[(bottom + d) * padded_cols + x] =
+                    reflect(at(means, bottom), at(means, bottom.saturating_sub(d).max(top)));
+            }
+        }
+        light.compute(means, padded_cols, padded_rows, look, simd);
+        // Each cell's light from the four nearest pixels' (cell centres at (x + 1/2) / grid).
+        self.shift = 0;
+        (self.width, self.height) = (width, height);
+        self.gains.resize(width * height, UNIT_GAIN);
+        let taps = |n: usize, size: usize| -> (usize, usize, f32) {
+            let at = ((n as f32 + 0.5) / grid as f32 - 0.5).clamp(0.0, (size - 1) as f32);
+            let lo = at as usize;
+            (lo + PAD, (lo + 1).min(size - 1) + PAD, at - lo as f32)
+        };
+        for y in 0..height {
+            let (y0, y1, fy) = taps(y, rows);
+            let out = &mut self.gains[y * width..(y + 1) * width];
+            for (x, gain) in out.iter_mut().enumerate() {
+                let (x0, x1, fx) = taps(x, cols);
+                let g = |x: usize, y: usize| f32::from(light.gain(x, y));
+                let top = g(x0, y0) + (g(x1, y0) - g(x0, y0)) * fx;
+                let bottom = g(x0, y1) + (g(x1, y1) - g(x0, y1)) * fx;
+                *gain = (top + (bottom - top) * fy + 0.5) as u8;
+            }
+        }
+    }
+}
+
+/// The margin of the light computed for a pool finer than its picture, in pixels: the
+/// smoothing and the curvature together reach three pixels out.
+const PAD: usize = 3;
 
 /// The pool's heights and how the light map samples them.
 struct Field<'a> {

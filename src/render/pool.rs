@@ -21,6 +21,7 @@ mod look;
 pub use look::{PoolLook, Refraction, Sun};
 
 use super::caustics::{self, AMPLITUDE_PER_PIXEL, WATER_INDEX};
+#[cfg(test)]
 use crate::sim::ripple::RipplePool;
 use crate::simd::{Simd, Tier};
 
@@ -53,6 +54,8 @@ pub struct PoolRenderer {
     lighting: Lighting,
     /// The instruction set the rows and the caustics run with.
     simd: Simd,
+    /// Pool cells per picture pixel along each axis (the background has the pool's size).
+    grid: u32,
 }
 
 /// The sun's light, prepared once per renderer.
@@ -116,8 +119,18 @@ const PIXELS_PER_TASK: usize = 1 << 15;
 
 impl PoolRenderer {
     /// A renderer for pools the size of `background` (already fitted, e.g. with
-    /// [`crate::render::background::cover`]).
+    /// [`crate::render::background::cover`]), one cell a pixel.
+    #[cfg(test)]
     pub fn new(background: Pixmap, look: PoolLook) -> PoolRenderer {
+        PoolRenderer::on_grid(background, look, 1)
+    }
+
+    /// A renderer for pools of `grid x grid` cells a picture pixel, the size of `background`
+    /// (already fitted), drawn at the pool's resolution: the caustics are computed per picture
+    /// pixel and their depth is in picture pixels, so they look as on a pool of one cell a
+    /// pixel.
+    pub fn on_grid(background: Pixmap, look: PoolLook, grid: u32) -> PoolRenderer {
+        let grid = grid.max(1);
         let factor = look.refraction.factor(background.width(), background.height());
         let refraction_q8 = (factor * 256.0).round().clamp(0.0, 1e6) as i32;
         // One extra row and texel past the end, so the filter's right and lower neighbours can be
@@ -135,7 +148,7 @@ impl PoolRenderer {
         let light_shift = match look.caustics {
             Some(c) => {
                 let sin_refracted = (horizontal / WATER_INDEX).min(1.0);
-                let run = c.depth_px() * sin_refracted / (1.0 - sin_refracted * sin_refracted).sqrt();
+                let run = grid as f32 * c.depth_px() * sin_refracted / (1.0 - sin_refracted * sin_refracted).sqrt();
                 ((-sun[0] / horizontal * run).round() as i32, (-sun[1] / horizontal * run).round() as i32)
             }
             None => (0, 0),
@@ -168,6 +181,7 @@ impl PoolRenderer {
             light_shift,
             lighting,
             simd: Simd::detect(),
+            grid,
         }
     }
 
@@ -181,18 +195,27 @@ impl PoolRenderer {
         self.look
     }
 
-    /// Draws `pool` into `out`. Both must have the background's size. Large pictures are drawn
-    /// in row bands on all cores; every pixel is computed the same way whatever the split.
-    ///
-    /// # Panics
-    /// When the sizes differ (a programming error, not a user error).
+    /// Draws `pool` into `out` ([`PoolRenderer::render_heights`] of its heights).
+    #[cfg(test)]
     pub fn render(&mut self, pool: &RipplePool, out: &mut Pixmap) {
         let (w, h) = (self.background.width() as usize, self.background.height() as usize);
         assert_eq!((pool.width(), pool.height()), (w, h), "pool and background sizes differ");
+        self.render_heights(pool.heights(), out);
+    }
+
+    /// Draws the water of `heights` (a pool of the background's size, row by row) into `out`,
+    /// which has the background's size. Large pictures are drawn in row bands on all cores;
+    /// every pixel is computed the same way whatever the split. The heights need not be a
+    /// pool's own: the scene adds the gusts' ripples to them.
+    ///
+    /// # Panics
+    /// When the sizes differ (a programming error, not a user error).
+    pub fn render_heights(&mut self, heights: &[i16], out: &mut Pixmap) {
+        let (w, h) = (self.background.width() as usize, self.background.height() as usize);
+        assert_eq!(heights.len(), w * h, "heights and background sizes differ");
         assert_eq!((out.width() as usize, out.height() as usize), (w, h), "output size differs");
-        let heights = pool.heights();
         if let Some(look) = self.look.caustics {
-            self.light.compute(heights, w, h, look, self.simd);
+            self.light.compute_on_grid(heights, (w, h), self.grid as usize, look, self.simd);
         }
         let this = &*self;
         let bytes = out.data_mut();

@@ -7,7 +7,9 @@ use crate::error::{Error, Result};
 use crate::output::heightmap::Heightmap;
 use crate::render::background;
 use crate::render::pool::{PoolLook, PoolRenderer};
-use crate::sim::breeze::Breeze;
+use crate::render::supersample::{Downsample, downsample};
+use crate::sim::breeze::gusts::{GustShape, Gusts};
+use crate::sim::breeze::{Breeze, BreezeStyle};
 use crate::sim::rain::Rain;
 use crate::sim::ripple::{Damping, RipplePool, Stone};
 use crate::simd::Simd;
@@ -21,6 +23,15 @@ pub struct PoolSettings {
     pub rain_rate: f64,
     /// The breeze's level (0: the papers' still water; at most 4).
     pub breeze: f64,
+    /// How the breeze moves the water: the first breeze's short wavelets, or gusts.
+    pub breeze_style: BreezeStyle,
+    /// Simulation cells per picture pixel along each axis, `1..=`[`MAX_GRID`]: 1 is the
+    /// papers' pool (its cells are its pixels); a finer grid moves the waves `1/grid` pixels a
+    /// step and draws each pixel as the mean of its cells.
+    pub grid: u32,
+    /// Simulation steps per second of real time, `1..=`[`MAX_STEPS_PER_SECOND`] (the player's
+    /// pace; animations follow it): waves move `0.7/grid` pixels a step.
+    pub steps_per_second: u32,
     /// Seed of the rain.
     pub seed: u64,
     /// How the water is drawn.
@@ -30,13 +41,16 @@ pub struct PoolSettings {
 }
 
 impl Default for PoolSettings {
-    /// The papers' damping, no rain, no breeze, seed 1, the default look over the built-in tiled
-    /// floor.
+    /// The papers' damping, no rain, no breeze, one cell a pixel, seed 1, the default look over
+    /// the built-in tiled floor.
     fn default() -> Self {
         PoolSettings {
             damping: Damping::PAPERS,
             rain_rate: 0.0,
             breeze: 0.0,
+            breeze_style: BreezeStyle::default(),
+            grid: 1,
+            steps_per_second: POOL_STEPS_PER_SECOND as u32,
             seed: 1,
             look: PoolLook::default(),
             floor: background::pool_floor(),
@@ -44,15 +58,104 @@ impl Default for PoolSettings {
     }
 }
 
-/// A ripple pool with its rain and floor, one simulation cell per pixel.
+/// The most simulation steps a second.
+pub const MAX_STEPS_PER_SECOND: u32 = 240;
+
+/// Checks a pace (simulation steps per second).
+pub fn check_steps_per_second(steps: u64) -> std::result::Result<u32, crate::error::ValueError> {
+    match u32::try_from(steps) {
+        Ok(s) if (1..=MAX_STEPS_PER_SECOND).contains(&s) => Ok(s),
+        _ => Err(crate::error::ValueError::new(
+            "steps per second",
+            format!(
+                "{steps} steps a second is outside 1..={MAX_STEPS_PER_SECOND}; the papers' pool runs 60, the player's 30"
+            ),
+        )),
+    }
+}
+
+/// Parses a pace: a whole number of simulation steps a second, `1..=`[`MAX_STEPS_PER_SECOND`].
+pub fn parse_steps_per_second(text: &str) -> std::result::Result<u32, crate::error::ValueError> {
+    let steps: u64 = text.trim().parse().map_err(|_| {
+        crate::error::ValueError::new("steps per second", format!("'{text}' is not a whole number of steps, e.g. 30"))
+    })?;
+    check_steps_per_second(steps)
+}
+
+/// The finest simulation grid, in cells per pixel along each axis.
+pub const MAX_GRID: u32 = 4;
+
+/// Parses a grid: a whole number of simulation cells per picture pixel, `1..=`[`MAX_GRID`].
+pub fn parse_grid(text: &str) -> std::result::Result<u32, crate::error::ValueError> {
+    let grid: u64 = text.trim().parse().map_err(|_| {
+        crate::error::ValueError::new("grid", format!("'{text}' is not a whole number of cells per pixel, e.g. 2"))
+    })?;
+    check_grid(grid)
+}
+
+/// Checks a grid (simulation cells per picture pixel).
+pub fn check_grid(grid: u64) -> std::result::Result<u32, crate::error::ValueError> {
+    match u32::try_from(grid) {
+        Ok(g) if (1..=MAX_GRID).contains(&g) => Ok(g),
+        _ => Err(crate::error::ValueError::new(
+            "grid",
+            format!("the grid {grid} is outside 1..={MAX_GRID} simulation cells per pixel; 1 is the papers' pool"),
+        )),
+    }
+}
+
+/// The breeze of a pool, in the style its settings ask for.
+#[derive(Clone, Debug)]
+enum Wind {
+    Wavelets(Breeze),
+    Gusts(Gusts),
+}
+
+impl Wind {
+    fn new(style: BreezeStyle, level: f64, seed: u64, grid: u32) -> Wind {
+        match style {
+            BreezeStyle::Wavelets => Wind::Wavelets(Breeze::with_shape(
+                level,
+                seed,
+                crate::sim::breeze::BreezeShape::default().on_grid(grid),
+            )),
+            BreezeStyle::Gusts => Wind::Gusts(Gusts::new(level, seed, GustShape::default().on_grid(grid))),
+        }
+    }
+
+    fn level(&self) -> f64 {
+        match self {
+            Wind::Wavelets(b) => b.level(),
+            Wind::Gusts(s) => s.level(),
+        }
+    }
+
+    fn set_level(&mut self, level: f64) {
+        match self {
+            Wind::Wavelets(b) => b.set_level(level),
+            Wind::Gusts(s) => s.set_level(level),
+        }
+    }
+}
+
+/// A ripple pool with its rain and floor, `grid x grid` simulation cells a pixel.
 #[derive(Clone, Debug)]
 pub struct PoolScene {
     pool: RipplePool,
     rain: Rain,
-    breeze: Breeze,
+    wind: Wind,
     renderer: PoolRenderer,
     floor: Pixmap,
     drops: Vec<Stone>,
+    /// The picture's size in pixels.
+    size: (u32, u32),
+    grid: u32,
+    steps_per_second: u32,
+    /// The picture at the simulation's resolution, when the grid is finer than the picture.
+    fine: Option<Pixmap>,
+    /// The pool's heights with the gusts' ripples added (amplitude units), and those alone.
+    field: Vec<i16>,
+    gust_heights: Vec<f32>,
     /// The rate `r` switches the rain back on to.
     rain_when_on: f64,
     /// The level `b` switches the breeze back on to.
@@ -72,38 +175,55 @@ pub const BIG_STONE_FACTOR: u32 = 2;
 const STIR_SPACING: f32 = 2.0;
 /// The weight of the small stones of a stir.
 const STIR_WEIGHT: i16 = 32;
-/// The papers' pool runs at 60 steps a second: waves cross a 160-pixel terminal in ~4 s.
+/// The papers' pool runs at 60 steps a second: waves cross a 160-pixel terminal in ~4 s (in
+/// ~8 s on a grid of two cells a pixel).
 pub const POOL_STEPS_PER_SECOND: f64 = 60.0;
 
 impl PoolScene {
     /// A still pool of `width x height` pixels.
     ///
-    /// Returns `None` when the size is zero or too large for a pixmap.
+    /// Returns `None` when the size is zero or too large for a pixmap (at the simulation's
+    /// resolution), or the grid or the pace is out of range.
     pub fn new(width: u32, height: u32, settings: PoolSettings) -> Option<PoolScene> {
-        let fitted = background::cover(&settings.floor, width, height)?;
+        let grid = check_grid(u64::from(settings.grid)).ok()?;
+        let steps_per_second = check_steps_per_second(u64::from(settings.steps_per_second)).ok()?;
+        let (cols, rows) = (width.checked_mul(grid)?, height.checked_mul(grid)?);
+        let fitted = background::cover(&settings.floor, cols, rows)?;
+        let fine = if grid > 1 { Some(Pixmap::new(cols, rows)?) } else { None };
         Some(PoolScene {
-            pool: RipplePool::new(width as usize, height as usize, settings.damping),
+            pool: RipplePool::new(cols as usize, rows as usize, settings.damping),
             rain: Rain::new(settings.rain_rate, settings.seed),
-            breeze: Breeze::new(settings.breeze, settings.seed),
-            renderer: PoolRenderer::new(fitted, settings.look),
+            wind: Wind::new(settings.breeze_style, settings.breeze, settings.seed, grid),
+            renderer: PoolRenderer::on_grid(fitted, settings.look, grid),
             floor: settings.floor,
             drops: Vec::new(),
+            size: (width, height),
+            grid,
+            steps_per_second,
+            fine,
+            field: Vec::new(),
+            gust_heights: Vec::new(),
             rain_when_on: if settings.rain_rate > 0.0 { settings.rain_rate } else { DEFAULT_TOGGLE_RAIN },
             breeze_when_on: if settings.breeze > 0.0 { settings.breeze } else { crate::sim::breeze::DEFAULT_LEVEL },
         })
     }
 
-    /// Width in pixels (= cells).
+    /// Width in pixels.
     pub fn width(&self) -> u32 {
-        self.pool.width() as u32
+        self.size.0
     }
 
-    /// Height in pixels (= cells).
+    /// Height in pixels.
     pub fn height(&self) -> u32 {
-        self.pool.height() as u32
+        self.size.1
     }
 
-    /// The water.
+    /// Simulation cells per pixel along each axis.
+    pub fn grid(&self) -> u32 {
+        self.grid
+    }
+
+    /// The water (`grid` times the picture's size in cells).
     pub fn pool(&self) -> &RipplePool {
         &self.pool
     }
@@ -115,33 +235,52 @@ impl PoolScene {
         self.renderer.set_simd(simd);
     }
 
-    /// Drops a stone now.
+    /// Drops a stone now; its centre and radius are in pixels (on a finer grid it covers the
+    /// same pixels' cells).
     pub fn drop_stone(&mut self, stone: Stone) {
-        self.pool.drop_stone(stone);
+        self.pool.drop_stone(self.in_cells(stone));
     }
 
-    /// `steps` simulation steps: each step the breeze adds its wave packets, the raindrops
-    /// land, then the water moves.
+    /// A stone given in pixels, in the simulation's cells.
+    fn in_cells(&self, stone: Stone) -> Stone {
+        match self.grid {
+            1 => stone,
+            g => {
+                let centre = |v: i32| v.saturating_mul(g as i32).saturating_add(g as i32 / 2);
+                Stone::clamped(centre(stone.x()), centre(stone.y()), stone.radius().saturating_mul(g), stone.weight())
+            }
+        }
+    }
+
+    /// `steps` simulation steps: each step the breeze adds its wave packets (or the gusts
+    /// age), the raindrops land, then the water moves.
     ///
     /// The rain is drawn step by step (so the random stream is the same as single steps), and
     /// the calm runs between raindrops go to [`RipplePool::advance`] in one piece, which
-    /// computes them many times faster than single steps. A breeze touches every step, so with
-    /// one the steps run one at a time.
+    /// computes them many times faster than single steps. The first breeze's wavelets touch
+    /// every step, so with them the steps run one at a time; the gusts are not in the pool.
     pub fn advance(&mut self, steps: u64) {
-        let (width, height) = (self.pool.width(), self.pool.height());
-        let breezy = self.breeze.level() > 0.0;
+        let (width, height) = (self.size.0 as usize, self.size.1 as usize);
+        let (cols, rows) = (self.pool.width(), self.pool.height());
+        let wavelets = matches!(&self.wind, Wind::Wavelets(b) if b.level() > 0.0);
         let mut calm = 0;
         for _ in 0..steps {
+            if let Wind::Gusts(gusts) = &mut self.wind {
+                gusts.step(cols, rows);
+            }
             self.drops.clear();
             self.rain.drops(width, height, &mut self.drops);
-            if self.drops.is_empty() && !breezy {
+            if self.drops.is_empty() && !wavelets {
                 calm += 1;
                 continue;
             }
             self.pool.advance(calm);
             calm = 0;
-            self.breeze.excite(&mut self.pool);
-            for &drop in &self.drops {
+            if let Wind::Wavelets(breeze) = &mut self.wind {
+                breeze.excite(&mut self.pool);
+            }
+            for k in 0..self.drops.len() {
+                let drop = self.in_cells(self.drops[k]);
                 self.pool.drop_stone(drop);
             }
             self.pool.advance(1);
@@ -149,32 +288,79 @@ impl PoolScene {
         self.pool.advance(calm);
     }
 
+    /// Adds the gusts' ripples to the pool's heights in `self.field`, when there are any;
+    /// returns
+    /// whether it did (otherwise the picture shows the pool's own heights).
+    fn compose(&mut self) -> bool {
+        let Wind::Gusts(gusts) = &mut self.wind else { return false };
+        if gusts.is_calm() {
+            return false;
+        }
+        let (cols, rows) = (self.pool.width(), self.pool.height());
+        self.gust_heights.clear();
+        self.gust_heights.resize(cols * rows, 0.0);
+        gusts.add_to(&mut self.gust_heights, cols, rows);
+        self.field.clear();
+        self.field.extend(
+            self.pool
+                .heights()
+                .iter()
+                .zip(&self.gust_heights)
+                .map(|(&h, &s)| (f32::from(h) + s).round().clamp(f32::from(i16::MIN), f32::from(i16::MAX)) as i16),
+        );
+        true
+    }
+
     /// Draws the current water into `out`, which must have the scene's size.
     pub fn render(&mut self, out: &mut Pixmap) {
-        self.renderer.render(&self.pool, out);
+        let heights = if self.compose() { &self.field[..] } else { self.pool.heights() };
+        match &mut self.fine {
+            None => self.renderer.render_heights(heights, out),
+            Some(fine) => {
+                self.renderer.render_heights(heights, fine);
+                downsample(fine, self.grid, Downsample::Box, out);
+            }
+        }
     }
 
     /// Starts over at a new size: still water, the floor refitted, the rain continuing.
     ///
     /// Returns `false` (and changes nothing) when the size is zero or too large.
     pub fn resize(&mut self, width: u32, height: u32) -> bool {
-        let Some(fitted) = background::cover(&self.floor, width, height) else {
+        let g = self.grid;
+        let Some((cols, rows)) = width.checked_mul(g).zip(height.checked_mul(g)) else {
             return false;
         };
+        let Some(fitted) = background::cover(&self.floor, cols, rows) else {
+            return false;
+        };
+        let fine = match g {
+            1 => None,
+            _ => match Pixmap::new(cols, rows) {
+                Some(p) => Some(p),
+                None => return false,
+            },
+        };
         let damping = self.pool.damping();
-        self.pool = RipplePool::new(width as usize, height as usize, damping);
-        self.renderer = PoolRenderer::new(fitted, self.renderer.look());
+        self.pool = RipplePool::new(cols as usize, rows as usize, damping);
+        self.renderer = PoolRenderer::on_grid(fitted, self.renderer.look(), g);
+        self.fine = fine;
+        self.size = (width, height);
+        if let Wind::Gusts(gusts) = &mut self.wind {
+            gusts.clear();
+        }
         true
     }
 
-    /// The current amplitudes as a heightmap (raw amplitude units, one PNG level each).
+    /// The current heights as a heightmap, one value per simulation cell (raw amplitude
+    /// units, one PNG level each; the gusts' ripples included).
     pub fn heightmap(&self) -> Heightmap {
-        Heightmap {
-            width: self.pool.width(),
-            height: self.pool.height(),
-            values: self.pool.heights().iter().map(|&v| f32::from(v)).collect(),
-            png_levels_per_unit: 1.0,
+        let mut values: Vec<f32> = self.pool.heights().iter().map(|&v| f32::from(v)).collect();
+        if let Wind::Gusts(gusts) = &self.wind {
+            let mut gusts = gusts.clone();
+            gusts.add_to(&mut values, self.pool.width(), self.pool.height());
         }
+        Heightmap { width: self.pool.width(), height: self.pool.height(), values, png_levels_per_unit: 1.0 }
     }
 }
 
@@ -224,7 +410,7 @@ impl Scene for PoolScene {
     }
 
     fn steps_per_second(&self) -> f64 {
-        POOL_STEPS_PER_SECOND
+        f64::from(self.steps_per_second)
     }
 
     fn advance(&mut self, steps: u64) {
@@ -249,9 +435,14 @@ impl Scene for PoolScene {
                 if level > 0.0 {
                     self.breeze_when_on = level;
                 }
-                self.breeze.set_level(level);
+                self.wind.set_level(level);
             }
-            Event::Clear => self.pool.clear(),
+            Event::Clear => {
+                self.pool.clear();
+                if let Wind::Gusts(gusts) = &mut self.wind {
+                    gusts.clear();
+                }
+            }
             Event::Resize([w, h]) => {
                 PoolScene::resize(self, w, h);
             }
@@ -305,7 +496,7 @@ impl Controls for PoolScene {
                 vec![Event::Damping(if stronger { d.stronger() } else { d.weaker() })]
             }
             Action::Key('b') => {
-                let level = if self.breeze.level() > 0.0 { 0.0 } else { self.breeze_when_on };
+                let level = if self.wind.level() > 0.0 { 0.0 } else { self.breeze_when_on };
                 vec![Event::Breeze(level)]
             }
             Action::Key(_) => Vec::new(),
@@ -319,8 +510,8 @@ impl Controls for PoolScene {
             rate if rate > 0.0 => write!(out, "rain {rate}"),
             _ => write!(out, "rain off"),
         };
-        if self.breeze.level() > 0.0 {
-            let _ = write!(out, " \u{b7} breeze {}", self.breeze.level());
+        if self.wind.level() > 0.0 {
+            let _ = write!(out, " \u{b7} breeze {}", self.wind.level());
         }
         let _ = write!(out, " \u{b7} damping {}", self.pool.damping());
     }

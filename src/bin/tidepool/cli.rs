@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use tidepool::{CausticsLook, Damping, Refraction, SceneKind, Size, Stone, Sun, ValueError, values};
+use tidepool::{BreezeStyle, CausticsLook, Damping, Refraction, SceneKind, Size, Stone, Sun, ValueError, values};
 
 pub mod lake;
 pub mod ocean;
@@ -214,7 +214,38 @@ impl From<GraphicsChoice> for tidepool::player::probe::GraphicsRequest {
 }
 
 /// The player's default `--damping`.
-pub const PLAYER_DAMPING: &str = "6";
+pub const PLAYER_DAMPING: &str = "7";
+
+/// The pool flags' defaults where `render` and the live scenes (`play`, `serve`) differ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PoolDefaults {
+    /// `--rain`.
+    pub rain: f64,
+    /// `--breeze`.
+    pub breeze: f64,
+    /// `--breeze-style`.
+    pub breeze_style: BreezeStyle,
+    /// `--grid`.
+    pub grid: u32,
+    /// `--steps-per-second`.
+    pub steps_per_second: u32,
+}
+
+impl PoolDefaults {
+    /// `render pool`: the papers' still water, one cell a pixel, 60 steps a second.
+    pub const RENDER: PoolDefaults =
+        PoolDefaults { rain: 0.0, breeze: 0.0, breeze_style: BreezeStyle::Wavelets, grid: 1, steps_per_second: 60 };
+    /// `play` and `serve`: water alive at rest that moves like water filmed at 30 fps: rain
+    /// you can see, gusts of ripples, a grid of two cells a pixel and 30 steps a second, so
+    /// waves move a third of a pixel a frame instead of 1.4 pixels.
+    pub const PLAYER: PoolDefaults = PoolDefaults {
+        rain: 0.05,
+        breeze: values::DEFAULT_BREEZE,
+        breeze_style: BreezeStyle::Gusts,
+        grid: 2,
+        steps_per_second: 30,
+    };
+}
 
 /// The scenes `play` knows; `tab` cycles through them in this order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -327,7 +358,7 @@ pub struct RenderPool {
     /// Re-simulate a session recorded with `tidepool play --record FILE` and render its last
     /// step (or --steps N): identical to a screenshot taken at that step. The replay fixes the
     /// size, seed, stones and water flags.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "grid", "breeze_style", "steps_per_second", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
     pub replay: Option<PathBuf>,
 
     /// An animation instead of one picture.
@@ -403,6 +434,26 @@ pub struct PoolArgs {
     #[arg(long, value_name = "LEVEL", value_parser = parse_breeze, allow_negative_numbers = true)]
     pub breeze: Option<f64>,
 
+    /// How the breeze moves the water: `gusts` (patches of ripples that rise and fade over
+    /// seconds as they drift downwind: water as a camera films it at 30 fps) or `wavelets`
+    /// (short wavelets that appear at once; the first breeze). [default: wavelets for render,
+    /// gusts for play]
+    #[arg(long, value_name = "STYLE", value_parser = parse_breeze_style)]
+    pub breeze_style: Option<BreezeStyle>,
+
+    /// Simulation cells per picture pixel along each axis (1..=4): a finer grid moves the
+    /// waves 1/N pixels a step (they cross the picture N times slower, as if filmed from
+    /// further away) and draws each pixel as the mean of its cells; 1 is the papers' pool, one
+    /// cell a pixel. [default: 1 for render, 2 for play]
+    #[arg(long, value_name = "N", value_parser = parse_grid)]
+    pub grid: Option<u32>,
+
+    /// Simulation steps per second of real time (1..=240): the pool's pace in the player and
+    /// in animations (waves move 0.7/N pixels a step on a grid of N). [default: 60 for render,
+    /// 30 for play]
+    #[arg(long, value_name = "STEPS", value_parser = parse_steps_per_second)]
+    pub steps_per_second: Option<u32>,
+
     /// Damping: each step the water loses 1/2^SHIFT of its amplitude (SHIFT 1..=15; higher
     /// calms more slowly), or `off` for none.
     #[arg(long, value_name = "SHIFT|off", default_value = "5", value_parser = parse_damping, allow_negative_numbers = true)]
@@ -451,14 +502,17 @@ impl PoolArgs {
         }
     }
 
-    /// The pool's settings from these flags, with `seed`, and the rain and breeze when
-    /// `--rain` and `--breeze` are not given; the floor is `--background` decoded, or the
-    /// built-in tiles.
-    pub fn settings(&self, seed: u64, defaults: (f64, f64)) -> crate::error::Result<tidepool::PoolSettings> {
+    /// The pool's settings from these flags, with `seed`, and `defaults` for the flags not
+    /// given (rain, breeze, its style and the grid); the floor is `--background` decoded, or
+    /// the built-in tiles.
+    pub fn settings(&self, seed: u64, defaults: PoolDefaults) -> crate::error::Result<tidepool::PoolSettings> {
         Ok(tidepool::PoolSettings {
             damping: self.damping,
-            rain_rate: self.rain.unwrap_or(defaults.0),
-            breeze: self.breeze.unwrap_or(defaults.1),
+            rain_rate: self.rain.unwrap_or(defaults.rain),
+            breeze: self.breeze.unwrap_or(defaults.breeze),
+            breeze_style: self.breeze_style.unwrap_or(defaults.breeze_style),
+            grid: self.grid.unwrap_or(defaults.grid),
+            steps_per_second: self.steps_per_second.unwrap_or(defaults.steps_per_second),
             seed,
             look: self.look(),
             floor: self.floor()?,
@@ -533,6 +587,21 @@ pub fn parse_rate(text: &str) -> Result<f64, String> {
 /// Parses a breeze level, 0..=4.
 pub fn parse_breeze(text: &str) -> Result<f64, String> {
     values::parse_breeze(text).map_err(|e| e.to_string())
+}
+
+/// Parses a breeze style: `gusts` or `wavelets`.
+pub fn parse_breeze_style(text: &str) -> Result<BreezeStyle, String> {
+    check(text)
+}
+
+/// Parses a pace, 1..=240 simulation steps a second.
+pub fn parse_steps_per_second(text: &str) -> Result<u32, String> {
+    values::parse_steps_per_second(text).map_err(|e| e.to_string())
+}
+
+/// Parses a grid, 1..=4 simulation cells per pixel.
+pub fn parse_grid(text: &str) -> Result<u32, String> {
+    values::parse_grid(text).map_err(|e| e.to_string())
 }
 
 /// Parses a refraction factor (finite, 0..=100) or `auto`.
