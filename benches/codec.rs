@@ -35,9 +35,12 @@
 //!     CODEC=cpu cargo bench --bench codec      # the CPU figures only
 //!     CODEC=stale cargo bench --bench codec    # PSNR and SSIM of the true frame k frames late
 //!     CODEC=quick cargo bench --bench codec    # the shipped encoder on the pool clip, for tuning
+//!                                              # (CODEC_MODE=256, CODEC_CLIPS, CODEC_SERIES=1)
 //!
 //! `CODEC_CLIPS=pool,lake` limits the table to some clips (names: pool, stones, ocean, lake);
-//! `CODEC_POOL=FILE` replaces the pool clip's replay (to try other looks on the same session).
+//! `CODEC_POOL=FILE` replaces the pool clip's replay (to try other looks on the same session:
+//! edit a copy's header); `CODEC_SERIES=1` with `CODEC=quick` prints SSIM second by second,
+//! the shipped encoder's and the scan-order baseline's.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::hint::black_box;
@@ -545,25 +548,42 @@ fn stale() {
     }
 }
 
-/// The shipped encoder alone on the pool clip, for trying changes.
+/// The shipped encoder (and with `CODEC_SERIES=1` the scan-order baseline beside it) on the
+/// pool clip, or the clips `CODEC_CLIPS` names, in truecolor (`CODEC_MODE=256`: 256 colours),
+/// for trying changes.
 fn quick() {
-    let clip = pool_clip("pool", "pool-160x48.jsonl");
-    let frames: Vec<Frame> = (0..clip.pictures.len()).map(|k| clip.frame(k, ColorMode::TrueColor, 1)).collect();
-    for rate in [Some(25e3), Some(50e3), Some(100e3), Some(250e3), Some(500e3), Some(2e6), None] {
-        let t = Instant::now();
-        let r = run(&clip, &frames, ColorMode::TrueColor, rate, Sender::Rate(Strategy::ErrorPerByte));
-        println!(
-            "{:>9}: sent {:.1} kB/s, SSIM {:.3}, PSNR {:.2} dB, 5th pct {:.2} ({:.1} s)",
-            rate.map_or("unlimited".into(), |r| format!("{:.0} kB/s", r / 1e3)),
-            r.bytes as f64 / clip.seconds() / 1000.0,
-            Run::mean(&r.ssim),
-            Run::mean(&r.psnr),
-            percentile(&r.psnr, 0.05),
-            t.elapsed().as_secs_f64()
-        );
-        if std::env::var_os("CODEC_SERIES").is_some() {
-            let seconds: Vec<String> = r.ssim.chunks(FPS as usize).map(|s| format!("{:.2}", Run::mean(s))).collect();
-            println!("           SSIM second by second: {}", seconds.join(" "));
+    let mode = match std::env::var("CODEC_MODE").as_deref() {
+        Ok("256") => ColorMode::Palette256,
+        _ => ColorMode::TrueColor,
+    };
+    let series = std::env::var_os("CODEC_SERIES").is_some();
+    let clips = match std::env::var_os("CODEC_CLIPS") {
+        Some(_) => clips(),
+        None => vec![pool_clip("pool", "pool-160x48.jsonl")],
+    };
+    for clip in &clips {
+        println!("{} in {}:", clip.name, mode.name());
+        let frames: Vec<Frame> = (0..clip.pictures.len()).map(|k| clip.frame(k, mode, 1)).collect();
+        for rate in [Some(25e3), Some(50e3), Some(100e3), Some(250e3), Some(500e3), Some(2e6), None] {
+            let t = Instant::now();
+            let r = run(clip, &frames, mode, rate, Sender::Rate(Strategy::ErrorPerByte));
+            println!(
+                "{:>9}: sent {:.1} kB/s, SSIM {:.3}, PSNR {:.2} dB, 5th pct {:.2} ({:.1} s)",
+                rate.map_or("unlimited".into(), |r| format!("{:.0} kB/s", r / 1e3)),
+                r.bytes as f64 / clip.seconds() / 1000.0,
+                Run::mean(&r.ssim),
+                Run::mean(&r.psnr),
+                percentile(&r.psnr, 0.05),
+                t.elapsed().as_secs_f64()
+            );
+            if series {
+                let by_second = |r: &Run| -> String {
+                    r.ssim.chunks(FPS as usize).map(|s| format!("{:.2}", Run::mean(s))).collect::<Vec<_>>().join(" ")
+                };
+                println!("           SSIM second by second: {}", by_second(&r));
+                let scan = run(clip, &frames, mode, rate, Sender::Rate(Strategy::ScanOrder));
+                println!("           scan order ({:.3}):       {}", Run::mean(&scan.ssim), by_second(&scan));
+            }
         }
     }
 }

@@ -98,7 +98,7 @@ pub struct LightMap {
     windows: Vec<Window>,
     /// For a pool finer than its picture: the heights averaged to one value a pixel, and
     /// their light (see [`LightMap::compute_on_grid`]).
-    coarse: Option<Box<(Vec<i16>, LightMap)>>,
+    coarse: Option<Box<Coarse>>,
 }
 
 impl LightMap {
@@ -108,15 +108,29 @@ impl LightMap {
         self.gains[(y >> self.shift) * self.width + (x >> self.shift)]
     }
 
-    /// Recomputes the light of the `width x height` pool `heights`. Rows are split across
-    /// threads for large pools; the result does not depend on the split.
+    /// [`LightMap::compute_in_units`] of a pool's own heights.
+    #[cfg(test)]
+    pub fn compute(&mut self, heights: &[i16], width: usize, height: usize, look: CausticsLook, simd: Simd) {
+        self.compute_in_units(heights, width, height, (look, 1.0), simd);
+    }
+
+    /// Recomputes the light of the `width x height` pool `heights`, which hold `units` per
+    /// amplitude unit (1: the pool's own; more: heights at a finer precision). Rows are split
+    /// across threads for large pools; the result does not depend on the split.
     ///
     /// The heights are first smoothed with the binomial filter [1 4 6 4 1] along rows and
     /// columns: the integer scheme carries a grid-scale texture whose curvature would otherwise
     /// turn into glitter (the filter removes the checkerboard exactly and keeps ripples of
     /// eight cells and more). The three passes (along rows, along columns, the Jacobian) run
     /// fused over a few cached rows, so only the heights and the result cross main memory.
-    pub fn compute(&mut self, heights: &[i16], width: usize, height: usize, look: CausticsLook, simd: Simd) {
+    pub fn compute_in_units(
+        &mut self,
+        heights: &[i16],
+        width: usize,
+        height: usize,
+        (look, units): (CausticsLook, f32),
+        simd: Simd,
+    ) {
         self.shift = u32::from(width * height >= HALF_RESOLUTION_FROM);
         let step = 1usize << self.shift;
         (self.width, self.height) = (width.div_ceil(step), height.div_ceil(step));
@@ -128,7 +142,8 @@ impl LightMap {
         // det J with J = I + k·H', where H' is the stencil sum on the smoothed field (which is
         // 256x the heights, sampled every `step` cells): the Hessian in amplitude units per
         // cell² is H' / (256·step²).
-        let k = look.depth_px * (1.0 - 1.0 / WATER_INDEX) / AMPLITUDE_PER_PIXEL / (256.0 * (step * step) as f32);
+        let k =
+            look.depth_px * (1.0 - 1.0 / WATER_INDEX) / (AMPLITUDE_PER_PIXEL * units) / (256.0 * (step * step) as f32);
         let field = Field { heights, width, height, rows, step };
         let parallel = width * height >= (1 << 16);
         // Each task smooths a few rows beyond its own (its halo): tasks of 16 rows or more
@@ -158,26 +173,27 @@ impl LightMap {
 }
 
 impl LightMap {
-    /// The light of a pool of `grid x grid` cells a pixel, `width x height` cells: computed
-    /// on the heights averaged over each pixel's cells (so the caustics have the shapes, the
-    /// smoothing and the depth in pixels they have on a pool of one cell a pixel), then spread
-    /// back over the cells bilinearly. The result has one entry a cell. Grid 1 is
-    /// [`LightMap::compute`].
+    /// The light of a pool of `grid x grid` cells a pixel, `width x height` cells, whose
+    /// heights hold `look.1` units per amplitude unit: computed on the heights averaged over
+    /// each pixel's cells (so the caustics have the shapes, the smoothing and the depth in
+    /// pixels they have on a pool of one cell a pixel), then spread back over the cells
+    /// bilinearly. The result has one entry a cell. Grid 1 is
+    /// [`LightMap::compute_in_units`].
     pub fn compute_on_grid(
         &mut self,
         heights: &[i16],
         (width, height): (usize, usize),
         grid: usize,
-        look: CausticsLook,
+        look: (CausticsLook, f32),
         simd: Simd,
     ) {
         if grid <= 1 {
-            self.compute(heights, width, height, look, simd);
+            self.compute_in_units(heights, width, height, look, simd);
             return;
         }
         let (cols, rows) = (width / grid, height / grid);
         let coarse = self.coarse.get_or_insert_with(Box::default);
-        let (means, light) = &mut **coarse;
+        let Coarse { means, light, columns, line } = &mut **coarse;
         // The means with a margin of PAD pixels around them, continued by odd reflection
         // (h(-d) = 2·h(0) - h(d)): a slope runs on past the edge instead of folding back, so
         // the edge draws no false caustic line (repeating the edge value would bend every
@@ -216,28 +232,43 @@ impl LightMap {
                     reflect(at(means, bottom), at(means, bottom.saturating_sub(d).max(top)));
             }
         }
-        light.compute(means, padded_cols, padded_rows, look, simd);
-        // Each cell's light from the four nearest pixels' (cell centres at (x + 1/2) / grid).
+        light.compute_in_units(means, padded_cols, padded_rows, look, simd);
+        // Each cell's light from the four nearest pixels' (cell centres at (x + 1/2) / grid),
+        // in 1/256 steps: the rows blended first, then the columns.
         self.shift = 0;
         (self.width, self.height) = (width, height);
         self.gains.resize(width * height, UNIT_GAIN);
-        let taps = |n: usize, size: usize| -> (usize, usize, f32) {
-            let at = ((n as f32 + 0.5) / grid as f32 - 0.5).clamp(0.0, (size - 1) as f32);
-            let lo = at as usize;
-            (lo + PAD, (lo + 1).min(size - 1) + PAD, at - lo as f32)
+        let tap = |n: usize, size: usize| -> (usize, usize, u32) {
+            let at = (((2 * n + 1) * 128 / grid) as i64 - 128).clamp(0, 256 * (size as i64 - 1)) as usize;
+            let lo = at >> 8;
+            (lo + PAD, (lo + 1).min(size - 1) + PAD, (at & 255) as u32)
         };
+        columns.clear();
+        columns.extend((0..width).map(|x| tap(x, cols)));
+        line.resize(padded_cols, 0);
         for y in 0..height {
-            let (y0, y1, fy) = taps(y, rows);
+            let (y0, y1, wy) = tap(y, rows);
+            for (x, v) in line.iter_mut().enumerate() {
+                *v = u32::from(light.gain(x, y0)) * (256 - wy) + u32::from(light.gain(x, y1)) * wy;
+            }
             let out = &mut self.gains[y * width..(y + 1) * width];
-            for (x, gain) in out.iter_mut().enumerate() {
-                let (x0, x1, fx) = taps(x, cols);
-                let g = |x: usize, y: usize| f32::from(light.gain(x, y));
-                let top = g(x0, y0) + (g(x1, y0) - g(x0, y0)) * fx;
-                let bottom = g(x0, y1) + (g(x1, y1) - g(x0, y1)) * fx;
-                *gain = (top + (bottom - top) * fy + 0.5) as u8;
+            for (gain, &(x0, x1, wx)) in out.iter_mut().zip(columns.iter()) {
+                *gain = ((line[x0] * (256 - wx) + line[x1] * wx + (1 << 15)) >> 16) as u8;
             }
         }
     }
+}
+
+/// What [`LightMap::compute_on_grid`] keeps between frames: the heights averaged per pixel
+/// (with a margin), their light, and the interpolation's taps and row.
+#[derive(Clone, Debug, Default)]
+struct Coarse {
+    means: Vec<i16>,
+    light: LightMap,
+    /// Per cell column: the two light columns it lies between and the weight of the second.
+    columns: Vec<(usize, usize, u32)>,
+    /// One row of light blended between two light rows, in 1/256.
+    line: Vec<u32>,
 }
 
 /// The margin of the light computed for a pool finer than its picture, in pixels: the

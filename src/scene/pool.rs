@@ -6,7 +6,7 @@ use super::{Action, Controls, Event, Scene, SceneKind};
 use crate::error::{Error, Result};
 use crate::output::heightmap::Heightmap;
 use crate::render::background;
-use crate::render::pool::{PoolLook, PoolRenderer};
+use crate::render::pool::{Fields, PoolLook, PoolRenderer};
 use crate::render::supersample::{Downsample, downsample};
 use crate::sim::breeze::gusts::{GustShape, Gusts};
 use crate::sim::breeze::{Breeze, BreezeStyle};
@@ -82,6 +82,40 @@ pub fn parse_steps_per_second(text: &str) -> std::result::Result<u32, crate::err
     check_steps_per_second(steps)
 }
 
+/// Height units per amplitude unit of the pictures of a pool with gusts: the gusts' ripples
+/// are smooth, and rounding them to whole amplitude units would flicker a unit here and there
+/// every frame as they move (a unit of slope is a step of shading), which costs every cell
+/// on the wire and looks like grain. The pool's own heights are whole units; piles of stones
+/// deeper than 32767 / 4 saturate in the picture (not in the water).
+pub const GUST_UNITS: u32 = 4;
+
+/// How much of the gusts' swells displaces the floor (all of them light it), a departure from
+/// optics chosen by measuring: the floor's tiles are drawn sharp, and a swell sliding them a
+/// fraction of a pixel changes their edges' pixels every frame, structure that a slow link
+/// cannot keep up with (SSIM at 50 kB/s 0.70 with the full displacement, 0.73 with this share,
+/// on the codec benchmark's pool), while the light a swell focuses drifts smoothly.
+pub const GUST_REFRACTION: f32 = 0.3;
+
+/// `heights` plus `share` of `ripples`, in [`GUST_UNITS`] a unit, rounded to the nearest unit
+/// (floor(v + 1/2) by truncating a positive number: a conversion the compiler vectorizes;
+/// `round` is a call), into `out`.
+fn fill_units(out: &mut Vec<i16>, heights: &[i16], ripples: &[f32], share: f32) {
+    let (lowest, highest, units) = (f32::from(i16::MIN), f32::from(i16::MAX), GUST_UNITS as f32);
+    out.clear();
+    out.extend(heights.iter().zip(ripples).map(|(&h, &r)| {
+        let v = ((f32::from(h) + share * r) * units).clamp(lowest, highest);
+        ((v - lowest + 0.5) as i32 + i32::from(i16::MIN)).min(i32::from(i16::MAX)) as i16
+    }));
+}
+
+/// The units of the pictures of a pool whose breeze is `style`.
+fn units_for(style: BreezeStyle) -> u32 {
+    match style {
+        BreezeStyle::Wavelets => 1,
+        BreezeStyle::Gusts => GUST_UNITS,
+    }
+}
+
 /// The finest simulation grid, in cells per pixel along each axis.
 pub const MAX_GRID: u32 = 4;
 
@@ -155,6 +189,7 @@ pub struct PoolScene {
     fine: Option<Pixmap>,
     /// The pool's heights with the gusts' ripples added (amplitude units), and those alone.
     field: Vec<i16>,
+    refraction: Vec<i16>,
     gust_heights: Vec<f32>,
     /// The rate `r` switches the rain back on to.
     rain_when_on: f64,
@@ -194,7 +229,7 @@ impl PoolScene {
             pool: RipplePool::new(cols as usize, rows as usize, settings.damping),
             rain: Rain::new(settings.rain_rate, settings.seed),
             wind: Wind::new(settings.breeze_style, settings.breeze, settings.seed, grid),
-            renderer: PoolRenderer::on_grid(fitted, settings.look, grid),
+            renderer: PoolRenderer::on_grid(fitted, settings.look, grid, units_for(settings.breeze_style)),
             floor: settings.floor,
             drops: Vec::new(),
             size: (width, height),
@@ -202,6 +237,7 @@ impl PoolScene {
             steps_per_second,
             fine,
             field: Vec::new(),
+            refraction: Vec::new(),
             gust_heights: Vec::new(),
             rain_when_on: if settings.rain_rate > 0.0 { settings.rain_rate } else { DEFAULT_TOGGLE_RAIN },
             breeze_when_on: if settings.breeze > 0.0 { settings.breeze } else { crate::sim::breeze::DEFAULT_LEVEL },
@@ -288,36 +324,40 @@ impl PoolScene {
         self.pool.advance(calm);
     }
 
-    /// Adds the gusts' ripples to the pool's heights in `self.field`, when there are any;
-    /// returns
-    /// whether it did (otherwise the picture shows the pool's own heights).
+    /// Height units per amplitude unit of the picture's heights.
+    fn units(&self) -> u32 {
+        match self.wind {
+            Wind::Wavelets(_) => 1,
+            Wind::Gusts(_) => GUST_UNITS,
+        }
+    }
+
+    /// With gusts, the heights the picture shows, in [`GUST_UNITS`] a unit: the pool's and
+    /// the gusts' ripples in `self.field` (they light the floor), and in `self.refraction` the
+    /// pool's with [`GUST_REFRACTION`] of the ripples (they displace it). Returns whether it
+    /// made them (otherwise the picture shows the pool's own heights).
     fn compose(&mut self) -> bool {
         let Wind::Gusts(gusts) = &mut self.wind else { return false };
-        if gusts.is_calm() {
-            return false;
-        }
         let (cols, rows) = (self.pool.width(), self.pool.height());
         self.gust_heights.clear();
         self.gust_heights.resize(cols * rows, 0.0);
         gusts.add_to(&mut self.gust_heights, cols, rows);
-        self.field.clear();
-        self.field.extend(
-            self.pool
-                .heights()
-                .iter()
-                .zip(&self.gust_heights)
-                .map(|(&h, &s)| (f32::from(h) + s).round().clamp(f32::from(i16::MIN), f32::from(i16::MAX)) as i16),
-        );
+        let heights = self.pool.heights();
+        fill_units(&mut self.field, heights, &self.gust_heights, 1.0);
+        fill_units(&mut self.refraction, heights, &self.gust_heights, GUST_REFRACTION);
         true
     }
 
     /// Draws the current water into `out`, which must have the scene's size.
     pub fn render(&mut self, out: &mut Pixmap) {
-        let heights = if self.compose() { &self.field[..] } else { self.pool.heights() };
+        let fields = match self.compose() {
+            true => Fields { refraction: &self.refraction, light: &self.field },
+            false => Fields { refraction: self.pool.heights(), light: self.pool.heights() },
+        };
         match &mut self.fine {
-            None => self.renderer.render_heights(heights, out),
+            None => self.renderer.render_fields(fields, out),
             Some(fine) => {
-                self.renderer.render_heights(heights, fine);
+                self.renderer.render_fields(fields, fine);
                 downsample(fine, self.grid, Downsample::Box, out);
             }
         }
@@ -343,7 +383,7 @@ impl PoolScene {
         };
         let damping = self.pool.damping();
         self.pool = RipplePool::new(cols as usize, rows as usize, damping);
-        self.renderer = PoolRenderer::on_grid(fitted, self.renderer.look(), g);
+        self.renderer = PoolRenderer::on_grid(fitted, self.renderer.look(), g, self.units());
         self.fine = fine;
         self.size = (width, height);
         if let Wind::Gusts(gusts) = &mut self.wind {
@@ -548,9 +588,9 @@ mod tests {
     /// computed at half resolution on several threads.
     #[test]
     fn every_simd_tier_draws_the_same_pixels() {
-        for (w, h) in [(160u32, 94u32), (1024, 600)] {
+        for (w, h, pool) in [(160u32, 94u32, settings(0.4)), (1024, 600, settings(0.4)), (160, 94, coherent(2))] {
             let run = |simd: Simd| {
-                let mut scene = PoolScene::new(w, h, settings(0.4)).unwrap();
+                let mut scene = PoolScene::new(w, h, pool.clone()).unwrap();
                 scene.set_simd(simd);
                 for k in 0..12 {
                     scene.drop_stone(Stone::clamped((k * 37 % w) as i32, (k * 53 % h) as i32, 5, 300));
@@ -565,6 +605,72 @@ mod tests {
                 assert!(pixels == portable.1, "{w}x{h}: the picture on {simd} differs from portable");
             }
         }
+    }
+
+    fn coherent(grid: u32) -> PoolSettings {
+        PoolSettings {
+            grid,
+            steps_per_second: 30,
+            breeze: 1.0,
+            breeze_style: BreezeStyle::Gusts,
+            rain_rate: 0.3,
+            ..settings(0.0)
+        }
+    }
+
+    #[test]
+    fn a_finer_grid_takes_stones_in_pixels_and_moves_their_rings_slower() {
+        // The same stone in pixels on one and on two cells a pixel: the dent covers the same
+        // pixels, and after the same steps the ring has travelled the same cells, half the
+        // pixels.
+        let ring_radius = |grid: u32| {
+            let mut scene = PoolScene::new(80, 60, PoolSettings { grid, ..settings(0.0) }).unwrap();
+            scene.drop_stone(Stone::new(40, 30, 3, 128).unwrap());
+            let dent = scene.pool().heights().iter().filter(|&&v| v < 0).count() as f32;
+            let disc = std::f32::consts::PI * (3 * grid * 3 * grid) as f32;
+            assert!((dent / disc - 1.0).abs() < 0.25, "a disc of radius 3 pixels: {dent} cells on grid {grid}");
+            scene.advance(40);
+            // The ring's front: the farthest cell the wave has moved by a few units.
+            let (w, pool) = (scene.pool().width(), scene.pool());
+            let centre = (40.0 * grid as f32 + (grid / 2) as f32, 30.0 * grid as f32 + (grid / 2) as f32);
+            let front = pool.heights().iter().enumerate().filter(|&(_, &v)| v.abs() >= 4).map(|(i, _)| {
+                let (x, y) = ((i % w) as f32, (i / w) as f32);
+                (x - centre.0).hypot(y - centre.1)
+            });
+            front.fold(0f32, f32::max) / grid as f32
+        };
+        // 0.7 cells a step: 28 cells past the dent's edge (3 pixels = 3 or 6 cells).
+        let (one, two) = (ring_radius(1), ring_radius(2));
+        assert!((one - 31.0).abs() < 4.0, "{one} pixels after 40 steps on one cell a pixel");
+        assert!((two - 17.0).abs() < 3.0, "{two} pixels after 40 steps on two cells a pixel");
+        assert_eq!(PoolScene::new(10, 10, PoolSettings { grid: 5, ..settings(0.0) }).map(|s| s.grid()), None);
+    }
+
+    #[test]
+    fn gusts_move_the_water_at_rest_and_clearing_stills_them() {
+        let mut scene = PoolScene::new(80, 48, PoolSettings { rain_rate: 0.0, ..coherent(2) }).unwrap();
+        let calm = PoolSettings { rain_rate: 0.0, breeze: 0.0, ..coherent(2) };
+        let still = PoolScene::new(80, 48, calm).unwrap().snapshot().unwrap();
+        scene.advance(30);
+        assert!(scene.pool().heights().iter().all(|&v| v == 0), "the gusts are drawn, not put into the pool");
+        let breezy = scene.snapshot().unwrap();
+        let moved = breezy.pixels().iter().zip(still.pixels()).filter(|(a, b)| a != b).count();
+        assert!(moved > 80 * 48 / 10, "the gusts light the floor: {moved} pixels moved");
+        scene.apply(&Event::Clear);
+        assert!(scene.snapshot().unwrap().data() == still.data(), "clear stills the gusts too");
+        assert_eq!(scene.steps_per_second(), 30.0);
+    }
+
+    #[test]
+    fn grids_paces_and_styles_are_checked() {
+        assert_eq!(parse_grid(" 2 "), Ok(2));
+        assert!(parse_grid("5").unwrap_err().to_string().contains("outside 1..=4"));
+        assert!(parse_grid("1.5").unwrap_err().to_string().contains("whole number"));
+        assert_eq!(parse_steps_per_second("30"), Ok(30));
+        assert!(parse_steps_per_second("0").unwrap_err().to_string().contains("outside 1..=240"));
+        assert_eq!("gusts".parse(), Ok(BreezeStyle::Gusts));
+        assert_eq!("wavelets".parse(), Ok(BreezeStyle::Wavelets));
+        assert!("storm".parse::<BreezeStyle>().unwrap_err().to_string().contains("'gusts'"));
     }
 
     #[test]

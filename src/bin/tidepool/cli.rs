@@ -129,10 +129,10 @@ pub struct LiveSceneArgs {
     pub seed: u64,
 }
 
-/// The player's water is alive at rest: a light breeze, rain you can see, and stones whose
-/// rings cross the pool (damping shift 6, a little less than the papers' 5, because the
-/// breeze's wavelets keep the water moving; the rate-controlled encoder makes that affordable
-/// on any link).
+/// The player's water is alive at rest and coherent from frame to frame: gusts of broad swells
+/// of light, a few raindrops, stones whose rings spread crisp at a third of a pixel a frame (a
+/// grid of two cells a pixel, 30 steps a second; see [`PoolDefaults::PLAYER`]), the papers'
+/// damping.
 #[derive(Args, Debug, Clone)]
 #[command(after_help = PLAY_KEYS, mut_arg("damping", |a| a.default_value(PLAYER_DAMPING)))]
 pub struct PlayCommand {
@@ -214,7 +214,7 @@ impl From<GraphicsChoice> for tidepool::player::probe::GraphicsRequest {
 }
 
 /// The player's default `--damping`.
-pub const PLAYER_DAMPING: &str = "7";
+pub const PLAYER_DAMPING: &str = "5";
 
 /// The pool flags' defaults where `render` and the live scenes (`play`, `serve`) differ.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -235,11 +235,12 @@ impl PoolDefaults {
     /// `render pool`: the papers' still water, one cell a pixel, 60 steps a second.
     pub const RENDER: PoolDefaults =
         PoolDefaults { rain: 0.0, breeze: 0.0, breeze_style: BreezeStyle::Wavelets, grid: 1, steps_per_second: 60 };
-    /// `play` and `serve`: water alive at rest that moves like water filmed at 30 fps: rain
-    /// you can see, gusts of ripples, a grid of two cells a pixel and 30 steps a second, so
-    /// waves move a third of a pixel a frame instead of 1.4 pixels.
+    /// `play` and `serve`: water alive at rest that moves like water filmed at 30 fps and
+    /// survives a slow link: gusts (broad swells of light drifting downwind), a few raindrops,
+    /// a grid of two cells a pixel and 30 steps a second, so waves move a third of a pixel a
+    /// frame instead of 1.4 pixels (`tests/integration/coherence.rs`, `benches/codec.rs`).
     pub const PLAYER: PoolDefaults = PoolDefaults {
-        rain: 0.05,
+        rain: 0.01,
         breeze: values::DEFAULT_BREEZE,
         breeze_style: BreezeStyle::Gusts,
         grid: 2,
@@ -425,11 +426,11 @@ pub struct OutputArgs {
 #[derive(Args, Debug, Clone)]
 pub struct PoolArgs {
     /// Raindrops per simulation step on average (radius 2, weight 64), a number >= 0.
-    /// [default: 0 for render, 0.05 for play]
+    /// [default: 0 for render, 0.01 for play]
     #[arg(long, value_name = "RATE", value_parser = parse_rate, allow_negative_numbers = true)]
     pub rain: Option<f64>,
 
-    /// A light breeze of fine wavelets running over the water, so it is never still (0..=4;
+    /// A light breeze over the water, so it is never still (0..=4; its style is --breeze-style;
     /// 0 is the papers' still water). [default: 0 for render, 1 for play]
     #[arg(long, value_name = "LEVEL", value_parser = parse_breeze, allow_negative_numbers = true)]
     pub breeze: Option<f64>,
@@ -670,7 +671,15 @@ mod tests {
             assert!(parse_seed(bad).unwrap_err().contains("whole number"), "{bad}");
         }
         assert_eq!(parse_seed(" 42 "), Ok(42));
-        for flag in [&["--size", "10x10"][..], &["--seed", "3"], &["--stone", "1,2"], &["--damping", "4"]] {
+        for flag in [
+            &["--size", "10x10"][..],
+            &["--seed", "3"],
+            &["--stone", "1,2"],
+            &["--damping", "4"],
+            &["--grid", "2"],
+            &["--steps-per-second", "30"],
+            &["--breeze-style", "gusts"],
+        ] {
             let err = parse(&[&["--replay", "r.jsonl"][..], flag].concat()).unwrap_err();
             assert_eq!(err.kind(), clap::error::ErrorKind::ArgumentConflict, "{flag:?}");
         }
@@ -684,7 +693,13 @@ mod tests {
             (play.scene, play.fps, play.color, play.water.pool.rain),
             (PlayScene::Pool, 30, ColorChoice::Auto, None)
         );
-        assert_eq!(play.water.pool.damping.shift(), Some(6), "the player's own damping");
+        assert_eq!(play.water.pool.damping.shift(), Some(5), "the player's damping");
+        let pool = play.water.pool.settings(1, PoolDefaults::PLAYER).unwrap();
+        assert_eq!(
+            (pool.grid, pool.steps_per_second, pool.breeze_style, pool.breeze, pool.rain_rate),
+            (2, 30, BreezeStyle::Gusts, 1.0, 0.01),
+            "the player's coherent pool"
+        );
         assert_eq!(play.bandwidth, tidepool::player::Bandwidth::Auto);
         assert_eq!(play.graphics, GraphicsChoice::Auto, "pictures in real pixels where the terminal answers");
         for (flag, want) in
@@ -698,6 +713,12 @@ mod tests {
         let cli = Cli::try_parse_from(["tidepool", "render", "pool"]).unwrap();
         let Some(Command::Render(RenderCommand { scene: RenderScene::Pool(pool) })) = cli.command else { panic!() };
         assert_eq!(pool.pool.damping, Damping::PAPERS);
+        let render = pool.pool.settings(1, PoolDefaults::RENDER).unwrap();
+        assert_eq!(
+            (render.grid, render.steps_per_second, render.breeze_style, render.breeze, render.rain_rate),
+            (1, 60, BreezeStyle::Wavelets, 0.0, 0.0),
+            "render draws the papers' pool"
+        );
         assert!(Cli::try_parse_from(["tidepool", "play", "--fps", "0"]).is_err());
         assert!(Cli::try_parse_from(["tidepool", "play", "--color", "256"]).is_ok());
     }

@@ -15,9 +15,11 @@
 //! a time, and stepping costs nothing: only the list of live packets changes. Packets travel at
 //! the scheme's own wave speed (`1/√2` cells a step), so the ripples and the rings move alike.
 //!
-//! A packet is a cosine under an isotropic Gaussian envelope; both factor into a function of
-//! the column times a function of the row (`Re(X(x)·Y(y))` with complex `X`, `Y`), so a packet
-//! costs two multiplications and a subtraction per cell it covers. Everything is `f32` through
+//! A packet is a cosine under a compact envelope, `(1 - (dx/r)²)²·(1 - (dy/r)²)²` within `r` of
+//! its centre and 0 beyond (the water outside every packet is exactly still, which is what an
+//! encoder of changed cells needs); both factor into a function of the column times a function
+//! of the row (`Re(X(x)·Y(y))` with complex `X`, `Y`), so a packet costs two multiplications and
+//! a subtraction per cell it covers. Everything is `f32` through
 //! `libm` in a fixed order, and the stream of packets is ChaCha8 from the scene's seed: the
 //! same seed gives the same water on every machine.
 
@@ -33,7 +35,7 @@ pub struct GustShape {
     pub life_steps: u32,
     /// The range wavelengths are drawn from, in cells.
     pub wavelength_cells: (f32, f32),
-    /// The envelope's standard deviation, in wavelengths.
+    /// The envelope's half-width, in wavelengths.
     pub envelope_waves: f32,
     /// The crest amplitude at level 1 at the peak of a packet's life, in amplitude units.
     pub amplitude_at_level_1: f32,
@@ -44,15 +46,20 @@ pub struct GustShape {
 }
 
 impl Default for GustShape {
-    /// The player's gusts, tuned by looking at 160x94 pixels on a grid of two cells a pixel
-    /// at 30 steps a second (and by the coherence measure, `tests/integration/coherence.rs`).
+    /// The player's gusts: broad, low swells of light, 60 to 120 pixels long, each over a patch
+    /// 1.2 wavelengths across either way of its centre, three alive per 10,000 pixels, living
+    /// ten seconds at the player's 30 steps a second. Chosen by looking at 160x94 pixels on a
+    /// grid of two cells a pixel, and by measuring (`tests/integration/coherence.rs`,
+    /// `benches/codec.rs`): shorter wavelets, or more of them, kept the water as alive but cost
+    /// the rate-controlled encoder far more (every cell they cover changes every frame), and
+    /// their structure is what SSIM weighs; broad light moves are what it forgives.
     fn default() -> Self {
         GustShape {
-            packets_per_10k_cells: 20.0,
+            packets_per_10k_cells: 3.0,
             life_steps: 300,
-            wavelength_cells: (10.0, 20.0),
-            envelope_waves: 0.7,
-            amplitude_at_level_1: 20.0,
+            wavelength_cells: (60.0, 120.0),
+            envelope_waves: 1.2,
+            amplitude_at_level_1: 100.0,
             heading_deg: super::HEADING_DEG,
             spread_deg: 60.0,
         }
@@ -74,8 +81,6 @@ impl GustShape {
 
 /// How far the scheme's waves travel per step, in cells.
 const WAVE_SPEED: f32 = std::f32::consts::FRAC_1_SQRT_2;
-/// The envelope is cut off this many standard deviations out.
-const ENVELOPE_CUTOFF: f32 = 3.0;
 /// Mixed into the seed so that the gusts, the first breeze and the rain of one seed differ.
 const SEED_SALT: u64 = 0x6775_7374_73; // "gusts"
 /// The most packets alive at once (a bound on work per picture, whatever the pool's size).
@@ -89,7 +94,8 @@ struct Packet {
     /// The unit direction it travels, in picture coordinates (x right, y down).
     direction: (f32, f32),
     wavenumber: f32,
-    sigma: f32,
+    /// The envelope's half-width (it is 0 beyond), in cells.
+    radius: f32,
     /// The crest amplitude at the peak of its life.
     amplitude: f32,
     /// The phase of its crests at birth.
@@ -142,6 +148,7 @@ impl Gusts {
     }
 
     /// Whether any packet is alive.
+    #[cfg(test)]
     pub fn is_calm(&self) -> bool {
         self.packets.is_empty()
     }
@@ -204,7 +211,7 @@ impl Gusts {
             origin: (x - direction.0 * half_drift, y - direction.1 * half_drift),
             direction,
             wavenumber: std::f32::consts::TAU / wavelength,
-            sigma: (shape.envelope_waves * wavelength).max(1.0),
+            radius: (shape.envelope_waves * wavelength).max(1.0),
             amplitude: shape.amplitude_at_level_1 * self.level as f32 * strength,
             phase,
             born: self.step,
@@ -224,7 +231,7 @@ impl Gusts {
             let amplitude = p.amplitude * window * window;
             let travelled = WAVE_SPEED * age;
             let centre = (p.origin.0 + p.direction.0 * travelled, p.origin.1 + p.direction.1 * travelled);
-            let reach = ENVELOPE_CUTOFF * p.sigma;
+            let reach = p.radius;
             let span = |c: f32, n: usize| {
                 let lo = ((c - reach).floor() as i64).clamp(0, n as i64) as usize;
                 let hi = ((c + reach).ceil() as i64 + 1).clamp(0, n as i64) as usize;
@@ -237,7 +244,8 @@ impl Gusts {
             // cos(k·d·(p - c) + φ)·exp(-|p - c|²/2σ²) = Re(X(x)·Y(y)), with the amplitude and
             // the phase in the row factor.
             let factor = |offset: f32, along: f32| {
-                let envelope = libm::expf(-0.5 * (offset / p.sigma) * (offset / p.sigma));
+                let u = (offset / p.radius) * (offset / p.radius);
+                let envelope = if u < 1.0 { (1.0 - u) * (1.0 - u) } else { 0.0 };
                 let angle = p.wavenumber * along * offset;
                 (envelope * libm::cosf(angle), envelope * libm::sinf(angle))
             };
@@ -317,6 +325,7 @@ mod tests {
         let mut gusts = Gusts::new(1.0, 9, GustShape::default());
         let mut p = gusts.packet(400, 400);
         p.origin = (200.0 - 80.0 * p.direction.0, 200.0 - 80.0 * p.direction.1);
+        (p.wavenumber, p.radius) = (std::f32::consts::TAU / 20.0, 24.0);
         gusts.packets.push(p);
         let centroid = |gusts: &mut Gusts| {
             let mut field = vec![0.0; 400 * 400];
@@ -343,7 +352,7 @@ mod tests {
     #[test]
     fn the_shape_scales_with_the_grid() {
         let s = GustShape::default().on_grid(2);
-        assert_eq!(s.wavelength_cells, (20.0, 40.0));
+        assert_eq!(s.wavelength_cells, (120.0, 240.0));
         assert_eq!(s.packets_per_10k_cells, GustShape::default().packets_per_10k_cells / 4.0);
     }
 }
