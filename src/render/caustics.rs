@@ -193,7 +193,7 @@ impl LightMap {
         }
         let (cols, rows) = (width / grid, height / grid);
         let coarse = self.coarse.get_or_insert_with(Box::default);
-        let Coarse { means, light, columns, line } = &mut **coarse;
+        let Coarse { means, light, columns, line, sums } = &mut **coarse;
         // The means with a margin of PAD pixels around them, continued by odd reflection
         // (h(-d) = 2·h(0) - h(d)): a slope runs on past the edge instead of folding back, so
         // the edge draws no false caustic line (repeating the edge value would bend every
@@ -201,16 +201,21 @@ impl LightMap {
         let (padded_cols, padded_rows) = (cols + 2 * PAD, rows + 2 * PAD);
         means.clear();
         means.resize(padded_cols * padded_rows, 0);
+        // Each pixel's mean, rounded to the nearest unit: floor((2·sum + area) / (2·area)).
         let area = (grid * grid) as i32;
+        sums.clear();
+        sums.resize(cols, 0);
         for cy in 0..rows {
-            for cx in 0..cols {
-                let mut sum = 0i32;
-                for y in cy * grid..(cy + 1) * grid {
-                    let row = &heights[y * width + cx * grid..y * width + (cx + 1) * grid];
-                    sum += row.iter().map(|&v| i32::from(v)).sum::<i32>();
+            sums.fill(0);
+            for y in cy * grid..(cy + 1) * grid {
+                let row = &heights[y * width..y * width + cols * grid];
+                for (sum, cell) in sums.iter_mut().zip(row.chunks_exact(grid)) {
+                    *sum += cell.iter().map(|&v| i32::from(v)).sum::<i32>();
                 }
-                let mean = sum.div_euclid(area) + i32::from(2 * sum.rem_euclid(area) >= area);
-                means[(cy + PAD) * padded_cols + cx + PAD] = mean as i16;
+            }
+            let out = &mut means[(cy + PAD) * padded_cols + PAD..(cy + PAD) * padded_cols + PAD + cols];
+            for (mean, &sum) in out.iter_mut().zip(sums.iter()) {
+                *mean = (2 * sum + area).div_euclid(2 * area) as i16;
             }
         }
         let reflect =
@@ -269,6 +274,8 @@ struct Coarse {
     columns: Vec<(usize, usize, u32)>,
     /// One row of light blended between two light rows, in 1/256.
     line: Vec<u32>,
+    /// One row of pixels' sums of heights.
+    sums: Vec<i32>,
 }
 
 /// The margin of the light computed for a pool finer than its picture, in pixels: the

@@ -96,16 +96,22 @@ pub const GUST_UNITS: u32 = 4;
 /// on the codec benchmark's pool), while the light a swell focuses drifts smoothly.
 pub const GUST_REFRACTION: f32 = 0.3;
 
-/// `heights` plus `share` of `ripples`, in [`GUST_UNITS`] a unit, rounded to the nearest unit
-/// (floor(v + 1/2) by truncating a positive number: a conversion the compiler vectorizes;
-/// `round` is a call), into `out`.
-fn fill_units(out: &mut Vec<i16>, heights: &[i16], ripples: &[f32], share: f32) {
+/// `heights` plus `ripples` in `light`, and plus `share` of them in `refraction`, in
+/// [`GUST_UNITS`] a unit, each rounded to the nearest unit (floor(v + 1/2) by truncating a
+/// positive number: a conversion the compiler vectorizes; `round` is a call).
+fn fill_units((light, refraction): (&mut Vec<i16>, &mut Vec<i16>), heights: &[i16], ripples: &[f32], share: f32) {
+    let n = heights.len().min(ripples.len());
+    light.resize(n, 0);
+    refraction.resize(n, 0);
     let (lowest, highest, units) = (f32::from(i16::MIN), f32::from(i16::MAX), GUST_UNITS as f32);
-    out.clear();
-    out.extend(heights.iter().zip(ripples).map(|(&h, &r)| {
-        let v = ((f32::from(h) + share * r) * units).clamp(lowest, highest);
-        ((v - lowest + 0.5) as i32 + i32::from(i16::MIN)).min(i32::from(i16::MAX)) as i16
-    }));
+    let unit = |v: f32| ((v * units).clamp(lowest, highest) - lowest + 0.5) as i32 as f32 + lowest;
+    let (heights, ripples) = (&heights[..n], &ripples[..n]);
+    let (light, refraction) = (&mut light[..n], &mut refraction[..n]);
+    for i in 0..n {
+        let h = f32::from(heights[i]);
+        light[i] = unit(h + ripples[i]).min(highest) as i16;
+        refraction[i] = unit(h + share * ripples[i]).min(highest) as i16;
+    }
 }
 
 /// The units of the pictures of a pool whose breeze is `style`.
@@ -342,9 +348,8 @@ impl PoolScene {
         self.gust_heights.clear();
         self.gust_heights.resize(cols * rows, 0.0);
         gusts.add_to(&mut self.gust_heights, cols, rows);
-        let heights = self.pool.heights();
-        fill_units(&mut self.field, heights, &self.gust_heights, 1.0);
-        fill_units(&mut self.refraction, heights, &self.gust_heights, GUST_REFRACTION);
+        let fields = (&mut self.field, &mut self.refraction);
+        fill_units(fields, self.pool.heights(), &self.gust_heights, GUST_REFRACTION);
         true
     }
 

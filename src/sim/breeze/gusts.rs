@@ -223,6 +223,9 @@ impl Gusts {
     /// simulated, and ripples cut off at the wall would draw a false crease along it.
     pub fn add_to(&mut self, field: &mut [f32], width: usize, height: usize) {
         assert_eq!(field.len(), width * height, "the field is the pool's size");
+        // Room for the widest packet at once: no steady-state frame allocates.
+        self.columns.reserve(width.saturating_sub(self.columns.len()));
+        self.rows.reserve(height.saturating_sub(self.rows.len()));
         let life = self.shape.life_steps.max(1) as f32;
         for k in 0..self.packets.len() {
             let p = self.packets[k];
