@@ -415,11 +415,12 @@ fn table() {
     }
     println!();
     for (rate, ssim, sent) in targets {
-        match rate {
-            Some(r) if r == 250e3 => println!("pool at 250 kB/s: SSIM {ssim:.3} (target >= 0.85)"),
-            Some(r) if r == 50e3 => println!("pool at 50 kB/s: SSIM {ssim:.3} (target >= 0.70)"),
-            None => println!("pool, exact frames: {:.2} MB/s (target < 2 MB/s)", sent / 1000.0),
-            _ => {}
+        if rate == Some(250e3) {
+            println!("pool at 250 kB/s: SSIM {ssim:.3} (target >= 0.85)");
+        } else if rate == Some(50e3) {
+            println!("pool at 50 kB/s: SSIM {ssim:.3} (target >= 0.70)");
+        } else if rate.is_none() {
+            println!("pool, exact frames: {:.2} MB/s (target < 2 MB/s)", sent / 1000.0);
         }
     }
     match losses.is_empty() {

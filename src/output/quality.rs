@@ -63,8 +63,8 @@ pub fn measure(screen: &Screen, truth: &Pixmap) -> Quality {
 }
 
 /// The luma `screen` shows over a `width x height` picture drawn from its top-left corner (two
-/// pixel rows a text row), for [`crate::output::ssim`]: what the terminal shows, against the
-/// true frame. Pixels it does not show as half-block colours count as [`UNKNOWN_PIXEL`].
+/// pixel rows a text row), for SSIM: what the terminal shows, against the true frame. Pixels it
+/// does not show as half-block colours count as black, as in [`measure`].
 pub fn screen_luma(screen: &Screen, width: usize, height: usize) -> Luma {
     Luma::from_fn(width, height, |x, y| screen.pixel(x, y).unwrap_or(UNKNOWN_PIXEL))
 }

@@ -130,13 +130,10 @@ impl SsimReference {
         }
         let kernel = gaussian();
         let n = w * h;
-        let mut planes = [vec![0f64; n], vec![0f64; n], vec![0f64; n]];
-        for i in 0..n {
-            let (x, y) = (f64::from(a.values[i]), f64::from(b.values[i]));
-            planes[0][i] = y;
-            planes[1][i] = y * y;
-            planes[2][i] = x * y;
-        }
+        let y: Vec<f64> = b.values.iter().map(|&v| f64::from(v)).collect();
+        let yy: Vec<f64> = y.iter().map(|&v| v * v).collect();
+        let xy: Vec<f64> = a.values.iter().zip(&y).map(|(&x, &y)| f64::from(x) * y).collect();
+        let mut planes = [y, yy, xy];
         let mut scratch = vec![0f64; n];
         for plane in &mut planes {
             blur(plane, &mut scratch, w, h, &kernel);

@@ -26,12 +26,12 @@ pub mod gusts;
 /// How a breeze moves the pool.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum BreezeStyle {
-    /// Short wave packets added to the integer pool at once, here and there ([`Breeze`]): the
+    /// Short wave packets added to the integer pool at once, here and there: the
     /// first breeze, what a replay without a style means.
     #[default]
     Wavelets,
-    /// Patches of ripples that rise and fade over seconds as they drift downwind, as gusts
-    /// raise them ([`gusts::Gusts`]): water that moves like water filmed at 30 fps.
+    /// Broad swells of light that rise and fade over seconds as they drift downwind, drawn
+    /// over the water rather than added to it: water that moves like water filmed at 30 fps.
     Gusts,
 }
 

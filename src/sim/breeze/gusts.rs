@@ -82,7 +82,7 @@ impl GustShape {
 /// How far the scheme's waves travel per step, in cells.
 const WAVE_SPEED: f32 = std::f32::consts::FRAC_1_SQRT_2;
 /// Mixed into the seed so that the gusts, the first breeze and the rain of one seed differ.
-const SEED_SALT: u64 = 0x6775_7374_73; // "gusts"
+const SEED_SALT: u64 = 0x0067_7573_7473; // "gusts"
 /// The most packets alive at once (a bound on work per picture, whatever the pool's size).
 pub const MAX_PACKETS: usize = 64;
 
