@@ -1,27 +1,46 @@
-//! The terminal encoder measured like a codec (issue 14 §5).
+//! The terminal encoder measured like a codec (issue 14 §5, issue 21 §2).
 //!
-//! The fixture: `tests/fixtures/alive-160x48.jsonl`, about 12 s of the alive pool recorded by
-//! the player in a 160x48 terminal (160x94 pixels and a status line) with its defaults (the
-//! breeze, rain, damping 6) and a stone about every second, re-simulated exactly. The player's
-//! 30 fps means one frame every two steps.
+//! Four clips of 160x48 cells (160x94 pixels and a status line), as the player shows them:
+//! - **pool**: `tests/fixtures/pool-160x48.jsonl`, the player's defaults, a stone a second
+//!   after a 4 s warm-up (recorded in tmux by `scripts/record_pool_fixtures.sh`), re-simulated
+//!   exactly from the replay;
+//! - **pool, stones**: `tests/fixtures/pool-stones-160x48.jsonl`, the same with a stone every
+//!   half second;
+//! - **ocean B6**: the replay format holds the pool only, so the sea is a scripted scene: the
+//!   player's ocean (one sample a pixel, the default camera and sun, seed 1) at Beaufort 6
+//!   (12.3 m/s from 330°), advanced at its own 60 steps a second from t = 0, a frame every two
+//!   steps: the same frames as `tidepool render ocean --beaufort 6 --ssaa 1 --size 160x94
+//!   --frames 300 --fps 30`;
+//! - **lake**: the player's lake (3 m/s, seed 1, one sample a pixel) at its 30 steps a second,
+//!   a frame a step: `tidepool render lake --ssaa 1 --size 160x94 --frames 300 --fps 30`.
 //!
-//! For each budget (50, 100, 250 and 500 kB/s, and unlimited) the rate-controlled encoder
-//! ([`tidepool::terminal::RateEncoder`]) and the naive strategy (changed cells in screen order until the
-//! budget runs out, the same encoder with [`Strategy::ScanOrder`]) encode every frame with a
-//! [`ByteBucket`] at that rate on a simulated 30 fps clock; every emitted frame is fed to the
-//! terminal model ([`tidepool::terminal::TerminalModel`], exactly 160x48, no spare row) and the screen is
-//! compared with the true frame: bytes/s, mean and 5th-percentile PSNR (8-bit sRGB, both
-//! halves of every picture cell, the status row left out, an exact frame counted as 99 dB) and
-//! the mean OKLab distance per pixel. The unlimited rows also check that every frame is exact
-//! and compare the bytes with today's encoder (`tidepool::terminal::encode_into`) on the same frames.
+//! Each clip is encoded at 25, 50, 100, 250 and 500 kB/s and unlimited, in truecolor and in
+//! 256 colours, by three strategies in the same run: the shipped rate-controlled encoder
+//! ([`tidepool::terminal::RateEncoder`]), changed cells in scan order until the budget runs out
+//! (the same encoder with [`Strategy::ScanOrder`]), and whole exact frames as often as the link
+//! allows (best of colour quantization steps 1, 8, 16 and 32: colours rounded to multiples of
+//! the step before the frame is drawn, so fewer cells change and more colour codes repeat). The
+//! budgeted strategies take what a [`ByteBucket`] at the rate allows on a simulated 30 fps clock;
+//! a whole frame goes when the link has carried the previous one and shows when it has arrived
+//! (`bytes / rate` later). Every emitted byte goes through the terminal model
+//! ([`tidepool::terminal::TerminalModel`], exactly 160x48) and the screen is compared with the true
+//! frame at each display instant: SSIM of luma ([`tidepool::terminal::ssim`], Gaussian window of
+//! 1.5) and PSNR (8-bit sRGB, both halves of every picture cell, an exact frame counted as
+//! 99 dB), the status row left out.
 //!
-//! Then criterion measures the encoder's CPU per frame at 160x48 on the same frames.
+//! Then criterion measures the encoder's CPU per frame at 160x48 on the pool clip.
 //!
 //!     cargo bench --bench codec                # the table, then the CPU figures
-//!     CODEC=table cargo bench --bench codec    # the table only (about a minute)
+//!     CODEC=table cargo bench --bench codec    # the table only (a few minutes)
 //!     CODEC=cpu cargo bench --bench codec      # the CPU figures only
-//!     CODEC=stale cargo bench --bench codec    # PSNR of the true frame k frames late
-//!     CODEC=quick cargo bench --bench codec    # the rate-controlled rows alone, for tuning
+//!     CODEC=stale cargo bench --bench codec    # PSNR and SSIM of the true frame k frames late
+//!     CODEC=quick cargo bench --bench codec    # the shipped encoder on the pool clip, for tuning
+//!                                              # (CODEC_MODE=256, CODEC_CLIPS, CODEC_SERIES=1)
+//!
+//! `CODEC_CLIPS=pool,lake` limits the table to some clips (names: pool, stones, ocean, lake);
+//! `CODEC_POOL=FILE` replaces the pool clip's replay (to try other looks on the same session:
+//! edit a copy's header); `CODEC_SERIES=1` with `CODEC=quick` prints SSIM second by second,
+//! the shipped encoder's and the scan-order baseline's.
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::hint::black_box;
@@ -29,29 +48,33 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
-use tidepool::Script;
 use tidepool::terminal::{
-    self as quality, ByteBucket, Color, ColorMode, EncodeOptions, Frame, RateEncoder, RateOptions, Shown, Strategy,
-    Target, TerminalModel, UNLIMITED,
+    self as quality, ByteBucket, Color, ColorMode, EncodeOptions, Frame, Luma, RateEncoder, RateOptions, Shown,
+    SsimReference, Strategy, Target, TerminalModel, UNLIMITED,
 };
+use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneSpec, Script};
 use tiny_skia::Pixmap;
-
-/// The fixture replay.
-const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/alive-160x48.jsonl");
 
 const COLS: usize = 160;
 const ROWS: usize = 48;
-const STEPS_PER_FRAME: u64 = 2;
 const FPS: u32 = 30;
+/// The picture's size: every row but the status line, two pixels a row.
+const PICTURE: (u32, u32) = (COLS as u32, 2 * (ROWS as u32 - 1));
 /// Budgets in bytes per second; `None` is unlimited.
-const BUDGETS: [Option<f64>; 5] = [Some(50e3), Some(100e3), Some(250e3), Some(500e3), None];
+const BUDGETS: [Option<f64>; 6] = [Some(25e3), Some(50e3), Some(100e3), Some(250e3), Some(500e3), None];
+/// The colour quantization steps the whole-frame baseline tries.
+const QUANTIZATION_STEPS: [u8; 4] = [1, 8, 16, 32];
+/// Frames of the scripted clips (10 s at 30 fps).
+const SCRIPTED_FRAMES: usize = 300;
 
-/// The strategies compared: (name, order, approximations allowed).
-const STRATEGIES: [(&str, Strategy, bool); 3] = [
-    ("rate-controlled", Strategy::ErrorPerByte, true),
-    ("rate-controlled, exact cells only", Strategy::ErrorPerByte, false),
-    ("naive scan order", Strategy::ScanOrder, false),
-];
+fn fixture(name: &str) -> String {
+    if name == "pool-160x48.jsonl"
+        && let Ok(path) = std::env::var("CODEC_POOL")
+    {
+        return path;
+    }
+    format!("{}/tests/fixtures/{name}", env!("CARGO_MANIFEST_DIR"))
+}
 
 /// Counts allocations, to check that the encoder's steady state allocates nothing.
 struct Counting;
@@ -75,96 +98,217 @@ unsafe impl GlobalAlloc for Counting {
 #[global_allocator]
 static ALLOCATOR: Counting = Counting;
 
-/// One frame of the fixture: the cells the player would send and the true picture.
-struct Shot {
-    frame: Frame,
-    picture: Pixmap,
+/// A clip: the true pictures at each display instant, with what the truth's SSIM needs.
+struct Clip {
+    name: &'static str,
+    pictures: Vec<Pixmap>,
+    references: Vec<SsimReference>,
 }
 
-/// The fixture, frame by frame, in `mode`: the replay re-simulated, a frame every two steps,
-/// with a status line as the player draws one.
-fn fixture(mode: ColorMode) -> Vec<Shot> {
-    let replay = tidepool::replay::read(std::path::Path::new(FIXTURE)).expect("the committed fixture replay");
-    assert_eq!(replay.header.size, [COLS as u32, 2 * (ROWS as u32 - 1)], "a 160x48-cell recording");
-    let spec = replay.spec(tidepool::pool_floor());
-    let [w, h] = replay.header.size;
-    let mut scene = spec.build(w, h).expect("a valid size");
-    let events = replay.script();
-    let mut script = Script::new(&events);
-    let mut shots = Vec::new();
-    let mut step = 0;
-    while step + STEPS_PER_FRAME <= replay.end_step() {
-        step += STEPS_PER_FRAME;
-        script.run_to(scene.as_mut(), step);
-        let picture = scene.snapshot().expect("a valid size");
+impl Clip {
+    fn new(name: &'static str, pictures: Vec<Pixmap>) -> Clip {
+        let references = pictures.iter().map(|p| SsimReference::new(&Luma::of_pixmap(p))).collect();
+        Clip { name, pictures, references }
+    }
+
+    fn seconds(&self) -> f64 {
+        self.pictures.len() as f64 / f64::from(FPS)
+    }
+
+    /// The frame the player would send for picture `k` in `mode`, its colours first rounded
+    /// to multiples of `step`, with a status line.
+    fn frame(&self, k: usize, mode: ColorMode, step: u8) -> Frame {
         let mut frame = Frame::new(COLS, ROWS);
-        frame.draw_pixels(&picture, mode);
-        let seconds = step as f64 / 60.0;
-        let status = format!(" pool \u{b7} rain 0.05 \u{b7} breeze 1 \u{b7} damping 6 \u{b7} {seconds:.1} s");
+        if step <= 1 {
+            frame.draw_pixels(&self.pictures[k], mode);
+        } else {
+            frame.draw_pixels(&quantized(&self.pictures[k], step), mode);
+        }
+        let status = format!(" {} \u{b7} 30 fps \u{b7} {:.1} s", self.name, k as f64 / f64::from(FPS));
         frame.clear_row(ROWS - 1, Color::Index(4));
         frame.text(0, ROWS - 1, &status, Color::Index(15), Color::Index(4));
-        shots.push(Shot { frame, picture });
+        frame
     }
-    shots
+}
+
+/// `picture` with every channel rounded to the nearest multiple of `step` (at most 255).
+fn quantized(picture: &Pixmap, step: u8) -> Pixmap {
+    let mut out = picture.clone();
+    let step = u16::from(step);
+    for p in out.pixels_mut() {
+        let c = p.demultiply();
+        let q = |v: u8| ((u16::from(v) + step / 2) / step * step).min(255) as u8;
+        *p = tiny_skia::ColorU8::from_rgba(q(c.red()), q(c.green()), q(c.blue()), 255).premultiply();
+    }
+    out
+}
+
+/// A pool clip: the replay re-simulated, a picture at every 30 fps display instant.
+fn pool_clip(name: &'static str, file: &str) -> Clip {
+    let replay = tidepool::replay::read(std::path::Path::new(&fixture(file))).expect("a committed fixture replay");
+    assert_eq!(replay.header.size, [PICTURE.0, PICTURE.1], "a 160x48-cell recording");
+    let mut scene = replay.spec(tidepool::pool_floor()).build(PICTURE.0, PICTURE.1).expect("a valid size");
+    let events = replay.script();
+    let mut script = Script::new(&events);
+    let per_second = scene.steps_per_second();
+    let mut pictures = Vec::new();
+    for k in 1.. {
+        // The step shown at display instant k, as animations and the player's clock count.
+        let step = (k as f64 * per_second / f64::from(FPS)).floor() as u64;
+        if step > replay.end_step() {
+            break;
+        }
+        script.run_to(scene.as_mut(), step);
+        pictures.push(scene.snapshot().expect("a valid size"));
+    }
+    Clip::new(name, pictures)
+}
+
+/// A scripted clip: `spec` from its start, a picture at every 30 fps display instant (as
+/// `tidepool render ... --frames` takes them: step floor(k · steps a second / 30)).
+fn scripted_clip(name: &'static str, spec: SceneSpec) -> Clip {
+    let mut scene = spec.build(PICTURE.0, PICTURE.1).expect("a valid size");
+    let per_second = scene.steps_per_second();
+    let mut step = 0;
+    let mut pictures = Vec::new();
+    for k in 0..SCRIPTED_FRAMES {
+        let wanted = (k as f64 * per_second / f64::from(FPS)).floor() as u64;
+        scene.advance(wanted - step);
+        step = wanted;
+        pictures.push(scene.snapshot().expect("a valid size"));
+    }
+    Clip::new(name, pictures)
+}
+
+/// The four clips (or those `CODEC_CLIPS` names).
+fn clips() -> Vec<Clip> {
+    let wanted = std::env::var("CODEC_CLIPS").unwrap_or_default();
+    let take = |name: &str| wanted.is_empty() || wanted.split(',').any(|w| w.trim() == name);
+    let mut clips = Vec::new();
+    if take("pool") {
+        clips.push(pool_clip("pool", "pool-160x48.jsonl"));
+    }
+    if take("stones") {
+        clips.push(pool_clip("pool, stones", "pool-stones-160x48.jsonl"));
+    }
+    if take("ocean") {
+        let wind = tidepool::sea::beaufort_speed_m_s(6).expect("Beaufort 6");
+        let defaults = OceanSettings::default();
+        let ocean = OceanSettings {
+            sea: tidepool::SeaParams { wind_m_s: wind, ..defaults.sea },
+            view: OceanView { ssaa: 1, ..OceanView::default() },
+            ..defaults
+        };
+        clips.push(scripted_clip("ocean B6", SceneSpec::Ocean(ocean)));
+    }
+    if take("lake") {
+        let lake = LakeSettings { lake: LakeParams { seed: 1, ..LakeParams::default() }, ..LakeSettings::default() };
+        clips.push(scripted_clip("lake", SceneSpec::Lake(lake)));
+    }
+    clips
+}
+
+/// How a run sends frames.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Sender {
+    /// The rate-controlled encoder with this order (approximations with the shipped order).
+    Rate(Strategy),
+    /// Whole exact frames of colours rounded to this step, as often as the link allows.
+    Whole(u8),
 }
 
 /// The numbers of one run.
+#[derive(Clone, Debug, Default)]
 struct Run {
     bytes: usize,
+    ssim: Vec<f64>,
     psnr: Vec<f64>,
-    oklab: f64,
     exact_frames: usize,
     max_over_bucket: isize,
 }
 
-fn run(shots: &[Shot], mode: ColorMode, rate: Option<f64>, strategy: Strategy, approximate: bool) -> Run {
-    let start = Instant::now();
-    let mut bucket = rate.map_or_else(ByteBucket::unlimited, ByteBucket::new);
-    bucket.refill(start);
-    let mut encoder = RateEncoder::new();
-    let mut shown = Shown::UNKNOWN;
+impl Run {
+    fn mean(values: &[f64]) -> f64 {
+        values.iter().sum::<f64>() / values.len().max(1) as f64
+    }
+}
+
+/// The screen compared with the truth at display instant `k`.
+fn score(run: &mut Run, clip: &Clip, k: usize, screen: &TerminalModel) {
+    let (w, h) = (PICTURE.0 as usize, PICTURE.1 as usize);
+    run.ssim.push(clip.references[k].ssim(&quality::screen_luma(screen, w, h)));
+    let q = quality::measure(screen, &clip.pictures[k]);
+    run.psnr.push(q.psnr());
+    run.exact_frames += usize::from(q.mse == 0.0);
+}
+
+fn run(clip: &Clip, frames: &[Frame], mode: ColorMode, rate: Option<f64>, sender: Sender) -> Run {
     let mut screen = TerminalModel::new(COLS, ROWS);
     screen.lf_returns = false;
-    let options = RateOptions { strategy, approximate, ..RateOptions::default() };
+    let mut shown = Shown::UNKNOWN;
     let mut out = Vec::new();
-    let mut result = Run { bytes: 0, psnr: Vec::new(), oklab: 0.0, exact_frames: 0, max_over_bucket: isize::MIN };
-    for (n, shot) in shots.iter().enumerate() {
-        // The first frame at t = 0 finds an empty bucket: give it one frame's worth.
-        bucket.refill(start + Duration::from_secs_f64((n + 1) as f64 / f64::from(FPS)));
-        let budget = bucket.budget();
-        out.clear();
-        let target = if mode == ColorMode::TrueColor {
-            Target::new(&shot.frame)
-        } else {
-            Target::with_truth(&shot.frame, &shot.picture, mode)
-        };
-        encoder.encode_into(&mut shown, target, budget, options, &mut out);
-        bucket.spend(out.len());
-        if budget != UNLIMITED {
-            result.max_over_bucket = result.max_over_bucket.max(out.len() as isize - budget as isize);
+    let mut result = Run { max_over_bucket: isize::MIN, ..Run::default() };
+    match sender {
+        Sender::Rate(strategy) => {
+            let start = Instant::now();
+            let mut bucket = rate.map_or_else(ByteBucket::unlimited, ByteBucket::new);
+            bucket.refill(start);
+            let mut encoder = RateEncoder::new();
+            let options =
+                RateOptions { strategy, approximate: strategy == Strategy::ErrorPerByte, ..RateOptions::default() };
+            for (k, frame) in frames.iter().enumerate() {
+                // The first frame at t = 0 finds an empty bucket: give it one frame's worth.
+                bucket.refill(start + Duration::from_secs_f64((k + 1) as f64 / f64::from(FPS)));
+                let budget = bucket.budget();
+                out.clear();
+                let target = match mode {
+                    ColorMode::TrueColor => Target::new(frame),
+                    _ => Target::with_truth(frame, &clip.pictures[k], mode),
+                };
+                encoder.encode_into(&mut shown, target, budget, options, &mut out);
+                bucket.spend(out.len());
+                if budget != UNLIMITED {
+                    result.max_over_bucket = result.max_over_bucket.max(out.len() as isize - budget as isize);
+                }
+                result.bytes += out.len();
+                screen.feed(&out);
+                score(&mut result, clip, k, &screen);
+            }
         }
-        result.bytes += out.len();
-        screen.feed(&out);
-        let q = quality::measure(&screen, &shot.picture);
-        result.psnr.push(q.psnr());
-        result.oklab += q.oklab;
-        result.exact_frames += usize::from(q.mse == 0.0);
+        Sender::Whole(_) => {
+            // The link is busy until `free` (in frames); a frame sent at k shows at `arrives`.
+            let (mut free, mut pending): (f64, Option<(f64, Vec<u8>)>) = (0.0, None);
+            for (k, frame) in frames.iter().enumerate() {
+                let now = k as f64;
+                if let Some((arrives, bytes)) = &pending
+                    && *arrives <= now
+                {
+                    screen.feed(bytes);
+                    pending = None;
+                }
+                if pending.is_none() && free <= now {
+                    let mut bytes = Vec::new();
+                    quality_exact(&mut shown, frame, &mut bytes);
+                    let took = rate.map_or(0.0, |r| bytes.len() as f64 / r * f64::from(FPS));
+                    result.bytes += bytes.len();
+                    free = now + took;
+                    if took <= 0.0 {
+                        screen.feed(&bytes);
+                    } else {
+                        pending = Some((now + took, bytes));
+                    }
+                }
+                score(&mut result, clip, k, &screen);
+            }
+        }
     }
-    result.oklab /= shots.len() as f64;
     result
 }
 
-/// Today's encoder on the same frames: its total bytes.
-fn today(shots: &[Shot]) -> usize {
-    let mut shown = Shown::UNKNOWN;
-    let mut out = Vec::new();
-    let mut total = 0;
-    for shot in shots {
-        out.clear();
-        tidepool::terminal::encode_into(&mut shown, &shot.frame, EncodeOptions::default(), &mut out);
-        total += out.len();
-    }
-    total
+/// The bytes that show `frame` exactly after `shown`: today's diff encoder, which sends the
+/// changed cells (a whole screen the first time).
+fn quality_exact(shown: &mut Shown, frame: &Frame, out: &mut Vec<u8>) {
+    tidepool::terminal::encode_into(shown, frame, EncodeOptions::default(), out);
 }
 
 fn percentile(values: &[f64], p: f64) -> f64 {
@@ -173,104 +317,135 @@ fn percentile(values: &[f64], p: f64) -> f64 {
     sorted[((sorted.len() - 1) as f64 * p).round() as usize]
 }
 
+/// One row of the table: a strategy's mean SSIM and PSNR at a budget.
+struct Row {
+    label: String,
+    sent_kbps: f64,
+    ssim: f64,
+    psnr: f64,
+    psnr_p5: f64,
+    exact: (usize, usize),
+}
+
+impl Row {
+    fn of(label: String, run: &Run, seconds: f64) -> Row {
+        Row {
+            label,
+            sent_kbps: run.bytes as f64 / seconds / 1000.0,
+            ssim: Run::mean(&run.ssim),
+            psnr: Run::mean(&run.psnr),
+            psnr_p5: percentile(&run.psnr, 0.05),
+            exact: (run.exact_frames, run.ssim.len()),
+        }
+    }
+}
+
 fn table() {
     let t = Instant::now();
-    let shots = fixture(ColorMode::TrueColor);
-    let seconds = shots.len() as f64 / f64::from(FPS);
-    println!(
-        "codec fixture: {} frames of {COLS}x{ROWS} cells ({seconds:.0} s at {FPS} fps of {FIXTURE}), made in {:.1} s",
-        shots.len(),
-        t.elapsed().as_secs_f64()
-    );
-    println!();
-    println!("| budget | strategy | sent kB/s | mean PSNR dB | 5th pct PSNR dB | mean ΔE_OK | exact frames |");
-    println!("|---|---|---|---|---|---|---|");
-    let mut gains = Vec::new();
-    for rate in BUDGETS {
-        let label = rate.map_or("unlimited".to_string(), |r| format!("{:.0} kB/s", r / 1000.0));
-        let mut means = Vec::new();
-        for (name, strategy, approximate) in STRATEGIES {
-            if rate.is_none() && !approximate && strategy == Strategy::ErrorPerByte {
-                continue; // the same as the row above: unlimited draws every cell exactly
-            }
-            let r = run(&shots, ColorMode::TrueColor, rate, strategy, approximate);
-            assert!(r.max_over_bucket <= 0, "a frame exceeded its bucket by {} bytes", r.max_over_bucket);
-            let mean = r.psnr.iter().sum::<f64>() / r.psnr.len() as f64;
-            println!(
-                "| {label} | {name} | {:.1} | {mean:.2} | {:.2} | {:.4} | {}/{} |",
-                r.bytes as f64 / seconds / 1000.0,
-                percentile(&r.psnr, 0.05),
-                r.oklab,
-                r.exact_frames,
-                r.psnr.len()
-            );
-            means.push(mean);
-            if rate.is_none() && strategy == Strategy::ErrorPerByte {
-                let old = today(&shots);
-                assert_eq!(r.exact_frames, shots.len(), "unlimited is exact");
-                println!(
-                    "|  | today's diff encoder | {:.1} | exact | exact | 0 | {}/{} |",
-                    old as f64 / seconds / 1000.0,
-                    shots.len(),
-                    shots.len()
-                );
-                assert!(r.bytes <= old, "unlimited sent {} bytes, today's encoder {old}", r.bytes);
-                gains.push(format!(
-                    "unlimited: {} bytes vs today's {old} ({:+.2}%)",
-                    r.bytes,
-                    100.0 * (r.bytes as f64 / old as f64 - 1.0)
-                ));
-            }
-        }
-        if rate.is_some() {
-            gains.push(format!(
-                "{label}: {:+.2} dB over naive ({:+.2} dB from the approximations)",
-                means[0] - means[2],
-                means[0] - means[1]
-            ));
-        }
-    }
-    println!();
-    for g in gains {
-        println!("{g}");
-    }
-    // The palette modes: same rate control, errors against the true colours.
+    let clips = clips();
+    println!("clips made in {:.1} s", t.elapsed().as_secs_f64());
     println!();
     println!(
-        "| colours @ 100 kB/s | strategy | sent kB/s | mean PSNR dB | 5th pct PSNR dB | mean ΔE_OK | exact frames |"
+        "| clip | colours | budget | strategy | sent kB/s | mean SSIM | mean PSNR dB | 5th pct PSNR | exact frames |"
     );
-    println!("|---|---|---|---|---|---|---|");
-    for mode in [ColorMode::Palette256, ColorMode::Palette16] {
-        let shots = fixture(mode);
-        for (name, strategy, approximate) in STRATEGIES {
-            let r = run(&shots, mode, Some(100e3), strategy, approximate);
-            let mean = r.psnr.iter().sum::<f64>() / r.psnr.len() as f64;
-            println!(
-                "| {} | {name} | {:.1} | {mean:.2} | {:.2} | {:.4} | {}/{} |",
-                mode.name(),
-                r.bytes as f64 / seconds / 1000.0,
-                percentile(&r.psnr, 0.05),
-                r.oklab,
-                r.exact_frames,
-                r.psnr.len()
-            );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let mut losses = Vec::new();
+    let mut targets = Vec::new();
+    for clip in &clips {
+        let seconds = clip.seconds();
+        for mode in [ColorMode::TrueColor, ColorMode::Palette256] {
+            let frames: Vec<Vec<Frame>> = QUANTIZATION_STEPS
+                .iter()
+                .map(|&q| (0..clip.pictures.len()).map(|k| clip.frame(k, mode, q)).collect())
+                .collect();
+            for rate in BUDGETS {
+                let budget = rate.map_or("unlimited".to_string(), |r| format!("{:.0} kB/s", r / 1000.0));
+                let mut rows = Vec::new();
+                for (name, strategy) in
+                    [("shipped", Strategy::ErrorPerByte), ("changed cells in scan order", Strategy::ScanOrder)]
+                {
+                    let r = run(clip, &frames[0], mode, rate, Sender::Rate(strategy));
+                    assert!(r.max_over_bucket <= 0, "a frame exceeded its bucket by {} bytes", r.max_over_bucket);
+                    rows.push(Row::of(name.to_string(), &r, seconds));
+                }
+                // The whole-frame baseline: the best of its quantization steps by SSIM.
+                let whole = QUANTIZATION_STEPS
+                    .iter()
+                    .zip(&frames)
+                    .map(|(&q, frames)| (q, run(clip, frames, mode, rate, Sender::Whole(q))))
+                    .map(|(q, r)| Row::of(format!("whole exact frames (step {q})"), &r, seconds))
+                    .max_by(|a, b| a.ssim.total_cmp(&b.ssim))
+                    .expect("four steps");
+                rows.push(whole);
+                for row in &rows {
+                    println!(
+                        "| {} | {} | {budget} | {} | {:.1} | {:.3} | {:.2} | {:.2} | {}/{} |",
+                        clip.name,
+                        mode.name(),
+                        row.label,
+                        row.sent_kbps,
+                        row.ssim,
+                        row.psnr,
+                        row.psnr_p5,
+                        row.exact.0,
+                        row.exact.1
+                    );
+                }
+                // The shipped encoder must be the best at every rate, by both measures.
+                let shipped = &rows[0];
+                for other in &rows[1..] {
+                    if other.ssim > shipped.ssim + 1e-9 || other.psnr > shipped.psnr + 1e-9 {
+                        losses.push(format!(
+                            "{} {} {budget}: {} {:.3} / {:.2} dB beats the shipped {:.3} / {:.2} dB",
+                            clip.name,
+                            mode.name(),
+                            other.label,
+                            other.ssim,
+                            other.psnr,
+                            shipped.ssim,
+                            shipped.psnr
+                        ));
+                    }
+                }
+                if clip.name == "pool" && mode == ColorMode::TrueColor {
+                    targets.push((rate, shipped.ssim, shipped.sent_kbps));
+                }
+            }
         }
     }
     println!();
+    for (rate, ssim, sent) in targets {
+        if rate == Some(250e3) {
+            println!("pool at 250 kB/s: SSIM {ssim:.3} (target >= 0.85)");
+        } else if rate == Some(50e3) {
+            println!("pool at 50 kB/s: SSIM {ssim:.3} (target >= 0.70)");
+        } else if rate.is_none() {
+            println!("pool, exact frames: {:.2} MB/s (target < 2 MB/s)", sent / 1000.0);
+        }
+    }
+    match losses.is_empty() {
+        true => println!("the shipped encoder is the best at every rate, clip and colour mode (SSIM and PSNR)"),
+        false => {
+            println!("where a baseline beats the shipped encoder:");
+            for loss in &losses {
+                println!("  {loss}");
+            }
+        }
+    }
     println!("table made in {:.1} s", t.elapsed().as_secs_f64());
 }
 
-/// Allocations of the encoder per frame after a warm-up of one pass over the fixture.
-fn steady_state_allocations(shots: &[Shot]) -> usize {
+/// Allocations of the encoder per frame after a warm-up of one pass over the clip.
+fn steady_state_allocations(frames: &[Frame]) -> usize {
     let mut encoder = RateEncoder::new();
     let mut shown = Shown::UNKNOWN;
     let mut out = Vec::with_capacity(1 << 20);
     let mut count = 0;
     for pass in 0..2 {
-        for shot in shots {
+        for frame in frames {
             out.clear();
             let before = ALLOCATIONS.load(Ordering::Relaxed);
-            encoder.encode_into(&mut shown, Target::new(&shot.frame), 250_000 / 30, RateOptions::default(), &mut out);
+            encoder.encode_into(&mut shown, Target::new(frame), 250_000 / 30, RateOptions::default(), &mut out);
             if pass == 1 {
                 count += ALLOCATIONS.load(Ordering::Relaxed) - before;
             }
@@ -280,9 +455,10 @@ fn steady_state_allocations(shots: &[Shot]) -> usize {
 }
 
 fn cpu(c: &mut Criterion) {
-    let shots = fixture(ColorMode::TrueColor);
-    let allocations = steady_state_allocations(&shots);
-    println!("encoder allocations in {} steady-state frames: {allocations}", shots.len());
+    let clip = pool_clip("pool", "pool-160x48.jsonl");
+    let frames: Vec<Frame> = (0..clip.pictures.len()).map(|k| clip.frame(k, ColorMode::TrueColor, 1)).collect();
+    let allocations = steady_state_allocations(&frames);
+    println!("encoder allocations in {} steady-state frames: {allocations}", frames.len());
     assert_eq!(allocations, 0, "the encoder's steady state allocates nothing");
     let mut group = c.benchmark_group("codec/encode_frame_160x48");
     for (name, budget, strategy) in [
@@ -300,19 +476,20 @@ fn cpu(c: &mut Criterion) {
         let options = RateOptions { strategy, ..RateOptions::default() };
         group.bench_function(name, |b| {
             b.iter(|| {
-                let shot = &shots[n % shots.len()];
+                let frame = &frames[n % frames.len()];
                 n += 1;
                 out.clear();
-                encoder.encode_into(&mut shown, Target::new(black_box(&shot.frame)), budget, options, &mut out);
+                encoder.encode_into(&mut shown, Target::new(black_box(frame)), budget, options, &mut out);
                 out.len()
             })
         });
     }
-    // The whole player's frame: two steps of the alive pool (breeze, rain, a stone a second),
-    // the picture, the cells and the encoder at 250 kB/s.
-    let replay = tidepool::replay::read(std::path::Path::new(FIXTURE)).expect("the committed fixture replay");
+    // The whole player's frame: the steps a 30 fps frame covers of the player's pool (gusts,
+    // rain, a stone a second), the picture, the cells and the encoder at 250 kB/s.
+    let replay = tidepool::replay::read(std::path::Path::new(&fixture("pool-160x48.jsonl"))).expect("the fixture");
     let [w, h] = replay.header.size;
     let mut scene = replay.spec(tidepool::pool_floor()).build(w, h).expect("a valid size");
+    let steps_per_frame = (scene.steps_per_second() / f64::from(FPS)).round().max(1.0) as u64;
     let mut picture = Pixmap::new(w, h).expect("a valid size");
     let mut frame = Frame::new(COLS, ROWS);
     let mut encoder = RateEncoder::new();
@@ -326,7 +503,7 @@ fn cpu(c: &mut Criterion) {
                 let (x, y) = ((k * 53 % w) as i64, (k * 31 % h) as i64);
                 scene.apply(&tidepool::Event::Stone(tidepool::Stone::new(x, y, 3, 128).expect("a valid stone")));
             }
-            scene.advance(STEPS_PER_FRAME);
+            scene.advance(steps_per_frame);
             scene.render(&mut picture);
             frame.draw_pixels(&picture, ColorMode::TrueColor);
             frame.text(0, ROWS - 1, " pool \u{b7} 30 fps", Color::Index(15), Color::Index(4));
@@ -341,49 +518,74 @@ fn cpu(c: &mut Criterion) {
     let mut n = 0;
     group.bench_function("today_diff_unlimited", |b| {
         b.iter(|| {
-            let shot = &shots[n % shots.len()];
+            let frame = &frames[n % frames.len()];
             n += 1;
             out.clear();
-            tidepool::terminal::encode_into(&mut shown, black_box(&shot.frame), EncodeOptions::default(), &mut out);
+            tidepool::terminal::encode_into(&mut shown, black_box(frame), EncodeOptions::default(), &mut out);
             out.len()
         })
     });
     group.finish();
 }
 
+/// How far a screen falls behind when it shows the true frame k frames late (what a link too
+/// slow for any approximation would give).
 fn stale() {
-    let shots = fixture(ColorMode::TrueColor);
+    let clip = pool_clip("pool", "pool-160x48.jsonl");
+    let (w, h) = (PICTURE.0 as usize, PICTURE.1 as usize);
     for k in [1usize, 2, 5, 10, 20, 40] {
-        let mut psnr = 0.0;
-        let mut n = 0;
-        for i in (60 + k)..shots.len() {
+        let (mut psnr, mut ssim, mut n) = (0.0, 0.0, 0);
+        for i in (60 + k)..clip.pictures.len() {
             let mut screen = TerminalModel::new(COLS, ROWS);
             screen.lf_returns = false;
-            let (bytes, _) = tidepool::terminal::encode(&Shown::UNKNOWN, &shots[i - k].frame, EncodeOptions::default());
+            let frame = clip.frame(i - k, ColorMode::TrueColor, 1);
+            let (bytes, _) = tidepool::terminal::encode(&Shown::UNKNOWN, &frame, EncodeOptions::default());
             screen.feed(&bytes);
-            psnr += quality::measure(&screen, &shots[i].picture).psnr();
+            psnr += quality::measure(&screen, &clip.pictures[i]).psnr();
+            ssim += clip.references[i].ssim(&quality::screen_luma(&screen, w, h));
             n += 1;
         }
-        println!("stale by {k} frames: {:.2} dB", psnr / n as f64);
+        println!("stale by {k} frames: {:.2} dB, SSIM {:.3}", psnr / n as f64, ssim / n as f64);
     }
 }
 
-/// A short table of the rate-controlled encoder alone, for trying changes.
+/// The shipped encoder (and with `CODEC_SERIES=1` the scan-order baseline beside it) on the
+/// pool clip, or the clips `CODEC_CLIPS` names, in truecolor (`CODEC_MODE=256`: 256 colours),
+/// for trying changes.
 fn quick() {
-    let shots = fixture(ColorMode::TrueColor);
-    let seconds = shots.len() as f64 / f64::from(FPS);
-    for rate in [50e3, 100e3, 250e3, 500e3, 2e6] {
-        let t = Instant::now();
-        let r = run(&shots, ColorMode::TrueColor, Some(rate), Strategy::ErrorPerByte, true);
-        let mean = r.psnr.iter().sum::<f64>() / r.psnr.len() as f64;
-        println!(
-            "{:>5.0} kB/s: sent {:.1} kB/s, mean PSNR {mean:.2} dB, 5th pct {:.2}, ΔE {:.4} ({:.1} s)",
-            rate / 1e3,
-            r.bytes as f64 / seconds / 1000.0,
-            percentile(&r.psnr, 0.05),
-            r.oklab,
-            t.elapsed().as_secs_f64()
-        );
+    let mode = match std::env::var("CODEC_MODE").as_deref() {
+        Ok("256") => ColorMode::Palette256,
+        _ => ColorMode::TrueColor,
+    };
+    let series = std::env::var_os("CODEC_SERIES").is_some();
+    let clips = match std::env::var_os("CODEC_CLIPS") {
+        Some(_) => clips(),
+        None => vec![pool_clip("pool", "pool-160x48.jsonl")],
+    };
+    for clip in &clips {
+        println!("{} in {}:", clip.name, mode.name());
+        let frames: Vec<Frame> = (0..clip.pictures.len()).map(|k| clip.frame(k, mode, 1)).collect();
+        for rate in [Some(25e3), Some(50e3), Some(100e3), Some(250e3), Some(500e3), Some(2e6), None] {
+            let t = Instant::now();
+            let r = run(clip, &frames, mode, rate, Sender::Rate(Strategy::ErrorPerByte));
+            println!(
+                "{:>9}: sent {:.1} kB/s, SSIM {:.3}, PSNR {:.2} dB, 5th pct {:.2} ({:.1} s)",
+                rate.map_or("unlimited".into(), |r| format!("{:.0} kB/s", r / 1e3)),
+                r.bytes as f64 / clip.seconds() / 1000.0,
+                Run::mean(&r.ssim),
+                Run::mean(&r.psnr),
+                percentile(&r.psnr, 0.05),
+                t.elapsed().as_secs_f64()
+            );
+            if series {
+                let by_second = |r: &Run| -> String {
+                    r.ssim.chunks(FPS as usize).map(|s| format!("{:.2}", Run::mean(s))).collect::<Vec<_>>().join(" ")
+                };
+                println!("           SSIM second by second: {}", by_second(&r));
+                let scan = run(clip, &frames, mode, rate, Sender::Rate(Strategy::ScanOrder));
+                println!("           scan order ({:.3}):       {}", Run::mean(&scan.ssim), by_second(&scan));
+            }
+        }
     }
 }
 

@@ -59,6 +59,7 @@ pub use scene::lake::{LakeScene, LakeSettings};
 pub use scene::ocean::{OceanScene, OceanSettings};
 pub use scene::pool::{PoolScene, PoolSettings, showcase as pool_showcase};
 pub use scene::{Action, Controls, Event, Heightmap, Playable, Scene, SceneKind, SceneSpec, Script};
+pub use sim::breeze::BreezeStyle;
 pub use sim::lake::LakeParams;
 pub use sim::noise::NoiseKind;
 pub use sim::ocean::SeaParams;

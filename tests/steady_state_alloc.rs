@@ -55,6 +55,7 @@ fn frames_allocate_nothing_after_warm_up() {
     pool_frames();
     let pool = PoolSettings { rain_rate: 0.3, seed: 5, ..PoolSettings::default() };
     assert_eq!(player_frames(SceneSpec::Pool(pool)), 0, "pool player frames: no allocation");
+    assert_eq!(player_frames(SceneSpec::Pool(coherent(0.3, 5))), 0, "the player's pool: no allocation");
     let lake = SceneSpec::Lake(LakeSettings::default());
     assert_eq!(player_frames(lake), 0, "lake player frames: no allocation");
     let ocean = SceneSpec::Ocean(OceanSettings::default());
@@ -144,11 +145,28 @@ fn player_frames(scene: SceneSpec) -> usize {
     marks[1] - marks[0]
 }
 
+/// The player's pool: two cells a pixel, 30 steps a second, gusts.
+fn coherent(rain_rate: f64, seed: u64) -> PoolSettings {
+    PoolSettings {
+        rain_rate,
+        seed,
+        grid: 2,
+        steps_per_second: 30,
+        breeze: 1.0,
+        breeze_style: tidepool::BreezeStyle::Gusts,
+        ..PoolSettings::default()
+    }
+}
+
 /// The pool's own frames: a terminal-sized pool (one thread) and a full-HD one (row bands on
-/// rayon).
+/// rayon), the papers' and the player's.
 fn pool_frames() {
-    for (w, h) in [(160u32, 94u32), (1920, 1080)] {
-        let settings = PoolSettings { rain_rate: 0.5, seed: 3, ..PoolSettings::default() };
+    for (w, h, settings) in [
+        (160u32, 94u32, PoolSettings { rain_rate: 0.5, seed: 3, ..PoolSettings::default() }),
+        (1920, 1080, PoolSettings { rain_rate: 0.5, seed: 3, ..PoolSettings::default() }),
+        (160, 94, coherent(0.5, 3)),
+        (480, 300, coherent(0.5, 3)),
+    ] {
         let mut scene = PoolScene::new(w, h, settings).unwrap();
         let mut frame = tiny_skia::Pixmap::new(w, h).unwrap();
         let mut run_frames = |scene: &mut PoolScene, frames: u32| {
@@ -167,7 +185,7 @@ fn pool_frames() {
             run_frames(&mut scene, 60);
             ALLOCATIONS.load(Ordering::Relaxed) - before
         });
-        assert_eq!(during, 0, "{w}x{h}: {during} allocations in 60 steady-state frames");
+        assert_eq!(during, 0, "{w}x{h} grid {}: {during} allocations in 60 steady-state frames", scene.grid());
     }
 }
 

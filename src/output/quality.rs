@@ -10,6 +10,7 @@ use tiny_skia::Pixmap;
 
 use crate::output::halfblock::{Rgb, pixel_rgb};
 use crate::output::oklab;
+use crate::output::ssim::Luma;
 use crate::output::vt::TerminalModel;
 
 /// What a pixel the screen does not show as a half-block colour counts as.
@@ -61,6 +62,13 @@ pub fn measure(screen: &TerminalModel, truth: &Pixmap) -> Quality {
     Quality { mse: squared / (3 * pixels).max(1) as f64, oklab: distance / pixels.max(1) as f64, pixels }
 }
 
+/// The luma `screen` shows over a `width x height` picture drawn from its top-left corner (two
+/// pixel rows a text row), for SSIM: what the terminal shows, against the true frame. Pixels it
+/// does not show as half-block colours count as black, as in [`measure`].
+pub fn screen_luma(screen: &TerminalModel, width: usize, height: usize) -> Luma {
+    Luma::from_fn(width, height, |x, y| screen.pixel(x, y).unwrap_or(UNKNOWN_PIXEL))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -86,6 +94,11 @@ mod tests {
         assert_eq!(q.mse, 25.0);
         assert!((q.psnr() - 34.15).abs() < 0.01, "{}", q.psnr());
         assert!(q.oklab > 0.0 && q.oklab < f64::from(oklab::JND));
+        // The screen's luma: the exact screen's is the picture's; the other differs in one pixel.
+        let exact = screen_luma(&TerminalModel::new(2, 2), 2, 2);
+        assert_eq!(exact.get(0, 0), 0.0, "an empty screen is black");
+        let shown = screen_luma(&screen, 2, 2);
+        assert_eq!(shown, Luma::from_fn(2, 2, |x, y| if (x, y) == (0, 0) { [110; 3] } else { [100; 3] }));
     }
 
     #[test]

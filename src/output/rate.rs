@@ -184,6 +184,8 @@ pub struct RateEncoder {
     weighed: usize,
     weighing: Weighing,
     choice: Vec<u8>,
+    /// Per cell, 1 + the place on its hull of the furthest step chosen (0: none).
+    furthest: Vec<u8>,
     variants: Vec<[Cell; MAX_VARIANTS]>,
     candidate: Vec<bool>,
     shown_lab: LabMemo,
@@ -440,12 +442,21 @@ impl RateEncoder {
         *sorted = upto;
     }
 
-    /// Sets `self.choice` from the first `k` steps: each cell's highest variant among them.
+    /// Sets `self.choice` from the first `k` steps: each cell is drawn with the variant of the
+    /// furthest of its steps among them. A cell's steps run from the cheapest way to draw it
+    /// to the exact cell, each improving on the one before, so the furthest step paid for is
+    /// the best way paid for (the variants' ranks are not in that order: a space in the
+    /// nearest palette colour of the mean costs less than a space in the mean itself).
     fn set_choice(&mut self, k: usize) {
         self.choice.fill(SKIP);
+        self.furthest.clear();
+        self.furthest.resize(self.choice.len(), 0);
         for item in &self.items[..k] {
-            let c = &mut self.choice[item.cell()];
-            *c = (*c).max(item.rank());
+            let (cell, step) = (item.cell(), item.step() + 1);
+            if step > self.furthest[cell] {
+                self.furthest[cell] = step;
+                self.choice[cell] = item.rank();
+            }
         }
     }
 }

@@ -21,6 +21,7 @@ mod look;
 pub use look::{PoolLook, Refraction, Sun};
 
 use super::caustics::{self, AMPLITUDE_PER_PIXEL, WATER_INDEX};
+#[cfg(test)]
 use crate::sim::ripple::RipplePool;
 use crate::simd::{Simd, Tier};
 
@@ -53,6 +54,10 @@ pub struct PoolRenderer {
     lighting: Lighting,
     /// The instruction set the rows and the caustics run with.
     simd: Simd,
+    /// Pool cells per picture pixel along each axis (the background has the pool's size).
+    grid: u32,
+    /// Height units per amplitude unit of the pool.
+    units: f32,
 }
 
 /// The sun's light, prepared once per renderer.
@@ -65,11 +70,31 @@ struct Lighting {
     /// slope that mirrors the sun exactly is its centre. Pixels outside skip the exact test.
     glint_centre: [f32; 2],
     glint_radius_sq: f32,
+    /// From the stencils to the normal's (nx, ny): 1 / (the stencil's span in height units
+    /// per pixel of slope).
+    glint_scale: f32,
     /// The half-way vector between the sun and the viewer (looking straight down).
     half: [f32; 3],
     /// N·H above which a crest glints: a little above flat water's, so that flat water
     /// (which an overhead view would show uniformly lit by the sun) never does.
     glint_from: f32,
+}
+
+/// The heights a picture is drawn from, each the background's size: `refraction` displaces the
+/// floor (the papers' offsets), `light` lights it (caustics, shading, glints). For a pool's
+/// own picture both are its heights.
+#[derive(Clone, Copy, Debug)]
+pub struct Fields<'a> {
+    /// Displaces the floor.
+    pub refraction: &'a [i16],
+    /// Lights the floor and the surface.
+    pub light: &'a [i16],
+}
+
+/// Rows y-2..=y+2 of both fields around one picture row.
+struct Rows<'a> {
+    refraction: [&'a [i16]; 5],
+    light: [&'a [i16]; 5],
 }
 
 /// Pixels per staged span (see [`PoolRenderer::render_span`]).
@@ -116,10 +141,23 @@ const PIXELS_PER_TASK: usize = 1 << 15;
 
 impl PoolRenderer {
     /// A renderer for pools the size of `background` (already fitted, e.g. with
-    /// [`crate::render::background::cover`]).
+    /// [`crate::render::background::cover`]), one cell a pixel.
+    #[cfg(test)]
     pub fn new(background: Pixmap, look: PoolLook) -> PoolRenderer {
+        PoolRenderer::on_grid(background, look, 1, 1)
+    }
+
+    /// A renderer for pools of `grid x grid` cells a picture pixel, the size of `background`
+    /// (already fitted), drawn at the pool's resolution: the caustics are computed per picture
+    /// pixel and their depth is in picture pixels, so they look as on a pool of one cell a
+    /// pixel. The heights it is given hold `units` per amplitude unit of the pool (1: the
+    /// pool's own; more: heights at a finer precision, such as the pool with the gusts' ripples
+    /// added, which would flicker by whole units where they are rounded).
+    pub fn on_grid(background: Pixmap, look: PoolLook, grid: u32, units: u32) -> PoolRenderer {
+        let grid = grid.max(1);
+        let units = units.max(1) as f32;
         let factor = look.refraction.factor(background.width(), background.height());
-        let refraction_q8 = (factor * 256.0).round().clamp(0.0, 1e6) as i32;
+        let refraction_q8 = (factor / units * 256.0).round().clamp(0.0, 1e6) as i32;
         // One extra row and texel past the end, so the filter's right and lower neighbours can be
         // fetched without a check at the last column and row (their weight is 0 there).
         let (w, h) = (background.width() as usize, background.height() as usize);
@@ -135,7 +173,7 @@ impl PoolRenderer {
         let light_shift = match look.caustics {
             Some(c) => {
                 let sin_refracted = (horizontal / WATER_INDEX).min(1.0);
-                let run = c.depth_px() * sin_refracted / (1.0 - sin_refracted * sin_refracted).sqrt();
+                let run = grid as f32 * c.depth_px() * sin_refracted / (1.0 - sin_refracted * sin_refracted).sqrt();
                 ((-sun[0] / horizontal * run).round() as i32, (-sun[1] / horizontal * run).round() as i32)
             }
             None => (0, 0),
@@ -146,13 +184,14 @@ impl PoolRenderer {
         // a conic around H's trace tan(θH)·(hx, hy)/|h|; its farthest point is at
         // tan(θH + θg) - tan(θH) from that centre, so a disc of that radius (plus a margin)
         // holds all of them.
-        let span = STENCIL_SPAN * AMPLITUDE_PER_PIXEL;
+        let span = STENCIL_SPAN * AMPLITUDE_PER_PIXEL * units;
         let theta_h = half[2].clamp(-1.0, 1.0).acos();
         let theta_g = glint_from.clamp(-1.0, 1.0).acos();
         let reach = ((theta_h + theta_g).min(1.5).tan() - theta_h.tan()) * 1.1 + 0.01;
         let lighting = Lighting {
-            shade_x_q8: (sun[0] * SHADE_PER_SLOPE * 256.0).round() as i32,
-            shade_y_q8: (sun[1] * SHADE_PER_SLOPE * 256.0).round() as i32,
+            shade_x_q8: (sun[0] * SHADE_PER_SLOPE / units * 256.0).round() as i32,
+            shade_y_q8: (sun[1] * SHADE_PER_SLOPE / units * 256.0).round() as i32,
+            glint_scale: 1.0 / span,
             // The normal's (nx, ny) is (across, along) / span, and points along (hx, hy)/hz.
             glint_centre: [half[0] / half[2] * span, half[1] / half[2] * span],
             glint_radius_sq: (reach * span) * (reach * span),
@@ -168,6 +207,8 @@ impl PoolRenderer {
             light_shift,
             lighting,
             simd: Simd::detect(),
+            grid,
+            units,
         }
     }
 
@@ -181,71 +222,84 @@ impl PoolRenderer {
         self.look
     }
 
-    /// Draws `pool` into `out`. Both must have the background's size. Large pictures are drawn
-    /// in row bands on all cores; every pixel is computed the same way whatever the split.
-    ///
-    /// # Panics
-    /// When the sizes differ (a programming error, not a user error).
+    /// Draws `pool` into `out` ([`PoolRenderer::render_fields`] of its heights).
+    #[cfg(test)]
     pub fn render(&mut self, pool: &RipplePool, out: &mut Pixmap) {
         let (w, h) = (self.background.width() as usize, self.background.height() as usize);
         assert_eq!((pool.width(), pool.height()), (w, h), "pool and background sizes differ");
+        self.render_fields(Fields { refraction: pool.heights(), light: pool.heights() }, out);
+    }
+
+    /// Draws the water into `out`, which has the background's size: the floor displaced by
+    /// one set of heights and lit (caustics, shading, glints) by another, each a pool of the
+    /// background's size row by row (for a pool's own picture both are its heights; the scene
+    /// adds the gusts' swells to them). Large pictures are drawn in row bands on all cores;
+    /// every pixel is computed the same way whatever the split.
+    ///
+    /// # Panics
+    /// When the sizes differ (a programming error, not a user error).
+    pub fn render_fields(&mut self, fields: Fields<'_>, out: &mut Pixmap) {
+        let (w, h) = (self.background.width() as usize, self.background.height() as usize);
+        assert_eq!(fields.refraction.len(), w * h, "heights and background sizes differ");
+        assert_eq!(fields.light.len(), w * h, "heights and background sizes differ");
         assert_eq!((out.width() as usize, out.height() as usize), (w, h), "output size differs");
-        let heights = pool.heights();
         if let Some(look) = self.look.caustics {
-            self.light.compute(heights, w, h, look, self.simd);
+            self.light.compute_on_grid(fields.light, (w, h), self.grid as usize, (look, self.units), self.simd);
         }
         let this = &*self;
         let bytes = out.data_mut();
         if w * h < PARALLEL_MIN_PIXELS {
-            this.render_rows(heights, 0, bytes);
+            this.render_rows(fields, 0, bytes);
         } else {
             use rayon::prelude::*;
             let rows_per_task = (PIXELS_PER_TASK / w).max(1);
             bytes
                 .par_chunks_mut(rows_per_task * w * 4)
                 .enumerate()
-                .for_each(|(task, rows)| this.render_rows(heights, task * rows_per_task, rows));
+                .for_each(|(task, rows)| this.render_rows(fields, task * rows_per_task, rows));
         }
     }
 
     /// Draws the rows starting at `first_row` into `out` (whole rows of RGBA bytes), with the
     /// widest instruction set this CPU has (see [`crate::simd`]).
-    fn render_rows(&self, heights: &[i16], first_row: usize, out: &mut [u8]) {
+    fn render_rows(&self, fields: Fields<'_>, first_row: usize, out: &mut [u8]) {
         match self.simd.tier() {
             // SAFETY: a `Simd` of this tier exists only when run-time detection found the
             // feature (see `crate::simd`).
             #[cfg(target_arch = "x86_64")]
-            Tier::Avx512 => unsafe { self.render_rows_avx512(heights, first_row, out) },
+            Tier::Avx512 => unsafe { self.render_rows_avx512(fields, first_row, out) },
             #[cfg(target_arch = "x86_64")]
-            Tier::Avx2 => unsafe { self.render_rows_avx2(heights, first_row, out) },
-            _ => self.render_rows_with(heights, first_row, out),
+            Tier::Avx2 => unsafe { self.render_rows_avx2(fields, first_row, out) },
+            _ => self.render_rows_with(fields, first_row, out),
         }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx2")]
-    fn render_rows_avx2(&self, heights: &[i16], first_row: usize, out: &mut [u8]) {
-        self.render_rows_with(heights, first_row, out)
+    fn render_rows_avx2(&self, fields: Fields<'_>, first_row: usize, out: &mut [u8]) {
+        self.render_rows_with(fields, first_row, out)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "avx512f,avx512bw")]
-    fn render_rows_avx512(&self, heights: &[i16], first_row: usize, out: &mut [u8]) {
-        self.render_rows_with(heights, first_row, out)
+    fn render_rows_avx512(&self, fields: Fields<'_>, first_row: usize, out: &mut [u8]) {
+        self.render_rows_with(fields, first_row, out)
     }
 
     #[inline(always)]
-    fn render_rows_with(&self, heights: &[i16], first_row: usize, out: &mut [u8]) {
+    fn render_rows_with<'a>(&self, fields: Fields<'a>, first_row: usize, out: &mut [u8]) {
         let (w, h) = (self.background.width() as usize, self.background.height() as usize);
         let mut scratch = SpanScratch::default();
         for (i, out_row) in out.chunks_exact_mut(w * 4).enumerate() {
             let y = first_row + i;
-            // Rows y-2..=y+2, the picture's edge rows repeated beyond it.
-            let row = |dy: isize| {
-                let r = (y as isize + dy).clamp(0, h as isize - 1) as usize;
-                &heights[r * w..(r + 1) * w]
+            // Rows y-2..=y+2 of both fields, the picture's edge rows repeated beyond it.
+            let around = |heights: &'a [i16]| {
+                [-2isize, -1, 0, 1, 2].map(|dy| {
+                    let r = (y as isize + dy).clamp(0, h as isize - 1) as usize;
+                    &heights[r * w..(r + 1) * w]
+                })
             };
-            let rows = [row(-2), row(-1), row(0), row(1), row(2)];
+            let rows = Rows { refraction: around(fields.refraction), light: around(fields.light) };
             let pixels: &mut [[u8; 4]] = out_row.as_chunks_mut::<4>().0;
             // Columns two or more away from the edges need no clamping: they go through the
             // staged span renderer in chunks; the edge columns one pixel at a time.
@@ -269,10 +323,13 @@ impl PoolRenderer {
     /// clamped indexing, so the compiler vectorizes them; only the fetches stay scalar.
     /// Computes exactly what [`PoolRenderer::pixel`] does.
     #[inline(always)]
-    fn render_span(&self, rows: &[&[i16]; 5], y: usize, x0: usize, out: &mut [[u8; 4]], scratch: &mut SpanScratch) {
+    fn render_span(&self, rows: &Rows<'_>, y: usize, x0: usize, out: &mut [[u8; 4]], scratch: &mut SpanScratch) {
         let (w, h) = (self.background.width() as i32, self.background.height() as i32);
         let n = out.len();
-        let [up2, up, mid, down, down2] = rows.map(|r| &r[x0 - 2..x0 + n + 2]);
+        let [_, up, mid, down, _] = rows.refraction.map(|r| &r[x0 - 2..x0 + n + 2]);
+        let (m1, p1) = (&mid[1..n + 1], &mid[3..n + 3]);
+        let (u1, d1) = (&up[2..n + 2], &down[2..n + 2]);
+        let [up2, up, mid, down, down2] = rows.light.map(|r| &r[x0 - 2..x0 + n + 2]);
         let q = self.refraction_q8;
         let SpanScratch { index, fx, fy, light_index, delta, across, along, p00, p01, p10, p11, gain } = scratch;
         // Every slice exactly `n` long, so the loops below carry no bounds checks.
@@ -280,8 +337,8 @@ impl PoolRenderer {
         let (light_index, delta, across, along) =
             (&mut light_index[..n], &mut delta[..n], &mut across[..n], &mut along[..n]);
         let (p00, p01, p10, p11, gain) = (&mut p00[..n], &mut p01[..n], &mut p10[..n], &mut p11[..n], &mut gain[..n]);
-        let (m2, m1, p1, p2) = (&mid[..n], &mid[1..n + 1], &mid[3..n + 3], &mid[4..n + 4]);
-        let (u2, u1, d1, d2) = (&up2[2..n + 2], &up[2..n + 2], &down[2..n + 2], &down2[2..n + 2]);
+        let (lm2, lm1, lp1, lp2) = (&mid[..n], &mid[1..n + 1], &mid[3..n + 3], &mid[4..n + 4]);
+        let (lu2, lu1, ld1, ld2) = (&up2[2..n + 2], &up[2..n + 2], &down[2..n + 2], &down2[2..n + 2]);
         let (lw, lshift) = (self.light.width as i32, self.light.shift);
         let (shift_x, shift_y) = self.light_shift;
         let lighting = self.lighting;
@@ -298,8 +355,8 @@ impl PoolRenderer {
             let lx = (tx - shift_x).clamp(0, w - 1) >> lshift;
             let ly = (ty - shift_y).clamp(0, h - 1) >> lshift;
             light_index[i] = (ly * lw + lx) as u32;
-            across[i] = i32::from(m2[i]) + i32::from(m1[i]) - i32::from(p1[i]) - i32::from(p2[i]);
-            along[i] = i32::from(u2[i]) + i32::from(u1[i]) - i32::from(d1[i]) - i32::from(d2[i]);
+            across[i] = i32::from(lm2[i]) + i32::from(lm1[i]) - i32::from(lp1[i]) - i32::from(lp2[i]);
+            along[i] = i32::from(lu2[i]) + i32::from(lu1[i]) - i32::from(ld1[i]) - i32::from(ld2[i]);
             delta[i] = ((across[i] * lighting.shade_x_q8 + along[i] * lighting.shade_y_q8) >> 8)
                 .clamp(-SHADE_LIMIT, SHADE_LIMIT);
         }
@@ -357,14 +414,15 @@ impl PoolRenderer {
     /// One output pixel: `rows` are the height rows y-2..=y+2, `near` the columns x-2, x-1,
     /// x+1, x+2 (clamped at the edges).
     #[inline(always)]
-    fn pixel(&self, rows: &[&[i16]; 5], x: usize, y: usize, near: [usize; 4]) -> u32 {
+    fn pixel(&self, rows: &Rows<'_>, x: usize, y: usize, near: [usize; 4]) -> u32 {
         let (w, h) = (self.background.width() as i32, self.background.height() as i32);
-        let [up2, up, mid, down, down2] = *rows;
         let [l2, l1, r1, r2] = near;
         let q = self.refraction_q8;
         // The papers' offsets: left minus right, up minus down.
+        let [_, up, mid, down, _] = rows.refraction;
         let xoff = i32::from(mid[l1]) - i32::from(mid[r1]);
         let yoff = i32::from(up[x]) - i32::from(down[x]);
+        let [up2, up, mid, down, down2] = rows.light;
         let sx = (((x as i32) << 8) + xoff * q).clamp(0, (w - 1) << 8);
         let sy = (((y as i32) << 8) + yoff * q).clamp(0, (h - 1) << 8);
         let colour = self.sample(sx, sy);
@@ -426,7 +484,7 @@ impl PoolRenderer {
         let light = &self.lighting;
         // The normal is (-dh/dx, -dh/dy, 1) in pixels; the stencils are -6x the gradient in
         // amplitude units.
-        let scale = 1.0 / (STENCIL_SPAN * AMPLITUDE_PER_PIXEL);
+        let scale = light.glint_scale;
         let (nx, ny) = (across as f32 * scale, along as f32 * scale);
         let n_dot_h = (nx * light.half[0] + ny * light.half[1] + light.half[2]) / (nx * nx + ny * ny + 1.0).sqrt();
         if n_dot_h <= light.glint_from {

@@ -38,6 +38,7 @@ use crate::render::caustics::CausticsLook;
 use crate::render::pool::{PoolLook, Refraction, Sun};
 use crate::scene::pool::PoolSettings;
 use crate::scene::{Event, Playable, SceneKind, SceneSpec, Script};
+use crate::sim::breeze::BreezeStyle;
 use crate::sim::ripple::Damping;
 use crate::size::Size;
 
@@ -124,6 +125,18 @@ pub struct PoolOptions {
     /// The breeze's level; a header without it (recorded before the breeze existed) means 0.
     #[serde(default, deserialize_with = "breeze")]
     pub breeze: f64,
+    /// How the breeze moves the water (`"gusts"`, `"wavelets"`); a header without it
+    /// (recorded before the gusts existed) means the first breeze's wavelets.
+    #[serde(default, with = "display_from_str")]
+    pub breeze_style: BreezeStyle,
+    /// Simulation cells per pixel along each axis; a header without it means 1, the papers'
+    /// pool.
+    #[serde(default = "one_cell_a_pixel", deserialize_with = "grid")]
+    pub grid: u32,
+    /// Simulation steps a second (how animations of the replay pace it); a header without it
+    /// means the papers' 60.
+    #[serde(default = "papers_pace", deserialize_with = "steps_per_second")]
+    pub steps_per_second: u32,
 }
 
 impl PoolOptions {
@@ -140,6 +153,9 @@ impl PoolOptions {
             sun: settings.look.sun,
             background,
             breeze: settings.breeze,
+            breeze_style: settings.breeze_style,
+            grid: settings.grid,
+            steps_per_second: settings.steps_per_second,
         }
     }
 
@@ -151,6 +167,9 @@ impl PoolOptions {
             damping: self.damping,
             rain_rate: self.rain,
             breeze: self.breeze,
+            breeze_style: self.breeze_style,
+            grid: self.grid,
+            steps_per_second: self.steps_per_second,
             seed,
             look: PoolLook { refraction: self.refraction, shading: self.shading, caustics, sun: self.sun },
             floor,
@@ -448,6 +467,25 @@ fn rain<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<f64, D::Err
 fn breeze<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<f64, D::Error> {
     let text = crate::numbers::text_or_number(deserializer)?;
     crate::sim::breeze::parse_level(&text).map_err(|e| serde::de::Error::custom(format!("breeze: {e}")))
+}
+
+fn one_cell_a_pixel() -> u32 {
+    1
+}
+
+fn grid<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<u32, D::Error> {
+    let text = crate::numbers::text_or_number(deserializer)?;
+    crate::scene::pool::parse_grid(&text).map_err(|e| serde::de::Error::custom(format!("grid: {e}")))
+}
+
+fn papers_pace() -> u32 {
+    crate::scene::pool::POOL_STEPS_PER_SECOND as u32
+}
+
+fn steps_per_second<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<u32, D::Error> {
+    let text = crate::numbers::text_or_number(deserializer)?;
+    crate::scene::pool::parse_steps_per_second(&text)
+        .map_err(|e| serde::de::Error::custom(format!("steps_per_second: {e}")))
 }
 
 fn depth<'de, D: serde::Deserializer<'de>>(deserializer: D) -> Result<f32, D::Error> {

@@ -55,6 +55,45 @@ fn a_file_written_by_0_1_0_reads_back() {
     assert_eq!(replay.header.options.sun, Sun::default());
     assert_eq!(replay.entries[0].event, Event::Stone(Stone::new(8, 18, 3, 48).unwrap()));
     assert_eq!(replay.entries.len(), 5);
+    // Without the fields of the coherent pool, the pool of then: one cell a pixel, 60 steps a
+    // second, the first breeze's wavelets.
+    let options = &replay.header.options;
+    assert_eq!((options.grid, options.steps_per_second, options.breeze_style), (1, 60, BreezeStyle::Wavelets));
+    let settings = options.settings(7, Pixmap::new(1, 1).unwrap());
+    assert_eq!((settings.grid, settings.steps_per_second, settings.breeze_style), (1, 60, BreezeStyle::Wavelets));
+}
+
+#[test]
+fn the_coherent_pools_fields_round_trip_and_are_checked() {
+    let settings = PoolSettings {
+        grid: 2,
+        steps_per_second: 30,
+        breeze_style: BreezeStyle::Gusts,
+        breeze: 1.0,
+        ..PoolSettings::default()
+    };
+    let header = Header { options: PoolOptions::of(&settings, None), ..header() };
+    let line = header_line(&header);
+    assert!(line.contains(r#""breeze_style":"gusts","grid":2,"steps_per_second":30"#), "{line}");
+    let text = format!("{line}\n{}\n", event_line(&Entry { step: 3, event: Event::End }));
+    let replay = parse(Path::new("r"), &text).unwrap();
+    assert_eq!(replay.header, header);
+    for (bad, needle) in [
+        (r#""grid":2"#, r#""grid":9"#),
+        (r#""steps_per_second":30"#, r#""steps_per_second":0"#),
+        (r#""breeze_style":"gusts""#, r#""breeze_style":"storm""#),
+    ] {
+        let broken = text.replacen(bad, needle, 1);
+        let message = err(&broken);
+        assert!(message.starts_with("r.jsonl, line 1: the header: "), "{message}");
+        let name = needle.split('"').nth(1).unwrap();
+        let expected = match name {
+            "grid" => "outside 1..=4",
+            "steps_per_second" => "outside 1..=240",
+            _ => "is not a breeze style",
+        };
+        assert!(message.contains(expected), "{needle}: {message}");
+    }
 }
 
 #[test]

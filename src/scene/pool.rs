@@ -6,8 +6,10 @@ use super::Heightmap;
 use super::{Action, Controls, Event, Scene, SceneKind};
 use crate::error::{Error, Result};
 use crate::render::background;
-use crate::render::pool::{PoolLook, PoolRenderer};
-use crate::sim::breeze::Breeze;
+use crate::render::pool::{Fields, PoolLook, PoolRenderer};
+use crate::render::supersample::{Downsample, downsample};
+use crate::sim::breeze::gusts::{GustShape, Gusts};
+use crate::sim::breeze::{Breeze, BreezeStyle};
 use crate::sim::rain::Rain;
 use crate::sim::ripple::{Damping, RipplePool, Stone};
 use crate::simd::Simd;
@@ -21,6 +23,15 @@ pub struct PoolSettings {
     pub rain_rate: f64,
     /// The breeze's level (0: the papers' still water; at most 4).
     pub breeze: f64,
+    /// How the breeze moves the water: the first breeze's short wavelets, or gusts.
+    pub breeze_style: BreezeStyle,
+    /// Simulation cells per picture pixel along each axis, `1..=`[`MAX_GRID`]: 1 is the
+    /// papers' pool (its cells are its pixels); a finer grid moves the waves `1/grid` pixels a
+    /// step and draws each pixel as the mean of its cells.
+    pub grid: u32,
+    /// Simulation steps per second of real time, `1..=`[`MAX_STEPS_PER_SECOND`] (the player's
+    /// pace; animations follow it): waves move `0.7/grid` pixels a step.
+    pub steps_per_second: u32,
     /// Seed of the rain.
     pub seed: u64,
     /// How the water is drawn.
@@ -30,13 +41,16 @@ pub struct PoolSettings {
 }
 
 impl Default for PoolSettings {
-    /// The papers' damping, no rain, no breeze, seed 1, the default look over the built-in tiled
-    /// floor.
+    /// The papers' damping, no rain, no breeze, one cell a pixel, seed 1, the default look over
+    /// the built-in tiled floor.
     fn default() -> Self {
         PoolSettings {
             damping: Damping::PAPERS,
             rain_rate: 0.0,
             breeze: 0.0,
+            breeze_style: BreezeStyle::default(),
+            grid: 1,
+            steps_per_second: POOL_STEPS_PER_SECOND as u32,
             seed: 1,
             look: PoolLook::default(),
             floor: background::pool_floor(),
@@ -44,15 +58,145 @@ impl Default for PoolSettings {
     }
 }
 
-/// A ripple pool with its rain and floor, one simulation cell per pixel.
+/// The most simulation steps a second.
+pub const MAX_STEPS_PER_SECOND: u32 = 240;
+
+/// Checks a pace (simulation steps per second).
+pub fn check_steps_per_second(steps: u64) -> std::result::Result<u32, crate::error::ValueError> {
+    match u32::try_from(steps) {
+        Ok(s) if (1..=MAX_STEPS_PER_SECOND).contains(&s) => Ok(s),
+        _ => Err(crate::error::ValueError::new(
+            "steps per second",
+            format!(
+                "{steps} steps a second is outside 1..={MAX_STEPS_PER_SECOND}; the papers' pool runs 60, the player's 30"
+            ),
+        )),
+    }
+}
+
+/// Parses a pace: a whole number of simulation steps a second, `1..=`[`MAX_STEPS_PER_SECOND`].
+pub fn parse_steps_per_second(text: &str) -> std::result::Result<u32, crate::error::ValueError> {
+    let steps: u64 = text.trim().parse().map_err(|_| {
+        crate::error::ValueError::new("steps per second", format!("'{text}' is not a whole number of steps, e.g. 30"))
+    })?;
+    check_steps_per_second(steps)
+}
+
+/// Height units per amplitude unit of the pictures of a pool with gusts: the gusts' ripples
+/// are smooth, and rounding them to whole amplitude units would flicker a unit here and there
+/// every frame as they move (a unit of slope is a step of shading), which costs every cell
+/// on the wire and looks like grain. The pool's own heights are whole units; piles of stones
+/// deeper than 32767 / 4 saturate in the picture (not in the water).
+pub const GUST_UNITS: u32 = 4;
+
+/// How much of the gusts' swells displaces the floor (all of them light it), a departure from
+/// optics chosen by measuring: the floor's tiles are drawn sharp, and a swell sliding them a
+/// fraction of a pixel changes their edges' pixels every frame, structure that a slow link
+/// cannot keep up with (SSIM at 50 kB/s 0.70 with the full displacement, 0.73 with this share,
+/// on the codec benchmark's pool), while the light a swell focuses drifts smoothly.
+pub const GUST_REFRACTION: f32 = 0.3;
+
+/// `heights` plus `ripples` in `light`, and plus `share` of them in `refraction`, in
+/// [`GUST_UNITS`] a unit, each rounded to the nearest unit (floor(v + 1/2) by truncating a
+/// positive number: a conversion the compiler vectorizes; `round` is a call).
+fn fill_units((light, refraction): (&mut Vec<i16>, &mut Vec<i16>), heights: &[i16], ripples: &[f32], share: f32) {
+    let n = heights.len().min(ripples.len());
+    light.resize(n, 0);
+    refraction.resize(n, 0);
+    let (lowest, highest, units) = (f32::from(i16::MIN), f32::from(i16::MAX), GUST_UNITS as f32);
+    let unit = |v: f32| ((v * units).clamp(lowest, highest) - lowest + 0.5) as i32 as f32 + lowest;
+    let (heights, ripples) = (&heights[..n], &ripples[..n]);
+    let (light, refraction) = (&mut light[..n], &mut refraction[..n]);
+    for i in 0..n {
+        let h = f32::from(heights[i]);
+        light[i] = unit(h + ripples[i]).min(highest) as i16;
+        refraction[i] = unit(h + share * ripples[i]).min(highest) as i16;
+    }
+}
+
+/// The units of the pictures of a pool whose breeze is `style`.
+fn units_for(style: BreezeStyle) -> u32 {
+    match style {
+        BreezeStyle::Wavelets => 1,
+        BreezeStyle::Gusts => GUST_UNITS,
+    }
+}
+
+/// The finest simulation grid, in cells per pixel along each axis.
+pub const MAX_GRID: u32 = 4;
+
+/// Parses a grid: a whole number of simulation cells per picture pixel, `1..=`[`MAX_GRID`].
+pub fn parse_grid(text: &str) -> std::result::Result<u32, crate::error::ValueError> {
+    let grid: u64 = text.trim().parse().map_err(|_| {
+        crate::error::ValueError::new("grid", format!("'{text}' is not a whole number of cells per pixel, e.g. 2"))
+    })?;
+    check_grid(grid)
+}
+
+/// Checks a grid (simulation cells per picture pixel).
+pub fn check_grid(grid: u64) -> std::result::Result<u32, crate::error::ValueError> {
+    match u32::try_from(grid) {
+        Ok(g) if (1..=MAX_GRID).contains(&g) => Ok(g),
+        _ => Err(crate::error::ValueError::new(
+            "grid",
+            format!("the grid {grid} is outside 1..={MAX_GRID} simulation cells per pixel; 1 is the papers' pool"),
+        )),
+    }
+}
+
+/// The breeze of a pool, in the style its settings ask for.
+#[derive(Clone, Debug)]
+enum Wind {
+    Wavelets(Breeze),
+    Gusts(Gusts),
+}
+
+impl Wind {
+    fn new(style: BreezeStyle, level: f64, seed: u64, grid: u32) -> Wind {
+        match style {
+            BreezeStyle::Wavelets => Wind::Wavelets(Breeze::with_shape(
+                level,
+                seed,
+                crate::sim::breeze::BreezeShape::default().on_grid(grid),
+            )),
+            BreezeStyle::Gusts => Wind::Gusts(Gusts::new(level, seed, GustShape::default().on_grid(grid))),
+        }
+    }
+
+    fn level(&self) -> f64 {
+        match self {
+            Wind::Wavelets(b) => b.level(),
+            Wind::Gusts(s) => s.level(),
+        }
+    }
+
+    fn set_level(&mut self, level: f64) {
+        match self {
+            Wind::Wavelets(b) => b.set_level(level),
+            Wind::Gusts(s) => s.set_level(level),
+        }
+    }
+}
+
+/// A ripple pool with its rain and floor, `grid x grid` simulation cells a pixel.
 #[derive(Clone, Debug)]
 pub struct PoolScene {
     pool: RipplePool,
     rain: Rain,
-    breeze: Breeze,
+    wind: Wind,
     renderer: PoolRenderer,
     floor: Pixmap,
     drops: Vec<Stone>,
+    /// The picture's size in pixels.
+    size: (u32, u32),
+    grid: u32,
+    steps_per_second: u32,
+    /// The picture at the simulation's resolution, when the grid is finer than the picture.
+    fine: Option<Pixmap>,
+    /// The pool's heights with the gusts' ripples added (amplitude units), and those alone.
+    field: Vec<i16>,
+    refraction: Vec<i16>,
+    gust_heights: Vec<f32>,
     /// The rate `r` switches the rain back on to.
     rain_when_on: f64,
     /// The level `b` switches the breeze back on to.
@@ -72,38 +216,56 @@ pub const BIG_STONE_FACTOR: u32 = 2;
 const STIR_SPACING: f32 = 2.0;
 /// The weight of the small stones of a stir.
 const STIR_WEIGHT: i16 = 32;
-/// The papers' pool runs at 60 steps a second: waves cross a 160-pixel terminal in ~4 s.
+/// The papers' pool runs at 60 steps a second: waves cross a 160-pixel terminal in ~4 s (in
+/// ~8 s on a grid of two cells a pixel).
 pub const POOL_STEPS_PER_SECOND: f64 = 60.0;
 
 impl PoolScene {
     /// A still pool of `width x height` pixels.
     ///
-    /// Returns `None` when the size is zero or too large for a pixmap.
+    /// Returns `None` when the size is zero or too large for a pixmap (at the simulation's
+    /// resolution), or the grid or the pace is out of range.
     pub fn new(width: u32, height: u32, settings: PoolSettings) -> Option<PoolScene> {
-        let fitted = background::cover(&settings.floor, width, height)?;
+        let grid = check_grid(u64::from(settings.grid)).ok()?;
+        let steps_per_second = check_steps_per_second(u64::from(settings.steps_per_second)).ok()?;
+        let (cols, rows) = (width.checked_mul(grid)?, height.checked_mul(grid)?);
+        let fitted = background::cover(&settings.floor, cols, rows)?;
+        let fine = if grid > 1 { Some(Pixmap::new(cols, rows)?) } else { None };
         Some(PoolScene {
-            pool: RipplePool::new(width as usize, height as usize, settings.damping),
+            pool: RipplePool::new(cols as usize, rows as usize, settings.damping),
             rain: Rain::new(settings.rain_rate, settings.seed),
-            breeze: Breeze::new(settings.breeze, settings.seed),
-            renderer: PoolRenderer::new(fitted, settings.look),
+            wind: Wind::new(settings.breeze_style, settings.breeze, settings.seed, grid),
+            renderer: PoolRenderer::on_grid(fitted, settings.look, grid, units_for(settings.breeze_style)),
             floor: settings.floor,
             drops: Vec::new(),
+            size: (width, height),
+            grid,
+            steps_per_second,
+            fine,
+            field: Vec::new(),
+            refraction: Vec::new(),
+            gust_heights: Vec::new(),
             rain_when_on: if settings.rain_rate > 0.0 { settings.rain_rate } else { DEFAULT_TOGGLE_RAIN },
             breeze_when_on: if settings.breeze > 0.0 { settings.breeze } else { crate::sim::breeze::DEFAULT_LEVEL },
         })
     }
 
-    /// Width in pixels (= cells).
+    /// Width in pixels.
     pub fn width(&self) -> u32 {
-        self.pool.width() as u32
+        self.size.0
     }
 
-    /// Height in pixels (= cells).
+    /// Height in pixels.
     pub fn height(&self) -> u32 {
-        self.pool.height() as u32
+        self.size.1
     }
 
-    /// The water.
+    /// Simulation cells per pixel along each axis.
+    pub fn grid(&self) -> u32 {
+        self.grid
+    }
+
+    /// The water (`grid` times the picture's size in cells).
     pub fn pool(&self) -> &RipplePool {
         &self.pool
     }
@@ -115,33 +277,52 @@ impl PoolScene {
         self.renderer.set_simd(simd);
     }
 
-    /// Drops a stone now.
+    /// Drops a stone now; its centre and radius are in pixels (on a finer grid it covers the
+    /// same pixels' cells).
     pub fn drop_stone(&mut self, stone: Stone) {
-        self.pool.drop_stone(stone);
+        self.pool.drop_stone(self.in_cells(stone));
     }
 
-    /// `steps` simulation steps: each step the breeze adds its wave packets, the raindrops
-    /// land, then the water moves.
+    /// A stone given in pixels, in the simulation's cells.
+    fn in_cells(&self, stone: Stone) -> Stone {
+        match self.grid {
+            1 => stone,
+            g => {
+                let centre = |v: i32| v.saturating_mul(g as i32).saturating_add(g as i32 / 2);
+                Stone::clamped(centre(stone.x()), centre(stone.y()), stone.radius().saturating_mul(g), stone.weight())
+            }
+        }
+    }
+
+    /// `steps` simulation steps: each step the breeze adds its wave packets (or the gusts
+    /// age), the raindrops land, then the water moves.
     ///
     /// The rain is drawn step by step (so the random stream is the same as single steps), and
     /// the calm runs between raindrops go to [`RipplePool::advance`] in one piece, which
-    /// computes them many times faster than single steps. A breeze touches every step, so with
-    /// one the steps run one at a time.
+    /// computes them many times faster than single steps. The first breeze's wavelets touch
+    /// every step, so with them the steps run one at a time; the gusts are not in the pool.
     pub fn advance(&mut self, steps: u64) {
-        let (width, height) = (self.pool.width(), self.pool.height());
-        let breezy = self.breeze.level() > 0.0;
+        let (width, height) = (self.size.0 as usize, self.size.1 as usize);
+        let (cols, rows) = (self.pool.width(), self.pool.height());
+        let wavelets = matches!(&self.wind, Wind::Wavelets(b) if b.level() > 0.0);
         let mut calm = 0;
         for _ in 0..steps {
+            if let Wind::Gusts(gusts) = &mut self.wind {
+                gusts.step(cols, rows);
+            }
             self.drops.clear();
             self.rain.drops(width, height, &mut self.drops);
-            if self.drops.is_empty() && !breezy {
+            if self.drops.is_empty() && !wavelets {
                 calm += 1;
                 continue;
             }
             self.pool.advance(calm);
             calm = 0;
-            self.breeze.excite(&mut self.pool);
-            for &drop in &self.drops {
+            if let Wind::Wavelets(breeze) = &mut self.wind {
+                breeze.excite(&mut self.pool);
+            }
+            for k in 0..self.drops.len() {
+                let drop = self.in_cells(self.drops[k]);
                 self.pool.drop_stone(drop);
             }
             self.pool.advance(1);
@@ -149,32 +330,82 @@ impl PoolScene {
         self.pool.advance(calm);
     }
 
+    /// Height units per amplitude unit of the picture's heights.
+    fn units(&self) -> u32 {
+        match self.wind {
+            Wind::Wavelets(_) => 1,
+            Wind::Gusts(_) => GUST_UNITS,
+        }
+    }
+
+    /// With gusts, the heights the picture shows, in [`GUST_UNITS`] a unit: the pool's and
+    /// the gusts' ripples in `self.field` (they light the floor), and in `self.refraction` the
+    /// pool's with [`GUST_REFRACTION`] of the ripples (they displace it). Returns whether it
+    /// made them (otherwise the picture shows the pool's own heights).
+    fn compose(&mut self) -> bool {
+        let Wind::Gusts(gusts) = &mut self.wind else { return false };
+        let (cols, rows) = (self.pool.width(), self.pool.height());
+        self.gust_heights.clear();
+        self.gust_heights.resize(cols * rows, 0.0);
+        gusts.add_to(&mut self.gust_heights, cols, rows);
+        let fields = (&mut self.field, &mut self.refraction);
+        fill_units(fields, self.pool.heights(), &self.gust_heights, GUST_REFRACTION);
+        true
+    }
+
     /// Draws the current water into `out`, which must have the scene's size.
     pub fn render(&mut self, out: &mut Pixmap) {
-        self.renderer.render(&self.pool, out);
+        let fields = match self.compose() {
+            true => Fields { refraction: &self.refraction, light: &self.field },
+            false => Fields { refraction: self.pool.heights(), light: self.pool.heights() },
+        };
+        match &mut self.fine {
+            None => self.renderer.render_fields(fields, out),
+            Some(fine) => {
+                self.renderer.render_fields(fields, fine);
+                downsample(fine, self.grid, Downsample::Box, out);
+            }
+        }
     }
 
     /// Starts over at a new size: still water, the floor refitted, the rain continuing.
     ///
     /// Returns `false` (and changes nothing) when the size is zero or too large.
     pub fn resize(&mut self, width: u32, height: u32) -> bool {
-        let Some(fitted) = background::cover(&self.floor, width, height) else {
+        let g = self.grid;
+        let Some((cols, rows)) = width.checked_mul(g).zip(height.checked_mul(g)) else {
             return false;
         };
+        let Some(fitted) = background::cover(&self.floor, cols, rows) else {
+            return false;
+        };
+        let fine = match g {
+            1 => None,
+            _ => match Pixmap::new(cols, rows) {
+                Some(p) => Some(p),
+                None => return false,
+            },
+        };
         let damping = self.pool.damping();
-        self.pool = RipplePool::new(width as usize, height as usize, damping);
-        self.renderer = PoolRenderer::new(fitted, self.renderer.look());
+        self.pool = RipplePool::new(cols as usize, rows as usize, damping);
+        self.renderer = PoolRenderer::on_grid(fitted, self.renderer.look(), g, self.units());
+        self.fine = fine;
+        self.size = (width, height);
+        if let Wind::Gusts(gusts) = &mut self.wind {
+            gusts.clear();
+        }
         true
     }
 
-    /// The current amplitudes as a heightmap (raw amplitude units, one PNG level each).
+    /// The current heights as a heightmap, one value per simulation cell (raw amplitude
+    /// units, one PNG level each; the gusts' ripples included).
     pub fn heightmap(&self) -> Heightmap {
-        Heightmap {
-            width: self.pool.width(),
-            height: self.pool.height(),
-            values: self.pool.heights().iter().map(|&v| f32::from(v)).collect(),
-            png_levels_per_unit: 1.0,
+        let mut values: Vec<f32> = self.pool.heights().iter().map(|&v| f32::from(v)).collect();
+        if let Wind::Gusts(gusts) = &self.wind {
+            let mut gusts = gusts.clone();
+            gusts.add_to(&mut values, self.pool.width(), self.pool.height());
         }
+        Heightmap { width: self.pool.width(), height: self.pool.height(), values, png_levels_per_unit: 1.0 }
     }
 }
 
@@ -224,7 +455,7 @@ impl Scene for PoolScene {
     }
 
     fn steps_per_second(&self) -> f64 {
-        POOL_STEPS_PER_SECOND
+        f64::from(self.steps_per_second)
     }
 
     fn advance(&mut self, steps: u64) {
@@ -249,9 +480,14 @@ impl Scene for PoolScene {
                 if level > 0.0 {
                     self.breeze_when_on = level;
                 }
-                self.breeze.set_level(level);
+                self.wind.set_level(level);
             }
-            Event::Clear => self.pool.clear(),
+            Event::Clear => {
+                self.pool.clear();
+                if let Wind::Gusts(gusts) = &mut self.wind {
+                    gusts.clear();
+                }
+            }
             Event::Resize([w, h]) => {
                 PoolScene::resize(self, w, h);
             }
@@ -305,7 +541,7 @@ impl Controls for PoolScene {
                 vec![Event::Damping(if stronger { d.stronger() } else { d.weaker() })]
             }
             Action::Key('b') => {
-                let level = if self.breeze.level() > 0.0 { 0.0 } else { self.breeze_when_on };
+                let level = if self.wind.level() > 0.0 { 0.0 } else { self.breeze_when_on };
                 vec![Event::Breeze(level)]
             }
             Action::Key(_) => Vec::new(),
@@ -319,8 +555,8 @@ impl Controls for PoolScene {
             rate if rate > 0.0 => write!(out, "rain {rate}"),
             _ => write!(out, "rain off"),
         };
-        if self.breeze.level() > 0.0 {
-            let _ = write!(out, " \u{b7} breeze {}", self.breeze.level());
+        if self.wind.level() > 0.0 {
+            let _ = write!(out, " \u{b7} breeze {}", self.wind.level());
         }
         let _ = write!(out, " \u{b7} damping {}", self.pool.damping());
     }
@@ -357,9 +593,9 @@ mod tests {
     /// computed at half resolution on several threads.
     #[test]
     fn every_simd_tier_draws_the_same_pixels() {
-        for (w, h) in [(160u32, 94u32), (1024, 600)] {
+        for (w, h, pool) in [(160u32, 94u32, settings(0.4)), (1024, 600, settings(0.4)), (160, 94, coherent(2))] {
             let run = |simd: Simd| {
-                let mut scene = PoolScene::new(w, h, settings(0.4)).unwrap();
+                let mut scene = PoolScene::new(w, h, pool.clone()).unwrap();
                 scene.set_simd(simd);
                 for k in 0..12 {
                     scene.drop_stone(Stone::clamped((k * 37 % w) as i32, (k * 53 % h) as i32, 5, 300));
@@ -374,6 +610,72 @@ mod tests {
                 assert!(pixels == portable.1, "{w}x{h}: the picture on {simd} differs from portable");
             }
         }
+    }
+
+    fn coherent(grid: u32) -> PoolSettings {
+        PoolSettings {
+            grid,
+            steps_per_second: 30,
+            breeze: 1.0,
+            breeze_style: BreezeStyle::Gusts,
+            rain_rate: 0.3,
+            ..settings(0.0)
+        }
+    }
+
+    #[test]
+    fn a_finer_grid_takes_stones_in_pixels_and_moves_their_rings_slower() {
+        // The same stone in pixels on one and on two cells a pixel: the dent covers the same
+        // pixels, and after the same steps the ring has travelled the same cells, half the
+        // pixels.
+        let ring_radius = |grid: u32| {
+            let mut scene = PoolScene::new(80, 60, PoolSettings { grid, ..settings(0.0) }).unwrap();
+            scene.drop_stone(Stone::new(40, 30, 3, 128).unwrap());
+            let dent = scene.pool().heights().iter().filter(|&&v| v < 0).count() as f32;
+            let disc = std::f32::consts::PI * (3 * grid * 3 * grid) as f32;
+            assert!((dent / disc - 1.0).abs() < 0.25, "a disc of radius 3 pixels: {dent} cells on grid {grid}");
+            scene.advance(40);
+            // The ring's front: the farthest cell the wave has moved by a few units.
+            let (w, pool) = (scene.pool().width(), scene.pool());
+            let centre = (40.0 * grid as f32 + (grid / 2) as f32, 30.0 * grid as f32 + (grid / 2) as f32);
+            let front = pool.heights().iter().enumerate().filter(|&(_, &v)| v.abs() >= 4).map(|(i, _)| {
+                let (x, y) = ((i % w) as f32, (i / w) as f32);
+                (x - centre.0).hypot(y - centre.1)
+            });
+            front.fold(0f32, f32::max) / grid as f32
+        };
+        // 0.7 cells a step: 28 cells past the dent's edge (3 pixels = 3 or 6 cells).
+        let (one, two) = (ring_radius(1), ring_radius(2));
+        assert!((one - 31.0).abs() < 4.0, "{one} pixels after 40 steps on one cell a pixel");
+        assert!((two - 17.0).abs() < 3.0, "{two} pixels after 40 steps on two cells a pixel");
+        assert_eq!(PoolScene::new(10, 10, PoolSettings { grid: 5, ..settings(0.0) }).map(|s| s.grid()), None);
+    }
+
+    #[test]
+    fn gusts_move_the_water_at_rest_and_clearing_stills_them() {
+        let mut scene = PoolScene::new(80, 48, PoolSettings { rain_rate: 0.0, ..coherent(2) }).unwrap();
+        let calm = PoolSettings { rain_rate: 0.0, breeze: 0.0, ..coherent(2) };
+        let still = PoolScene::new(80, 48, calm).unwrap().snapshot().unwrap();
+        scene.advance(30);
+        assert!(scene.pool().heights().iter().all(|&v| v == 0), "the gusts are drawn, not put into the pool");
+        let breezy = scene.snapshot().unwrap();
+        let moved = breezy.pixels().iter().zip(still.pixels()).filter(|(a, b)| a != b).count();
+        assert!(moved > 80 * 48 / 10, "the gusts light the floor: {moved} pixels moved");
+        scene.apply(&Event::Clear);
+        assert!(scene.snapshot().unwrap().data() == still.data(), "clear stills the gusts too");
+        assert_eq!(scene.steps_per_second(), 30.0);
+    }
+
+    #[test]
+    fn grids_paces_and_styles_are_checked() {
+        assert_eq!(parse_grid(" 2 "), Ok(2));
+        assert!(parse_grid("5").unwrap_err().to_string().contains("outside 1..=4"));
+        assert!(parse_grid("1.5").unwrap_err().to_string().contains("whole number"));
+        assert_eq!(parse_steps_per_second("30"), Ok(30));
+        assert!(parse_steps_per_second("0").unwrap_err().to_string().contains("outside 1..=240"));
+        assert_eq!("gusts".parse(), Ok(BreezeStyle::Gusts));
+        assert_eq!("wavelets".parse(), Ok(BreezeStyle::Wavelets));
+        assert!("storm".parse::<BreezeStyle>().unwrap_err().to_string().contains("'gusts'"));
     }
 
     #[test]

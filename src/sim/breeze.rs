@@ -21,6 +21,52 @@ use rand_chacha::ChaCha8Rng;
 
 use super::ripple::RipplePool;
 
+pub mod gusts;
+
+/// How a breeze moves the pool.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum BreezeStyle {
+    /// Short wave packets added to the integer pool at once, here and there: the
+    /// first breeze, what a replay without a style means.
+    #[default]
+    Wavelets,
+    /// Broad swells of light that rise and fade over seconds as they drift downwind, drawn
+    /// over the water rather than added to it: water that moves like water filmed at 30 fps.
+    Gusts,
+}
+
+impl BreezeStyle {
+    /// The style's name on the command line and in replays.
+    pub fn name(self) -> &'static str {
+        match self {
+            BreezeStyle::Wavelets => "wavelets",
+            BreezeStyle::Gusts => "gusts",
+        }
+    }
+}
+
+impl std::fmt::Display for BreezeStyle {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for BreezeStyle {
+    type Err = crate::error::ValueError;
+
+    /// `gusts` or `wavelets`.
+    fn from_str(text: &str) -> Result<BreezeStyle, Self::Err> {
+        match text.trim() {
+            "wavelets" => Ok(BreezeStyle::Wavelets),
+            "gusts" => Ok(BreezeStyle::Gusts),
+            other => Err(crate::error::ValueError::new(
+                "breeze style",
+                format!("'{other}' is not a breeze style; use 'gusts' (ripples that rise and fade) or 'wavelets'"),
+            )),
+        }
+    }
+}
+
 /// Parses a breeze level, `0..=`[`MAX_LEVEL`] (0 is the papers' still water).
 pub fn parse_level(text: &str) -> Result<f64, crate::error::ValueError> {
     check_level(crate::numbers::finite(text, "breeze", "1")?)
@@ -91,6 +137,22 @@ impl Default for BreezeShape {
     }
 }
 
+impl BreezeShape {
+    /// The same breeze on a pool of `grid` cells per pixel: the same packets in pixels
+    /// (lengths times `grid`, the same number per pixel area). Grid 1 is this shape unchanged.
+    pub fn on_grid(self, grid: u32) -> BreezeShape {
+        if grid <= 1 {
+            return self;
+        }
+        let g = grid as f32;
+        BreezeShape {
+            packets_per_10k_cells: self.packets_per_10k_cells / f64::from(g * g),
+            wavelength_cells: (self.wavelength_cells.0 * g, self.wavelength_cells.1 * g),
+            ..self
+        }
+    }
+}
+
 /// How far the scheme's waves travel per step, in cells: `c² dt² / dx² = 1/2`.
 const WAVE_SPEED: f32 = std::f32::consts::FRAC_1_SQRT_2;
 /// The envelope is cut off this many standard deviations out.
@@ -109,6 +171,7 @@ pub struct Breeze {
 impl Breeze {
     /// A breeze of `level` (0 = still water; negative, NaN or infinite count as 0; levels over
     /// [`MAX_LEVEL`] are lowered to it), its gusts drawn from `seed`.
+    #[cfg(test)]
     pub fn new(level: f64, seed: u64) -> Breeze {
         Breeze::with_shape(level, seed, BreezeShape::default())
     }

@@ -7,6 +7,7 @@
 mod animation;
 mod bytes_per_frame;
 mod cli;
+mod coherence;
 mod common;
 mod goldens;
 mod graphics;

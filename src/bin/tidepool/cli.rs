@@ -9,7 +9,7 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use tidepool::{CausticsLook, Damping, Refraction, SceneKind, Size, Stone, Sun, ValueError, values};
+use tidepool::{BreezeStyle, CausticsLook, Damping, Refraction, SceneKind, Size, Stone, Sun, ValueError, values};
 
 pub mod lake;
 pub mod ocean;
@@ -129,10 +129,10 @@ pub struct LiveSceneArgs {
     pub seed: u64,
 }
 
-/// The player's water is alive at rest: a light breeze, rain you can see, and stones whose
-/// rings cross the pool (damping shift 6, a little less than the papers' 5, because the
-/// breeze's wavelets keep the water moving; the rate-controlled encoder makes that affordable
-/// on any link).
+/// The player's water is alive at rest and coherent from frame to frame: gusts of broad swells
+/// of light, a few raindrops, stones whose rings spread crisp at a third of a pixel a frame (a
+/// grid of two cells a pixel, 30 steps a second; see [`PoolDefaults::PLAYER`]), the papers'
+/// damping.
 #[derive(Args, Debug, Clone)]
 #[command(after_help = PLAY_KEYS, mut_arg("damping", |a| a.default_value(PLAYER_DAMPING)))]
 pub struct PlayCommand {
@@ -214,7 +214,39 @@ impl From<GraphicsFlag> for tidepool::play::GraphicsRequest {
 }
 
 /// The player's default `--damping`.
-pub const PLAYER_DAMPING: &str = "6";
+pub const PLAYER_DAMPING: &str = "5";
+
+/// The pool flags' defaults where `render` and the live scenes (`play`, `serve`) differ.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PoolDefaults {
+    /// `--rain`.
+    pub rain: f64,
+    /// `--breeze`.
+    pub breeze: f64,
+    /// `--breeze-style`.
+    pub breeze_style: BreezeStyle,
+    /// `--grid`.
+    pub grid: u32,
+    /// `--steps-per-second`.
+    pub steps_per_second: u32,
+}
+
+impl PoolDefaults {
+    /// `render pool`: the papers' still water, one cell a pixel, 60 steps a second.
+    pub const RENDER: PoolDefaults =
+        PoolDefaults { rain: 0.0, breeze: 0.0, breeze_style: BreezeStyle::Wavelets, grid: 1, steps_per_second: 60 };
+    /// `play` and `serve`: water alive at rest that moves like water filmed at 30 fps and
+    /// survives a slow link: gusts (broad swells of light drifting downwind), a few raindrops,
+    /// a grid of two cells a pixel and 30 steps a second, so waves move a third of a pixel a
+    /// frame instead of 1.4 pixels (`tests/integration/coherence.rs`, `benches/codec.rs`).
+    pub const PLAYER: PoolDefaults = PoolDefaults {
+        rain: 0.01,
+        breeze: values::DEFAULT_BREEZE,
+        breeze_style: BreezeStyle::Gusts,
+        grid: 2,
+        steps_per_second: 30,
+    };
+}
 
 /// The scenes `play` knows; `tab` cycles through them in this order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -327,7 +359,7 @@ pub struct RenderPool {
     /// Re-simulate a session recorded with `tidepool play --record FILE` and render its last
     /// step (or --steps N): identical to a screenshot taken at that step. The replay fixes the
     /// size, seed, stones and water flags.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "grid", "breeze_style", "steps_per_second", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
     pub replay: Option<PathBuf>,
 
     /// An animation instead of one picture.
@@ -394,14 +426,34 @@ pub struct OutputArgs {
 #[derive(Args, Debug, Clone)]
 pub struct PoolArgs {
     /// Raindrops per simulation step on average (radius 2, weight 64), a number >= 0.
-    /// [default: 0 for render, 0.05 for play]
+    /// [default: 0 for render, 0.01 for play]
     #[arg(long, value_name = "RATE", value_parser = parse_rate, allow_negative_numbers = true)]
     pub rain: Option<f64>,
 
-    /// A light breeze of fine wavelets running over the water, so it is never still (0..=4;
+    /// A light breeze over the water, so it is never still (0..=4; its style is --breeze-style;
     /// 0 is the papers' still water). [default: 0 for render, 1 for play]
     #[arg(long, value_name = "LEVEL", value_parser = parse_breeze, allow_negative_numbers = true)]
     pub breeze: Option<f64>,
+
+    /// How the breeze moves the water: `gusts` (patches of ripples that rise and fade over
+    /// seconds as they drift downwind: water as a camera films it at 30 fps) or `wavelets`
+    /// (short wavelets that appear at once; the first breeze). [default: wavelets for render,
+    /// gusts for play]
+    #[arg(long, value_name = "STYLE", value_parser = parse_breeze_style)]
+    pub breeze_style: Option<BreezeStyle>,
+
+    /// Simulation cells per picture pixel along each axis (1..=4): a finer grid moves the
+    /// waves 1/N pixels a step (they cross the picture N times slower, as if filmed from
+    /// further away) and draws each pixel as the mean of its cells; 1 is the papers' pool, one
+    /// cell a pixel. [default: 1 for render, 2 for play]
+    #[arg(long, value_name = "N", value_parser = parse_grid)]
+    pub grid: Option<u32>,
+
+    /// Simulation steps per second of real time (1..=240): the pool's pace in the player and
+    /// in animations (waves move 0.7/N pixels a step on a grid of N). [default: 60 for render,
+    /// 30 for play]
+    #[arg(long, value_name = "STEPS", value_parser = parse_steps_per_second)]
+    pub steps_per_second: Option<u32>,
 
     /// Damping: each step the water loses 1/2^SHIFT of its amplitude (SHIFT 1..=15; higher
     /// calms more slowly), or `off` for none.
@@ -451,14 +503,17 @@ impl PoolArgs {
         }
     }
 
-    /// The pool's settings from these flags, with `seed`, and the rain and breeze when
-    /// `--rain` and `--breeze` are not given; the floor is `--background` decoded, or the
-    /// built-in tiles.
-    pub fn settings(&self, seed: u64, defaults: (f64, f64)) -> crate::error::Result<tidepool::PoolSettings> {
+    /// The pool's settings from these flags, with `seed`, and `defaults` for the flags not
+    /// given (rain, breeze, its style and the grid); the floor is `--background` decoded, or
+    /// the built-in tiles.
+    pub fn settings(&self, seed: u64, defaults: PoolDefaults) -> crate::error::Result<tidepool::PoolSettings> {
         Ok(tidepool::PoolSettings {
             damping: self.damping,
-            rain_rate: self.rain.unwrap_or(defaults.0),
-            breeze: self.breeze.unwrap_or(defaults.1),
+            rain_rate: self.rain.unwrap_or(defaults.rain),
+            breeze: self.breeze.unwrap_or(defaults.breeze),
+            breeze_style: self.breeze_style.unwrap_or(defaults.breeze_style),
+            grid: self.grid.unwrap_or(defaults.grid),
+            steps_per_second: self.steps_per_second.unwrap_or(defaults.steps_per_second),
             seed,
             look: self.look(),
             floor: self.floor()?,
@@ -535,6 +590,21 @@ pub fn parse_breeze(text: &str) -> Result<f64, String> {
     values::parse_breeze(text).map_err(|e| e.to_string())
 }
 
+/// Parses a breeze style: `gusts` or `wavelets`.
+pub fn parse_breeze_style(text: &str) -> Result<BreezeStyle, String> {
+    check(text)
+}
+
+/// Parses a pace, 1..=240 simulation steps a second.
+pub fn parse_steps_per_second(text: &str) -> Result<u32, String> {
+    values::parse_steps_per_second(text).map_err(|e| e.to_string())
+}
+
+/// Parses a grid, 1..=4 simulation cells per pixel.
+pub fn parse_grid(text: &str) -> Result<u32, String> {
+    values::parse_grid(text).map_err(|e| e.to_string())
+}
+
 /// Parses a refraction factor (finite, 0..=100) or `auto`.
 pub fn parse_refraction(text: &str) -> Result<Refraction, String> {
     check(text)
@@ -601,7 +671,15 @@ mod tests {
             assert!(parse_seed(bad).unwrap_err().contains("whole number"), "{bad}");
         }
         assert_eq!(parse_seed(" 42 "), Ok(42));
-        for flag in [&["--size", "10x10"][..], &["--seed", "3"], &["--stone", "1,2"], &["--damping", "4"]] {
+        for flag in [
+            &["--size", "10x10"][..],
+            &["--seed", "3"],
+            &["--stone", "1,2"],
+            &["--damping", "4"],
+            &["--grid", "2"],
+            &["--steps-per-second", "30"],
+            &["--breeze-style", "gusts"],
+        ] {
             let err = parse(&[&["--replay", "r.jsonl"][..], flag].concat()).unwrap_err();
             assert_eq!(err.kind(), clap::error::ErrorKind::ArgumentConflict, "{flag:?}");
         }
@@ -615,7 +693,13 @@ mod tests {
             (play.scene, play.fps, play.color, play.water.pool.rain),
             (PlayScene::Pool, 30, ColorChoice::Auto, None)
         );
-        assert_eq!(play.water.pool.damping.shift(), Some(6), "the player's own damping");
+        assert_eq!(play.water.pool.damping.shift(), Some(5), "the player's damping");
+        let pool = play.water.pool.settings(1, PoolDefaults::PLAYER).unwrap();
+        assert_eq!(
+            (pool.grid, pool.steps_per_second, pool.breeze_style, pool.breeze, pool.rain_rate),
+            (2, 30, BreezeStyle::Gusts, 1.0, 0.01),
+            "the player's coherent pool"
+        );
         assert_eq!(play.bandwidth, tidepool::play::Bandwidth::Auto);
         assert_eq!(play.graphics, GraphicsFlag::Auto, "pictures in real pixels where the terminal answers");
         for (flag, want) in
@@ -629,6 +713,12 @@ mod tests {
         let cli = Cli::try_parse_from(["tidepool", "render", "pool"]).unwrap();
         let Some(Command::Render(RenderCommand { scene: RenderScene::Pool(pool) })) = cli.command else { panic!() };
         assert_eq!(pool.pool.damping, Damping::PAPERS);
+        let render = pool.pool.settings(1, PoolDefaults::RENDER).unwrap();
+        assert_eq!(
+            (render.grid, render.steps_per_second, render.breeze_style, render.breeze, render.rain_rate),
+            (1, 60, BreezeStyle::Wavelets, 0.0, 0.0),
+            "render draws the papers' pool"
+        );
         assert!(Cli::try_parse_from(["tidepool", "play", "--fps", "0"]).is_err());
         assert!(Cli::try_parse_from(["tidepool", "play", "--color", "256"]).is_ok());
     }

@@ -30,17 +30,19 @@ pub(crate) struct Item {
     /// The sort key, smallest first: the tier (0: a noticeable error; 1: below the JND; 2: no
     /// error removed, convergence only), then the most error removed per byte (a positive
     /// float's bits order like the float; inverted, so the largest comes first), then the cell
-    /// (22 bits) and the rank (8 bits), so that the order is total.
+    /// (22 bits) and the step's place on the cell's hull (8 bits), so that the order is total.
     pub order: u64,
     /// Estimated bytes of this step.
     pub cost: u32,
+    /// The variant this step reaches ([`EXACT`] or a rank into the cell's variants).
+    rank: u8,
 }
 
 impl Item {
-    fn new(tier: u8, ratio: f32, cell: u32, rank: u8, cost: f32) -> Item {
+    fn new(tier: u8, ratio: f32, cell: u32, (step, rank): (u8, u8), cost: f32) -> Item {
         let ratio = !ratio.max(0.0).to_bits();
-        let order = u64::from(tier) << 62 | u64::from(ratio) << 30 | u64::from(cell & 0x3f_ffff) << 8 | u64::from(rank);
-        Item { order, cost: cost.round() as u32 }
+        let order = u64::from(tier) << 62 | u64::from(ratio) << 30 | u64::from(cell & 0x3f_ffff) << 8 | u64::from(step);
+        Item { order, cost: cost.round() as u32, rank }
     }
 
     /// The cell's index.
@@ -48,9 +50,15 @@ impl Item {
         (self.order >> 8 & 0x3f_ffff) as usize
     }
 
+    /// The step's place on its cell's hull: 0 for the cheapest, each step improving on the one
+    /// before it.
+    pub fn step(&self) -> u8 {
+        self.order as u8
+    }
+
     /// The variant this step reaches ([`EXACT`] or a rank into the cell's variants).
     pub fn rank(&self) -> u8 {
-        self.order as u8
+        self.rank
     }
 }
 
@@ -416,7 +424,7 @@ impl RateEncoder {
         let tier = m.tier();
         if tier == 2 {
             let ratio = m.distance / exact_cost;
-            self.items.push(Item::new(tier, ratio, cell, EXACT, exact_cost));
+            self.items.push(Item::new(tier, ratio, cell, (0, EXACT), exact_cost));
             return;
         }
         // Approximations only for noticeable errors: a cell below the JND is drawn exactly,
@@ -448,9 +456,9 @@ impl RateEncoder {
             }
         }
         let (mut cost, mut benefit) = (0.0, 0.0);
-        for p in upper_hull(&mut points[..n]) {
+        for (step, p) in upper_hull(&mut points[..n]).enumerate() {
             let (dc, db) = (p.cost - cost, p.benefit - benefit);
-            self.items.push(Item::new(tier, db / dc, cell, p.rank, dc));
+            self.items.push(Item::new(tier, db / dc, cell, (step as u8, p.rank), dc));
             (cost, benefit) = (p.cost, p.benefit);
         }
     }

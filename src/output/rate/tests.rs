@@ -447,3 +447,38 @@ mod properties {
         }
     }
 }
+
+/// Under a tight budget a cell's steps are bought cheapest first (a space in the nearest
+/// palette colour of the cell's mean, then a space in the mean itself, then the exact cell):
+/// when the second step is paid for, the cell is drawn with it, never with the cheaper
+/// approximation it improves on.
+#[test]
+fn a_cell_is_drawn_with_the_best_approximation_paid_for() {
+    // One cell of two close colours whose mean is far from the xterm palette, on a known
+    // black screen.
+    let (top, bottom) = ([120u8, 90, 60], [130u8, 100, 70]);
+    let p = picture(1, 1, |_, y| if y == 0 { top } else { bottom });
+    let wanted = frame_of(&p, ColorMode::TrueColor);
+    let black = Cell::Pixels { top: Color::Rgb([0, 0, 0]), bottom: Color::Rgb([0, 0, 0]) };
+    let mut blank = Frame::new(1, 1);
+    blank.set(0, 0, black);
+    let shown = Shown { frame: Some(blank), ..Shown::UNKNOWN };
+    let mean = [125u8, 95, 65];
+    let flat = Cell::Pixels { top: Color::Rgb(mean), bottom: Color::Rgb(mean) };
+    let palette = Color::Index(crate::output::color::nearest_256(mean));
+    let flat_palette = Cell::Pixels { top: palette, bottom: palette };
+    let drawn = |budget: usize| {
+        let (_, next) = encode(&shown, Target::new(&wanted), budget, RateOptions::default());
+        next.frame.unwrap().get(0, 0)
+    };
+    let draws: Vec<(usize, Cell)> = (1..=60).map(|b| (b, drawn(b))).collect();
+    // Every way is drawn at some budget, cheapest first, and once a better way fits the
+    // cell is never drawn in a worse one.
+    let first = |cell: Cell| draws.iter().find(|(_, c)| *c == cell).map(|&(b, _)| b);
+    let (palette_at, flat_at, exact_at) = (first(flat_palette), first(flat), first(wanted.get(0, 0)));
+    assert!(palette_at.is_some() && flat_at.is_some() && exact_at.is_some(), "{draws:?}");
+    assert!(palette_at < flat_at && flat_at < exact_at, "{palette_at:?} {flat_at:?} {exact_at:?}");
+    for &(budget, cell) in &draws[flat_at.unwrap() - 1..] {
+        assert_ne!(cell, flat_palette, "at {budget} bytes the flat mean was paid for, the palette colour drawn");
+    }
+}

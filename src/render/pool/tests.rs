@@ -178,7 +178,8 @@ fn staged_spans_compute_exactly_what_single_pixels_do() {
                 let r = (y as isize + dy).clamp(0, hu as isize - 1) as usize;
                 &heights[r * wu..(r + 1) * wu]
             };
-            let rows = [row(-2), row(-1), row(0), row(1), row(2)];
+            let around = [row(-2), row(-1), row(0), row(1), row(2)];
+            let rows = Rows { refraction: around, light: around };
             for x in 0..wu {
                 let near = [x.saturating_sub(2), x.saturating_sub(1), (x + 1).min(wu - 1), (x + 2).min(wu - 1)];
                 let expected = renderer.pixel(&rows, x, y, near).to_ne_bytes();
@@ -210,7 +211,8 @@ fn parallel_rows_equal_single_thread_rows() {
     let mut parallel = Pixmap::new(w, h).unwrap();
     renderer.render(&pool, &mut parallel);
     let mut single = Pixmap::new(w, h).unwrap();
-    renderer.render_rows(pool.heights(), 0, single.data_mut());
+    let fields = Fields { refraction: pool.heights(), light: pool.heights() };
+    renderer.render_rows(fields, 0, single.data_mut());
     assert_eq!(parallel.data(), single.data());
 }
 

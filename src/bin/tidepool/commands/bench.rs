@@ -71,10 +71,21 @@ fn papers_step(current: &mut Vec<i16>, previous: &mut Vec<i16>, w: usize, h: usi
     std::mem::swap(current, previous);
 }
 
-/// The scenes at their defaults as the player shows them (no supersampling), and with `ssaa`
-/// for pictures.
+/// The scenes at their defaults as the player shows them (no supersampling; the pool with its
+/// grid, pace and gusts), and with `ssaa` for pictures (the pool as `render` draws it).
 fn scenes(ssaa: u32) -> [(&'static str, SceneSpec); 3] {
-    let pool = PoolSettings { rain_rate: 0.3, ..PoolSettings::default() };
+    let mut pool = PoolSettings { rain_rate: 0.3, ..PoolSettings::default() };
+    if ssaa == 1 {
+        let player = crate::cli::PoolDefaults::PLAYER;
+        pool = PoolSettings {
+            breeze: player.breeze,
+            breeze_style: player.breeze_style,
+            grid: player.grid,
+            steps_per_second: player.steps_per_second,
+            damping: crate::cli::PLAYER_DAMPING.parse().expect("the player's damping"),
+            ..pool
+        };
+    }
     let ocean = OceanSettings { view: OceanView { ssaa, ..OceanView::default() }, ..OceanSettings::default() };
     let lake = LakeSettings { ssaa, ..LakeSettings::default() };
     [("pool", SceneSpec::Pool(pool)), ("ocean", SceneSpec::Ocean(ocean)), ("lake", SceneSpec::Lake(lake))]

@@ -17,7 +17,7 @@ pub fn render(args: RenderPool) -> Result<()> {
         return animate_pool(&args, frames);
     }
     let plan = OutputPlan::new(&args.output, "pool", std::io::stdout().is_terminal(), terminal_pixels())?;
-    let spec = SceneSpec::Pool(args.pool.settings(args.output.seed, (0.0, 0.0))?);
+    let spec = SceneSpec::Pool(args.pool.settings(args.output.seed, crate::cli::PoolDefaults::RENDER)?);
     let script = script(&args, plan.size);
     let steps = args.steps.unwrap_or_else(|| default_pool_steps(plan.size));
     let still = Still { spec: &spec, script: &script, steps, too_large_hint: "", print_stats: args.output.stats };
@@ -45,7 +45,7 @@ fn animate_pool(args: &RenderPool, frames: u32) -> Result<()> {
     super::animate::check_animation_flags(&args.output)?;
     let target = AnimationTarget::from_out(args.output.out.as_deref(), "pool", args.animation.fps)?;
     let size = args.output.size.unwrap_or(DEFAULT_PNG_SIZE);
-    let spec = SceneSpec::Pool(args.pool.settings(args.output.seed, (0.0, 0.0))?);
+    let spec = SceneSpec::Pool(args.pool.settings(args.output.seed, crate::cli::PoolDefaults::RENDER)?);
     let script = script(args, size);
     let animation = Animation { frames, fps: args.animation.fps, start_step: args.steps.unwrap_or(0), script: &script };
     animate(&spec, size, &animation, &target, "", args.output.stats)

@@ -7,10 +7,6 @@ use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneKind, Sc
 use crate::cli::{LiveSceneArgs, PlayScene};
 use crate::error::Result;
 
-/// The player's rain when `--rain` is not given: three drops a second at 60 steps/s, seen as
-/// small rings.
-pub const DEFAULT_PLAYER_RAIN: f64 = 0.05;
-
 /// The lake the player starts with: the default breeze and noise, no supersampling (a
 /// terminal cell is two pixels; the frame budget goes to the water instead).
 pub fn lake_settings(seed: u64) -> LakeSettings {
@@ -19,7 +15,7 @@ pub fn lake_settings(seed: u64) -> LakeSettings {
 
 /// Every scene, in `tab` order, starting from `first`.
 pub fn specs(first: PlayScene, flags: &LiveSceneArgs) -> Result<Vec<SceneSpec>> {
-    let pool = flags.pool.settings(flags.seed, (DEFAULT_PLAYER_RAIN, tidepool::values::DEFAULT_BREEZE))?;
+    let pool = flags.pool.settings(flags.seed, crate::cli::PoolDefaults::PLAYER)?;
     let default_view = OceanView::default();
     let ocean = OceanSettings {
         sea: flags.sea.shape().params(
