@@ -33,6 +33,8 @@ use std::str::FromStr;
 use super::dispersion;
 use super::spectrum::{ALPHA, G, PEAK_FACTOR, PiersonMoskowitz, spreading};
 
+pub mod swell;
+
 /// JONSWAP's default peak enhancement γ (Hasselmann et al.'s mean).
 pub const DEFAULT_GAMMA: f64 = 3.3;
 /// The range of γ tidepool accepts (1 = no enhancement, Pierson–Moskowitz's shape).
@@ -85,6 +87,81 @@ impl SpectrumKind {
             SpectrumKind::Tma => "tma",
         }
     }
+}
+
+/// How the wind sea's energy spreads over directions about the wind, as a function of
+/// frequency (Horvath 2015 gathers these for graphics).
+///
+/// ```text
+/// cos-2s   D(f, θ) = Γ(s+1)/(2√π Γ(s+½)) · cos(θ/2)^(2s)          (r = f/fp)
+///   paper       s = 9.77·r^-2.5 (r ≥ 1), 6.97·r^5 below              seed 004's mix (the default)
+///   mitsuyasu   s = s_p·r^-2.5 (r > 1), s_p·r^5 below, s_p = 11.5·(2π·fp·U/g)^-2.5
+///   hasselmann  s = 9.77·r^μ (r ≥ 1.05), 6.97·r^4.06 below, μ = -2.33 - 1.45·(U/c_p - 1.17)
+/// sech²    D(f, θ) = β/(2·tanh(βπ)) · sech²(βθ)                      donelan-banner
+///   β = 2.61·r^1.3 (0.56 ≤ r < 0.95), 2.28·r^-1.3 (0.95 ≤ r < 1.6),
+///   10^ε above (Banner 1990), ε = -0.4 + 0.8393·exp(-0.567·ln r²); below r = 0.56, β(0.56)
+/// ```
+///
+/// c_p = 2π·fp/k(fp) is the peak's phase speed in the sea's depth.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Spreading {
+    /// Seed 004's mix: Hasselmann's constants with Mitsuyasu's exponents (the default).
+    #[default]
+    Paper,
+    /// Mitsuyasu et al. (1975), s_p from the wave age.
+    Mitsuyasu,
+    /// Hasselmann et al. (1980), the exponent from the wave age.
+    Hasselmann,
+    /// Donelan, Hamilton and Hui (1985) with Banner's (1990) high-frequency tail.
+    DonelanBanner,
+}
+
+impl FromStr for Spreading {
+    type Err = ValueError;
+
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.trim().to_ascii_lowercase().as_str() {
+            "paper" => Ok(Spreading::Paper),
+            "mitsuyasu" => Ok(Spreading::Mitsuyasu),
+            "hasselmann" => Ok(Spreading::Hasselmann),
+            "donelan-banner" | "donelan" => Ok(Spreading::DonelanBanner),
+            other => Err(ValueError::new(
+                "spreading",
+                format!("unknown spreading '{other}'; use paper, mitsuyasu, hasselmann or donelan-banner"),
+            )),
+        }
+    }
+}
+
+impl Spreading {
+    /// The name the command line takes.
+    pub fn name(self) -> &'static str {
+        match self {
+            Spreading::Paper => "paper",
+            Spreading::Mitsuyasu => "mitsuyasu",
+            Spreading::Hasselmann => "hasselmann",
+            Spreading::DonelanBanner => "donelan-banner",
+        }
+    }
+}
+
+/// The Donelan–Banner β at r = f/fp.
+fn donelan_banner_beta(r: f64) -> f64 {
+    let r = r.max(0.56);
+    if r < 0.95 {
+        2.61 * r.powf(1.3)
+    } else if r < 1.6 {
+        2.28 * r.powf(-1.3)
+    } else {
+        10f64.powf(-0.4 + 0.8393 * (-0.567 * (r * r).ln()).exp())
+    }
+}
+
+/// The sech² spreading β/(2·tanh(βπ))·sech²(βθ), θ wrapped into [-π, π].
+fn sech2_spreading(beta: f64, theta: f64) -> f64 {
+    let t = (theta + PI).rem_euclid(2.0 * PI) - PI;
+    let c = (beta * t).cosh();
+    beta / (2.0 * (beta * PI).tanh()) / (c * c)
 }
 
 fn finite(v: f64, what: &'static str, example: &str) -> Result<f64, ValueError> {
@@ -297,6 +374,7 @@ impl SpectrumChoice {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SeaSpectrum {
     choice: SpectrumChoice,
+    spreading: Spreading,
     pm: PiersonMoskowitz,
     peak_hz: Option<f64>,
     alpha: f64,
@@ -314,7 +392,7 @@ impl SeaSpectrum {
             SpectrumChoice::PiersonMoskowitz => (pm.peak_hz(), ALPHA),
             SpectrumChoice::Jonswap(j) | SpectrumChoice::Tma(j, _) => (j.peak_hz(wind), j.alpha(wind)),
         };
-        let mut s = SeaSpectrum { choice, pm, peak_hz, alpha, table: None, m0: pm.m0() };
+        let mut s = SeaSpectrum { choice, spreading: Spreading::Paper, pm, peak_hz, alpha, table: None, m0: pm.m0() };
         if let (Some(fp), false) = (peak_hz, matches!(choice, SpectrumChoice::PiersonMoskowitz)) {
             let (lo, hi) = ((TABLE_LOW * fp).ln(), (TABLE_HIGH * fp).ln());
             let n = ((hi - lo) * TABLE_PER_E).ceil() as usize;
@@ -339,9 +417,20 @@ impl SeaSpectrum {
         s
     }
 
+    /// The same spectrum spread over directions by `spreading` (the default is
+    /// [`Spreading::Paper`]).
+    pub fn with_spreading(self, spreading: Spreading) -> SeaSpectrum {
+        SeaSpectrum { spreading, ..self }
+    }
+
     /// The choice it was made from.
     pub fn choice(&self) -> SpectrumChoice {
         self.choice
+    }
+
+    /// How its energy spreads over directions.
+    pub fn spreading(&self) -> Spreading {
+        self.spreading
     }
 
     /// The wind speed, m/s.
@@ -414,18 +503,41 @@ impl SeaSpectrum {
         jonswap * dispersion::depth_factor(2.0 * PI * f_hz, self.depth_m())
     }
 
-    /// The Mitsuyasu spreading exponent at `f_hz`, about this spectrum's peak.
-    pub fn spreading_exponent(&self, f_hz: f64) -> f64 {
-        let Some(fp) = self.peak_hz else { return 0.0 };
+    /// The exponent s of the cos-2s spreading at `f_hz` (None for Donelan–Banner's sech², or a
+    /// calm).
+    pub fn spreading_exponent(&self, f_hz: f64) -> Option<f64> {
+        let fp = self.peak_hz?;
         let r = f_hz / fp;
-        if r >= 1.0 { 9.77 * r.powf(-2.5) } else { 6.97 * r.powi(5) }
+        match self.spreading {
+            Spreading::Paper => Some(if r >= 1.0 { 9.77 * r.powf(-2.5) } else { 6.97 * r.powi(5) }),
+            Spreading::Mitsuyasu => {
+                let sp = 11.5 * (2.0 * PI * fp * self.wind_m_s() / G).powf(-2.5);
+                Some(if r <= 1.0 { sp * r.powi(5) } else { sp * r.powf(-2.5) })
+            }
+            Spreading::Hasselmann => {
+                let phase_speed = 2.0 * PI * fp / self.wavenumber(fp);
+                let mu = -2.33 - 1.45 * (self.wind_m_s() / phase_speed - 1.17);
+                Some(if r < 1.05 { 6.97 * r.powf(4.06) } else { 9.77 * r.powf(mu) })
+            }
+            Spreading::DonelanBanner => None,
+        }
+    }
+
+    /// The directional spreading D(f, θ) (1/rad, integrating to 1 over θ in [-π, π]); θ from
+    /// downwind.
+    pub fn spread(&self, f_hz: f64, theta: f64) -> f64 {
+        let Some(fp) = self.peak_hz else { return 0.0 };
+        match self.spreading_exponent(f_hz) {
+            Some(s) => spreading(s, theta),
+            None => sech2_spreading(donelan_banner_beta(f_hz / fp), theta),
+        }
     }
 
     /// E(f, θ) = E(f)·D(f, θ), m²/(Hz·rad); θ from downwind.
     pub fn directional_energy(&self, f_hz: f64, theta: f64) -> f64 {
-        match self.choice {
-            SpectrumChoice::PiersonMoskowitz => self.pm.directional_energy(f_hz, theta),
-            _ => self.energy(f_hz) * spreading(self.spreading_exponent(f_hz), theta),
+        match (self.choice, self.spreading) {
+            (SpectrumChoice::PiersonMoskowitz, Spreading::Paper) => self.pm.directional_energy(f_hz, theta),
+            _ => self.energy(f_hz) * self.spread(f_hz, theta),
         }
     }
 

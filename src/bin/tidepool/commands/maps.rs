@@ -8,8 +8,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use tidepool::SeaParams;
-use tidepool::encode::{human_bytes, sea_maps};
-use tidepool::sea::{PatchSea, SeaSpectrum, check_map_size, check_patch, default_map_extent_m};
+use tidepool::encode::{MapFields, human_bytes, sea_maps};
+use tidepool::sea::{PatchSea, check_map_size, check_patch, default_map_extent_m};
 
 use super::stats::Stats;
 use crate::cli::ocean::RenderOcean;
@@ -60,8 +60,7 @@ pub fn write(args: &RenderOcean, dir: &Path, params: SeaParams) -> Result<()> {
             .map_err(|e| Error::arg("--size", e.to_string()))?,
         None => DEFAULT_MAP_SIDE,
     };
-    let extent =
-        args.extent.unwrap_or_else(|| default_map_extent_m(&SeaSpectrum::new(params.wind_m_s, params.spectrum)));
+    let extent = args.extent.unwrap_or_else(|| default_map_extent_m(&params));
     check_patch(n, extent)
         .map_err(|e| Error::arg(if e.what() == "map size" { "--size" } else { "--extent" }, e.to_string()))?;
     let frames = args.animation.frames.unwrap_or(1);
@@ -81,13 +80,17 @@ pub fn write(args: &RenderOcean, dir: &Path, params: SeaParams) -> Result<()> {
     let mut bytes = 0usize;
     let mut progress = Progress::new("maps", u64::from(frames));
     for k in 0..frames {
-        let t = args.time
-            + match params.loop_period {
-                Some(period) => period.frame_time(k, frames),
-                None => f64::from(k) / f64::from(args.animation.fps),
-            };
-        let maps = patch.maps(t);
-        for (name, file) in sea_maps(&maps, args.animation.frames.map(|_| k)) {
+        // Frame k shows --time + k/fps, counted apart from --time so that a looping series
+        // closes exactly: frame T·fps is frame 0.
+        let maps = patch.maps_after(args.time, f64::from(k) / f64::from(args.animation.fps));
+        let fields = MapFields {
+            size: maps.size,
+            height: &maps.height,
+            displacement: &maps.displacement,
+            normal: &maps.normal,
+            foam: &maps.foam,
+        };
+        for (name, file) in sea_maps(&fields, args.animation.frames.map(|_| k)) {
             bytes += file.len();
             files::write_file(&dir.join(name), &file)?;
         }
