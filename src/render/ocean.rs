@@ -14,7 +14,7 @@
 use tiny_skia::Pixmap;
 
 use super::camera::{Camera, CameraPose};
-use super::foam_texture::{FOAM_STREAK, FOAM_TILE_ACROSS_M};
+use super::foam_texture::FOAM_TILE_ACROSS_M;
 use super::mesh::{MeshRenderer, Shading};
 use super::shade::{Facet, WaterLook, shade_facet};
 use super::sky::Sky;
@@ -28,10 +28,16 @@ use crate::sim::ocean::{Sea, SeaFrame, SeaTime, cox_munk_slope_variance};
 /// (the wind drift of the top centimetres, about 3 %).
 pub const FOAM_DRIFT_FRACTION: f64 = 0.03;
 
+/// How much longer aged foam's streaks are along the wind than across it: 2 + U/4, a whole
+/// number from 3 (Beaufort 4) to 9 (a storm): a gale's foam lies in long streaks.
+pub fn foam_streak(wind_m_s: f64) -> f32 {
+    (2.0 + wind_m_s / 4.0).round().clamp(3.0, 9.0) as f32
+}
+
 /// How far the foam texture has drifted downwind at `time`, m: modulo one texture length,
 /// and for a looping sea at a speed that crosses a whole number of texture lengths per loop.
 pub fn foam_drift_m(sea: &Sea, time: SeaTime) -> f32 {
-    let length = f64::from(FOAM_TILE_ACROSS_M * FOAM_STREAK);
+    let length = f64::from(FOAM_TILE_ACROSS_M * foam_streak(sea.params().wind_m_s));
     let speed = FOAM_DRIFT_FRACTION * sea.params().wind_m_s;
     match (time, sea.params().loop_period) {
         (SeaTime::Ticks(u), Some(p)) => {
@@ -206,7 +212,11 @@ impl OceanRenderer {
         let below = self.far_sea(sea.params().wind_m_s);
         let Some(topology) = self.mesh.topology() else { return };
         let foam = self.foam.update(sea, topology.points(), topology.footprints(), frame.time());
-        let layout = FoamLayout { downwind: sea.downwind(), drift_m: foam_drift_m(sea, frame.time()) };
+        let layout = FoamLayout {
+            downwind: sea.downwind(),
+            drift_m: foam_drift_m(sea, frame.time()),
+            streak: foam_streak(sea.params().wind_m_s),
+        };
         let shading =
             Shading { environment: &self.sky, light: self.sky.light(), look: self.look, texture: &self.texture };
         let target = self.supersampled.as_mut().unwrap_or(out);

@@ -68,19 +68,52 @@ pub const FOAM_STEP_S: f64 = 0.2;
 pub const FOAM_MEMORY_S: f64 = 6.0;
 /// Below this expected cover a sea draws no foam.
 pub const NEGLIGIBLE_COVER: f64 = 1e-4;
+/// Foam younger than this is fresh (the breaking crest itself: dense white), s.
+pub const FRESH_FOAM_S: f64 = 0.6;
 /// Sources are kept as 16-bit fixed point, this many to 1 (at most 16).
 const SOURCE_SCALE: f32 = 4096.0;
 
-/// E[(m + σ·Z)⁺] for a standard normal Z: the expected excess of a Gaussian over -m.
+/// E[(m + σ·Z)⁺] for a standard normal Z: the expected excess of a Gaussian over -m,
+/// `σ·h(m/σ)` with `h(z) = φ(z) + z·Φ(z)` read from a table ([`EXCESS_TABLE`] points over
+/// ±[`EXCESS_RANGE`], linear between them: within 1e-6 of the integral, and a few
+/// operations where libm's erf and exp took most of a foam step).
 #[inline(always)]
 pub fn expected_excess(m: f32, sigma: f32) -> f32 {
     if sigma <= 1e-6 {
         return m.max(0.0);
     }
     let z = m / sigma;
-    let pdf = 0.398_942_3 * libm::expf(-0.5 * z * z);
-    let cdf = 0.5 * libm::erfcf(-z * std::f32::consts::FRAC_1_SQRT_2);
-    (sigma * pdf + m * cdf).max(0.0)
+    if z <= -EXCESS_RANGE {
+        return 0.0;
+    }
+    if z >= EXCESS_RANGE {
+        return m;
+    }
+    let table = excess_table();
+    let pos = (z + EXCESS_RANGE) * ((EXCESS_TABLE - 1) as f32 / (2.0 * EXCESS_RANGE));
+    let i = (pos as usize).min(EXCESS_TABLE - 2);
+    let t = pos - i as f32;
+    sigma * (table[i] + (table[i + 1] - table[i]) * t)
+}
+
+/// Points of the table of h(z) = φ(z) + z·Φ(z).
+pub const EXCESS_TABLE: usize = 4097;
+/// The table spans z in ±this (beyond, h is 0 below and z above to within 1e-16).
+pub const EXCESS_RANGE: f32 = 8.0;
+
+fn excess_table() -> &'static [f32; EXCESS_TABLE] {
+    static TABLE: std::sync::OnceLock<Box<[f32; EXCESS_TABLE]>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut t = Box::new([0.0f32; EXCESS_TABLE]);
+        for (i, v) in t.iter_mut().enumerate() {
+            let z = -f64::from(EXCESS_RANGE) + 2.0 * f64::from(EXCESS_RANGE) * i as f64 / (EXCESS_TABLE - 1) as f64;
+            // libm, not std: the same bits on every machine (glibc picks code by CPU).
+            let pdf = libm::exp(-0.5 * z * z) / (2.0 * std::f64::consts::PI).sqrt();
+            let cdf = 0.5 * libm::erfc(-z / std::f64::consts::SQRT_2);
+            *v = (pdf + z * cdf) as f32;
+        }
+        t
+    })
 }
 
 /// The foam model of one sea: its choppiness and the slope variance of its whole surface.
@@ -160,8 +193,8 @@ impl FoamClock {
 
     /// The weights w_a of ages a = 0..W (the newest first): ∝ e^(-a·Δt/τ), summing to G.
     pub fn weights(&self) -> Vec<f32> {
-        let d = (-self.step_s / FOAM_LIFETIME_S).exp();
-        let raw: Vec<f64> = (0..self.memory_steps()).map(|a| d.powi(a as i32)).collect();
+        let decay = |a: usize| libm::exp(-(a as f64) * self.step_s / FOAM_LIFETIME_S);
+        let raw: Vec<f64> = (0..self.memory_steps()).map(decay).collect();
         let sum: f64 = raw.iter().sum();
         raw.iter().map(|w| (w / sum * f64::from(FOAM_GAIN)) as f32).collect()
     }
@@ -199,8 +232,18 @@ pub struct FoamTracker {
     /// The sea and number of points the ring belongs to, and its newest step.
     at: Option<(SeaParams, usize, i64)>,
     ring: Vec<u16>,
-    foam: Vec<f32>,
+    foam: Vec<Foam>,
     rows: PhaseRows,
+}
+
+/// The foam at a point: its cover 0..=1, and how much of it is fresh (younger than
+/// [`FRESH_FOAM_S`], 0..=1 of the cover).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Foam {
+    /// The fraction of the surface covered, 0..=1.
+    pub cover: f32,
+    /// The fraction of that foam made in the last [`FRESH_FOAM_S`], 0..=1.
+    pub fresh: f32,
 }
 
 impl FoamTracker {
@@ -215,15 +258,15 @@ impl FoamTracker {
     }
 
     /// Brings the foam at `points` (resting points with their footprints) up to `time` and
-    /// returns it, one cover 0..=1 per point. Continues from the last call when the sea and
+    /// returns it, one per point. Continues from the last call when the sea and
     /// the points are the same and time moved forward by less than the memory; otherwise
     /// computes the whole memory. Either way the result is the same bits. Allocates only when
     /// the number of points grows.
-    pub fn update(&mut self, sea: &Sea, points: &[[f32; 2]], footprints: &[Footprint], time: SeaTime) -> &[f32] {
+    pub fn update(&mut self, sea: &Sea, points: &[[f32; 2]], footprints: &[Footprint], time: SeaTime) -> &[Foam] {
         let model = FoamModel::of(sea);
         self.foam.clear();
         if !model.is_active() {
-            self.foam.resize(points.len(), 0.0);
+            self.foam.resize(points.len(), Foam::default());
             self.at = None;
             return &self.foam;
         }
@@ -267,31 +310,45 @@ impl FoamTracker {
         }
         self.at = Some((sea.params(), points.len(), top));
         let weights = clock.weights();
-        self.foam.resize(points.len(), 0.0);
+        let fresh = ((FRESH_FOAM_S / clock.step_s).round() as usize).clamp(1, weights.len());
+        let (taps_now, taps_next) = (taps(&weights, now, slots), taps(&weights, now + 1, slots));
+        // The taps run oldest first: the fresh ones are the last.
+        let (fresh_now, fresh_next) = (&taps_now[taps_now.len() - fresh..], &taps_next[taps_next.len() - fresh..]);
+        self.foam.resize(points.len(), Foam::default());
         self.foam.par_chunks_mut(64).zip(self.ring.par_chunks(slots * 64)).for_each(|(foam, ring)| {
             for (f, history) in foam.iter_mut().zip(ring.chunks_exact(slots)) {
-                let at = |n: i64| fir(history, &weights, n, slots);
-                let (a, b) = (at(now), at(now + 1));
-                *f = (a + (b - a) * frac).clamp(0.0, 1.0);
+                let (a, b) = (fir(history, &taps_now), fir(history, &taps_next));
+                let all = a + (b - a) * frac;
+                let (a, b) = (fir(history, fresh_now), fir(history, fresh_next));
+                let young = a + (b - a) * frac;
+                *f = Foam {
+                    cover: all.clamp(0.0, 1.0),
+                    fresh: if all > 0.0 { (young / all).clamp(0.0, 1.0) } else { 0.0 },
+                };
             }
         });
         &self.foam
     }
 }
 
-/// A source as 16-bit fixed point (saturating at 16).
+/// A source as 16-bit fixed point, rounded (saturating at 16).
 #[inline(always)]
 pub(crate) fn quantize(s: f32) -> u16 {
-    (s * SOURCE_SCALE).round().clamp(0.0, 65535.0) as u16
+    (s * SOURCE_SCALE + 0.5).clamp(0.0, 65535.0) as u16
 }
 
-/// F_n = Σ w_a·s_{n-a} over a ring of `slots` steps (step m at slot m mod slots), the oldest
-/// first: a fixed order, so the same ring gives the same bits.
+/// The FIR of step `n` over a ring of `slots` steps (step m at slot m mod slots): each
+/// weight with the slot of its step, the oldest first.
+pub(crate) fn taps(weights: &[f32], n: i64, slots: usize) -> Vec<(f32, usize)> {
+    weights.iter().enumerate().rev().map(|(a, &w)| (w, (n - a as i64).rem_euclid(slots as i64) as usize)).collect()
+}
+
+/// F_n = Σ w_a·s_{n-a} by the [`taps`] of step n, the oldest first: a fixed order, so the
+/// same ring gives the same bits.
 #[inline(always)]
-pub(crate) fn fir(history: &[u16], weights: &[f32], n: i64, slots: usize) -> f32 {
+pub(crate) fn fir(history: &[u16], taps: &[(f32, usize)]) -> f32 {
     let mut sum = 0.0f32;
-    for (a, w) in weights.iter().enumerate().rev() {
-        let slot = (n - a as i64).rem_euclid(slots as i64) as usize;
+    for &(w, slot) in taps {
         sum += w * f32::from(history[slot]);
     }
     sum / SOURCE_SCALE
