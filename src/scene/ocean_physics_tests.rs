@@ -185,7 +185,7 @@ pub(crate) fn mean_cover(sea: &Sea, seconds: f64, rate: f64) -> f64 {
     let frames = (seconds * rate).round() as usize;
     for k in 0..frames {
         let time = sea.time_after(1000.0, k as f64 / rate);
-        sum += tracker.update(sea, &points, &footprints, time).iter().map(|&f| f64::from(f)).sum::<f64>();
+        sum += tracker.update(sea, &points, &footprints, time).iter().map(|f| f64::from(f.cover)).sum::<f64>();
         count += points.len();
     }
     sum / count as f64

@@ -355,6 +355,10 @@ pub(crate) fn fir(history: &[u16], taps: &[(f32, usize)]) -> f32 {
 }
 
 #[cfg(test)]
+#[path = "foam_tests.rs"]
+mod measured;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::sim::ocean::SeaParams;

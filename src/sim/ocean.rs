@@ -92,15 +92,17 @@ pub const DEFAULT_CHOPPINESS: f64 = 1.0;
 pub const MAX_CHOPPINESS: f64 = 4.0;
 /// Fixed-point iterations that find the resting point under a fixed position.
 pub const EULER_ITERATIONS: usize = 4;
-/// Frequency bins of a swell's sines, from [`SWELL_BAND`]`.0` to `.1` times its peak.
-pub const SWELL_FREQUENCY_BINS: usize = 12;
+/// Frequency bins of a swell's sines, from [`SWELL_BAND`]`.0` to `.1` times its peak (each
+/// bin 5.6 % wide: a sampled swell peaks within 3 % of its period).
+pub const SWELL_FREQUENCY_BINS: usize = 16;
 /// Direction bins of a swell's sines, over ±[`SWELL_HALF_WIDTH_RAD`] about its direction.
-pub const SWELL_DIRECTION_BINS: usize = 10;
-/// The frequencies a swell's sines span, as multiples of its peak frequency.
-pub const SWELL_BAND: (f64, f64) = (0.7, 2.0);
-/// Half the width of the directions a swell's sines span, radians (60°: its cos-2s spread
-/// has left e^-4 of its peak there).
-pub const SWELL_HALF_WIDTH_RAD: f64 = std::f64::consts::FRAC_PI_3;
+pub const SWELL_DIRECTION_BINS: usize = 8;
+/// The frequencies a swell's sines span, as multiples of its peak frequency (95 % of a
+/// swell's variance; the sines carry all of it).
+pub const SWELL_BAND: (f64, f64) = (0.75, 1.8);
+/// Half the width of the directions a swell's sines span, radians (50°: three standard
+/// deviations of its cos-2s spread).
+pub const SWELL_HALF_WIDTH_RAD: f64 = 50.0 * std::f64::consts::PI / 180.0;
 
 /// Monahan's whitecap fraction 3.84e-6·U^3.41 for a wind of `wind_m_s`, capped at 1.
 pub fn whitecap_fraction(wind_m_s: f64) -> f64 {

@@ -613,6 +613,10 @@ impl SeaSpectrum {
 }
 
 #[cfg(test)]
+#[path = "spectra_tests.rs"]
+mod measured;
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
