@@ -644,6 +644,41 @@ fn cubic(f: &[f32], n: usize, x: f32, y: f32) -> f32 {
 mod tests {
     use super::*;
 
+    /// The maps are a periodic field, not a picture that happens to tile: a linear sea's
+    /// height texels equal, to the centimetre of the 16-bit PNG (one level), the sum of the
+    /// lattice's waves evaluated directly in f64, at the last column and one period on,
+    /// where the first column is.
+    #[test]
+    fn the_maps_continue_across_their_edges_to_a_centimetre() {
+        let params = SeaParams { wind_m_s: 12.0, choppiness: 0.0, seed: 4, ..SeaParams::default() };
+        let (n, extent) = (64, 400.0);
+        let patch = PatchSea::new(params, n, extent).unwrap();
+        let maps = patch.surface(3.0);
+        let waves = patch.sea.waves(patch.time(3.0));
+        let direct = |x: f64, y: f64| -> f64 {
+            waves
+                .iter()
+                .zip(patch.sea.kx.iter().zip(&patch.sea.ky))
+                .map(|(w, (kx, ky))| {
+                    let phase = f64::from(*kx) * x + f64::from(*ky) * y;
+                    f64::from(w.re) * phase.cos() - f64::from(w.im) * phase.sin()
+                })
+                .sum()
+        };
+        let level = |h: f64| (h * 100.0).round() as i64;
+        let cell = extent / n as f64;
+        let mut worst = 0;
+        for r in [0, 17, 40, 63] {
+            let y = -(r as f64) * cell;
+            for (c, x) in [(0, extent), (0, 0.0), (n - 1, (n - 1) as f64 * cell), (n / 2, extent * 1.5)] {
+                let got = level(f64::from(maps.height[r * n + c]));
+                worst = worst.max((got - level(direct(x, y))).abs());
+            }
+        }
+        assert!(worst <= 1, "the maps differ from their waves by {worst} levels at the seam");
+        assert!(maps.height.iter().any(|h| h.abs() > 0.3), "a sea with waves");
+    }
+
     #[test]
     fn sincos_turns_is_accurate_everywhere() {
         for i in -3000..3000 {
