@@ -238,10 +238,18 @@ impl SmoothShader {
                                 let fresh = f[4].clamp(0.0, 1.0);
                                 // Aged foam in streaks (half the texture's width across the
                                 // wind: thin), fresh foam in patches: each keeps the mean cover,
-                                // so their blend does too.
-                                let aged = coverage(cover, texture.sample(level, f[5], 2.0 * f[7]), detail);
-                                let patch = coverage(cover, texture.sample(level, f[6], f[7] + 0.5), detail);
-                                let amount = aged + (patch - aged) * fresh;
+                                // so their blend does too (a texture read only where it counts).
+                                let aged = if fresh < 1.0 {
+                                    coverage(cover, texture.sample(level, f[5], 2.0 * f[7]), detail)
+                                } else {
+                                    0.0
+                                };
+                                let amount = if fresh > 0.0 {
+                                    let patch = coverage(cover, texture.sample(level, f[6], f[7] + 0.5), detail);
+                                    aged + (patch - aged) * fresh
+                                } else {
+                                    aged
+                                };
                                 let dense = THIN_FOAM + (1.0 - THIN_FOAM) * fresh.max(cover);
                                 rgb = mix(rgb, [f[0], f[1], f[2]], FOAM_OPACITY * dense * amount);
                             }

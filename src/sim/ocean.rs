@@ -78,6 +78,9 @@ pub const FREQUENCY_BINS: usize = 24;
 pub const DIRECTION_BINS: usize = 16;
 /// Components with less variance than this fraction of m0 are dropped.
 pub const NEGLIGIBLE: f64 = 1e-5;
+/// Components with less slope variance than this fraction of the sines' are left out of the
+/// foam's Jacobian.
+pub const FOLD_NEGLIGIBLE: f64 = 1e-3;
 /// Lanes of the vectorised sum over components.
 pub const LANES: usize = 8;
 /// Corner lattice points per side of the tail (its period is this many cut-off wavelengths).
@@ -280,6 +283,13 @@ pub struct Sea {
     lanes: Lanes,
     /// Unpadded, longest first.
     wavelength: Vec<f32>,
+    /// The sines the foam's Jacobian sums: each carrying at least [`FOLD_NEGLIGIBLE`] of the
+    /// sines' slope variance (the few hundred small side and upwind waves a sea has add
+    /// little to its folding; what they carry counts as unresolved).
+    fold: Lanes,
+    fold_wavelength: Vec<f32>,
+    /// For each of those, its index among the components.
+    fold_index: Vec<usize>,
     tail: Option<Tail>,
     /// The slope variance of the whole surface (both axes): Cox–Munk's for the wind plus the
     /// swells' own.
@@ -375,10 +385,29 @@ impl Sea {
         components.sort_by(|a, b| a.wavenumber.total_cmp(&b.wavenumber));
         let lanes = Lanes::new(&components);
         let wavelength = components.iter().map(|c| (2.0 * PI / c.wavenumber) as f32).collect();
+        let slope = |c: &Component| 0.5 * (c.amplitude_m * c.wavenumber).powi(2);
+        let total_slope: f64 = components.iter().map(slope).sum();
+        let fold_index: Vec<usize> =
+            (0..components.len()).filter(|&i| slope(&components[i]) >= FOLD_NEGLIGIBLE * total_slope).collect();
+        let kept: Vec<Component> = fold_index.iter().map(|&i| components[i]).collect();
+        let fold = Lanes::new(&kept);
+        let fold_wavelength = kept.iter().map(|c| (2.0 * PI / c.wavenumber) as f32).collect();
         let slope_total = (cox_munk_slope_variance(spectrum.wind_m_s()) + swell_slope) as f32;
         let to = (params.wind_from_deg + 180.0).to_radians();
         let downwind = [to.sin() as f32, to.cos() as f32];
-        Sea { params, spectrum, components, lanes, wavelength, tail, slope_total, downwind }
+        Sea {
+            params,
+            spectrum,
+            components,
+            lanes,
+            wavelength,
+            fold,
+            fold_wavelength,
+            fold_index,
+            tail,
+            slope_total,
+            downwind,
+        }
     }
 
     /// A swell's sines: [`SWELL_FREQUENCY_BINS`] x [`SWELL_DIRECTION_BINS`] bins about its
@@ -484,6 +513,11 @@ impl Sea {
         self.lanes.amp.len()
     }
 
+    /// The sines the foam's Jacobian sums (padded), of [`Sea::padded_len`].
+    pub fn fold_len(&self) -> usize {
+        self.fold.amp.len()
+    }
+
     /// The variance carried by the fBm tail, m² (0 for a calm).
     pub fn tail_variance(&self) -> f64 {
         self.tail.as_ref().map_or(0.0, |t| t.variance)
@@ -583,17 +617,17 @@ impl Sea {
         SeaFrame { sea: self, phase, tail_offset, time, time_s: self.seconds(time) }
     }
 
-    /// cos and sin of every component's phase at each of `times`, one row each, for
-    /// [`Sea::fold_rows`] (padding lanes are 0).
+    /// cos and sin of the phase of every sine the foam's Jacobian sums at each of `times`,
+    /// one row each, for [`Sea::fold_rows`] (padding lanes are 0).
     pub(crate) fn phase_rows(&self, times: impl Iterator<Item = SeaTime>, rows: &mut PhaseRows) {
-        let padded = self.padded_len();
+        let padded = self.fold.amp.len();
         rows.padded = padded;
         rows.cos.clear();
         rows.sin.clear();
         for time in times {
             for i in 0..padded {
-                let (s, c) = match self.components.get(i) {
-                    Some(comp) => fast_sincos(self.phase(comp, time)),
+                let (s, c) = match self.fold_index.get(i) {
+                    Some(&k) => fast_sincos(self.phase(&self.components[k], time)),
                     None => (0.0, 0.0),
                 };
                 rows.cos.push(c);
@@ -603,7 +637,8 @@ impl Sea {
     }
 
     /// The resolved displacement gradient at the resting point (x, y) for a sample standing
-    /// for `footprint`, at each of the rows `first..first + count` of `rows`: per row
+    /// for `footprint` (from the sines the Jacobian sums, [`FOLD_NEGLIGIBLE`]), at each of
+    /// the rows `first..first + count` of `rows`: per row
     /// `[gxx, gyy, gxy]` with ∇D = -λ·g (so J = (1 - λ·gxx)(1 - λ·gyy) - λ²·gxy²), into `out`.
     /// Returns the slope variance the kept sines carry (both axes).
     ///
@@ -621,8 +656,8 @@ impl Sea {
         first: usize,
         out: &mut [[f32; 3]],
     ) -> f32 {
-        let l = &self.lanes;
-        let n = self.wavelength.partition_point(|&w| w > 2.0 * footprint.min_m());
+        let l = &self.fold;
+        let n = self.fold_wavelength.partition_point(|&w| w > 2.0 * footprint.min_m());
         let count = out.len();
         debug_assert!(count <= FOLD_ROWS);
         let mut acc = [[[0.0f32; LANES]; 3]; FOLD_ROWS];

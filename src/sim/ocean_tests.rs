@@ -256,3 +256,15 @@ fn same_seed_same_sea() {
     let c = Sea::new(SeaParams { wind_m_s: 9.0, wind_from_deg: 270.0, seed: 43, ..SeaParams::default() });
     assert_ne!(a.height(1.0, 2.0), c.frame(5.0).height(1.0, 2.0));
 }
+
+#[test]
+fn the_jacobian_sums_the_sines_that_fold_the_surface() {
+    for wind in [6.7, 18.95] {
+        let s = sea(wind);
+        let slope = |c: &Component| 0.5 * (c.amplitude_m * c.wavenumber).powi(2);
+        let total: f64 = s.components().iter().map(slope).sum();
+        let kept: f64 = s.components().iter().map(slope).filter(|&v| v >= FOLD_NEGLIGIBLE * total).sum();
+        println!("U {wind}: {} of {} sines, {:.3} of the slope", s.fold_len(), s.padded_len(), kept / total);
+        assert!(kept / total > 0.95 && s.fold_len() < s.padded_len());
+    }
+}
