@@ -69,7 +69,7 @@ pub const FOAM_MEMORY_S: f64 = 6.0;
 /// Below this expected cover a sea draws no foam.
 pub const NEGLIGIBLE_COVER: f64 = 1e-4;
 /// Foam younger than this is fresh (the breaking crest itself: dense white), s.
-pub const FRESH_FOAM_S: f64 = 0.6;
+pub const FRESH_FOAM_S: f64 = 1.0;
 /// Sources are kept as 16-bit fixed point, this many to 1 (at most 16).
 const SOURCE_SCALE: f32 = 4096.0;
 
