@@ -84,14 +84,16 @@ impl FoamTexture {
         level.min(self.levels.len() - 1)
     }
 
-    /// The value at (u, v) tiles (u across the texture's width, wrapping), nearest texel.
+    /// The value at (u, v) tiles (u across the texture's width, wrapping), nearest texel. The
+    /// levels are powers of two, so wrapping is a mask of the texel number (truncated towards
+    /// zero: left of the origin the texels shift by one, the same on every frame).
     #[inline(always)]
     pub fn sample(&self, level: usize, u: f32, v: f32) -> f32 {
         let (size, values) = &self.levels[level];
-        let s = *size as f32;
-        let x = ((u - u.floor()) * s) as usize;
-        let y = ((v - v.floor()) * s) as usize;
-        values[y.min(size - 1) * size + x.min(size - 1)]
+        let (s, mask) = (*size as f32, *size as i32 - 1);
+        let x = ((u * s) as i32 & mask) as usize;
+        let y = ((v * s) as i32 & mask) as usize;
+        values[y * size + x]
     }
 }
 

@@ -38,6 +38,10 @@ pub const FOAM_OPACITY: f32 = 0.9;
 /// How opaque the thinnest foam is, as a fraction of [`FOAM_OPACITY`]: fresh foam is dense,
 /// fading foam a translucent lace.
 pub const THIN_FOAM: f32 = 0.35;
+/// Foam cover below this is not drawn: it would change no pixel by half a level (and the
+/// foam's statistics leave a little cover almost everywhere, which would send every face
+/// through the per-pixel foam pass).
+pub const FOAM_VISIBLE: f32 = 1.0 / 256.0;
 
 /// Where the foam texture lies on the water this frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -127,7 +131,7 @@ impl SmoothShader {
         let (world, normals, samples) = (&self.world, &self.normals, &self.samples);
         // Foam colours are read only by faces with a foaming vertex: without foam (a linear or
         // calm sea) the second shading of every vertex is skipped.
-        let any_foam = foam.iter().any(|f| f.cover > 0.0);
+        let any_foam = foam.iter().any(|f| f.cover >= FOAM_VISIBLE);
         self.water.resize(n, [0.0; 3]);
         self.foam_rgb.resize(n, [0.0; 3]);
         self.foam_uv.resize(n, [0.0; 5]);
@@ -161,7 +165,7 @@ impl SmoothShader {
                 let g = ground[i];
                 let along = g[0] * dx + g[1] * dy - layout.drift_m;
                 let across = -g[0] * dy + g[1] * dx;
-                let f = foam.get(i).copied().unwrap_or_default();
+                let f = foam.get(i).copied().filter(|f| f.cover >= FOAM_VISIBLE).unwrap_or_default();
                 *foam_uv =
                     [f.cover, f.fresh, along / tile_along, along / FOAM_TILE_ACROSS_M, across / FOAM_TILE_ACROSS_M];
             });

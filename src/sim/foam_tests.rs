@@ -18,7 +18,7 @@ fn gale(beaufort: u8) -> Sea {
 
 /// Foam is made where the surface folds and stays on the water that made it: the quarter of
 /// the points whose resolved Jacobian fell lowest during the last two seconds carries a third
-/// more than its share of the foam (measured 0.40 at Beaufort 6 and 0.38 at 9; a foam placed
+/// more than its share of the foam (measured 0.39 at Beaufort 6 and 0.38 at 9; a foam placed
 /// at random puts a quarter there, and a fold indicator of the wrong sign 0.24). The waves the
 /// sines do not carry, which break by statistics alone, spread the rest.
 #[test]
