@@ -2,23 +2,23 @@
 //! supersampling) and at 1920x1080 with 2x2 supersampling, the camera still (the
 //! triangulation is reused, as in the player), the sea moving on 1/30 s per frame: a linear
 //! sea (choppiness 0) and `chop_foam` (the default, physical choppiness; foam is followed in
-//! every case). `render/ocean_new_camera` adds building the triangulation. `maps/1024`: the
+//! every case). `render/ocean_new_camera` adds building the triangulation. `still/`: a
+//! picture from nothing, as `render ocean` makes one: the scene, the triangulation and the
+//! foam's whole memory (a gale, Beaufort 8, and the default 10 m/s sea). `maps/1024`: the
 //! tileable maps (height, displacement, normals, foam) of a 1024x1024 patch for one time step
 //! of a series 1/30 s apart (foam continues), encoding and writing not counted;
-//! `maps/1024_surface` without foam. Scene descriptions are printed once.
+//! `maps/1024_surface` without foam; `maps/1024_cold` a set from nothing (the patch, the
+//! foam's memory and the maps); `maps/256` one step of a 256x256 series 1/3 s apart. Scene
+//! descriptions are printed once.
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use tiny_skia::Pixmap;
 
-use tidepool::sea::{DEFAULT_CHOPPINESS, PatchSea};
+use tidepool::sea::{DEFAULT_CHOPPINESS, PatchSea, beaufort_speed_m_s};
 use tidepool::{OceanScene, OceanSettings, OceanView, Scene, SeaParams};
 
-fn scene(width: u32, height: u32, ssaa: u32, choppiness: f64) -> OceanScene {
-    let settings = OceanSettings {
-        sea: SeaParams { choppiness, ..SeaParams::default() },
-        view: OceanView { ssaa, ..OceanView::default() },
-        ..OceanSettings::default()
-    };
+fn scene(width: u32, height: u32, ssaa: u32, sea: SeaParams) -> OceanScene {
+    let settings = OceanSettings { sea, view: OceanView { ssaa, ..OceanView::default() }, ..OceanSettings::default() };
     OceanScene::new(settings, width, height).expect("valid size")
 }
 
@@ -31,8 +31,8 @@ fn render_ocean(c: &mut Criterion) {
         ("1920x1080_ssaa2", 1920, 1080, 2, 0.0),
         ("1920x1080_ssaa2_chop_foam", 1920, 1080, 2, DEFAULT_CHOPPINESS),
     ];
-    for (name, w, h, ssaa, chop) in cases {
-        let mut s = scene(w, h, ssaa, chop);
+    for (name, w, h, ssaa, choppiness) in cases {
+        let mut s = scene(w, h, ssaa, SeaParams { choppiness, ..SeaParams::default() });
         let mut out = Pixmap::new(w, h).unwrap();
         s.render(&mut out);
         eprintln!("render/ocean/{name}: {}", s.describe());
@@ -48,7 +48,15 @@ fn render_ocean(c: &mut Criterion) {
     group.sample_size(10);
     for (name, w, h, ssaa) in [("160x96_ssaa1", 160, 96, 1), ("1920x1080_ssaa2", 1920, 1080, 2)] {
         let mut out = Pixmap::new(w, h).unwrap();
-        group.bench_function(name, |b| b.iter(|| scene(w, h, ssaa, DEFAULT_CHOPPINESS).render(&mut out)));
+        group.bench_function(name, |b| b.iter(|| scene(w, h, ssaa, SeaParams::default()).render(&mut out)));
+    }
+    group.finish();
+    let mut group = c.benchmark_group("still");
+    group.sample_size(10);
+    let gale = SeaParams { wind_m_s: beaufort_speed_m_s(8).unwrap(), ..SeaParams::default() };
+    for (name, sea) in [("1920x1080_ssaa2_beaufort8", gale), ("1920x1080_ssaa2_default", SeaParams::default())] {
+        let mut out = Pixmap::new(1920, 1080).unwrap();
+        group.bench_function(name, |b| b.iter(|| scene(1920, 1080, 2, sea).render(&mut out)));
     }
     group.finish();
 }
@@ -67,6 +75,19 @@ fn maps(c: &mut Criterion) {
         })
     });
     group.bench_function("1024_surface", |b| b.iter(|| patch.surface(3.0)));
+    group.bench_function("1024_cold", |b| {
+        b.iter(|| PatchSea::new(params, 1024, 1000.0).expect("valid patch").maps(5.0))
+    });
+    let small = SeaParams { wind_m_s: beaufort_speed_m_s(5).unwrap(), ..params };
+    let mut patch = PatchSea::new(small, 256, 900.0).expect("valid patch");
+    let mut t = 0.0;
+    patch.maps(t);
+    group.bench_function("256", |b| {
+        b.iter(|| {
+            t += 1.0 / 3.0;
+            patch.maps(t)
+        })
+    });
     group.finish();
 }
 

@@ -4,15 +4,16 @@
 //! cargo run --release --example ocean_gallery -- docs/gallery
 //! ```
 //!
-//! Beaufort 3, 6 and 9 with the physical choppiness and foam, a fetch-limited JONSWAP sea, a
-//! shallow TMA sea, the far crests of a 1920x1080 gale (cropped), the player's terminal frame
-//! (160x94, magnified), and a 2x2 tiling of a periodic map.
+//! Beaufort 3, 6, 9 and 10 with the physical choppiness and foam, a wind sea with swell, a
+//! fetch-limited JONSWAP sea, a shallow TMA sea, the far crests of a 1920x1080 gale
+//! (cropped), the player's terminal frame (160x94, magnified), and a 2x2 tiling of a periodic
+//! map. (The presets' pictures are `render ocean --preset NAME`: `scripts/gallery.sh`.)
 
 use std::path::{Path, PathBuf};
 
 use tiny_skia::{Pixmap, PixmapPaint, Transform};
 
-use tidepool::sea::{DEFAULT_CHOPPINESS, Depth, Jonswap, PatchSea, SpectrumChoice, beaufort_speed_m_s};
+use tidepool::sea::{DEFAULT_CHOPPINESS, Depth, Jonswap, PatchSea, SpectrumChoice, Swell, Swells, beaufort_speed_m_s};
 use tidepool::{CameraPose, OceanScene, OceanSettings, OceanView, Scene, SeaParams};
 
 struct Shot {
@@ -92,6 +93,25 @@ fn main() {
             name: "sea-beaufort-9.png",
             params: chop(b(9), 330.0),
             sun: (200.0, 12.0),
+            size: (640, 360),
+            ssaa: 2,
+            time_s: 0.0,
+        },
+        Shot {
+            name: "sea-beaufort-10.png",
+            params: chop(b(10), 330.0),
+            sun: (15.0, 22.0),
+            size: (640, 360),
+            ssaa: 2,
+            time_s: 0.0,
+        },
+        Shot {
+            name: "sea-swell.png",
+            params: SeaParams {
+                swells: Swells::new(&[Swell::new(1.5, 12.0, 250.0).expect("valid")]).expect("one swell"),
+                ..chop(b(4), 330.0)
+            },
+            sun: (15.0, 22.0),
             size: (640, 360),
             ssaa: 2,
             time_s: 0.0,

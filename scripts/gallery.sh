@@ -14,6 +14,10 @@ $T render pool --size 480x270 --frames 75 --fps 25 --out "$G/stones.gif"
 $T render ocean --beaufort 3 --size 640x360 --out "$G/sea-beaufort-3.png"
 $T render ocean --beaufort 6 --direction 60 --size 640x360 --out "$G/sea-beaufort-6.png"
 $T render ocean --beaufort 9 --size 640x360 --sun 200,12 --out "$G/sea-beaufort-9.png"
+for preset in calm-morning trade-wind north-atlantic-gale long-swell; do
+  $T render ocean --preset "$preset" --size 640x360 --out "$G/preset-$preset.png"
+done
+$T spectrum --preset trade-wind --out "$G/spectrum-trade-wind.png" >/dev/null
 if $T render lake --help >/dev/null 2>&1; then
   $T render lake --wind 0 --size 640x360 --out "$G/lake-calm.png"
   $T render lake --wind 6 --size 640x360 --out "$G/lake-windy.png"

@@ -1,6 +1,7 @@
 //! The sea state a wind raises and what an engine needs from it: the spectra
-//! (Pierson–Moskowitz, JONSWAP, TMA), the Beaufort and WMO scales, choppiness, seamless loops,
-//! tileable maps and plots of the spectrum.
+//! (Pierson–Moskowitz, JONSWAP, TMA) and their directional spreading, swell from distant
+//! storms, the Beaufort and WMO scales, choppiness, seamless loops, tileable maps and plots of
+//! the spectrum.
 //!
 //! ```
 //! use tidepool::sea::{PatchSea, SeaSpectrum, SpectrumChoice, SpectrumKind};
@@ -12,7 +13,14 @@
 //! let params = SeaParams { wind_m_s: 12.0, spectrum: choice, choppiness: 1.0, ..SeaParams::default() };
 //! let maps = PatchSea::new(params, 64, 300.0)?.maps(0.0);
 //! assert_eq!(maps.height.len(), 64 * 64);
-//! let files = tidepool::encode::sea_maps(&maps, None);
+//! let fields = tidepool::encode::MapFields {
+//!     size: maps.size,
+//!     height: &maps.height,
+//!     displacement: &maps.displacement,
+//!     normal: &maps.normal,
+//!     foam: &maps.foam,
+//! };
+//! let files = tidepool::encode::sea_maps(&fields, None);
 //! assert_eq!(files[0].0, "height.npy");
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -26,9 +34,10 @@ pub use crate::sim::patch::{
     default_extent_m as default_map_extent_m,
 };
 pub use crate::sim::sea_state::{beaufort_number, beaufort_speed_m_s, wmo_sea_state, wmo_sea_state_name};
+pub use crate::sim::spectra::swell::{Swell, Swells};
 pub use crate::sim::spectra::{
     DEFAULT_GAMMA, DEPTH_RANGE_M, Depth, FETCH_RANGE_KM, GAMMA_RANGE, Jonswap, SeaSpectrum, SpectrumChoice,
-    SpectrumChoiceError, SpectrumKind,
+    SpectrumChoiceError, SpectrumKind, Spreading,
 };
 pub use crate::sim::spectrum::PiersonMoskowitz;
 pub use crate::sim::wind::{DEFAULT_SEA_WIND_M_S, DEFAULT_WIND_FROM_DEG, MAX_LAKE_WIND_M_S, MAX_SEA_WIND_M_S};

@@ -1,5 +1,6 @@
-//! Tileable sea maps for engines ([`crate::sim::patch::PatchMaps`]) as file bytes: this
-//! module encodes, the caller writes (atomically) where it likes.
+//! Tileable sea maps for engines as file bytes ([`MapFields`]: plain slices, so this module
+//! knows nothing of the simulation that made them): this module encodes, the caller writes
+//! (atomically) where it likes.
 //!
 //! | file | format | content |
 //! |---|---|---|
@@ -14,8 +15,26 @@
 //! The maps are periodic: texel N is texel 0, so they tile without a seam. DirectX-style
 //! engines (Unreal) want the normal map's green flipped.
 
-use super::heightmap::{encode_map_png, encode_npy_shaped, levels16};
-use crate::sim::patch::PatchMaps;
+use image::ImageEncoder;
+use image::codecs::png::{CompressionType, FilterType, PngEncoder};
+use rayon::prelude::*;
+
+use super::heightmap::{encode_npy_shaped, levels16};
+
+/// The fields of one set of maps, each `size x size`, row-major, row 0 the north edge.
+#[derive(Clone, Copy, Debug)]
+pub struct MapFields<'a> {
+    /// Points per side.
+    pub size: usize,
+    /// Eulerian height, m.
+    pub height: &'a [f32],
+    /// Where the water resting at each point is carried (east, north, up), m.
+    pub displacement: &'a [[f32; 3]],
+    /// Unit normal (east, north, up).
+    pub normal: &'a [[f32; 3]],
+    /// Foam cover 0..=1.
+    pub foam: &'a [f32],
+}
 
 /// PNG levels per metre for heights and displacements: centimetres.
 pub const MAP_PNG_SCALE: f32 = 100.0;
@@ -37,18 +56,38 @@ pub fn file_names(frame: Option<u32>) -> [String; 6] {
 }
 
 /// Every file of `maps` as (name, bytes), in [`file_names`]' order.
-pub fn encode_maps(maps: &PatchMaps, frame: Option<u32>) -> Vec<(String, Vec<u8>)> {
+///
+/// # Panics
+/// When a field does not hold `size x size` values (a programming error).
+pub fn encode_maps(maps: &MapFields<'_>, frame: Option<u32>) -> Vec<(String, Vec<u8>)> {
     let n = maps.size;
+    for len in [maps.height.len(), maps.displacement.len(), maps.normal.len(), maps.foam.len()] {
+        assert_eq!(len, n * n, "every map holds size x size values");
+    }
     let displacement = maps.displacement.as_flattened();
-    let files = [
-        encode_npy_shaped(&[n, n], &maps.height),
-        encode_map_png(n, n, image::ExtendedColorType::L16, &levels16(&maps.height, MAP_PNG_SCALE)),
-        encode_npy_shaped(&[n, n, 3], displacement),
-        encode_map_png(n, n, image::ExtendedColorType::Rgb16, &levels16(displacement, MAP_PNG_SCALE)),
-        encode_map_png(n, n, image::ExtendedColorType::Rgb8, &normal_bytes(&maps.normal)),
-        encode_map_png(n, n, image::ExtendedColorType::L8, &foam_bytes(&maps.foam)),
-    ];
+    // The six files on all cores (each is encoded alone: the bytes do not depend on how).
+    let files: Vec<Vec<u8>> = (0..6)
+        .into_par_iter()
+        .map(|i| match i {
+            0 => encode_npy_shaped(&[n, n], maps.height),
+            1 => map_png(n, image::ExtendedColorType::L16, &levels16(maps.height, MAP_PNG_SCALE)),
+            2 => encode_npy_shaped(&[n, n, 3], displacement),
+            3 => map_png(n, image::ExtendedColorType::Rgb16, &levels16(displacement, MAP_PNG_SCALE)),
+            4 => map_png(n, image::ExtendedColorType::Rgb8, &normal_bytes(maps.normal)),
+            _ => map_png(n, image::ExtendedColorType::L8, &foam_bytes(maps.foam)),
+        })
+        .collect();
     file_names(frame).into_iter().zip(files).collect()
+}
+
+/// An `n x n` map as PNG with fast compression (maps are noisy; the best compression saved
+/// a few per cent and cost most of a series' time).
+fn map_png(n: usize, colour: image::ExtendedColorType, samples: &[u8]) -> Vec<u8> {
+    let mut out = Vec::new();
+    PngEncoder::new_with_quality(&mut out, CompressionType::Fast, FilterType::Adaptive)
+        .write_image(samples, n as u32, n as u32, colour)
+        .expect("encoding a PNG into memory cannot fail for a valid map");
+    out
 }
 
 /// Unit normals to 8-bit RGB: round((v + 1)·127.5).
@@ -72,13 +111,12 @@ mod tests {
         assert_eq!((10 + header_len) % 64, 0);
         assert!(std::str::from_utf8(&bytes[10..10 + header_len]).unwrap().contains("'shape': (2, 2, 3)"));
         assert_eq!(bytes.len(), 10 + header_len + 48);
-        let maps = PatchMaps {
+        let maps = MapFields {
             size: 2,
-            extent_m: 10.0,
-            height: vec![0.0, 1.0, -1.0, 0.25],
-            displacement: vec![[0.1, -0.2, 0.0]; 4],
-            normal: vec![[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.6, 0.0, 0.8]],
-            foam: vec![0.0, 1.0, 0.5, 2.0],
+            height: &[0.0, 1.0, -1.0, 0.25],
+            displacement: &[[0.1, -0.2, 0.0]; 4],
+            normal: &[[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.6, 0.0, 0.8]],
+            foam: &[0.0, 1.0, 0.5, 2.0],
         };
         let files = encode_maps(&maps, Some(7));
         assert_eq!(files[4].0, "normal_0007.png");

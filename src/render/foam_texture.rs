@@ -2,12 +2,12 @@
 //! lacework, not a white sheet; the simulation gives each vertex a foam cover F (0..=1) and
 //! the renderer draws, per pixel, foam where F exceeds this texture's value there.
 //!
-//! The texture is periodic value noise in four octaves, laid out in the wind's frame and
-//! [`FOAM_STREAK`] times longer along the wind than across it (foam lies in streaks along the
-//! wind). Each mip level is remapped to **uniform** values by rank, so that the fraction of a
-//! face's pixels that foam is F whatever the level: the picture keeps the simulation's
-//! coverage (Monahan's, calibrated) while showing its detail. Far faces, whose pixels cover
-//! metres, fade to the plain cover F ([`detail_for`]).
+//! The texture is periodic value noise in four octaves, laid out in the wind's frame (the
+//! smooth shader stretches it along the wind for aged foam: streaks, and reads it as it is
+//! for fresh foam: patches). Each mip level is remapped to **uniform** values by rank, so
+//! that the fraction of a face's pixels that foam is F whatever the level: the picture keeps
+//! the simulation's cover while showing its detail. Far faces, whose pixels cover metres,
+//! fade to the plain cover F ([`detail_for`]).
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -16,8 +16,6 @@ use rand_chacha::ChaCha8Rng;
 pub const FOAM_TEXELS: usize = 256;
 /// Metres one copy of the texture spans across the wind.
 pub const FOAM_TILE_ACROSS_M: f32 = 24.0;
-/// How much longer it is along the wind.
-pub const FOAM_STREAK: f32 = 5.0;
 /// Softness of a foam edge, in the texture's uniform units.
 pub const FOAM_EDGE: f32 = 0.3;
 /// Lattice spacing of the coarsest octave, texels, and the octaves' weights.
@@ -86,14 +84,16 @@ impl FoamTexture {
         level.min(self.levels.len() - 1)
     }
 
-    /// The value at (u, v) tiles (u across the texture's width, wrapping), nearest texel.
+    /// The value at (u, v) tiles (u across the texture's width, wrapping), nearest texel. The
+    /// levels are powers of two, so wrapping is a mask of the texel number (truncated towards
+    /// zero: left of the origin the texels shift by one, the same on every frame).
     #[inline(always)]
     pub fn sample(&self, level: usize, u: f32, v: f32) -> f32 {
         let (size, values) = &self.levels[level];
-        let s = *size as f32;
-        let x = ((u - u.floor()) * s) as usize;
-        let y = ((v - v.floor()) * s) as usize;
-        values[y.min(size - 1) * size + x.min(size - 1)]
+        let (s, mask) = (*size as f32, *size as i32 - 1);
+        let x = ((u * s) as i32 & mask) as usize;
+        let y = ((v * s) as i32 & mask) as usize;
+        values[y * size + x]
     }
 }
 

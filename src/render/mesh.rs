@@ -8,7 +8,8 @@
 //!    onto the mean water level, which makes the sampling of the sea view-dependent: dense
 //!    near the camera, sparse towards the horizon. The lattice overhangs the picture on the
 //!    sides and below, so waves lifted into view are not cut off, and stops at the real
-//!    horizon distance. Each point also gets its [`Footprint`], the ground step to its
+//!    horizon distance (its first row, at that distance's screen row, spans the whole width,
+//!    so no gap opens under the horizon at the sides). Each point also gets its [`Footprint`], the ground step to its
 //!    neighbours, which the surface uses to leave out waves the lattice cannot carry.
 //!    (Packing rows tighter near the horizon was tried and dropped: tall distant waves then
 //!    lift rows past their neighbours on the screen and the mesh folds into a saw-tooth.)
@@ -122,7 +123,11 @@ impl MeshTopology {
                 let py = if row == 0 { y } else { y + 0.3 * dy * jitter(row, col, 2) };
                 if let Some(g) = camera.ground_point(px, py) {
                     let d = length([g[0] - eye[0], g[1] - eye[1], 0.0]);
-                    if d <= max_m * 1.01 {
+                    // The first row lies at the far water's screen row across the whole
+                    // picture: off the centre its rays reach further than max_m, and dropping
+                    // them left a gap under the horizon at the sides, a stepped band of the
+                    // far-sea fill at terminal size.
+                    if d <= max_m * 1.01 || row == 0 {
                         let across = camera.ground_point(px + s, py).map(|a| [a[0] - g[0], a[1] - g[1]]);
                         let along = camera.ground_point(px, py + dy).map(|b| [b[0] - g[0], b[1] - g[1]]);
                         let fp = Footprint {

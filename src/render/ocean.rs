@@ -14,7 +14,7 @@
 use tiny_skia::Pixmap;
 
 use super::camera::{Camera, CameraPose};
-use super::foam_texture::{FOAM_STREAK, FOAM_TILE_ACROSS_M};
+use super::foam_texture::FOAM_TILE_ACROSS_M;
 use super::mesh::{MeshRenderer, Shading};
 use super::shade::{Facet, WaterLook, shade_facet};
 use super::sky::Sky;
@@ -22,25 +22,30 @@ use super::smooth::{FoamLayout, SmoothShader};
 use super::supersample::{Downsample, downsample};
 use super::texture::SeaTexture;
 use crate::sim::foam::FoamTracker;
-use crate::sim::ocean::{Sea, SeaFrame, cox_munk_slope_variance};
+use crate::sim::ocean::{Sea, SeaFrame, SeaTime, cox_munk_slope_variance};
 
 /// How fast foam drifts downwind with the surface water, as a fraction of the wind speed
 /// (the wind drift of the top centimetres, about 3 %).
 pub const FOAM_DRIFT_FRACTION: f64 = 0.03;
 
-/// How far the foam texture has drifted downwind at `time_s`, m: modulo one texture length,
+/// How much longer aged foam's streaks are along the wind than across it: 2 + U/4, a whole
+/// number from 3 (Beaufort 4) to 9 (a storm): a gale's foam lies in long streaks.
+pub fn foam_streak(wind_m_s: f64) -> f32 {
+    (2.0 + wind_m_s / 4.0).round().clamp(3.0, 9.0) as f32
+}
+
+/// How far the foam texture has drifted downwind at `time`, m: modulo one texture length,
 /// and for a looping sea at a speed that crosses a whole number of texture lengths per loop.
-pub fn foam_drift_m(sea: &Sea, time_s: f64) -> f32 {
-    let length = f64::from(FOAM_TILE_ACROSS_M * FOAM_STREAK);
+pub fn foam_drift_m(sea: &Sea, time: SeaTime) -> f32 {
+    let length = f64::from(FOAM_TILE_ACROSS_M * foam_streak(sea.params().wind_m_s));
     let speed = FOAM_DRIFT_FRACTION * sea.params().wind_m_s;
-    match sea.params().loop_period {
-        Some(p) => {
+    match (time, sea.params().loop_period) {
+        (SeaTime::Ticks(u), Some(p)) => {
             let lengths = (speed * p.seconds() / length).round() as u64;
-            let (_, tick) = p.loops_and_tick(time_s);
-            let turns = lengths.wrapping_mul(u64::from(tick)) & 0xFFFF_FFFF;
+            let turns = lengths.wrapping_mul(u64::from(u as u32)) & 0xFFFF_FFFF;
             (turns as f64 / 4_294_967_296.0 * length) as f32
         }
-        None => (speed * time_s).rem_euclid(length) as f32,
+        _ => (speed * sea.seconds(time)).rem_euclid(length) as f32,
     }
 }
 
@@ -206,8 +211,12 @@ impl OceanRenderer {
         let sea = frame.sea();
         let below = self.far_sea(sea.params().wind_m_s);
         let Some(topology) = self.mesh.topology() else { return };
-        let foam = self.foam.update(sea, topology.points(), topology.footprints(), frame.time_s());
-        let layout = FoamLayout { downwind: sea.downwind(), drift_m: foam_drift_m(sea, frame.time_s()) };
+        let foam = self.foam.update(sea, topology.points(), topology.footprints(), frame.time());
+        let layout = FoamLayout {
+            downwind: sea.downwind(),
+            drift_m: foam_drift_m(sea, frame.time()),
+            streak: foam_streak(sea.params().wind_m_s),
+        };
         let shading =
             Shading { environment: &self.sky, light: self.sky.light(), look: self.look, texture: &self.texture };
         let target = self.supersampled.as_mut().unwrap_or(out);

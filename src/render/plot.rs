@@ -1,12 +1,14 @@
-//! The plot of `tidepool spectrum --out`: E(f) and the spreading D(theta) at the peak, side by
-//! side, with axes, ticks and labels in an embedded 8x8 bitmap font (`font8x8`, drawn at twice
-//! its size so it reads at a glance).
+//! The plot of `tidepool spectrum --out`: E(f) and the spreading D(theta) at the peak (or,
+//! with swell, the directions the whole sea's energy travels in), side by side, with axes,
+//! ticks and labels in an embedded 8x8 bitmap font (`font8x8`, drawn at twice its size so it
+//! reads at a glance).
 
 use font8x8::UnicodeFonts;
 use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
-use crate::sim::spectra::{SeaSpectrum, SpectrumChoice};
-use crate::sim::spectrum::{PiersonMoskowitz, spreading};
+use crate::sim::ocean::SeaParams;
+use crate::sim::spectra::SpectrumChoice;
+use crate::sim::spectrum::PiersonMoskowitz;
 
 /// Plot width, px.
 pub const WIDTH: u32 = 1000;
@@ -16,6 +18,7 @@ const SCALE: i32 = 2;
 const INK: [u8; 3] = [30, 34, 40];
 const GRID: [u8; 3] = [222, 226, 232];
 const CURVE: [u8; 3] = [20, 96, 170];
+const PART: [u8; 3] = [150, 156, 166];
 
 /// Draws `text` with its top-left corner at (x, y), `SCALE` pixels per font pixel.
 pub fn draw_text(out: &mut Pixmap, x: i32, y: i32, text: &str, [r, g, b]: [u8; 3]) {
@@ -91,7 +94,14 @@ impl Panel {
         (self.rect.left() + fx * self.rect.width(), self.rect.bottom() - fy * self.rect.height())
     }
 
-    fn draw(&self, out: &mut Pixmap, title: &str, x_label: &str, y_label: &str, points: &[(f64, f64)]) {
+    /// Draws the frame, the labels, the grey `parts` and the curve `points` over them.
+    fn draw(
+        &self,
+        out: &mut Pixmap,
+        (title, x_label, y_label): (&str, &str, &str),
+        points: &[(f64, f64)],
+        parts: &[Vec<(f64, f64)>],
+    ) {
         let stroke = Stroke { width: 1.0, ..Stroke::default() };
         let r = self.rect;
         for tx in self.x_ticks.clone().unwrap_or_else(|| ticks(self.x.0, self.x.1)) {
@@ -111,19 +121,23 @@ impl Panel {
         if let Some(path) = PathBuilder::from_rect(r).into() {
             out.stroke_path(&path, &paint(INK), &stroke, Transform::identity(), None);
         }
-        let mut pb = PathBuilder::new();
-        for (i, &(x, y)) in points.iter().enumerate() {
-            let (px, py) = self.to_px(x, y);
-            if i == 0 { pb.move_to(px, py) } else { pb.line_to(px, py) }
-        }
-        if let Some(path) = pb.finish() {
-            out.stroke_path(
-                &path,
-                &paint(CURVE),
-                &Stroke { width: 2.5, ..Stroke::default() },
-                Transform::identity(),
-                None,
-            );
+        for (curve, colour, width) in
+            parts.iter().map(|p| (p.as_slice(), PART, 1.5)).chain(std::iter::once((points, CURVE, 2.5)))
+        {
+            let mut pb = PathBuilder::new();
+            for (i, &(x, y)) in curve.iter().enumerate() {
+                let (px, py) = self.to_px(x, y);
+                if i == 0 { pb.move_to(px, py) } else { pb.line_to(px, py) }
+            }
+            if let Some(path) = pb.finish() {
+                out.stroke_path(
+                    &path,
+                    &paint(colour),
+                    &Stroke { width, ..Stroke::default() },
+                    Transform::identity(),
+                    None,
+                );
+            }
         }
         draw_text(out, r.left() as i32, r.top() as i32 - 44, title, INK);
         draw_text(
@@ -148,16 +162,22 @@ fn line(out: &mut Pixmap, a: (f32, f32), b: (f32, f32), rgb: [u8; 3], stroke: &S
 
 /// The plot of `sea`: E(f) from 0 to 3·fm, and D(theta) at fm over -180..180 degrees.
 pub fn spectrum_plot(sea: &PiersonMoskowitz) -> Pixmap {
-    sea_spectrum_plot(&SeaSpectrum::new(sea.wind_m_s(), SpectrumChoice::PiersonMoskowitz))
+    sea_spectrum_plot(&SeaParams { wind_m_s: sea.wind_m_s(), ..SeaParams::default() })
 }
 
-/// The plot of any spectrum: E(f) from 0 to 3·fp and D(theta) at fp, its name, γ, fetch and
-/// depth in the heading (a Pierson–Moskowitz sea plots exactly as [`spectrum_plot`]).
-pub fn sea_spectrum_plot(sea: &SeaSpectrum) -> Pixmap {
+/// The plot of any sea: the wind sea's spectrum (its name, γ, fetch and depth and the
+/// spreading law in the heading) summed with its swells. Left, E(f) from 0 to 3 times the
+/// highest peak frequency (each part in grey under the sum); right, D(theta) at the wind
+/// sea's peak, or with swell the direction the whole sea's energy travels in,
+/// ∫E(f, θ)df/m0 against θ from downwind (a Pierson–Moskowitz sea plots exactly as
+/// [`spectrum_plot`]).
+pub fn sea_spectrum_plot(params: &SeaParams) -> Pixmap {
     let mut out = Pixmap::new(WIDTH, HEIGHT).expect("a fixed, valid size");
     out.fill(Color::WHITE);
-    let (u, hs) = (label(sea.wind_m_s()), sea.significant_height_m());
-    let heading = match sea.choice() {
+    let sea = params.wind_spectrum();
+    let swells = params.swell_spectra();
+    let (u, hs) = (label(sea.wind_m_s()), params.significant_height_m());
+    let mut heading = match sea.choice() {
         SpectrumChoice::PiersonMoskowitz => format!("Pierson-Moskowitz sea, U = {u} m/s, Hs = {hs:.2} m"),
         SpectrumChoice::Jonswap(j) | SpectrumChoice::Tma(j, _) => {
             let fetch = j.fetch_km().map_or("unlimited".to_string(), |f| format!("{} km", label(f)));
@@ -166,41 +186,91 @@ pub fn sea_spectrum_plot(sea: &SeaSpectrum) -> Pixmap {
             format!("{name}, U = {u} m/s, gamma {}, fetch {fetch}{depth}, Hs = {hs:.2} m", label(j.gamma()))
         }
     };
+    if !swells.is_empty() {
+        heading = heading.replace(", Hs", " + swell, Hs");
+    }
     draw_text(&mut out, 20, 12, &heading, INK);
-    let Some(fm) = sea.peak_hz() else {
+    let swell_text: Vec<String> = swells
+        .iter()
+        .map(|s| {
+            let w = s.swell();
+            format!("{} m {} s from {}", label(w.height_m()), label(w.period_s()), label(w.from_deg()))
+        })
+        .collect();
+    if !swell_text.is_empty() {
+        draw_text(&mut out, 20, 34, &format!("swell {}", swell_text.join(", ")), INK);
+    }
+    let peaks = sea.peak_hz().into_iter().chain(swells.iter().map(|s| s.peak_hz()));
+    let Some(f_top) = peaks.reduce(f64::max) else {
         draw_text(&mut out, 20, 200, "calm: no wind, no waves (E = 0 everywhere)", INK);
         return out;
     };
     let n = 400;
+    let f_at = |i: usize| 3.0 * f_top * i as f64 / n as f64;
     let energy: Vec<(f64, f64)> = (0..=n)
-        .map(|i| {
-            let f = 3.0 * fm * i as f64 / n as f64;
-            (f, sea.energy(f))
-        })
+        .map(|i| (f_at(i), sea.energy(f_at(i)) + swells.iter().map(|s| s.energy(f_at(i))).sum::<f64>()))
         .collect();
+    let parts: Vec<Vec<(f64, f64)>> = if swells.is_empty() {
+        Vec::new()
+    } else {
+        std::iter::once((0..=n).map(|i| (f_at(i), sea.energy(f_at(i)))).collect())
+            .chain(swells.iter().map(|s| (0..=n).map(|i| (f_at(i), s.energy(f_at(i)))).collect()))
+            .collect()
+    };
     let e_max = energy.iter().map(|p| p.1).fold(0.0, f64::max);
-    let s = sea.spreading_exponent(fm);
-    let spread: Vec<(f64, f64)> = (0..=n)
-        .map(|i| {
-            let deg = -180.0 + 360.0 * i as f64 / n as f64;
-            (deg, spreading(s, deg.to_radians()))
-        })
-        .collect();
+    let downwind = (params.wind_from_deg + 180.0).to_radians();
+    let (spread, title): (Vec<(f64, f64)>, String) = match (sea.peak_hz(), swells.is_empty()) {
+        (Some(fm), true) => {
+            let law = match sea.spreading_exponent(fm) {
+                Some(s) => format!("s = {s:.2}"),
+                None => "sech2".to_string(),
+            };
+            let curve = (0..=n)
+                .map(|i| {
+                    let deg = -180.0 + 360.0 * i as f64 / n as f64;
+                    (deg, sea.spread(fm, deg.to_radians()))
+                })
+                .collect();
+            (curve, format!("D(theta) at fm, {} {law}", sea.spreading().name()))
+        }
+        _ => {
+            // ∫E(f, θ)df/m0 by the midpoint rule over 0..6 times the highest peak.
+            let (steps, df) = (600, 6.0 * f_top / 600.0);
+            let m0 = params.m0().max(1e-300);
+            let curve = (0..=n)
+                .map(|i| {
+                    let deg = -180.0 + 360.0 * i as f64 / n as f64;
+                    let theta = deg.to_radians();
+                    let e: f64 = (0..steps)
+                        .map(|j| {
+                            let f = (j as f64 + 0.5) * df;
+                            let bearing = downwind + theta;
+                            sea.directional_energy(f, theta)
+                                + swells.iter().map(|s| s.directional_energy(f, bearing - s.bearing_rad())).sum::<f64>()
+                        })
+                        .sum::<f64>()
+                        * df;
+                    (deg, e / m0)
+                })
+                .collect();
+            (curve, "energy by direction (sum)".to_string())
+        }
+    };
     let d_max = spread.iter().map(|p| p.1).fold(0.0, f64::max);
     let left = Panel {
         rect: Rect::from_ltrb(120.0, 110.0, 470.0, 360.0).unwrap(),
-        x: (0.0, 3.0 * fm),
+        x: (0.0, 3.0 * f_top),
         y: (0.0, e_max * 1.1),
         x_ticks: None,
     };
-    left.draw(&mut out, "E(f)", "frequency f, Hz", "m^2/Hz", &energy);
+    left.draw(&mut out, ("E(f)", "frequency f, Hz", "m^2/Hz"), &energy, &parts);
     let right = Panel {
         rect: Rect::from_ltrb(590.0, 110.0, 940.0, 360.0).unwrap(),
         x: (-180.0, 180.0),
         y: (0.0, d_max * 1.1),
         x_ticks: Some(vec![-180.0, -90.0, 0.0, 90.0, 180.0]),
     };
-    right.draw(&mut out, &format!("D(theta) at fm, s = {:.2}", s), "theta to the wind, degrees", "1/rad", &spread);
+    right.draw(&mut out, (&title, "theta to the wind, degrees", "1/rad"), &spread, &[]);
     out
 }
 

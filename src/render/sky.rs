@@ -170,9 +170,11 @@ impl Sky {
             weights.extend((0..g as u32).map(|t| (t << 16) / g as u32));
             self.fill_rows(pixels, w, sky_rows, g, gw, lut, grid, row_levels, weights);
         });
-        // The sun, exactly, where its disc and tight glow matter (within about 4°).
+        // The sun, exactly, where its disc and tight glow matter: the glow 1.2·e^(900(cos γ - 1))
+        // falls below the 1e-3 the loop skips at γ = 7.2°, so the box reaches 7.5° (at 4° it
+        // cut the glow off at 0.13 in a visible square when the sun was in view).
         if let Some((sx, sy, _)) = camera.project(add_eye(camera, self.sun_dir)) {
-            let r = (4f32.to_radians().tan() * camera.focal_px()).ceil();
+            let r = (7.5f32.to_radians().tan() * camera.focal_px()).ceil();
             let (x0, x1) = ((sx - r).max(0.0) as usize, ((sx + r).max(0.0) as usize).min(w));
             let (y0, y1) = ((sy - r).max(0.0) as usize, ((sy + r).max(0.0) as usize).min(sky_rows));
             for y in y0..y1 {

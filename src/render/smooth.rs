@@ -8,9 +8,12 @@
 //! ([`shade_facet`]) and encoded to sRGB levels; each pixel interpolates its face's three
 //! levels (Gouraud shading in sRGB, so a pixel costs three adds and three casts), so
 //! neighbouring faces meet without a step and a far crest is a soft band. Foam is a per-pixel
-//! pass: the vertex foam cover F (from [`crate::sim::foam::FoamTracker`]) is interpolated,
-//! and the pixel foams where F exceeds the [`FoamTexture`] there, laid on the resting water
-//! (so it rides the waves) and drifting downwind.
+//! pass: the vertex foam cover F and its fresh share (from
+//! [`crate::sim::foam::FoamTracker`]) are interpolated, and the pixel foams where F exceeds
+//! the [`FoamTexture`] there, laid on the resting water (so it rides the waves). Aged foam
+//! reads the texture stretched along the wind ([`FoamLayout::streak`] times: streaks, longer
+//! the stronger the wind) and drifting downwind; fresh foam, the breaking crest, reads it
+//! unstretched (patches) and is drawn dense.
 //!
 //! Faces are filled by [`for_each_span`], the exact integer rule of the face-number fill
 //! (watertight: every pixel of the sea is drawn exactly once per face layer), in painter's
@@ -20,20 +23,25 @@
 use rayon::prelude::*;
 use tiny_skia::Pixmap;
 
-use super::foam_texture::{FOAM_STREAK, FOAM_TILE_ACROSS_M, FoamTexture, coverage, detail_for};
+use super::foam_texture::{FOAM_TILE_ACROSS_M, FoamTexture, coverage, detail_for};
 use super::light::{Rgb, mix, to_srgb8};
 use super::mesh::{BAND_ROWS, MeshTopology, Shading, sample_all};
 use super::raster::{for_each_span, shows_front};
 use super::shade::{Facet, shade_facet};
 use super::sky::Environment;
 use super::vec3::{Vec3, add, cross, length, normalize, scale, sub};
+use crate::sim::foam::Foam;
 use crate::sim::surface::{Surface, SurfaceSample};
 
 /// Foam is a froth over water, never a solid sheet: at most this much of a pixel's colour.
 pub const FOAM_OPACITY: f32 = 0.9;
-/// How opaque the thinnest foam is, as a fraction of [`FOAM_OPACITY`]: fresh foam (cover 1)
-/// is dense, fading foam a translucent lace.
+/// How opaque the thinnest foam is, as a fraction of [`FOAM_OPACITY`]: fresh foam is dense,
+/// fading foam a translucent lace.
 pub const THIN_FOAM: f32 = 0.35;
+/// Foam cover below this is not drawn: it would change no pixel by half a level (and the
+/// foam's statistics leave a little cover almost everywhere, which would send every face
+/// through the per-pixel foam pass).
+pub const FOAM_VISIBLE: f32 = 1.0 / 256.0;
 
 /// Where the foam texture lies on the water this frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -42,6 +50,9 @@ pub struct FoamLayout {
     pub downwind: [f32; 2],
     /// How far the texture has drifted downwind, m.
     pub drift_m: f32,
+    /// How much longer aged foam's texture is along the wind than across it (a whole number,
+    /// so the drift wraps both layouts at once).
+    pub streak: f32,
 }
 
 /// A face ready to fill.
@@ -66,8 +77,9 @@ pub struct SmoothShader {
     /// sRGB levels (+0.5) of the water and of full foam at each vertex.
     water: Vec<Rgb>,
     foam_rgb: Vec<Rgb>,
-    /// Foam cover and texture coordinates (u, v) per vertex.
-    foam_uv: Vec<[f32; 3]>,
+    /// Foam cover, its fresh share, and texture coordinates per vertex: along the wind for
+    /// aged and for fresh foam, and across.
+    foam_uv: Vec<[f32; 5]>,
     faces: Vec<Option<SmoothFace>>,
 }
 
@@ -78,12 +90,12 @@ impl SmoothShader {
     }
 
     /// Samples `surface` at the vertices of `topology`, draws it over `out` (the topology's
-    /// camera size) with `foam` (one cover per vertex, or empty for none).
+    /// camera size) with `foam` (one per vertex, or empty for none).
     pub fn draw<S: Surface + ?Sized, E: Environment + ?Sized>(
         &mut self,
         topology: &MeshTopology,
         surface: &S,
-        foam: &[f32],
+        foam: &[Foam],
         layout: FoamLayout,
         shading: &Shading<'_, E>,
         out: &mut Pixmap,
@@ -115,14 +127,14 @@ impl SmoothShader {
         }
         let eye = camera.eye();
         let [dx, dy] = layout.downwind;
-        let tile_along = FOAM_TILE_ACROSS_M * FOAM_STREAK;
+        let tile_along = FOAM_TILE_ACROSS_M * layout.streak;
         let (world, normals, samples) = (&self.world, &self.normals, &self.samples);
         // Foam colours are read only by faces with a foaming vertex: without foam (a linear or
         // calm sea) the second shading of every vertex is skipped.
-        let any_foam = foam.iter().any(|&f| f > 0.0);
+        let any_foam = foam.iter().any(|f| f.cover >= FOAM_VISIBLE);
         self.water.resize(n, [0.0; 3]);
         self.foam_rgb.resize(n, [0.0; 3]);
-        self.foam_uv.resize(n, [0.0; 3]);
+        self.foam_uv.resize(n, [0.0; 5]);
         self.water
             .par_iter_mut()
             .zip(self.foam_rgb.par_iter_mut())
@@ -153,7 +165,9 @@ impl SmoothShader {
                 let g = ground[i];
                 let along = g[0] * dx + g[1] * dy - layout.drift_m;
                 let across = -g[0] * dy + g[1] * dx;
-                *foam_uv = [foam.get(i).copied().unwrap_or(0.0), along / tile_along, across / FOAM_TILE_ACROSS_M];
+                let f = foam.get(i).copied().filter(|f| f.cover >= FOAM_VISIBLE).unwrap_or_default();
+                *foam_uv =
+                    [f.cover, f.fresh, along / tile_along, along / FOAM_TILE_ACROSS_M, across / FOAM_TILE_ACROSS_M];
             });
         self.shade_faces(topology);
         self.fill(out);
@@ -206,9 +220,11 @@ impl SmoothShader {
                 let Some(colour) = Planes::<3>::new(pts, [water[a], water[b], water[c]]) else { continue };
                 let foam = if face.foamy {
                     let f = |i: usize| {
-                        [foam_rgb[i][0], foam_rgb[i][1], foam_rgb[i][2], foam_uv[i][0], foam_uv[i][1], foam_uv[i][2]]
+                        let [r, g, b] = foam_rgb[i];
+                        let [cover, fresh, u_aged, u_fresh, v] = foam_uv[i];
+                        [r, g, b, cover, fresh, u_aged, u_fresh, v]
                     };
-                    Planes::<6>::new(pts, [f(a), f(b), f(c)])
+                    Planes::<8>::new(pts, [f(a), f(b), f(c)])
                 } else {
                     None
                 };
@@ -221,11 +237,26 @@ impl SmoothShader {
                     for out in row.chunks_exact_mut(4) {
                         let mut rgb = c;
                         if let Some(f) = &fm {
-                            let n = texture.sample(level, f[4], f[5]);
                             let cover = f[3].clamp(0.0, 1.0);
-                            let cover =
-                                FOAM_OPACITY * (THIN_FOAM + (1.0 - THIN_FOAM) * cover) * coverage(cover, n, detail);
-                            rgb = mix(rgb, [f[0], f[1], f[2]], cover);
+                            if cover > 0.0 {
+                                let fresh = f[4].clamp(0.0, 1.0);
+                                // Aged foam in streaks (half the texture's width across the
+                                // wind: thin), fresh foam in patches: each keeps the mean cover,
+                                // so their blend does too (a texture read only where it counts).
+                                let aged = if fresh < 1.0 {
+                                    coverage(cover, texture.sample(level, f[5], 2.0 * f[7]), detail)
+                                } else {
+                                    0.0
+                                };
+                                let amount = if fresh > 0.0 {
+                                    let patch = coverage(cover, texture.sample(level, f[6], f[7] + 0.5), detail);
+                                    aged + (patch - aged) * fresh
+                                } else {
+                                    aged
+                                };
+                                let dense = THIN_FOAM + (1.0 - THIN_FOAM) * fresh.max(cover);
+                                rgb = mix(rgb, [f[0], f[1], f[2]], FOAM_OPACITY * dense * amount);
+                            }
                         }
                         // Levels carry +0.5, so the cast rounds (and saturates).
                         out.copy_from_slice(&[rgb[0] as u8, rgb[1] as u8, rgb[2] as u8, 255]);

@@ -133,6 +133,9 @@ impl std::str::FromStr for SceneKind {
 }
 
 /// Everything about a scene except its size: the one factory from a scene choice to a scene.
+// Made once per scene and kept beside it: its size costs nothing, and boxing the sea's settings
+// would make every caller box them.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug)]
 pub enum SceneSpec {
     /// The ripple pool.

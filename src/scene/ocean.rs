@@ -54,7 +54,14 @@ pub struct OceanScene {
     sea: Sea,
     renderer: OceanRenderer,
     texture: SeaTexture,
-    time_s: f64,
+    /// The clock: a start and the time since, counted apart (a looping sea counts each in
+    /// whole ticks, so a whole number of loops after any start is the start exactly).
+    start_s: f64,
+    elapsed_s: f64,
+    /// Player steps since the clock was last set, and the elapsed time then (the elapsed
+    /// time is that plus steps/60, never a running sum).
+    steps: u64,
+    set_elapsed_s: f64,
     /// The component phases of the last frame, reused.
     phases: Vec<f32>,
     /// The heightmap patch's east-west size, m.
@@ -63,7 +70,7 @@ pub struct OceanScene {
 
 /// The heightmap's east-west extent when none is given: 8 peak wavelengths (100 m for a calm).
 pub fn default_extent_m(sea: &Sea) -> f64 {
-    sea.spectrum().peak_wavelength_m().map_or(100.0, |l| 8.0 * l)
+    sea.peak_wavelength_m().map_or(100.0, |l| 8.0 * l)
 }
 
 impl OceanScene {
@@ -76,7 +83,10 @@ impl OceanScene {
             sea: Sea::new(settings.sea),
             renderer,
             texture: settings.texture,
-            time_s: settings.start_time_s,
+            start_s: settings.start_time_s,
+            elapsed_s: 0.0,
+            steps: 0,
+            set_elapsed_s: 0.0,
             phases: Vec::new(),
             extent_m: settings.heightmap_extent_m,
         })
@@ -109,17 +119,24 @@ impl OceanScene {
 
     /// Physical time, s.
     pub fn time_s(&self) -> f64 {
-        self.time_s
+        self.start_s + self.elapsed_s
     }
 
     /// Sets the clock.
     pub fn set_time(&mut self, time_s: f64) {
-        self.time_s = time_s;
+        self.set_clock(time_s, 0.0);
+    }
+
+    /// Sets the clock to `elapsed_s` after `start_s`. The two are counted apart, so in a
+    /// looping sea a whole number of loops after a start is exactly the start's sea and foam
+    /// (an animation's frame N·T is its frame 0).
+    pub fn set_clock(&mut self, start_s: f64, elapsed_s: f64) {
+        (self.start_s, self.elapsed_s, self.steps, self.set_elapsed_s) = (start_s, elapsed_s, 0, elapsed_s);
     }
 
     /// Moves the clock on by `dt_s` seconds: the sea moves exactly that much.
     pub fn advance(&mut self, dt_s: f64) {
-        self.time_s += dt_s;
+        self.start_s += dt_s;
     }
 
     /// Replaces the sea (new wind, direction or seed); the clock and camera stay.
@@ -129,7 +146,8 @@ impl OceanScene {
 
     /// Draws the sea at the current time into `out` (the scene's size).
     pub fn render(&mut self, out: &mut Pixmap) {
-        let frame = self.sea.frame_in(self.time_s, std::mem::take(&mut self.phases));
+        let time = self.sea.time_after(self.start_s, self.elapsed_s);
+        let frame = self.sea.frame_at(time, std::mem::take(&mut self.phases));
         self.renderer.render(&frame, out);
         self.phases = frame.into_buffer();
     }
@@ -153,7 +171,7 @@ impl OceanScene {
     /// east-west and `extent_m·height/width` north-south, centred under the camera, at cell
     /// centres; columns run east, row 0 is the north edge.
     pub fn heightmap(&self, extent_m: f64, width: usize, height: usize) -> Heightmap {
-        let frame = self.sea.frame(self.time_s);
+        let frame = self.sea.frame_at(self.sea.time_after(self.start_s, self.elapsed_s), Vec::new());
         let pose = self.renderer.camera().pose();
         let cell = extent_m / width.max(1) as f64;
         let (west, north) = (pose.east_m - extent_m / 2.0, pose.north_m + cell * height as f64 / 2.0);
@@ -207,9 +225,8 @@ impl Scene for OceanScene {
 
     /// Each step is 1/60 s of the sea's time.
     fn advance(&mut self, steps: u64) {
-        for _ in 0..steps {
-            OceanScene::advance(self, 1.0 / OCEAN_STEPS_PER_SECOND);
-        }
+        self.steps += steps;
+        self.elapsed_s = self.set_elapsed_s + self.steps as f64 / OCEAN_STEPS_PER_SECOND;
     }
 
     fn render(&mut self, out: &mut Pixmap) {

@@ -1,65 +1,161 @@
-//! Foam where waves fold: born where the choppy surface compresses beyond a threshold,
-//! carried with the water, fading over seconds.
+//! Foam as a simulated field: made where the water is squeezed until it breaks, kept on the
+//! water that made it, fading with a time constant in seconds. Nothing in it is fitted to a
+//! sea: the same constants hold for every wind, and Monahan's whitecap fraction is what the
+//! model is checked against, not what it is told.
 //!
-//! # The source
-//! At a resting point the fold indicator q = (1 - J)/(λ·σ) ([`SeaFrame::fold_indicator`];
-//! J the Jacobian of the displacement, σ the standard deviation of its divergence over what
-//! the footprint resolves, so q has unit variance near and far) makes foam where it passes a
-//! threshold z: `s = clamp((q - z)/RAMP, 0, 1)`. In Jacobian terms foam forms where
-//! J < J_c = 1 - z·λ·σ ([`FoamCalibration::fold_jacobian`]).
+//! # Where foam is made
+//! The water resting at a point is carried to `x + λ·D(x)`; the Jacobian
+//! `J = det(I + λ·∇D)` is the area it covers per unit of its area at rest. Where J falls below
+//! [`FOLD_JACOBIAN`] (the water squeezed into half its area) the surface breaks. The sines a
+//! sample keeps give the resolved Jacobian `J_r`; the waves it cannot carry (the short waves
+//! beyond the sines, and those its footprint drops) squeeze it further by `λ·Y`, Y their
+//! divergence, a Gaussian whose variance is their slope variance `S_u = S - S_r` (S the
+//! surface's total: Cox–Munk's `0.003 + 0.00512·U` plus the swells', S_r what the kept sines
+//! carry). The source is the expected depth of the break,
+//!
+//! ```text
+//! s = E[(J_c - J_r - λ·Y)⁺] = σ·φ(m/σ) + m·Φ(m/σ),   m = J_c - J_r,  σ = λ·√S_u
+//! ```
+//!
+//! Short waves break on the crests of long ones, where the long ones squeeze the water: the
+//! source follows the resolved folds, and a sample far away (which resolves little) gets the
+//! same expected source from statistics alone, so the foam cover does not depend on how
+//! finely a sea is sampled.
 //!
 //! # Memory
-//! Foam is kept per resting point (it rides on the water, so a point fixed in the water is
-//! the right place to keep it) on a clock of [`FOAM_STEP_S`]: `F ← max(F·d, s)` with
-//! `d = exp(-step/`[`FOAM_FADE_S`]`)`, and F below [`FOAM_FORGET`] is set to 0. A crest moves
-//! on at its phase speed and leaves its foam fading behind it: the foam is drawn out in a
-//! trail along the waves' travel, downwind. Between clock steps foam fades smoothly
-//! (`F·d^fraction`). Because a larger history is either overtaken by a newer source or
-//! forgotten to exactly 0, two trackers that started at different times agree bit for bit
-//! once [`FoamClock::warm_up_steps`] have passed: a still picture warms up that long, and a
-//! looping sea's foam repeats exactly (its clock counts whole fractions of the loop).
+//! Foam obeys `dF/dt = -F/τ + (G/τ)·s` ([`FOAM_LIFETIME_S`] τ, [`FOAM_GAIN`] G): made in
+//! proportion to the source, fading to 1/e in τ seconds. It is kept per resting point: foam
+//! rides on the water that made it, carried by the water's horizontal motion (the orbital
+//! displacement that carries the point; the mean drift, a few per cent of the wind over a
+//! foam's few seconds, moves it less than a metre and is left to the foam texture). The
+//! equation is integrated on a clock of its own ([`FOAM_STEP_S`]), whatever the frame rate,
+//! as a finite impulse response over the last [`FOAM_MEMORY_S`] seconds (three lifetimes):
 //!
-//! # Calibration
-//! The Pierson–Moskowitz sea is self-similar: its folding is about the same at every wind,
-//! while Monahan's whitecap fraction W = 3.84e-6·U^3.41 grows some sixtyfold from Beaufort 4
-//! to 9. So z is calibrated per sea ([`FoamCalibration::calibrate`]): [`PROBES`] resting
-//! points spread over 16 peak wavelengths run the tracker through a warm-up and
-//! [`MEASURE_S`] seconds, and z is bisected until their mean foam equals W.
+//! ```text
+//! F_n = Σ_{a < W} w_a·s_{n-a},   w_a ∝ e^(-a·Δt/τ),   Σ w_a = G
+//! ```
+//!
+//! so the mean cover is exactly `G·E[s]`, and the foam at a moment depends only on the sea
+//! in the W steps before it: a still picture computes those steps, a stream of frames adds
+//! one step at a time, and the two agree bit for bit (each step's source is a function of
+//! the point and the step alone). A looping sea's clock counts a power of two steps per
+//! loop, so its foam loops exactly. Between steps the cover is interpolated linearly.
+//!
+//! # The constants
+//! J_c = 0.5 and τ = 2 s are physical choices (whitecaps fade over seconds; Callaghan et al.
+//! 2012 measured e-folding times of 1–10 s). G was set once, so that the model's mean cover
+//! runs through Monahan's `W = 3.84·10⁻⁶·U^3.41` in the middle of Beaufort 4–10; the physics
+//! then gives the growth with the wind (the short waves' slope variance grows with U, and
+//! the expected break grows faster than linearly with it). A sea whose expected cover is
+//! below [`NEGLIGIBLE_COVER`] (Beaufort 2 and calmer: glassy crests that do not break)
+//! skips foam altogether.
 
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 
-use super::ocean::{Sea, SeaFrame, SeaParams, SeaTime, whitecap_fraction};
+use super::looping::LoopPeriod;
+use super::ocean::{FOLD_ROWS, PhaseRows, Sea, SeaParams, SeaTime};
 use super::surface::Footprint;
 
-/// The foam clock's step, s.
-pub const FOAM_STEP_S: f64 = 0.1;
+/// The Jacobian below which the surface breaks: squeezed to half its area.
+pub const FOLD_JACOBIAN: f32 = 0.5;
+/// Foam made per unit of expected break, over a lifetime: the mean cover is G·E[s].
+pub const FOAM_GAIN: f32 = 12.0;
 /// The time over which foam fades to 1/e, s.
-pub const FOAM_FADE_S: f64 = 1.5;
-/// Foam thinner than this is gone (exactly 0).
-pub const FOAM_FORGET: f32 = 1.0 / 64.0;
-/// Width of the source's ramp, in standard deviations of the fold indicator.
-pub const RAMP: f32 = 0.5;
-/// Resting points the calibration follows.
-pub const PROBES: usize = 384;
-/// How long the calibration measures after its warm-up, s.
-pub const MEASURE_S: f64 = 40.0;
-/// The side of the calibration's square, peak wavelengths.
-pub const PROBE_SPREAD_WAVELENGTHS: f64 = 16.0;
+pub const FOAM_LIFETIME_S: f64 = 2.0;
+/// The foam clock's step, s (a looping sea: the power of two steps per loop nearest to it).
+pub const FOAM_STEP_S: f64 = 0.2;
+/// How far back a moment's foam remembers the sea, s: three lifetimes.
+pub const FOAM_MEMORY_S: f64 = 6.0;
+/// Below this expected cover a sea draws no foam.
+pub const NEGLIGIBLE_COVER: f64 = 1e-4;
+/// Foam younger than this is fresh (the breaking crest itself: dense white), s.
+pub const FRESH_FOAM_S: f64 = 1.0;
+/// Sources are kept as 16-bit fixed point, this many to 1 (at most 16).
+const SOURCE_SCALE: f32 = 4096.0;
 
-/// The foam source for a fold indicator `q` and threshold `z`.
+/// E[(m + σ·Z)⁺] for a standard normal Z: the expected excess of a Gaussian over -m,
+/// `σ·h(m/σ)` with `h(z) = φ(z) + z·Φ(z)` read from a table ([`EXCESS_TABLE`] points over
+/// ±[`EXCESS_RANGE`], linear between them: within 1e-6 of the integral, and a few
+/// operations where libm's erf and exp took most of a foam step).
 #[inline(always)]
-pub fn source(q: f32, z: f32) -> f32 {
-    ((q - z) / RAMP).clamp(0.0, 1.0)
+pub fn expected_excess(m: f32, sigma: f32) -> f32 {
+    if sigma <= 1e-6 {
+        return m.max(0.0);
+    }
+    let z = m / sigma;
+    if z <= -EXCESS_RANGE {
+        return 0.0;
+    }
+    if z >= EXCESS_RANGE {
+        return m;
+    }
+    let table = excess_table();
+    let pos = (z + EXCESS_RANGE) * ((EXCESS_TABLE - 1) as f32 / (2.0 * EXCESS_RANGE));
+    let i = (pos as usize).min(EXCESS_TABLE - 2);
+    let t = pos - i as f32;
+    sigma * (table[i] + (table[i + 1] - table[i]) * t)
 }
 
-/// One step of the memory: the older foam faded by `decay`, or the new source if larger;
-/// below [`FOAM_FORGET`], nothing.
-#[inline(always)]
-pub fn remember(old: f32, decay: f32, source: f32) -> f32 {
-    let f = (old * decay).max(source);
-    if f < FOAM_FORGET { 0.0 } else { f }
+/// Points of the table of h(z) = φ(z) + z·Φ(z).
+pub const EXCESS_TABLE: usize = 4097;
+/// The table spans z in ±this (beyond, h is 0 below and z above to within 1e-16).
+pub const EXCESS_RANGE: f32 = 8.0;
+
+fn excess_table() -> &'static [f32; EXCESS_TABLE] {
+    static TABLE: std::sync::OnceLock<Box<[f32; EXCESS_TABLE]>> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        let mut t = Box::new([0.0f32; EXCESS_TABLE]);
+        for (i, v) in t.iter_mut().enumerate() {
+            let z = -f64::from(EXCESS_RANGE) + 2.0 * f64::from(EXCESS_RANGE) * i as f64 / (EXCESS_TABLE - 1) as f64;
+            // libm, not std: the same bits on every machine (glibc picks code by CPU).
+            let pdf = libm::exp(-0.5 * z * z) / (2.0 * std::f64::consts::PI).sqrt();
+            let cdf = 0.5 * libm::erfc(-z / std::f64::consts::SQRT_2);
+            *v = (pdf + z * cdf) as f32;
+        }
+        t
+    })
+}
+
+/// The foam model of one sea: its choppiness and the slope variance of its whole surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FoamModel {
+    lambda: f32,
+    slope_total: f32,
+    active: bool,
+}
+
+impl FoamModel {
+    /// The model of `sea`.
+    pub fn of(sea: &Sea) -> FoamModel {
+        let lambda = sea.choppiness();
+        let slope_total = sea.slope_variance();
+        let mut model = FoamModel { lambda, slope_total, active: true };
+        model.active = lambda > 0.0 && !sea.components().is_empty() && model.expected_cover() >= NEGLIGIBLE_COVER;
+        model
+    }
+
+    /// The source where the kept sines give the displacement gradient `g` (`[gxx, gyy, gxy]`,
+    /// ∇D = -λ·g) and carry the slope variance `resolved_slope`.
+    #[inline(always)]
+    pub fn source(&self, g: [f32; 3], resolved_slope: f32) -> f32 {
+        let l = self.lambda;
+        let j = (1.0 - l * g[0]) * (1.0 - l * g[1]) - l * l * g[2] * g[2];
+        let sigma = l * (self.slope_total - resolved_slope).max(0.0).sqrt();
+        expected_excess(FOLD_JACOBIAN - j, sigma)
+    }
+
+    /// The mean cover the model expects of the sea: G·E[s] with J ≈ 1 - λ·(divergence), the
+    /// divergence Gaussian with the surface's slope variance.
+    pub fn expected_cover(&self) -> f64 {
+        let sigma = self.lambda * self.slope_total.max(0.0).sqrt();
+        f64::from(FOAM_GAIN) * f64::from(expected_excess(FOLD_JACOBIAN - 1.0, sigma))
+    }
+
+    /// False for a sea that makes no visible foam (a linear sea, a calm, or an expected cover
+    /// below [`NEGLIGIBLE_COVER`]).
+    pub fn is_active(&self) -> bool {
+        self.active
+    }
 }
 
 /// The foam clock of a sea: steps of [`FOAM_STEP_S`], or for a looping sea a power of two
@@ -68,147 +164,86 @@ pub fn remember(old: f32, decay: f32, source: f32) -> f32 {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FoamClock {
     step_s: f64,
-    /// log2 of the steps per loop, for a looping sea.
-    loop_bits: Option<(crate::sim::looping::LoopPeriod, u32)>,
+    /// The loop and log2 of its steps.
+    looping: Option<(LoopPeriod, u32)>,
 }
 
 impl FoamClock {
-    /// The clock of `sea`.
-    pub fn of(sea: &Sea) -> FoamClock {
-        match sea.params().loop_period {
+    /// The clock of a sea with `params`.
+    pub fn of(params: &SeaParams) -> FoamClock {
+        match params.loop_period {
             Some(p) => {
                 let bits = (p.seconds() / FOAM_STEP_S).log2().round().clamp(1.0, 24.0) as u32;
-                FoamClock { step_s: p.seconds() / f64::from(1u32 << bits), loop_bits: Some((p, bits)) }
+                FoamClock { step_s: p.seconds() / f64::from(1u32 << bits), looping: Some((p, bits)) }
             }
-            None => FoamClock { step_s: FOAM_STEP_S, loop_bits: None },
+            None => FoamClock { step_s: FOAM_STEP_S, looping: None },
         }
     }
 
     /// The step, s.
+    #[cfg(test)]
     pub fn step_s(&self) -> f64 {
         self.step_s
     }
 
-    /// The fade per step.
-    pub fn decay(&self) -> f32 {
-        (-self.step_s / FOAM_FADE_S).exp() as f32
+    /// W, the steps of memory.
+    pub fn memory_steps(&self) -> usize {
+        ((FOAM_MEMORY_S / self.step_s).round() as usize).max(1)
     }
 
-    /// Steps after which any earlier history is forgotten exactly (plus one).
-    pub fn warm_up_steps(&self) -> i64 {
-        let steps = f64::from(FOAM_FORGET).ln() / f64::from(self.decay()).ln();
-        steps.ceil() as i64 + 1
+    /// The weights w_a of ages a = 0..W (the newest first): ∝ e^(-a·Δt/τ), summing to G.
+    pub fn weights(&self) -> Vec<f32> {
+        let decay = |a: usize| libm::exp(-(a as f64) * self.step_s / FOAM_LIFETIME_S);
+        let raw: Vec<f64> = (0..self.memory_steps()).map(decay).collect();
+        let sum: f64 = raw.iter().sum();
+        raw.iter().map(|w| (w / sum * f64::from(FOAM_GAIN)) as f32).collect()
     }
 
-    /// The last step at or before `time_s`, and how far past it `time_s` is (0..1 steps).
-    pub fn step_at(&self, time_s: f64) -> (i64, f32) {
-        match self.loop_bits {
-            Some((p, bits)) => {
-                let (loops, tick) = p.loops_and_tick(time_s);
+    /// The last step at or before `time`, and how far past it `time` is (0..1 steps).
+    pub fn step_at(&self, time: SeaTime) -> (i64, f32) {
+        match (time, self.looping) {
+            (SeaTime::Ticks(u), Some((_, bits))) => {
                 let shift = 32 - bits;
-                let within = i64::from(tick >> shift);
-                let frac = f64::from(tick & ((1u32 << shift) - 1)) / f64::from(1u32 << shift);
-                ((loops << bits) + within, frac as f32)
+                let frac = (u & ((1i64 << shift) - 1)) as f64 / (1i64 << shift) as f64;
+                (u >> shift, frac as f32)
             }
-            None => {
-                let pos = time_s / self.step_s;
+            (SeaTime::Seconds(t), _) => {
+                let pos = t / self.step_s;
                 let n = pos.floor();
                 (n as i64, (pos - n) as f32)
             }
+            (SeaTime::Ticks(u), None) => (u, 0.0),
         }
     }
 
     /// The moment of the sea at step `n`.
     pub fn time_of(&self, n: i64) -> SeaTime {
-        match self.loop_bits {
-            Some((_, bits)) => {
-                let within = n.rem_euclid(1i64 << bits) as u64;
-                SeaTime::Tick((within << (32 - bits)) as u32)
-            }
+        match self.looping {
+            Some((_, bits)) => SeaTime::Ticks(n << (32 - bits)),
             None => SeaTime::Seconds(n as f64 * self.step_s),
         }
     }
 }
 
-/// The calibrated threshold of a sea's foam.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct FoamCalibration {
-    /// The fold indicator's threshold z (+inf: no foam).
-    pub threshold: f32,
-    /// The same in Jacobian terms at full resolution: foam forms where J < this.
-    pub fold_jacobian: f32,
-    /// Monahan's fraction it aimed at.
-    pub target: f64,
-    /// The mean foam the calibration's probes reached.
-    pub coverage: f64,
-}
-
-impl FoamCalibration {
-    /// Bisects the threshold until the probes' mean foam is Monahan's fraction for the wind.
-    pub fn calibrate(sea: &Sea) -> FoamCalibration {
-        let target = whitecap_fraction(sea.params().wind_m_s);
-        let none =
-            FoamCalibration { threshold: f32::INFINITY, fold_jacobian: f32::NEG_INFINITY, target, coverage: 0.0 };
-        let Some(wavelength) = sea.spectrum().peak_wavelength_m() else { return none };
-        if target <= 0.0 || sea.components().is_empty() {
-            return none;
-        }
-        let clock = FoamClock::of(sea);
-        let warm = clock.warm_up_steps() as usize;
-        let measure = (MEASURE_S / clock.step_s()).ceil() as usize;
-        let steps = warm + measure;
-        let mut rng = ChaCha8Rng::seed_from_u64(sea.params().seed ^ 0xf0a3);
-        let side = (PROBE_SPREAD_WAVELENGTHS * wavelength) as f32;
-        let probes: Vec<[f32; 2]> =
-            (0..PROBES).map(|_| [side * rng.random::<f32>(), side * rng.random::<f32>()]).collect();
-        let frames: Vec<SeaFrame<'_>> = (0..steps).map(|n| sea.frame_at(clock.time_of(n as i64), Vec::new())).collect();
-        let full = Footprint::default();
-        let series: Vec<Vec<f32>> =
-            probes.par_iter().map(|p| frames.iter().map(|f| f.fold_indicator(p[0], p[1], &full)).collect()).collect();
-        let decay = clock.decay();
-        let coverage = |z: f32| -> f64 {
-            let mut sum = 0.0f64;
-            for q in &series {
-                let mut foam = 0.0f32;
-                for (n, &q) in q.iter().enumerate() {
-                    foam = remember(foam, decay, source(q, z));
-                    if n >= warm {
-                        sum += f64::from(foam);
-                    }
-                }
-            }
-            sum / (series.len() * measure) as f64
-        };
-        let (mut lo, mut hi) = (-4.0f32, 12.0f32);
-        for _ in 0..40 {
-            let mid = 0.5 * (lo + hi);
-            if coverage(mid) > target { lo = mid } else { hi = mid }
-        }
-        let threshold = 0.5 * (lo + hi);
-        // J_c for the sea's λ (for λ = 0, whose surface never folds, the value at λ = 1).
-        let lambda = if sea.choppiness() > 0.0 { sea.choppiness() } else { 1.0 };
-        let sigma =
-            sea.components().iter().map(|c| 0.5 * (c.amplitude_m * c.wavenumber).powi(2)).sum::<f64>().sqrt() as f32;
-        FoamCalibration {
-            threshold,
-            fold_jacobian: 1.0 - threshold * lambda * sigma,
-            target,
-            coverage: coverage(threshold),
-        }
-    }
-}
-
-/// Foam at a fixed set of resting points, followed through time.
+/// Foam at a fixed set of resting points, followed through time: the last W + 1 steps'
+/// sources per point (a ring), and the cover they give.
 #[derive(Debug, Default)]
 pub struct FoamTracker {
-    /// The sea's parameters, the number of points and the last step taken.
+    /// The sea and number of points the ring belongs to, and its newest step.
     at: Option<(SeaParams, usize, i64)>,
-    /// The threshold calibrated for a sea's parameters (calibrating takes a while; a tracker
-    /// keeps it while the sea stays the same).
-    threshold: Option<(SeaParams, f32)>,
-    state: Vec<f32>,
-    foam: Vec<f32>,
-    phases: Vec<f32>,
+    ring: Vec<u16>,
+    foam: Vec<Foam>,
+    rows: PhaseRows,
+}
+
+/// The foam at a point: its cover 0..=1, and how much of it is fresh (younger than
+/// [`FRESH_FOAM_S`], 0..=1 of the cover).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Foam {
+    /// The fraction of the surface covered, 0..=1.
+    pub cover: f32,
+    /// The fraction of that foam made in the last [`FRESH_FOAM_S`], 0..=1.
+    pub fresh: f32,
 }
 
 impl FoamTracker {
@@ -222,123 +257,159 @@ impl FoamTracker {
         self.at = None;
     }
 
-    /// Brings the foam at `points` (resting points with their footprints) up to `time_s` and
-    /// returns it, one value 0..=1 per point. Continues from the last call when the sea and
-    /// the points are the same and time moved forward by less than a warm-up; otherwise warms
-    /// up from scratch. Allocates only when the number of points grows.
-    pub fn update(&mut self, sea: &Sea, points: &[[f32; 2]], footprints: &[Footprint], time_s: f64) -> &[f32] {
-        let clock = FoamClock::of(sea);
-        let (now, frac) = clock.step_at(time_s);
-        let warm = clock.warm_up_steps();
+    /// Brings the foam at `points` (resting points with their footprints) up to `time` and
+    /// returns it, one per point. Continues from the last call when the sea and
+    /// the points are the same and time moved forward by less than the memory; otherwise
+    /// computes the whole memory. Either way the result is the same bits. Allocates only when
+    /// the number of points grows.
+    pub fn update(&mut self, sea: &Sea, points: &[[f32; 2]], footprints: &[Footprint], time: SeaTime) -> &[Foam] {
+        let model = FoamModel::of(sea);
+        self.foam.clear();
+        if !model.is_active() {
+            self.foam.resize(points.len(), Foam::default());
+            self.at = None;
+            return &self.foam;
+        }
+        let clock = FoamClock::of(&sea.params());
+        let (now, frac) = clock.step_at(time);
+        let memory = clock.memory_steps();
+        let slots = memory + 1;
+        // The ring must hold steps now + 1 - W ..= now + 1.
+        let top = now + 1;
         let first = match self.at {
-            Some((params, count, last)) if params == sea.params() && count == points.len() && now >= last => {
-                if now - last > warm { now - warm } else { last + 1 }
+            Some((params, count, last)) if params == sea.params() && count == points.len() && last <= top => {
+                (last + 1).max(top + 1 - slots as i64)
             }
-            _ => {
-                self.state.clear();
-                self.state.resize(points.len(), 0.0);
-                now - warm
-            }
+            _ => top + 1 - slots as i64,
         };
-        let z = match self.threshold {
-            Some((params, z)) if params == sea.params() => z,
-            _ => {
-                let z = FoamCalibration::calibrate(sea).threshold;
-                self.threshold = Some((sea.params(), z));
-                z
-            }
-        };
-        let decay = clock.decay();
-        for n in first..=now {
-            let frame = sea.frame_at(clock.time_of(n), std::mem::take(&mut self.phases));
-            self.state.par_chunks_mut(256).enumerate().for_each(|(chunk, state)| {
-                for (i, f) in state.iter_mut().enumerate() {
-                    let k = chunk * 256 + i;
-                    let q = frame.fold_indicator(points[k][0], points[k][1], &footprints[k]);
-                    *f = remember(*f, decay, source(q, z));
+        if self.ring.len() != points.len() * slots {
+            self.ring.clear();
+            self.ring.resize(points.len() * slots, 0);
+        }
+        if first <= top {
+            sea.phase_rows((first..=top).map(|n| clock.time_of(n)), &mut self.rows);
+            let rows = &self.rows;
+            self.ring.par_chunks_mut(slots * 64).enumerate().for_each(|(chunk, ring)| {
+                let mut g = [[0.0f32; 3]; FOLD_ROWS];
+                for (i, history) in ring.chunks_exact_mut(slots).enumerate() {
+                    let k = chunk * 64 + i;
+                    let (p, fp) = (points[k], &footprints[k]);
+                    let mut row = 0;
+                    while row < rows.len() {
+                        let count = (rows.len() - row).min(FOLD_ROWS);
+                        let slope = sea.fold_rows(p[0], p[1], fp, rows, row, &mut g[..count]);
+                        for (r, g) in g[..count].iter().enumerate() {
+                            let n = first + (row + r) as i64;
+                            let s = model.source(*g, slope);
+                            history[n.rem_euclid(slots as i64) as usize] = quantize(s);
+                        }
+                        row += count;
+                    }
                 }
             });
-            self.phases = frame.into_buffer();
         }
-        self.at = Some((sea.params(), points.len(), now));
-        let fade = decay.powf(frac);
-        self.foam.clear();
-        self.foam.extend(self.state.iter().map(|f| f * fade));
+        self.at = Some((sea.params(), points.len(), top));
+        let weights = clock.weights();
+        let fresh = ((FRESH_FOAM_S / clock.step_s).round() as usize).clamp(1, weights.len());
+        let (taps_now, taps_next) = (taps(&weights, now, slots), taps(&weights, now + 1, slots));
+        // The taps run oldest first: the fresh ones are the last.
+        let (fresh_now, fresh_next) = (&taps_now[taps_now.len() - fresh..], &taps_next[taps_next.len() - fresh..]);
+        self.foam.resize(points.len(), Foam::default());
+        self.foam.par_chunks_mut(64).zip(self.ring.par_chunks(slots * 64)).for_each(|(foam, ring)| {
+            for (f, history) in foam.iter_mut().zip(ring.chunks_exact(slots)) {
+                let (a, b) = (fir(history, &taps_now), fir(history, &taps_next));
+                let all = a + (b - a) * frac;
+                let (a, b) = (fir(history, fresh_now), fir(history, fresh_next));
+                let young = a + (b - a) * frac;
+                *f = Foam {
+                    cover: all.clamp(0.0, 1.0),
+                    fresh: if all > 0.0 { (young / all).clamp(0.0, 1.0) } else { 0.0 },
+                };
+            }
+        });
         &self.foam
     }
 }
 
+/// A source as 16-bit fixed point, rounded (saturating at 16).
+#[inline(always)]
+pub(crate) fn quantize(s: f32) -> u16 {
+    (s * SOURCE_SCALE + 0.5).clamp(0.0, 65535.0) as u16
+}
+
+/// The FIR of step `n` over a ring of `slots` steps (step m at slot m mod slots): each
+/// weight with the slot of its step, the oldest first.
+pub(crate) fn taps(weights: &[f32], n: i64, slots: usize) -> Vec<(f32, usize)> {
+    weights.iter().enumerate().rev().map(|(a, &w)| (w, (n - a as i64).rem_euclid(slots as i64) as usize)).collect()
+}
+
+/// F_n = Σ w_a·s_{n-a} by the [`taps`] of step n, the oldest first: a fixed order, so the
+/// same ring gives the same bits.
+#[inline(always)]
+pub(crate) fn fir(history: &[u16], taps: &[(f32, usize)]) -> f32 {
+    let mut sum = 0.0f32;
+    for &(w, slot) in taps {
+        sum += w * f32::from(history[slot]);
+    }
+    sum / SOURCE_SCALE
+}
+
+#[cfg(test)]
+#[path = "foam_tests.rs"]
+mod measured;
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::looping::LoopPeriod;
-    use crate::sim::ocean::{SeaParams, whitecap_fraction};
-    use crate::sim::spectra::{SeaSpectrum, SpectrumChoice};
+    use crate::sim::ocean::SeaParams;
+    use crate::sim::spectra::SpectrumChoice;
 
-    /// Mean foam over a grid of resting points (not the calibration's probes) followed for
-    /// `seconds` after the warm-up, one value per foam step.
-    pub(crate) fn measured_coverage(sea: &Sea, seconds: f64) -> f64 {
-        let span = 16.0 * sea.spectrum().peak_wavelength_m().unwrap() as f32;
-        let points: Vec<[f32; 2]> = (0..1024)
-            .map(|i| [span * ((i % 32) as f32 + 0.5) / 32.0 - 900.0, span * ((i / 32) as f32 + 0.5) / 32.0])
-            .collect();
-        let footprints = vec![Footprint::default(); points.len()];
-        let mut tracker = FoamTracker::new();
-        let step = FoamClock::of(sea).step_s();
-        let (mut sum, mut count) = (0.0f64, 0usize);
-        let mut t = 500.0;
-        while t < 500.0 + seconds {
-            sum += tracker.update(sea, &points, &footprints, t).iter().map(|&f| f64::from(f)).sum::<f64>();
-            count += points.len();
-            t += step;
+    #[test]
+    fn the_expected_excess_is_the_gaussian_integral() {
+        for (m, sigma) in [(-0.5f32, 0.2f32), (0.0, 0.3), (0.2, 0.1), (-1.0, 0.4)] {
+            let n = 200_000;
+            let mut sum = 0.0f64;
+            for i in 0..n {
+                // Midpoint rule over ±8σ.
+                let z = -8.0 + 16.0 * (i as f64 + 0.5) / n as f64;
+                let pdf = (-0.5 * z * z).exp() / (2.0 * std::f64::consts::PI).sqrt();
+                sum += (f64::from(m) + f64::from(sigma) * z).max(0.0) * pdf * 16.0 / n as f64;
+            }
+            let got = f64::from(expected_excess(m, sigma));
+            assert!((got - sum).abs() < 1e-5 + 1e-3 * sum, "m {m} σ {sigma}: {got} vs {sum}");
         }
-        sum / count as f64
+        assert_eq!(expected_excess(0.3, 0.0), 0.3);
+        assert_eq!(expected_excess(-0.3, 0.0), 0.0);
     }
 
     #[test]
-    fn whitecaps_follow_monahan() {
-        // The calibration aims at Monahan's fraction; measured elsewhere and later, the foam
-        // must stay within half of it (no absolute slack: zero foam fails).
-        assert!((whitecap_fraction(10.0) - 3.84e-6 * 10f64.powf(3.41)).abs() < 1e-12);
-        for wind in [8.0, 15.0, 22.0] {
-            let sea = Sea::new(SeaParams { wind_m_s: wind, choppiness: 1.0, seed: 4, ..SeaParams::default() });
-            let want = whitecap_fraction(wind);
-            let cover = measured_coverage(&sea, 20.0);
-            assert!((cover / want - 1.0).abs() < 0.5, "U = {wind}: {cover} vs Monahan {want}");
-        }
-    }
-
-    #[test]
-    fn memory_fades_and_forgets_exactly() {
-        let d = 0.95;
-        let mut f = remember(0.0, d, 1.0);
-        assert_eq!(f, 1.0);
-        f = remember(f, d, 0.2);
-        assert_eq!(f, 0.95);
-        for _ in 0..200 {
-            f = remember(f, d, 0.0);
-        }
-        assert_eq!(f, 0.0, "forgotten exactly");
-        assert_eq!(source(2.0, 1.0), 1.0);
-        assert_eq!(source(0.9, 1.0), 0.0);
+    fn weights_sum_to_the_gain_and_fade_with_the_lifetime() {
+        let clock = FoamClock::of(&SeaParams::default());
+        let w = clock.weights();
+        assert_eq!(w.len(), 30, "6 s of 0.2 s steps");
+        assert!((w.iter().sum::<f32>() - FOAM_GAIN).abs() < 1e-4);
+        // One lifetime (10 steps) fades a weight to 1/e.
+        assert!((w[10] / w[0] - (-1.0f32).exp()).abs() < 1e-5);
     }
 
     #[test]
     fn the_clock_counts_whole_fractions_of_a_loop() {
         let params = SeaParams { wind_m_s: 8.0, ..SeaParams::default() };
-        let period = LoopPeriod::new(64.0, &SeaSpectrum::new(8.0, SpectrumChoice::PiersonMoskowitz)).unwrap();
-        let sea = Sea::new(SeaParams { loop_period: Some(period), ..params });
-        let clock = FoamClock::of(&sea);
-        assert_eq!(clock.step_s(), 0.125, "512 steps of 1/8 s");
-        assert_eq!(clock.step_at(0.0), (0, 0.0));
-        assert_eq!(clock.step_at(64.0), (512, 0.0));
-        assert_eq!(clock.step_at(64.0 * 29.0 / 29.0), (512, 0.0));
-        assert_eq!(clock.time_of(512), clock.time_of(0));
-        assert_eq!(clock.time_of(-1), clock.time_of(511));
-        let plain = FoamClock::of(&Sea::new(params));
-        let (n, frac) = plain.step_at(1.25);
-        assert!(n == 12 && (frac - 0.5).abs() < 1e-5, "{n} {frac}");
-        // 1.5 s to 1/e, forgotten below 1/64: ln 64 · 1.5 s = 6.2 s, 63 steps of 0.1 s.
-        assert_eq!(plain.warm_up_steps(), 64);
+        let period = LoopPeriod::new(64.0, params.longest_peak_period_s()).unwrap();
+        let looping = SeaParams { loop_period: Some(period), ..params };
+        let sea = Sea::new(looping);
+        let clock = FoamClock::of(&looping);
+        assert_eq!(clock.step_s(), 0.25, "256 steps of 1/4 s");
+        assert_eq!(clock.step_at(sea.time(0.0)), (0, 0.0));
+        assert_eq!(clock.step_at(sea.time(64.0)), (256, 0.0));
+        assert_eq!(clock.step_at(sea.time_after(0.3, 64.0)).0, clock.step_at(sea.time(0.3)).0 + 256);
+        assert_eq!(
+            sea.frame_at(clock.time_of(256), Vec::new()).into_buffer(),
+            sea.frame_at(clock.time_of(0), Vec::new()).into_buffer()
+        );
+        let plain = FoamClock::of(&params);
+        let (n, frac) = plain.step_at(SeaTime::Seconds(1.25));
+        assert!(n == 6 && (frac - 0.25).abs() < 1e-5, "{n} {frac}");
+        let _ = SpectrumChoice::PiersonMoskowitz;
     }
 }

@@ -9,13 +9,15 @@
 //! refuses a period under [`MIN_PEAK_PERIODS`] peak periods (the step is then at most a tenth
 //! of fp, and a component's frequency moves by at most 5 % of fp).
 
-use super::spectra::SeaSpectrum;
 use crate::error::ValueError;
 
 /// The shortest loop, in peak periods.
 pub const MIN_PEAK_PERIODS: f64 = 10.0;
 /// The longest loop, s (an hour).
 pub const MAX_LOOP_S: f64 = 3600.0;
+/// The shortest loop of any sea, s (a calm has no peak period to bound it; a second keeps
+/// the tick count of any moment tidepool takes, |t| <= 10⁷ s, far inside an i64).
+pub const MIN_LOOP_S: f64 = 1.0;
 /// Ticks in one loop period, as a shift: 2³².
 pub const TICK_BITS: u32 = 32;
 
@@ -26,15 +28,16 @@ pub struct LoopPeriod {
 }
 
 impl LoopPeriod {
-    /// The loop of `seconds` for a sea with `spectrum`: finite, positive, at most an hour and
-    /// at least [`MIN_PEAK_PERIODS`] peak periods (any positive period loops a calm).
-    pub fn new(seconds: f64, spectrum: &SeaSpectrum) -> Result<LoopPeriod, ValueError> {
+    /// The loop of `seconds` for a sea whose longest peak period is `peak_period_s` (None: a
+    /// calm; [`crate::SeaParams::longest_peak_period_s`]): finite, positive, at most an hour and
+    /// at least [`MIN_PEAK_PERIODS`] peak periods (a calm: at least [`MIN_LOOP_S`]).
+    pub fn new(seconds: f64, peak_period_s: Option<f64>) -> Result<LoopPeriod, ValueError> {
         if !seconds.is_finite() || seconds <= 0.0 {
             return Err(ValueError::new(
                 "loop",
                 format!(
                     "a loop of {seconds} s cannot repeat; give the loop's length in seconds, at least {}",
-                    min_loop_text(spectrum)
+                    min_loop_text(peak_period_s)
                 ),
             ));
         }
@@ -46,7 +49,7 @@ impl LoopPeriod {
                 ),
             ));
         }
-        let min = minimum_seconds(spectrum);
+        let min = minimum_seconds(peak_period_s);
         if seconds < min {
             return Err(ValueError::new(
                 "loop",
@@ -54,7 +57,7 @@ impl LoopPeriod {
                     "a loop of {seconds} s is too short for this sea: its frequency step 1/T must stay under a \
                      tenth of the peak frequency, so a loop lasts at least {MIN_PEAK_PERIODS} peak periods ({}); \
                      give {} or more",
-                    min_loop_text(spectrum),
+                    min_loop_text(peak_period_s),
                     min.ceil()
                 ),
             ));
@@ -72,71 +75,60 @@ impl LoopPeriod {
         1.0 / self.seconds
     }
 
-    /// The tick of time `t` seconds: t/T of the way round the loop, in units of 2⁻³².
-    pub fn tick(&self, time_s: f64) -> u32 {
-        let turns = (time_s / self.seconds).rem_euclid(1.0);
-        ((turns * (1u64 << TICK_BITS) as f64).round() as u64 & 0xFFFF_FFFF) as u32
-    }
-
-    /// Whole loops before `time_s` and the tick within the loop (a tick that rounds up to
-    /// the period carries into the next loop, so the pair never runs backwards).
-    pub fn loops_and_tick(&self, time_s: f64) -> (i64, u32) {
-        let turns = time_s / self.seconds;
-        let mut whole = turns.floor();
-        let mut tick = ((turns - whole) * (1u64 << TICK_BITS) as f64).round();
-        if tick >= (1u64 << TICK_BITS) as f64 {
-            whole += 1.0;
-            tick = 0.0;
-        }
-        (whole as i64, tick as u32)
-    }
-
-    /// The time of frame `k` of an `n`-frame loop, s (frame n is the period, which shows frame 0).
-    pub fn frame_time(&self, k: u32, n: u32) -> f64 {
-        self.seconds * f64::from(k) / f64::from(n.max(1))
+    /// Ticks (2³² a loop) from t = 0 to `time_s`, rounded to the nearest: the clock of a
+    /// looping sea. A moment given as a start and a time elapsed since it is best counted as
+    /// `ticks(start) + ticks(elapsed)`: an elapsed whole number of loops is then exactly a
+    /// whole number of 2³² ticks, whatever the start.
+    pub fn ticks(&self, time_s: f64) -> i64 {
+        (time_s / self.seconds * (1u64 << TICK_BITS) as f64).round() as i64
     }
 }
 
-/// The shortest loop for `spectrum`, s (0 for a calm).
-pub fn minimum_seconds(spectrum: &SeaSpectrum) -> f64 {
-    spectrum.peak_period_s().map_or(0.0, |tp| MIN_PEAK_PERIODS * tp)
+/// The shortest loop for a sea whose longest peak period is `peak_period_s`, s.
+pub fn minimum_seconds(peak_period_s: Option<f64>) -> f64 {
+    peak_period_s.map_or(MIN_LOOP_S, |tp| (MIN_PEAK_PERIODS * tp).max(MIN_LOOP_S))
 }
 
-fn min_loop_text(spectrum: &SeaSpectrum) -> String {
-    match spectrum.peak_period_s() {
+fn min_loop_text(peak_period_s: Option<f64>) -> String {
+    match peak_period_s {
         Some(tp) => format!("{:.1} s for this sea, whose peak period is {tp:.2} s", MIN_PEAK_PERIODS * tp),
-        None => "any length for a calm".to_string(),
+        None => format!("{MIN_LOOP_S} s for a calm"),
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sim::spectra::SpectrumChoice;
+    use crate::sim::spectra::{SeaSpectrum, SpectrumChoice};
 
     #[test]
     fn periods_are_checked_against_the_peak() {
-        let s = SeaSpectrum::new(10.0, SpectrumChoice::PiersonMoskowitz);
-        let min = minimum_seconds(&s);
+        let s = SeaSpectrum::new(10.0, SpectrumChoice::PiersonMoskowitz).peak_period_s();
+        let min = minimum_seconds(s);
         assert!((min - 78.4).abs() < 0.1, "{min}");
         for bad in [0.0, -3.0, f64::INFINITY, f64::NAN, 30.0, 4000.0] {
-            assert!(LoopPeriod::new(bad, &s).is_err(), "{bad}");
+            assert!(LoopPeriod::new(bad, s).is_err(), "{bad}");
         }
-        let short = LoopPeriod::new(30.0, &s).unwrap_err().to_string();
+        let short = LoopPeriod::new(30.0, s).unwrap_err().to_string();
         assert!(short.contains("78.4 s") && short.contains("give 79 or more"), "{short}");
-        assert!(LoopPeriod::new(80.0, &s).is_ok());
-        assert!(LoopPeriod::new(1.0, &SeaSpectrum::new(0.0, SpectrumChoice::PiersonMoskowitz)).is_ok());
+        assert!(LoopPeriod::new(80.0, s).is_ok());
+        assert!(LoopPeriod::new(1.0, None).is_ok() && LoopPeriod::new(0.5, None).is_err());
     }
 
     #[test]
-    fn ticks_wrap_exactly_at_the_period() {
-        let s = SeaSpectrum::new(10.0, SpectrumChoice::PiersonMoskowitz);
-        let p = LoopPeriod::new(100.0, &s).unwrap();
-        assert_eq!(p.tick(0.0), 0);
-        assert_eq!(p.tick(100.0), 0);
-        assert_eq!(p.tick(-100.0), 0);
-        assert_eq!(p.tick(50.0), 1 << 31);
-        assert_eq!(p.tick(p.frame_time(30, 30)), p.tick(p.frame_time(0, 30)));
-        assert_eq!(p.tick(125.0), p.tick(25.0));
+    fn ticks_count_whole_loops_exactly() {
+        let s = SeaSpectrum::new(10.0, SpectrumChoice::PiersonMoskowitz).peak_period_s();
+        let p = LoopPeriod::new(100.0, s).unwrap();
+        assert_eq!(p.ticks(0.0), 0);
+        assert_eq!(p.ticks(100.0), 1 << 32);
+        assert_eq!(p.ticks(-100.0), -(1 << 32));
+        assert_eq!(p.ticks(50.0), 1 << 31);
+        assert_eq!(p.ticks(125.0) - p.ticks(25.0), 1 << 32);
+        // A loop that is no whole number of milliseconds: 30 frames of 1/fps each still add up
+        // to exactly one loop of ticks.
+        let odd = LoopPeriod::new(97.3, s).unwrap();
+        let frame = odd.ticks(97.3 / 30.0 * 30.0);
+        assert_eq!(frame, 1 << 32);
+        assert_eq!(odd.ticks(0.3) + odd.ticks(97.3), odd.ticks(0.3) + (1 << 32));
     }
 }

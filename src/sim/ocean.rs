@@ -1,6 +1,7 @@
 //! The wind-driven sea: travelling sines drawn from a spectrum (Pierson–Moskowitz, JONSWAP or
-//! TMA, [`super::spectra`]) plus a diamond-square fBm tail, moved sideways by a choppy
-//! displacement and foaming where it folds (the foam module, `sim::foam`).
+//! TMA, spread by one of four laws, [`super::spectra`]) and from any swells, plus a
+//! diamond-square fBm tail, moved sideways by a choppy displacement and foaming where it folds
+//! (the foam module, `sim::foam`, which sums the sines through [`Sea::fold_rows`]).
 //!
 //! # The sines
 //! [`FREQUENCY_BINS`] geometric frequency bins from [`BAND_LOW`]·fp to [`CUTOFF`]·fp times
@@ -13,12 +14,20 @@
 //! The lanes of the vectorised sum are padded with silent components by construction, and a
 //! sample leaves out exactly the components its footprint cannot carry.
 //!
+//! # Swell
+//! Each swell ([`super::spectra::swell`]) adds [`SWELL_FREQUENCY_BINS`] x
+//! [`SWELL_DIRECTION_BINS`] sines of its own, from [`SWELL_BAND`] times its peak frequency and
+//! ±[`SWELL_HALF_WIDTH_RAD`] about its direction, drawn from their own seeded stream (adding a
+//! swell leaves the wind sea's sines as they were) and scaled to carry all of its variance.
+//! They join the wind sea's in one list, sorted longest first; the tail is the wind sea's.
+//!
 //! # Loops
 //! With a [`LoopPeriod`] T every frequency is rounded to a whole multiple of 1/T (at least
 //! one) and its wavenumber recomputed from it, so dispersion stays exact; time is counted in
 //! ticks of T/2³² and phases are advanced in whole ticks ([`super::looping`]). The tail's drift
 //! is rounded so that it crosses a whole number of tail periods in T. The sea at T is the sea
-//! at 0 bit for bit.
+//! at 0 bit for bit; [`Sea::time_after`] counts a start and the time since it apart, so a
+//! whole number of loops after any start is the start.
 //!
 //! # The tail
 //! Above the cut-off fc = 5·fp a wrapping diamond-square fBm with H = 1 carries the variance:
@@ -61,11 +70,16 @@ use rand_chacha::ChaCha8Rng;
 
 use super::fbm::{self, Fbm};
 use super::looping::LoopPeriod;
-use super::spectra::{SeaSpectrum, SpectrumChoice};
+use super::spectra::swell::{SwellSpectrum, Swells};
+use super::spectra::{SeaSpectrum, SpectrumChoice, Spreading};
 use super::spectrum::{G, wavelength_m};
 use super::surface::{Footprint, Surface, SurfaceSample};
 pub use super::trig::fast_cos;
 use super::trig::fast_sincos;
+
+mod build;
+mod fold;
+pub(crate) use fold::{FOLD_ROWS, PhaseRows};
 
 /// Lowest frequency of the sines, as a multiple of fp.
 pub const BAND_LOW: f64 = 0.5;
@@ -77,6 +91,9 @@ pub const FREQUENCY_BINS: usize = 24;
 pub const DIRECTION_BINS: usize = 16;
 /// Components with less variance than this fraction of m0 are dropped.
 pub const NEGLIGIBLE: f64 = 1e-5;
+/// Components with less slope variance than this fraction of the sines' are left out of the
+/// foam's Jacobian.
+pub const FOLD_NEGLIGIBLE: f64 = 1e-3;
 /// Lanes of the vectorised sum over components.
 pub const LANES: usize = 8;
 /// Corner lattice points per side of the tail (its period is this many cut-off wavelengths).
@@ -91,6 +108,17 @@ pub const DEFAULT_CHOPPINESS: f64 = 1.0;
 pub const MAX_CHOPPINESS: f64 = 4.0;
 /// Fixed-point iterations that find the resting point under a fixed position.
 pub const EULER_ITERATIONS: usize = 4;
+/// Frequency bins of a swell's sines, from [`SWELL_BAND`]`.0` to `.1` times its peak (each
+/// bin 5.6 % wide: a sampled swell peaks within 3 % of its period).
+pub const SWELL_FREQUENCY_BINS: usize = 16;
+/// Direction bins of a swell's sines, over ±[`SWELL_HALF_WIDTH_RAD`] about its direction.
+pub const SWELL_DIRECTION_BINS: usize = 8;
+/// The frequencies a swell's sines span, as multiples of its peak frequency (95 % of a
+/// swell's variance; the sines carry all of it).
+pub const SWELL_BAND: (f64, f64) = (0.75, 1.8);
+/// Half the width of the directions a swell's sines span, radians (50°: three standard
+/// deviations of its cos-2s spread).
+pub const SWELL_HALF_WIDTH_RAD: f64 = 50.0 * std::f64::consts::PI / 180.0;
 
 /// Monahan's whitecap fraction 3.84e-6·U^3.41 for a wind of `wind_m_s`, capped at 1.
 pub fn whitecap_fraction(wind_m_s: f64) -> f64 {
@@ -151,8 +179,9 @@ pub struct Component {
     pub harmonic: u32,
 }
 
-/// Everything that defines a sea. `Default` is the command line's sea: Pierson–Moskowitz, the
-/// physical choppiness ([`DEFAULT_CHOPPINESS`]), no loop, a 10 m/s wind from 330°, seed 1.
+/// Everything that defines a sea. `Default` is the command line's sea: Pierson–Moskowitz with
+/// the paper's spreading, no swell, the physical choppiness ([`DEFAULT_CHOPPINESS`]), no loop,
+/// a 10 m/s wind from 330°, seed 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SeaParams {
     /// Wind speed at 10 m, m/s (0 = flat calm).
@@ -161,8 +190,12 @@ pub struct SeaParams {
     pub wind_from_deg: f64,
     /// Seed of phases, jitter and the tail.
     pub seed: u64,
-    /// The spectrum.
+    /// The wind sea's spectrum.
     pub spectrum: SpectrumChoice,
+    /// How the wind sea spreads over directions.
+    pub spreading: Spreading,
+    /// Swell from distant storms, summed with the wind sea.
+    pub swells: Swells,
     /// λ, the scale of the horizontal displacement ([`check_choppiness`]); 0 = none.
     pub choppiness: f64,
     /// Repeat exactly every this many seconds (None = never).
@@ -176,19 +209,52 @@ impl Default for SeaParams {
             wind_from_deg: 330.0,
             seed: 1,
             spectrum: SpectrumChoice::PiersonMoskowitz,
+            spreading: Spreading::Paper,
+            swells: Swells::NONE,
             choppiness: DEFAULT_CHOPPINESS,
             loop_period: None,
         }
     }
 }
 
-/// A moment of the sea: seconds, or a tick of its loop.
+impl SeaParams {
+    /// The wind sea's spectrum, spread as asked.
+    pub fn wind_spectrum(&self) -> SeaSpectrum {
+        SeaSpectrum::new(self.wind_m_s, self.spectrum).with_spreading(self.spreading)
+    }
+
+    /// The longest peak period of the wind sea and the swells, s (None: a calm without swell).
+    /// A loop must last at least ten of these ([`LoopPeriod::new`]).
+    pub fn longest_peak_period_s(&self) -> Option<f64> {
+        let wind = self.wind_spectrum().peak_period_s();
+        self.swells.iter().map(|s| s.period_s()).chain(wind).reduce(f64::max)
+    }
+
+    /// Every swell's spectrum, in the wind sea's depth.
+    pub(crate) fn swell_spectra(&self) -> Vec<SwellSpectrum> {
+        let depth = self.spectrum.depth_m();
+        self.swells.iter().map(|s| SwellSpectrum::new(*s, depth)).collect()
+    }
+
+    /// The sea's total variance, m²: the wind sea's plus every swell's.
+    pub fn m0(&self) -> f64 {
+        self.wind_spectrum().m0() + self.swells.iter().map(|s| (s.height_m() / 4.0).powi(2)).sum::<f64>()
+    }
+
+    /// The significant height of the whole sea, m: 4·√m0 = √(Hs_sea² + Σ Hs_swell²).
+    pub fn significant_height_m(&self) -> f64 {
+        4.0 * self.m0().sqrt()
+    }
+}
+
+/// A moment of the sea: seconds, or for a looping sea ticks of T/2³² from t = 0 (the sea
+/// sees only the low 32 bits, the tick within the loop; the foam's clock counts them all).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum SeaTime {
     /// Seconds from t = 0 (a sea that does not loop).
     Seconds(f64),
-    /// Ticks of T/2³² into the loop.
-    Tick(u32),
+    /// Ticks of T/2³² from t = 0.
+    Ticks(i64),
 }
 
 /// The tail: a drifting wrapping fBm field.
@@ -230,118 +296,35 @@ pub struct Sea {
     lanes: Lanes,
     /// Unpadded, longest first.
     wavelength: Vec<f32>,
+    /// The sines the foam's Jacobian sums: each carrying at least [`FOLD_NEGLIGIBLE`] of the
+    /// sines' slope variance (the few hundred small side and upwind waves a sea has add
+    /// little to its folding; what they carry counts as unresolved).
+    fold: Lanes,
+    fold_wavelength: Vec<f32>,
+    /// For each of those, its index among the components.
+    fold_index: Vec<usize>,
     tail: Option<Tail>,
+    /// The slope variance of the whole surface (both axes): Cox–Munk's for the wind plus the
+    /// swells' own.
     slope_total: f32,
     /// Unit vector (east, north) the wind blows towards.
     downwind: [f32; 2],
 }
 
+/// The wavelength that sizes patches and maps of the sea `params` describes, m: the wind
+/// sea's peak wavelength (None for a calm without swell), but at least 0.4 of the longest
+/// swell's, so that ten of them hold four swell waves.
+pub fn sizing_wavelength_m(params: &SeaParams) -> Option<f64> {
+    let spectrum = params.wind_spectrum();
+    let wind = spectrum.peak_wavelength_m();
+    let swell = params.swells.iter().map(|s| 0.4 * 2.0 * PI / spectrum.wavenumber(1.0 / s.period_s())).reduce(f64::max);
+    match (wind, swell) {
+        (Some(w), Some(s)) => Some(w.max(s)),
+        (w, s) => w.or(s),
+    }
+}
+
 impl Sea {
-    /// Builds the sea for `params` (deterministic in its seed).
-    pub fn new(params: SeaParams) -> Sea {
-        Sea::with_bins(params, FREQUENCY_BINS, DIRECTION_BINS)
-    }
-
-    /// [`Sea::new`] with another number of frequency and direction bins (tests and studies).
-    pub fn with_bins(params: SeaParams, frequency_bins: usize, direction_bins: usize) -> Sea {
-        let spectrum = SeaSpectrum::new(params.wind_m_s, params.spectrum);
-        let mut rng = ChaCha8Rng::seed_from_u64(params.seed ^ 0x5ea_5ea_5ea);
-        let mut components = Vec::new();
-        let mut tail = None;
-        if let Some(fm) = spectrum.peak_hz() {
-            let downwind = (params.wind_from_deg + 180.0).to_radians();
-            let (f_lo, f_hi) = (BAND_LOW * fm, CUTOFF * fm);
-            let ratio = (f_hi / f_lo).powf(1.0 / frequency_bins.max(1) as f64);
-            let dtheta = 2.0 * PI / direction_bins.max(1) as f64;
-            let floor = NEGLIGIBLE * spectrum.m0();
-            for i in 0..frequency_bins {
-                let (e0, e1) = (f_lo * ratio.powi(i as i32), f_lo * ratio.powi(i as i32 + 1));
-                let (centre, df) = (0.5 * (e0 + e1), e1 - e0);
-                for j in 0..direction_bins {
-                    let theta = -PI + (j as f64 + 0.5) * dtheta;
-                    let variance = spectrum.directional_energy(centre, theta) * df * dtheta;
-                    // Draw the jitter and phase even for dropped components, so that the
-                    // stream (and every other component) does not depend on the threshold.
-                    let (uf, ut, phase): (f64, f64, f64) = (rng.random(), rng.random(), rng.random());
-                    if variance < floor {
-                        continue;
-                    }
-                    let (mut f, mut harmonic) = (e0 + uf * df, 0);
-                    if let Some(period) = params.loop_period {
-                        harmonic = (f * period.seconds()).round().max(1.0) as u32;
-                        f = f64::from(harmonic) / period.seconds();
-                    }
-                    components.push(Component {
-                        amplitude_m: (2.0 * variance).sqrt(),
-                        frequency_hz: f,
-                        omega: 2.0 * PI * f,
-                        wavenumber: spectrum.wavenumber(f),
-                        bearing_rad: downwind + theta + (ut - 0.5) * dtheta,
-                        phase_rad: 2.0 * PI * phase,
-                        harmonic,
-                    });
-                }
-            }
-            components.sort_by(|a, b| a.wavenumber.total_cmp(&b.wavenumber));
-            tail = Some(Self::tail(&spectrum, f_hi, downwind, &params));
-        }
-        let lanes = Lanes::new(&components);
-        let wavelength = components.iter().map(|c| (2.0 * PI / c.wavenumber) as f32).collect();
-        let slope_total = cox_munk_slope_variance(spectrum.wind_m_s()) as f32;
-        let to = (params.wind_from_deg + 180.0).to_radians();
-        let downwind = [to.sin() as f32, to.cos() as f32];
-        Sea { params, spectrum, components, lanes, wavelength, tail, slope_total, downwind }
-    }
-
-    fn tail(spectrum: &SeaSpectrum, cutoff_hz: f64, downwind: f64, params: &SeaParams) -> Tail {
-        let deep = matches!(params.spectrum, SpectrumChoice::PiersonMoskowitz);
-        let lambda_c = if deep { wavelength_m(cutoff_hz) } else { 2.0 * PI / spectrum.wavenumber(cutoff_hz) };
-        let variance = spectrum.m0() - spectrum.cumulative_variance(cutoff_hz);
-        let levels = ((lambda_c / TAIL_FINEST_M).log2().ceil().max(0.0) as u32).min(TAIL_MAX_LEVELS);
-        let sigma = variance.max(0.0).sqrt() as f32;
-        let seed = params.seed;
-        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x7a11);
-        let corners: Vec<f32> = (0..TAIL_CORNERS * TAIL_CORNERS).map(|_| sigma * fbm::gaussian(&mut rng)).collect();
-        let field = Fbm::diamond_square(
-            TAIL_CORNERS,
-            levels,
-            &corners,
-            sigma * fbm::UNIT_VARIANCE_DISPLACEMENT,
-            1.0,
-            seed ^ 0xd1a,
-        );
-        let speed =
-            if deep { G / (2.0 * PI * cutoff_hz) } else { 2.0 * PI * cutoff_hz / spectrum.wavenumber(cutoff_hz) };
-        let cell_m = lambda_c / f64::from(1u32 << levels);
-        let mut velocity_m_s = [speed * downwind.sin(), speed * downwind.cos()];
-        let mut loop_periods = [0; 2];
-        if let Some(period) = params.loop_period {
-            // Whole tail periods per loop, so the drift wraps exactly every T.
-            let tail_period = cell_m * field.size() as f64;
-            for axis in 0..2 {
-                loop_periods[axis] = (velocity_m_s[axis] * period.seconds() / tail_period).round() as i64;
-                velocity_m_s[axis] = loop_periods[axis] as f64 * tail_period / period.seconds();
-            }
-        }
-        // Measure each octave's slope on its own lattice (exact for the field).
-        let mut octave_slope = Vec::new();
-        let n = field.size() as isize;
-        for octave in 0..=levels {
-            let st = 1isize << octave;
-            let (mut sl, mut count) = (0.0f64, 0.0f64);
-            for y in (0..n).step_by(st as usize) {
-                for x in (0..n).step_by(st as usize) {
-                    let h = f64::from(field.at(x, y));
-                    let d = f64::from(field.at(x + st, y)) - h;
-                    sl += d * d;
-                    count += 1.0;
-                }
-            }
-            octave_slope.push((sl / count / (st as f64 * cell_m).powi(2)) as f32);
-        }
-        Tail { field, cell_m, velocity_m_s, loop_periods, variance, octave_slope }
-    }
-
     /// The parameters it was built from.
     pub fn params(&self) -> SeaParams {
         self.params
@@ -360,6 +343,11 @@ impl Sea {
     /// Components per sum including the silent padding (a whole number of lanes).
     pub fn padded_len(&self) -> usize {
         self.lanes.amp.len()
+    }
+
+    /// The sines the foam's Jacobian sums (padded), of [`Sea::padded_len`].
+    pub fn fold_len(&self) -> usize {
+        self.fold.amp.len()
     }
 
     /// The variance carried by the fBm tail, m² (0 for a calm).
@@ -382,55 +370,83 @@ impl Sea {
         self.params.choppiness as f32
     }
 
-    /// The moment `time_s` seconds from 0: a tick of the loop for a looping sea.
+    /// The slope variance of the whole surface (both axes): Cox–Munk's for the wind plus the
+    /// swells'.
+    pub fn slope_variance(&self) -> f32 {
+        self.slope_total
+    }
+
+    /// The wavelength that sizes patches of this sea, m ([`sizing_wavelength_m`]).
+    pub fn peak_wavelength_m(&self) -> Option<f64> {
+        sizing_wavelength_m(&self.params)
+    }
+
+    /// The moment `time_s` seconds from 0: ticks of the loop for a looping sea.
     pub fn time(&self, time_s: f64) -> SeaTime {
         match self.params.loop_period {
-            Some(p) => SeaTime::Tick(p.tick(time_s)),
+            Some(p) => SeaTime::Ticks(p.ticks(time_s)),
             None => SeaTime::Seconds(time_s),
+        }
+    }
+
+    /// The moment `elapsed_s` after `start_s`. For a looping sea the two are counted in ticks
+    /// apart, so a whole number of loops after any start is exactly the start again.
+    pub fn time_after(&self, start_s: f64, elapsed_s: f64) -> SeaTime {
+        match self.params.loop_period {
+            Some(p) => SeaTime::Ticks(p.ticks(start_s) + p.ticks(elapsed_s)),
+            None => SeaTime::Seconds(start_s + elapsed_s),
+        }
+    }
+
+    /// A [`SeaTime`] in seconds (for a looping sea, from t = 0 unwrapped).
+    pub fn seconds(&self, time: SeaTime) -> f64 {
+        match time {
+            SeaTime::Seconds(t) => t,
+            SeaTime::Ticks(u) => u as f64 / 4_294_967_296.0 * self.params.loop_period.map_or(0.0, |p| p.seconds()),
         }
     }
 
     /// The sea at `time_s` seconds, ready to sample.
     pub fn frame(&self, time_s: f64) -> SeaFrame<'_> {
-        self.frame_in(time_s, Vec::new())
+        self.frame_at(self.time(time_s), Vec::new())
     }
 
     /// [`Sea::frame`] reusing `buffer` (from [`SeaFrame::into_buffer`]), so that a stream of
     /// frames allocates nothing.
     pub fn frame_in(&self, time_s: f64, buffer: Vec<f32>) -> SeaFrame<'_> {
-        SeaFrame { time_s, ..self.frame_at(self.time(time_s), buffer) }
+        self.frame_at(self.time(time_s), buffer)
+    }
+
+    /// The phase of component `i` at `time`, radians in [0, 2π).
+    #[inline(always)]
+    fn phase(&self, c: &Component, time: SeaTime) -> f32 {
+        let tau = 2.0 * PI;
+        match time {
+            SeaTime::Seconds(t) => (c.phase_rad - c.omega * t).rem_euclid(tau) as f32,
+            SeaTime::Ticks(u) => {
+                let turn = f64::from(c.harmonic.wrapping_mul(u as u32)) / 4_294_967_296.0;
+                (c.phase_rad - tau * turn).rem_euclid(tau) as f32
+            }
+        }
     }
 
     /// The sea at a [`SeaTime`], reusing `buffer`.
     pub fn frame_at(&self, time: SeaTime, mut phase: Vec<f32>) -> SeaFrame<'_> {
         phase.clear();
-        let tau = 2.0 * PI;
-        match time {
-            SeaTime::Seconds(t) => {
-                phase.extend(self.components.iter().map(|c| (c.phase_rad - c.omega * t).rem_euclid(tau) as f32))
-            }
-            SeaTime::Tick(u) => phase.extend(self.components.iter().map(|c| {
-                let turn = f64::from(c.harmonic.wrapping_mul(u)) / 4_294_967_296.0;
-                (c.phase_rad - tau * turn).rem_euclid(tau) as f32
-            })),
-        }
+        phase.extend(self.components.iter().map(|c| self.phase(c, time)));
         phase.resize(self.padded_len(), 0.0);
         let tail_offset = self.tail.as_ref().map_or([0.0; 2], |t| {
             let period = t.cell_m * t.field.size() as f64;
             let at = |axis: usize| match time {
                 SeaTime::Seconds(s) => (t.velocity_m_s[axis] * s).rem_euclid(period) as f32,
-                SeaTime::Tick(u) => {
-                    let turns = (t.loop_periods[axis] as u64).wrapping_mul(u64::from(u)) & 0xFFFF_FFFF;
+                SeaTime::Ticks(u) => {
+                    let turns = (t.loop_periods[axis] as u64).wrapping_mul(u64::from(u as u32)) & 0xFFFF_FFFF;
                     (turns as f64 / 4_294_967_296.0 * period) as f32
                 }
             };
             [at(0), at(1)]
         });
-        let time_s = match time {
-            SeaTime::Seconds(t) => t,
-            SeaTime::Tick(u) => f64::from(u) / 4_294_967_296.0 * self.params.loop_period.map_or(0.0, |p| p.seconds()),
-        };
-        SeaFrame { sea: self, phase, tail_offset, time, time_s }
+        SeaFrame { sea: self, phase, tail_offset, time, time_s: self.seconds(time) }
     }
 }
 
@@ -467,23 +483,20 @@ pub struct SeaFrame<'a> {
 }
 
 /// The sums of one pass over the components: height, resolved slope variance,
-/// displacement, and the displacement's gradient (per unit λ, each times -1) or, in the
-/// displaced pass, Re B and Im B in `gxx` and `gyy`.
+/// displacement, and in the displaced pass Re B and Im B (the second-order height's sums).
 #[derive(Clone, Copy, Debug, Default)]
 struct Sums {
     h: f32,
     slope: f32,
     dx: f32,
     dy: f32,
-    gxx: f32,
-    gyy: f32,
-    gxy: f32,
+    b_re: f32,
+    b_im: f32,
 }
 
 /// What a pass over the components computes (a const parameter, so each pass is its own loop).
 const HEIGHT: u8 = 0;
 const DISPLACED: u8 = 1;
-const FOLD: u8 = 2;
 
 impl SeaFrame<'_> {
     /// Gives back the frame's buffer, for [`Sea::frame_in`].
@@ -516,7 +529,7 @@ impl SeaFrame<'_> {
         // Components are sorted longest first; those shorter than two of the footprint's
         // shorter side alias whatever their direction, and are left out exactly.
         let n = sea.wavelength.partition_point(|&w| w > 2.0 * footprint.min_m());
-        let mut acc = [[0.0f32; LANES]; 8];
+        let mut acc = [[0.0f32; LANES]; 7];
         let lane =
             |v: &Vec<f32>, base: usize| -> [f32; LANES] { v[base..base + LANES].try_into().expect("whole lanes") };
         let mut base = 0;
@@ -532,7 +545,7 @@ impl SeaFrame<'_> {
                     let a2 = 0.5 * a * a;
                     acc[2][i] += a2 * (kx[i] * kx[i] + ky[i] * ky[i]);
                 }
-            } else if PASS == DISPLACED {
+            } else {
                 let (ux, uy, sk) = (lane(&l.ux, base), lane(&l.uy, base), lane(&l.sqrt_k, base));
                 for i in 0..LANES {
                     let a = resolution_weight(footprint.phase_step(kx[i], ky[i])) * amp[i] * live[i];
@@ -545,23 +558,11 @@ impl SeaFrame<'_> {
                     let a2 = 0.5 * a * a;
                     acc[2][i] += a2 * (kx[i] * kx[i] + ky[i] * ky[i]);
                 }
-            } else {
-                let (dxx, dyy, dxy) = (lane(&l.dxx, base), lane(&l.dyy, base), lane(&l.dxy, base));
-                for i in 0..LANES {
-                    let w = resolution_weight(footprint.phase_step(kx[i], ky[i])) * live[i];
-                    let c = w * fast_cos(kx[i] * x + ky[i] * y + phase[i]);
-                    acc[5][i] += dxx[i] * c;
-                    acc[6][i] += dyy[i] * c;
-                    acc[7][i] += dxy[i] * c;
-                    let a = w * amp[i];
-                    let a2 = 0.5 * a * a;
-                    acc[2][i] += a2 * (kx[i] * kx[i] + ky[i] * ky[i]);
-                }
             }
             base += LANES;
         }
         let s = |k: usize| acc[k].iter().sum::<f32>();
-        Sums { h: s(0), slope: s(2), dx: s(3), dy: s(4), gxx: s(5), gyy: s(6), gxy: s(7) }
+        Sums { h: s(0), slope: s(2), dx: s(3), dy: s(4), b_re: s(5), b_im: s(6) }
     }
 
     /// Samples the surface at the resting point (east, north) metres for a sample standing
@@ -571,9 +572,8 @@ impl SeaFrame<'_> {
         let sea = self.sea;
         let chop = sea.choppiness();
         let s = if chop > 0.0 { self.sums::<DISPLACED>(x, y, footprint) } else { self.sums::<HEIGHT>(x, y, footprint) };
-        // The second-order height (see the module docs): λ·|B|²/2, B = Σ a·√k·e^(iθ); here the
-        // fold pass's slots hold Re B and Im B.
-        let bound = 0.5 * chop * (s.gxx * s.gxx + s.gyy * s.gyy);
+        // The second-order height (see the module docs): λ·|B|²/2, B = Σ a·√k·e^(iθ).
+        let bound = 0.5 * chop * (s.b_re * s.b_re + s.b_im * s.b_im);
         let (mut h, mut resolved_slope) = (s.h + bound, s.slope);
         if let Some(tail) = &sea.tail {
             let cell = tail.cell_m as f32;
@@ -596,28 +596,17 @@ impl SeaFrame<'_> {
         }
     }
 
-    /// The fold indicator at the resting point (x, y): `(1 - J)/(λ·σ)`, where J is the
-    /// Jacobian of the displaced surface and σ the standard deviation of the displacement's
-    /// divergence per unit λ over what the footprint keeps (so it has unit variance at every
-    /// distance). For λ = 0 it is its limit, the normalised convergence. 0 for a calm.
-    pub fn fold_indicator(&self, x: f32, y: f32, footprint: &Footprint) -> f32 {
-        let s = self.sums::<FOLD>(x, y, footprint);
-        if s.slope <= 0.0 {
-            return 0.0;
-        }
-        let sigma = s.slope.sqrt();
+    /// The Jacobian J of the displacement at the resting point (x, y) from the sines a
+    /// sample standing for `footprint` keeps: the area the water resting there now covers,
+    /// per unit of its area at rest (below 0 the surface has folded over).
+    pub fn jacobian(&self, x: f32, y: f32, footprint: &Footprint) -> f32 {
+        let mut rows = PhaseRows::default();
+        self.sea.phase_rows(std::iter::once(self.time), &mut rows);
+        let mut g = [[0.0f32; 3]];
+        self.sea.fold_rows(x, y, footprint, &rows, 0, &mut g);
         let chop = self.sea.choppiness();
-        // D's gradient is -λ·g (g the sums); J = (1 - λgxx)(1 - λgyy) - λ²gxy².
-        let det = s.gxx * s.gyy - s.gxy * s.gxy;
-        (s.gxx + s.gyy - chop * det) / sigma
-    }
-
-    /// The Jacobian J of the displacement at the resting point (x, y), full resolution: below
-    /// 0 the surface has folded over.
-    pub fn jacobian(&self, x: f32, y: f32) -> f32 {
-        let s = self.sums::<FOLD>(x, y, &Footprint::default());
-        let chop = self.sea.choppiness();
-        (1.0 - chop * s.gxx) * (1.0 - chop * s.gyy) - chop * chop * s.gxy * s.gxy
+        let [gxx, gyy, gxy] = g[0];
+        (1.0 - chop * gxx) * (1.0 - chop * gyy) - chop * chop * gxy * gxy
     }
 
     /// The full (Eulerian) surface height at the fixed position (east, north) metres: the

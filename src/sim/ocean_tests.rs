@@ -59,7 +59,8 @@ fn waves_advance_by_the_dispersion_relation() {
     // measured phase must move back by ω·dt with ω = √(g·k·tanh(k·h)), k the wave's own.
     let shallow = SpectrumChoice::Tma(Jonswap::default(), Depth::new(4.0).unwrap());
     let deep = SeaParams { wind_m_s: 10.0, wind_from_deg: 200.0, seed: 9, ..SeaParams::default() };
-    let looping = LoopPeriod::new(120.0, &SeaSpectrum::new(10.0, SpectrumChoice::PiersonMoskowitz)).unwrap();
+    let looping =
+        LoopPeriod::new(120.0, SeaSpectrum::new(10.0, SpectrumChoice::PiersonMoskowitz).peak_period_s()).unwrap();
     for params in [deep, SeaParams { spectrum: shallow, ..deep }, SeaParams { loop_period: Some(looping), ..deep }] {
         let sea = Sea::with_bins(params, 1, 1);
         assert_eq!(sea.components().len(), 1);
@@ -113,7 +114,7 @@ fn calm_is_flat() {
         f.sample(3.0, 4.0, &Footprint::isotropic(1.0)),
         SurfaceSample { unresolved_slope_variance: 0.0015, ..SurfaceSample::default() }
     );
-    assert_eq!(f.fold_indicator(1.0, 2.0, &Footprint::default()), 0.0);
+    assert_eq!(f.jacobian(1.0, 2.0, &Footprint::default()), 1.0);
 }
 
 #[test]
@@ -170,7 +171,8 @@ fn lanes_are_padded_by_construction_for_any_bin_count() {
 #[test]
 fn a_looping_sea_repeats_bit_for_bit() {
     let base = SeaParams { wind_m_s: 12.0, choppiness: 1.0, seed: 3, ..SeaParams::default() };
-    let period = LoopPeriod::new(100.0, &SeaSpectrum::new(12.0, SpectrumChoice::PiersonMoskowitz)).unwrap();
+    let period =
+        LoopPeriod::new(100.0, SeaSpectrum::new(12.0, SpectrumChoice::PiersonMoskowitz).peak_period_s()).unwrap();
     let s = Sea::new(SeaParams { loop_period: Some(period), ..base });
     for c in s.components() {
         assert!(c.harmonic >= 1 && (c.frequency_hz * 100.0 - f64::from(c.harmonic)).abs() < 1e-9);
@@ -253,4 +255,16 @@ fn same_seed_same_sea() {
     assert_eq!(a.sample(1.0, 2.0, &Footprint::isotropic(0.5)), b.sample(1.0, 2.0, &Footprint::isotropic(0.5)));
     let c = Sea::new(SeaParams { wind_m_s: 9.0, wind_from_deg: 270.0, seed: 43, ..SeaParams::default() });
     assert_ne!(a.height(1.0, 2.0), c.frame(5.0).height(1.0, 2.0));
+}
+
+#[test]
+fn the_jacobian_sums_the_sines_that_fold_the_surface() {
+    for wind in [6.7, 18.95] {
+        let s = sea(wind);
+        let slope = |c: &Component| 0.5 * (c.amplitude_m * c.wavenumber).powi(2);
+        let total: f64 = s.components().iter().map(slope).sum();
+        let kept: f64 = s.components().iter().map(slope).filter(|&v| v >= FOLD_NEGLIGIBLE * total).sum();
+        println!("U {wind}: {} of {} sines, {:.3} of the slope", s.fold_len(), s.padded_len(), kept / total);
+        assert!(kept / total > 0.95 && s.fold_len() < s.padded_len());
+    }
 }

@@ -1,20 +1,30 @@
-//! A periodic patch of sea for engines: the same spectrum, choppiness, second-order height,
-//! loop and foam as [`super::ocean::Sea`], but with wavenumbers on the patch's lattice
-//! (kx, ky multiples of 2π/extent), summed by FFT, so the maps tile without a seam.
+//! A periodic patch of sea for engines: the same spectra (wind sea and swells), choppiness,
+//! second-order height, loop and foam as [`super::ocean::Sea`], but with wavenumbers on the
+//! patch's lattice (kx, ky multiples of 2π/extent), summed by FFT, so the maps tile without a
+//! seam.
 //!
 //! Each lattice wavenumber k (|k| below the lattice's Nyquist, k ≠ 0) is one travelling wave
 //! `a·cos(k·x - ωt + φ)` with `a = √(2·F(k)·Δk²)`, F the directional wavenumber spectrum
-//! `E(f, θ)·(df/dk)/k` (so Σa²/2 is the lattice's integral of the spectrum), φ from the seed
-//! and ω from the depth's dispersion (rounded to a whole multiple of 2π/T for a loop: on a
-//! lattice the wavenumber cannot move, so the dispersion is then exact to half a frequency
-//! step). Per time step eight real fields and one complex one come from five complex inverse
-//! FFTs (two real fields packed in each): height, displacement, slopes, the displacement's
-//! gradient and B = Σ a·√k·e^(iθ) for the second-order height.
+//! `E(f, θ)·(df/dk)/k` summed over the wind sea and the swells (so Σa²/2 is the lattice's
+//! integral of the spectrum), φ from the seed and ω from the depth's dispersion (rounded to
+//! a whole multiple of 2π/T for a loop: on a lattice the wavenumber cannot move, so the
+//! dispersion is then exact to half a frequency step). Per moment eight real fields and one
+//! complex one come from five complex inverse FFTs (two real fields packed in each, by the
+//! Hermitian halves of their spectra): height, displacement, slopes, the displacement's
+//! gradient and B = Σ a·√k·e^(iθ) for the second-order height. The waves' rotations use
+//! tidepool's own sine ([`sincos_turns`]) and the FFT rustfft's scalar planner,
+//! so the maps are the same bytes on every machine.
 //!
 //! Heights are resampled at the fixed lattice points (Eulerian: what a height field holds),
-//! like [`super::ocean::SeaFrame::height`]; normals are those of that surface; foam is
-//! followed at the resting lattice points by the same memory as the rendered sea
-//! ([`super::foam`]) and resampled the same way.
+//! like [`super::ocean::SeaFrame::height`]; normals are those of that surface.
+//!
+//! # Foam
+//! Foam follows the model of [`super::foam`] at the resting points of a lattice of its own,
+//! the patch's lattice cut to at most [`FOAM_LATTICE`] points a side (the same waves, those
+//! beyond its Nyquist counted as unresolved): per foam step the fold fields (two complex
+//! FFTs), the source at every point (kept for the memory's W steps), and the cover as the
+//! memory's weighted sum, resampled under the Eulerian points like the heights. A series of
+//! maps adds one foam step at a time; a single set computes the memory's W steps.
 
 use crate::error::ValueError;
 use std::f64::consts::PI;
@@ -27,14 +37,19 @@ use rustfft::num_complex::Complex32;
 use rustfft::{Fft, FftPlannerScalar};
 
 use super::dispersion;
-use super::foam::{FoamCalibration, FoamClock, remember, source};
-use super::ocean::{EULER_ITERATIONS, Sea, SeaParams, SeaTime};
-use super::spectra::SeaSpectrum;
+use super::foam::{FoamClock, FoamModel};
+
+mod foam;
+mod sampling;
+use super::ocean::{EULER_ITERATIONS, Sea, SeaParams, SeaTime, sizing_wavelength_m};
+use sampling::{Bilinear, cubic, sincos_turns, transpose_square};
 
 /// Smallest and largest lattice side.
 pub const PATCH_SIZE_RANGE: (usize, usize) = (8, 4096);
 /// Smallest and largest extent, m.
 pub const PATCH_EXTENT_RANGE_M: (f64, f64) = (1.0, 100_000.0);
+/// The foam lattice's largest side.
+pub const FOAM_LATTICE: usize = 512;
 
 /// The fields of one moment, on the lattice; row 0 is the north edge, columns run east.
 #[derive(Clone, Debug, PartialEq)]
@@ -65,12 +80,10 @@ struct Lagrangian {
     gxy: Vec<f32>,
 }
 
-/// A periodic patch of sea and the foam it has made so far.
-pub struct PatchSea {
-    params: SeaParams,
-    size: usize,
-    extent_m: f64,
-    /// Per lattice point (row-major, FFT order): 2·h0 = a·e^(iφ), ω, harmonic, k components.
+/// The waves of a square lattice: per point (row-major, FFT order) a·e^(iφ), ω, the loop
+/// harmonic and the wavenumber; and the inverse FFT of its side.
+struct Lattice {
+    n: usize,
     amp: Vec<Complex32>,
     omega: Vec<f64>,
     harmonic: Vec<u32>,
@@ -79,11 +92,29 @@ pub struct PatchSea {
     /// |k| (1 where k = 0, whose wave is silent).
     k: Vec<f32>,
     fft: Arc<dyn Fft<f32>>,
-    sigma: f32,
-    threshold: f32,
+}
+
+/// A periodic patch of sea and the foam it has made so far.
+pub struct PatchSea {
+    params: SeaParams,
+    size: usize,
+    extent_m: f64,
+    sea: Lattice,
+    foam: Option<PatchFoam>,
+}
+
+/// The foam of a patch: its lattice, model, clock and memory.
+struct PatchFoam {
+    lattice: Lattice,
+    model: FoamModel,
+    /// The slope variance the foam lattice resolves (both axes).
+    resolved_slope: f32,
     clock: FoamClock,
-    foam: Vec<f32>,
-    foam_step: Option<i64>,
+    weights: Vec<f32>,
+    /// W + 1 sources per point (step n at slot n mod (W + 1)).
+    ring: Vec<u16>,
+    /// The newest step in the ring.
+    top: Option<i64>,
 }
 
 impl std::fmt::Debug for PatchSea {
@@ -130,10 +161,11 @@ pub fn check_map_size(width: usize, height: usize) -> Result<usize, ValueError> 
 /// How many peak wavelengths a map spans when no extent is given.
 pub const DEFAULT_MAP_WAVELENGTHS: f64 = 10.0;
 
-/// The default side of a map of `spectrum`'s sea, m ([`DEFAULT_MAP_WAVELENGTHS`] peak
-/// wavelengths; 100 m for a calm).
-pub fn default_extent_m(spectrum: &SeaSpectrum) -> f64 {
-    spectrum.peak_wavelength_m().map_or(100.0, |l| DEFAULT_MAP_WAVELENGTHS * l)
+/// The default side of a map of the sea `params` describes, m ([`DEFAULT_MAP_WAVELENGTHS`]
+/// peak wavelengths of the wind sea, and at least four of the longest swell's; 100 m for a
+/// calm without swell).
+pub fn default_extent_m(params: &SeaParams) -> f64 {
+    sizing_wavelength_m(params).map_or(100.0, |l| DEFAULT_MAP_WAVELENGTHS * l)
 }
 
 /// A lattice index as a signed wavenumber index.
@@ -141,105 +173,109 @@ fn signed(i: usize, n: usize) -> i64 {
     if i < n / 2 { i as i64 } else { i as i64 - n as i64 }
 }
 
-impl PatchSea {
-    /// A `size x size` patch `extent_m` metres across of the sea `params` describes.
-    pub fn new(params: SeaParams, size: usize, extent_m: f64) -> Result<PatchSea, ValueError> {
-        check_patch(size, extent_m)?;
-        let spectrum = SeaSpectrum::new(params.wind_m_s, params.spectrum);
+impl Lattice {
+    /// The waves of `params`' sea on an `n x n` lattice `extent_m` across: the wind sea's
+    /// spectrum and every swell's, a phase per point from the seed.
+    fn of_sea(params: &SeaParams, n: usize, extent_m: f64) -> Lattice {
+        let spectrum = params.wind_spectrum();
         let depth = spectrum.depth_m();
+        let swells = params.swell_spectra();
         let downwind = (params.wind_from_deg + 180.0).to_radians();
         let dk = 2.0 * PI / extent_m;
-        let n = size;
         let mut rng = ChaCha8Rng::seed_from_u64(params.seed ^ 0x9a7c);
-        let (mut amp, mut omega, mut harmonic) =
-            (vec![Complex32::new(0.0, 0.0); n * n], vec![0.0; n * n], vec![0; n * n]);
-        let (mut kxs, mut kys) = (vec![0.0f32; n * n], vec![0.0f32; n * n]);
-        let mut slope = 0.0f64;
+        let mut lattice = Lattice::empty(n, extent_m);
         for r in 0..n {
             for c in 0..n {
                 let i = r * n + c;
                 let phase: f64 = rng.random();
-                // Column: east wavenumber; row: the wavenumber of going south (row 0 is north).
                 let (mc, mr) = (signed(c, n), signed(r, n));
-                let (kx, ky) = (mc as f64 * dk, -(mr as f64) * dk);
-                (kxs[i], kys[i]) = (kx as f32, ky as f32);
+                let (kx, ky) = (f64::from(lattice.kx[i]), f64::from(lattice.ky[i]));
                 let k = kx.hypot(ky);
                 if k == 0.0 || mc.unsigned_abs() as usize == n / 2 || mr.unsigned_abs() as usize == n / 2 {
                     continue;
                 }
                 let w = dispersion::angular_frequency(k, depth);
                 let f = w / (2.0 * PI);
-                let theta = kx.atan2(ky) - downwind;
-                let density =
-                    spectrum.directional_energy(f, theta) * dispersion::group_speed(k, depth) / (2.0 * PI) / k;
-                let a = (2.0 * density * dk * dk).sqrt();
-                amp[i] = Complex32::from_polar(a as f32, (2.0 * PI * phase) as f32);
-                slope += 0.5 * a * a * k * k;
-                omega[i] = w;
-                if let Some(p) = params.loop_period {
-                    harmonic[i] = (f * p.seconds()).round().max(1.0) as u32;
-                    omega[i] = 2.0 * PI * f64::from(harmonic[i]) / p.seconds();
+                let bearing = kx.atan2(ky);
+                let mut directional = spectrum.directional_energy(f, bearing - downwind);
+                for swell in &swells {
+                    directional += swell.directional_energy(f, bearing - swell.bearing_rad());
                 }
+                let density = directional * dispersion::group_speed(k, depth) / (2.0 * PI) / k;
+                let a = (2.0 * density * dk * dk).sqrt();
+                let (s, co) = sincos_turns(phase);
+                lattice.amp[i] = Complex32::new((a * co) as f32, (a * s) as f32);
+                lattice.omega[i] = w;
+                if let Some(p) = params.loop_period {
+                    lattice.harmonic[i] = (f * p.seconds()).round().max(1.0) as u32;
+                    lattice.omega[i] = 2.0 * PI * f64::from(lattice.harmonic[i]) / p.seconds();
+                }
+            }
+        }
+        lattice
+    }
+
+    /// An `n x n` lattice `extent_m` across with no waves.
+    fn empty(n: usize, extent_m: f64) -> Lattice {
+        let dk = 2.0 * PI / extent_m;
+        let (mut kx, mut ky) = (vec![0.0f32; n * n], vec![0.0f32; n * n]);
+        for r in 0..n {
+            for c in 0..n {
+                // Column: east wavenumber; row: the wavenumber of going south (row 0 is north).
+                kx[r * n + c] = (signed(c, n) as f64 * dk) as f32;
+                ky[r * n + c] = (-(signed(r, n) as f64) * dk) as f32;
             }
         }
         // The scalar planner: rustfft's AVX, SSE and NEON plans pick other algorithms and round
         // differently, and maps must be the same bytes on every machine.
         let fft = FftPlannerScalar::new().plan_fft_inverse(n);
-        let sea = Sea::new(params);
-        let threshold = FoamCalibration::calibrate(&sea).threshold;
-        Ok(PatchSea {
-            params,
-            size,
-            extent_m,
-            amp,
-            omega,
-            harmonic,
-            k: kxs.iter().zip(&kys).map(|(x, y)| if *x == 0.0 && *y == 0.0 { 1.0 } else { x.hypot(*y) }).collect(),
-            kx: kxs,
-            ky: kys,
+        let k = kx.iter().zip(&ky).map(|(x, y)| if *x == 0.0 && *y == 0.0 { 1.0 } else { x.hypot(*y) }).collect();
+        Lattice {
+            n,
+            amp: vec![Complex32::new(0.0, 0.0); n * n],
+            omega: vec![0.0; n * n],
+            harmonic: vec![0; n * n],
+            kx,
+            ky,
+            k,
             fft,
-            sigma: slope.sqrt() as f32,
-            threshold,
-            clock: FoamClock::of(&sea),
-            foam: vec![0.0; n * n],
-            foam_step: None,
-        })
+        }
     }
 
-    /// Lattice points per side.
-    pub fn size(&self) -> usize {
-        self.size
+    /// The waves of `sea` whose indices both lie strictly inside an `m x m` lattice's Nyquist,
+    /// on that lattice (the same extent).
+    fn cut(sea: &Lattice, m: usize, extent_m: f64) -> Lattice {
+        let mut out = Lattice::empty(m, extent_m);
+        let n = sea.n;
+        for r in 0..m {
+            for c in 0..m {
+                let (mc, mr) = (signed(c, m), signed(r, m));
+                if mc.unsigned_abs() as usize == m / 2 || mr.unsigned_abs() as usize == m / 2 {
+                    continue;
+                }
+                let from = (mr.rem_euclid(n as i64) as usize) * n + mc.rem_euclid(n as i64) as usize;
+                let to = r * m + c;
+                out.amp[to] = sea.amp[from];
+                out.omega[to] = sea.omega[from];
+                out.harmonic[to] = sea.harmonic[from];
+            }
+        }
+        out
     }
 
-    /// The variance the lattice carries, m² (Σa²/2).
-    pub fn lattice_variance(&self) -> f64 {
-        self.amp.iter().map(|a| 0.5 * f64::from(a.norm_sqr())).sum()
+    /// The slope variance the lattice's waves carry (both axes), Σ a²k²/2.
+    fn slope_variance(&self) -> f64 {
+        self.amp.iter().zip(&self.k).map(|(a, k)| 0.5 * f64::from(a.norm_sqr()) * f64::from(*k).powi(2)).sum()
     }
 
-    /// The rotation e^(-iωt) of every lattice wave at `time`.
+    /// The rotation e^(-iωt) of lattice wave `i` at `time`.
     fn rotation(&self, i: usize, time: SeaTime) -> Complex32 {
         let turns = match time {
             SeaTime::Seconds(t) => (self.omega[i] * t / (2.0 * PI)).rem_euclid(1.0),
-            SeaTime::Tick(u) => f64::from(self.harmonic[i].wrapping_mul(u)) / 4_294_967_296.0,
+            SeaTime::Ticks(u) => f64::from(self.harmonic[i].wrapping_mul(u as u32)) / 4_294_967_296.0,
         };
-        Complex32::from_polar(1.0, (-2.0 * PI * turns) as f32)
-    }
-
-    fn time(&self, time_s: f64) -> SeaTime {
-        match self.params.loop_period {
-            Some(p) => SeaTime::Tick(p.tick(time_s)),
-            None => SeaTime::Seconds(time_s),
-        }
-    }
-
-    /// The inverse 2-D FFT of `buf` in place (rows, transpose, rows, transpose), rows in
-    /// parallel: the same result on any number of cores.
-    fn ifft2(&self, buf: &mut [Complex32]) {
-        let n = self.size;
-        for _ in 0..2 {
-            buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
-            transpose_square(buf, n);
-        }
+        let (s, c) = sincos_turns(-turns);
+        Complex32::new(c as f32, s as f32)
     }
 
     /// Every lattice wave at `time`: a·e^(iφ)·e^(-iωt).
@@ -250,17 +286,27 @@ impl PatchSea {
             .collect()
     }
 
-    /// Two real fields from one complex transform. `coefficients(i, w)` gives, for the travelling
-    /// wave w = a·e^(iφ)·e^(-iωt) at lattice point i, its coefficients (c_f, c_g) in the two
-    /// fields f = re Σ c_f·e^(ik·x) and g = re Σ c_g·e^(ik·x). Each real field's spectrum is
-    /// the Hermitian S(k) = (c(k) + conj(c(-k)))/2, and the transform of S_f + i·S_g is
-    /// f + i·g.
+    /// The inverse 2-D FFT of `buf` in place (rows, transpose, rows, transpose), rows in
+    /// parallel: the same result on any number of cores.
+    fn ifft2(&self, buf: &mut [Complex32]) {
+        let n = self.n;
+        for _ in 0..2 {
+            buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
+            transpose_square(buf, n);
+        }
+    }
+
+    /// Two real fields from one complex transform. `coefficients(i, w)` gives, for the
+    /// travelling wave w = a·e^(iφ)·e^(-iωt) at lattice point i, its coefficients (c_f, c_g)
+    /// in the two fields f = re Σ c_f·e^(ik·x) and g = re Σ c_g·e^(ik·x). Each real field's
+    /// spectrum is the Hermitian S(k) = (c(k) + conj(c(-k)))/2, and the transform of
+    /// S_f + i·S_g is f + i·g.
     fn real_fields(
         &self,
         waves: &[Complex32],
         coefficients: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
     ) -> (Vec<f32>, Vec<f32>) {
-        let n = self.size;
+        let n = self.n;
         let mut buf: Vec<Complex32> = (0..n * n)
             .into_par_iter()
             .map(|i| {
@@ -287,76 +333,110 @@ impl PatchSea {
         let (gxy, _) = self.real_fields(waves, |i, w| (w * coef(i).2, Complex32::new(0.0, 0.0)));
         (gxx, gyy, gxy)
     }
+}
+
+impl PatchSea {
+    /// A `size x size` patch `extent_m` metres across of the sea `params` describes.
+    pub fn new(params: SeaParams, size: usize, extent_m: f64) -> Result<PatchSea, ValueError> {
+        check_patch(size, extent_m)?;
+        let sea = Lattice::of_sea(&params, size, extent_m);
+        let model = FoamModel::of(&Sea::new(params));
+        let foam = model.is_active().then(|| {
+            let lattice = Lattice::cut(&sea, size.min(FOAM_LATTICE), extent_m);
+            let clock = FoamClock::of(&params);
+            let slots = clock.memory_steps() + 1;
+            PatchFoam {
+                resolved_slope: lattice.slope_variance() as f32,
+                ring: vec![0; lattice.n * lattice.n * slots],
+                lattice,
+                model,
+                clock,
+                weights: clock.weights(),
+                top: None,
+            }
+        });
+        Ok(PatchSea { params, size, extent_m, sea, foam })
+    }
+
+    /// Lattice points per side.
+    pub fn size(&self) -> usize {
+        self.size
+    }
+
+    /// The variance the lattice carries, m² (Σa²/2).
+    pub fn lattice_variance(&self) -> f64 {
+        self.sea.amp.iter().map(|a| 0.5 * f64::from(a.norm_sqr())).sum()
+    }
+
+    fn time(&self, time_s: f64) -> SeaTime {
+        match self.params.loop_period {
+            Some(p) => SeaTime::Ticks(p.ticks(time_s)),
+            None => SeaTime::Seconds(time_s),
+        }
+    }
+
+    fn time_after(&self, start_s: f64, elapsed_s: f64) -> SeaTime {
+        match self.params.loop_period {
+            Some(p) => SeaTime::Ticks(p.ticks(start_s) + p.ticks(elapsed_s)),
+            None => SeaTime::Seconds(start_s + elapsed_s),
+        }
+    }
 
     fn lagrangian(&self, time: SeaTime) -> (Lagrangian, Vec<Complex32>) {
+        let l = &self.sea;
         let i_unit = Complex32::new(0.0, 1.0);
-        let unit = |i: usize| (self.kx[i] / self.k[i], self.ky[i] / self.k[i], self.k[i]);
-        let waves = self.waves(time);
+        let unit = |i: usize| (l.kx[i] / l.k[i], l.ky[i] / l.k[i], l.k[i]);
+        let waves = l.waves(time);
         // The displacement per unit λ is -Σ a·û·sin θ = re Σ (i·û·w)·e^(ik·x); slopes re Σ (i·k·w)·e^(ik·x).
-        let (h, dx) = self.real_fields(&waves, |i, w| (w, i_unit * w * unit(i).0));
-        let (dy, hx) = self.real_fields(&waves, |i, w| (i_unit * w * unit(i).1, i_unit * w * self.kx[i]));
-        let (hy, _) = self.real_fields(&waves, |i, w| (i_unit * w * self.ky[i], Complex32::new(0.0, 0.0)));
-        let (gxx, gyy, gxy) = self.fold_fields(&waves);
+        let (h, dx) = l.real_fields(&waves, |i, w| (w, i_unit * w * unit(i).0));
+        let (dy, hx) = l.real_fields(&waves, |i, w| (i_unit * w * unit(i).1, i_unit * w * l.kx[i]));
+        let (hy, _) = l.real_fields(&waves, |i, w| (i_unit * w * l.ky[i], Complex32::new(0.0, 0.0)));
+        let (gxx, gyy, gxy) = l.fold_fields(&waves);
         // B = Σ a·√k·e^(iθ): the waves themselves, a complex field.
         let n = self.size;
         let mut b: Vec<Complex32> = (0..n * n)
             .into_par_iter()
-            .map(|i| if self.amp[i].norm_sqr() == 0.0 { Complex32::new(0.0, 0.0) } else { waves[i] * unit(i).2.sqrt() })
+            .map(|i| if l.amp[i].norm_sqr() == 0.0 { Complex32::new(0.0, 0.0) } else { waves[i] * unit(i).2.sqrt() })
             .collect();
-        self.ifft2(&mut b);
+        l.ifft2(&mut b);
         (Lagrangian { h, dx, dy, hx, hy, gxx, gyy, gxy }, b)
     }
 
-    /// Brings the foam at the resting lattice points up to `time_s`.
-    fn advance_foam(&mut self, time_s: f64) {
-        let (now, _) = self.clock.step_at(time_s);
-        let warm = self.clock.warm_up_steps();
-        let first = match self.foam_step {
-            Some(last) if now >= last && now - last <= warm => last + 1,
-            _ => {
-                self.foam.fill(0.0);
-                now - warm
-            }
-        };
-        let (decay, z, lambda, sigma) = (self.clock.decay(), self.threshold, self.params.choppiness as f32, self.sigma);
-        for n in first..=now {
-            let waves = self.waves(self.clock.time_of(n));
-            let (gxx, gyy, gxy) = self.fold_fields(&waves);
-            self.foam.par_iter_mut().enumerate().for_each(|(i, f)| {
-                let q = if sigma > 0.0 {
-                    (gxx[i] + gyy[i] - lambda * (gxx[i] * gyy[i] - gxy[i] * gxy[i])) / sigma
-                } else {
-                    0.0
-                };
-                *f = remember(*f, decay, source(q, z));
-            });
-        }
-        self.foam_step = Some(now);
+    /// The maps at `time_s`. Foam continues from the previous call when time moved forward
+    /// by less than the foam's memory, and computes the memory otherwise; the maps are the
+    /// same bits either way.
+    pub fn maps(&mut self, time_s: f64) -> PatchMaps {
+        let time = self.time(time_s);
+        self.maps_at(time)
     }
 
-    /// The maps at `time_s`: foam continues from the previous call when time moved forward by
-    /// less than a warm-up, and is warmed up otherwise.
-    pub fn maps(&mut self, time_s: f64) -> PatchMaps {
-        self.advance_foam(time_s);
-        let (_, frac) = self.clock.step_at(time_s);
-        let fade = self.clock.decay().powf(frac);
-        self.resample(time_s, fade)
+    /// The maps `elapsed_s` after `start_s` (a series' frames: for a looping sea a whole
+    /// number of loops after the start is exactly the start's maps).
+    pub fn maps_after(&mut self, start_s: f64, elapsed_s: f64) -> PatchMaps {
+        let time = self.time_after(start_s, elapsed_s);
+        self.maps_at(time)
+    }
+
+    fn maps_at(&mut self, time: SeaTime) -> PatchMaps {
+        let foam = self.foam.as_mut().map(|f| f.cover(time));
+        self.resample(time, foam.as_ref())
     }
 
     /// The maps at `time_s` without foam (its `foam` is all 0): heights, displacement and
-    /// normals only, without the foam's warm-up.
+    /// normals only, without the foam's memory.
     pub fn surface(&self, time_s: f64) -> PatchMaps {
-        self.resample(time_s, 0.0)
+        self.resample(self.time(time_s), None)
     }
 
-    fn resample(&self, time_s: f64, fade: f32) -> PatchMaps {
-        let (lag, b) = self.lagrangian(self.time(time_s));
+    /// Resamples the moment's fields under the Eulerian lattice points; `foam` is the cover
+    /// on the foam lattice.
+    fn resample(&self, time: SeaTime, foam_cover: Option<&(usize, Vec<f32>)>) -> PatchMaps {
+        let (lag, b) = self.lagrangian(time);
         let (n, cell) = (self.size, (self.extent_m / self.size as f64) as f32);
         let lambda = self.params.choppiness as f32;
         let h_l: Vec<f32> = (0..n * n).map(|i| lag.h[i] + 0.5 * lambda * b[i].norm_sqr()).collect();
         let displacement: Vec<[f32; 3]> =
             (0..n * n).map(|i| [lambda * lag.dx[i], lambda * lag.dy[i], h_l[i]]).collect();
-        let foam_l: Vec<f32> = self.foam.iter().map(|f| f * fade).collect();
         let mut height = vec![0.0f32; n * n];
         let mut normal = vec![[0.0f32; 3]; n * n];
         let mut foam = vec![0.0f32; n * n];
@@ -381,7 +461,10 @@ impl PatchSea {
                         if det.abs() > 1e-3 { ((d * hx - bc * hy) / det, (a * hy - bc * hx) / det) } else { (hx, hy) };
                     let len = (ex * ex + ey * ey + 1.0).sqrt();
                     normal[c] = [-ex / len, -ey / len, 1.0 / len];
-                    foam[c] = at.of(&foam_l).clamp(0.0, 1.0);
+                    if let Some((m, cover)) = foam_cover {
+                        let scale = *m as f32 / n as f32;
+                        foam[c] = Bilinear::new(*m, px * scale, py * scale).of(cover).clamp(0.0, 1.0);
+                    }
                 }
             },
         );
@@ -389,89 +472,52 @@ impl PatchSea {
     }
 }
 
-/// Transposes an n x n matrix in place, in 32 x 32 blocks (cache-friendly).
-fn transpose_square(m: &mut [Complex32], n: usize) {
-    const B: usize = 32;
-    for r0 in (0..n).step_by(B) {
-        for c0 in (r0..n).step_by(B) {
-            for r in r0..(r0 + B).min(n) {
-                for c in c0.max(r + 1)..(c0 + B).min(n) {
-                    m.swap(r * n + c, c * n + r);
-                }
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The maps are a periodic field, not a picture that happens to tile: a linear sea's
+    /// height texels equal, to the centimetre of the 16-bit PNG (one level), the sum of the
+    /// lattice's waves evaluated directly in f64, at the last column and one period on,
+    /// where the first column is.
+    #[test]
+    fn the_maps_continue_across_their_edges_to_a_centimetre() {
+        let params = SeaParams { wind_m_s: 12.0, choppiness: 0.0, seed: 4, ..SeaParams::default() };
+        let (n, extent) = (64, 400.0);
+        let patch = PatchSea::new(params, n, extent).unwrap();
+        let maps = patch.surface(3.0);
+        let waves = patch.sea.waves(patch.time(3.0));
+        let direct = |x: f64, y: f64| -> f64 {
+            waves
+                .iter()
+                .zip(patch.sea.kx.iter().zip(&patch.sea.ky))
+                .map(|(w, (kx, ky))| {
+                    let phase = f64::from(*kx) * x + f64::from(*ky) * y;
+                    f64::from(w.re) * phase.cos() - f64::from(w.im) * phase.sin()
+                })
+                .sum()
+        };
+        let level = |h: f64| (h * 100.0).round() as i64;
+        let cell = extent / n as f64;
+        let mut worst = 0;
+        for r in [0, 17, 40, 63] {
+            let y = -(r as f64) * cell;
+            for (c, x) in [(0, extent), (0, 0.0), (n - 1, (n - 1) as f64 * cell), (n / 2, extent * 1.5)] {
+                let got = level(f64::from(maps.height[r * n + c]));
+                worst = worst.max((got - level(direct(x, y))).abs());
             }
         }
+        assert!(worst <= 1, "the maps differ from their waves by {worst} levels at the seam");
+        assert!(maps.height.iter().any(|h| h.abs() > 0.3), "a sea with waves");
     }
-}
 
-/// A coordinate wrapped into 0..n (lattice units) with floats (no integer division).
-#[inline(always)]
-fn wrap(v: f32, n: usize) -> f32 {
-    let nf = n as f32;
-    let w = v - (v / nf).floor() * nf;
-    if w >= nf { 0.0 } else { w }
-}
-
-/// The four lattice points around a position of a periodic n x n field and their weights,
-/// for reading several fields at one point.
-struct Bilinear {
-    i00: usize,
-    i01: usize,
-    i10: usize,
-    i11: usize,
-    tx: f32,
-    ty: f32,
-}
-
-impl Bilinear {
-    #[inline(always)]
-    fn new(n: usize, x: f32, y: f32) -> Bilinear {
-        let (x, y) = (wrap(x, n), wrap(y, n));
-        let (x0, y0) = ((x as usize).min(n - 1), (y as usize).min(n - 1));
-        let (x1, y1) = (if x0 + 1 == n { 0 } else { x0 + 1 }, if y0 + 1 == n { 0 } else { y0 + 1 });
-        Bilinear {
-            i00: y0 * n + x0,
-            i01: y0 * n + x1,
-            i10: y1 * n + x0,
-            i11: y1 * n + x1,
-            tx: x - x0 as f32,
-            ty: y - y0 as f32,
+    #[test]
+    fn sincos_turns_is_accurate_everywhere() {
+        for i in -3000..3000 {
+            let t = i as f64 * 0.000_731 + 0.1 * (i % 7) as f64;
+            let (s, c) = sincos_turns(t);
+            let x = t * std::f64::consts::TAU;
+            assert!((s - x.sin()).abs() < 1e-14 && (c - x.cos()).abs() < 1e-14, "{t}");
         }
     }
-
-    #[inline(always)]
-    fn of(&self, f: &[f32]) -> f32 {
-        let top = f[self.i00] + (f[self.i01] - f[self.i00]) * self.tx;
-        let bottom = f[self.i10] + (f[self.i11] - f[self.i10]) * self.tx;
-        top + (bottom - top) * self.ty
-    }
-}
-
-/// Catmull–Rom interpolation of a periodic n x n field at (x, y) lattice units.
-fn cubic(f: &[f32], n: usize, x: f32, y: f32) -> f32 {
-    let (x, y) = (wrap(x, n), wrap(y, n));
-    let (fx, fy) = (x.floor(), y.floor());
-    let (tx, ty) = (x - fx, y - fy);
-    let (ix, iy) = (fx as usize + n, fy as usize + n);
-    let w = |i: usize| {
-        if i >= 2 * n {
-            i - 2 * n
-        } else if i >= n {
-            i - n
-        } else {
-            i
-        }
-    };
-    let weights = |t: f32| {
-        let (t2, t3) = (t * t, t * t * t);
-        [-0.5 * t3 + t2 - 0.5 * t, 1.5 * t3 - 2.5 * t2 + 1.0, -1.5 * t3 + 2.0 * t2 + 0.5 * t, 0.5 * t3 - 0.5 * t2]
-    };
-    let (wx, wy) = (weights(tx), weights(ty));
-    let mut sum = 0.0;
-    for (j, wyj) in wy.iter().enumerate() {
-        let row = w(iy + j - 1) * n;
-        for (i, wxi) in wx.iter().enumerate() {
-            sum += wyj * wxi * f[row + w(ix + i - 1)];
-        }
-    }
-    sum
 }

@@ -33,6 +33,12 @@ use std::str::FromStr;
 use super::dispersion;
 use super::spectrum::{ALPHA, G, PEAK_FACTOR, PiersonMoskowitz, spreading};
 
+mod spreading;
+pub mod swell;
+
+pub use spreading::Spreading;
+use spreading::{donelan_banner_beta, sech2_spreading};
+
 /// JONSWAP's default peak enhancement γ (Hasselmann et al.'s mean).
 pub const DEFAULT_GAMMA: f64 = 3.3;
 /// The range of γ tidepool accepts (1 = no enhancement, Pierson–Moskowitz's shape).
@@ -297,6 +303,7 @@ impl SpectrumChoice {
 #[derive(Clone, Debug, PartialEq)]
 pub struct SeaSpectrum {
     choice: SpectrumChoice,
+    spreading: Spreading,
     pm: PiersonMoskowitz,
     peak_hz: Option<f64>,
     alpha: f64,
@@ -314,7 +321,7 @@ impl SeaSpectrum {
             SpectrumChoice::PiersonMoskowitz => (pm.peak_hz(), ALPHA),
             SpectrumChoice::Jonswap(j) | SpectrumChoice::Tma(j, _) => (j.peak_hz(wind), j.alpha(wind)),
         };
-        let mut s = SeaSpectrum { choice, pm, peak_hz, alpha, table: None, m0: pm.m0() };
+        let mut s = SeaSpectrum { choice, spreading: Spreading::Paper, pm, peak_hz, alpha, table: None, m0: pm.m0() };
         if let (Some(fp), false) = (peak_hz, matches!(choice, SpectrumChoice::PiersonMoskowitz)) {
             let (lo, hi) = ((TABLE_LOW * fp).ln(), (TABLE_HIGH * fp).ln());
             let n = ((hi - lo) * TABLE_PER_E).ceil() as usize;
@@ -339,9 +346,20 @@ impl SeaSpectrum {
         s
     }
 
+    /// The same spectrum spread over directions by `spreading` (the default is
+    /// [`Spreading::Paper`]).
+    pub fn with_spreading(self, spreading: Spreading) -> SeaSpectrum {
+        SeaSpectrum { spreading, ..self }
+    }
+
     /// The choice it was made from.
     pub fn choice(&self) -> SpectrumChoice {
         self.choice
+    }
+
+    /// How its energy spreads over directions.
+    pub fn spreading(&self) -> Spreading {
+        self.spreading
     }
 
     /// The wind speed, m/s.
@@ -414,18 +432,41 @@ impl SeaSpectrum {
         jonswap * dispersion::depth_factor(2.0 * PI * f_hz, self.depth_m())
     }
 
-    /// The Mitsuyasu spreading exponent at `f_hz`, about this spectrum's peak.
-    pub fn spreading_exponent(&self, f_hz: f64) -> f64 {
-        let Some(fp) = self.peak_hz else { return 0.0 };
+    /// The exponent s of the cos-2s spreading at `f_hz` (None for Donelan–Banner's sech², or a
+    /// calm).
+    pub fn spreading_exponent(&self, f_hz: f64) -> Option<f64> {
+        let fp = self.peak_hz?;
         let r = f_hz / fp;
-        if r >= 1.0 { 9.77 * r.powf(-2.5) } else { 6.97 * r.powi(5) }
+        match self.spreading {
+            Spreading::Paper => Some(if r >= 1.0 { 9.77 * r.powf(-2.5) } else { 6.97 * r.powi(5) }),
+            Spreading::Mitsuyasu => {
+                let sp = 11.5 * (2.0 * PI * fp * self.wind_m_s() / G).powf(-2.5);
+                Some(if r <= 1.0 { sp * r.powi(5) } else { sp * r.powf(-2.5) })
+            }
+            Spreading::Hasselmann => {
+                let phase_speed = 2.0 * PI * fp / self.wavenumber(fp);
+                let mu = -2.33 - 1.45 * (self.wind_m_s() / phase_speed - 1.17);
+                Some(if r < 1.05 { 6.97 * r.powf(4.06) } else { 9.77 * r.powf(mu) })
+            }
+            Spreading::DonelanBanner => None,
+        }
+    }
+
+    /// The directional spreading D(f, θ) (1/rad, integrating to 1 over θ in [-π, π]); θ from
+    /// downwind.
+    pub fn spread(&self, f_hz: f64, theta: f64) -> f64 {
+        let Some(fp) = self.peak_hz else { return 0.0 };
+        match self.spreading_exponent(f_hz) {
+            Some(s) => spreading(s, theta),
+            None => sech2_spreading(donelan_banner_beta(f_hz / fp), theta),
+        }
     }
 
     /// E(f, θ) = E(f)·D(f, θ), m²/(Hz·rad); θ from downwind.
     pub fn directional_energy(&self, f_hz: f64, theta: f64) -> f64 {
-        match self.choice {
-            SpectrumChoice::PiersonMoskowitz => self.pm.directional_energy(f_hz, theta),
-            _ => self.energy(f_hz) * spreading(self.spreading_exponent(f_hz), theta),
+        match (self.choice, self.spreading) {
+            (SpectrumChoice::PiersonMoskowitz, Spreading::Paper) => self.pm.directional_energy(f_hz, theta),
+            _ => self.energy(f_hz) * self.spread(f_hz, theta),
         }
     }
 
@@ -499,6 +540,10 @@ impl SeaSpectrum {
         Some(0.5 * (a + b))
     }
 }
+
+#[cfg(test)]
+#[path = "spectra_tests.rs"]
+mod measured;
 
 #[cfg(test)]
 mod tests {

@@ -165,6 +165,37 @@ fn bad_flags_are_one_line_errors_with_status_2() {
         (&["render", "ocean", "--depth", "4"], "only the tma spectrum feels the bottom"),
         (&["render", "ocean", "--size", "300x200", "--maps", "m"], "maps are square"),
         (&["render", "ocean", "--maps", "m", "--out", "-"], "cannot go to standard output"),
+        (&["render", "ocean", "--swell", "1,12"], "'1,12' is not HEIGHT,PERIOD,DIRECTION"),
+        (&["render", "ocean", "--swell", "0,12,250"], "the swell height 0 m is outside"),
+        (&["render", "ocean", "--swell", "1,40,250"], "the swell period 40 s is outside 2..=30 s"),
+        (&["render", "ocean", "--swell", "1,12,west"], "'west' is not a number"),
+        (
+            &[
+                "render", "ocean", "--swell", "1,9,0", "--swell", "1,9,0", "--swell", "1,9,0", "--swell", "1,9,0",
+                "--swell", "1,9,0",
+            ],
+            "--swell: 5 swells are more than the 4 a sea takes",
+        ),
+        (&["render", "ocean", "--spreading", "cosine"], "--spreading"),
+        (&["render", "ocean", "--preset", "doldrums"], "--preset"),
+        (
+            &[
+                "render",
+                "ocean",
+                "--beaufort",
+                "4",
+                "--swell",
+                "1,16,0",
+                "--loop",
+                "100",
+                "--frames",
+                "2",
+                "--out",
+                "a.gif",
+            ],
+            "peak period is 16.00 s",
+        ),
+        (&["spectrum", "--swell", "1,1,1"], "the swell period 1 s is outside"),
     ];
     for (args, needle) in cases {
         let out = run_in(&dir, args);
@@ -238,4 +269,91 @@ fn maps_tile_across_their_edges_and_loop_in_time() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("--maps: 'afile' is a file"), "{}", stderr(&out));
     assert_eq!(std::fs::read(dir.join("afile")).unwrap(), b"keep me");
+}
+
+/// The frames of `render ocean ARGS --size 64x36 --ssaa 1 --frames N+1 --fps F --loop T` in
+/// `dir` (N = T·F), as pictures.
+fn loop_frames(dir: &std::path::Path, args: &[&str], period: u32, fps: u32) -> Vec<image::RgbaImage> {
+    let frames = period * fps + 1;
+    let (frames_text, fps_text, period_text) = (frames.to_string(), fps.to_string(), period.to_string());
+    let mut all = vec!["render", "ocean", "--size", "64x36", "--ssaa", "1", "--frames", &frames_text];
+    all.extend(["--fps", &fps_text, "--loop", &period_text, "--out", "f_{frame:04}.png"]);
+    all.extend(args);
+    let out = run_in(dir, &all);
+    assert!(out.status.success(), "{args:?}: {}", stderr(&out));
+    (0..frames).map(|k| read_png(&dir.join(format!("f_{k:04}.png")))).collect()
+}
+
+fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    a.as_raw().iter().zip(b.as_raw()).map(|(x, y)| f64::from(x.abs_diff(*y))).sum::<f64>() / a.as_raw().len() as f64
+}
+
+/// `render ocean --frames N+1 --loop T` as a user runs it, at several frame rates and winds
+/// (foam included, from a start that is not a whole second): frame N, one loop after frame 0,
+/// is frame 0 byte for byte, and the step into it is an ordinary step.
+#[test]
+fn the_loop_closes_through_the_command_line() {
+    let cases: &[(&str, &[&str], u32, u32)] = &[
+        ("b4_fps1", &["--beaufort", "4"], 60, 1),
+        ("b4_fps2_late", &["--beaufort", "4", "--time", "0.3"], 60, 2),
+        ("b8_fps1", &["--beaufort", "8", "--direction", "200"], 150, 1),
+        ("b2_no_foam", &["--beaufort", "2"], 20, 1),
+        ("swell", &["--beaufort", "5", "--swell", "1.2,10,250"], 100, 1),
+    ];
+    for (name, args, period, fps) in cases {
+        let dir = scratch(&format!("ocean_loop_{name}"));
+        let frames = loop_frames(&dir, args, *period, *fps);
+        let n = frames.len() - 1;
+        let bytes = |k: usize| std::fs::read(dir.join(format!("f_{k:04}.png"))).unwrap();
+        assert!(bytes(n) == bytes(0), "{name}: frame {n} is not frame 0");
+        assert_ne!(bytes(n / 2), bytes(0), "{name}: the sea moves");
+        let into_loop = mean_difference(&frames[n - 1], &frames[n]);
+        let before = mean_difference(&frames[n - 2], &frames[n - 1]);
+        let after = mean_difference(&frames[0], &frames[1]);
+        assert!(into_loop <= 1.5 * before.max(after), "{name}: a jump of {into_loop} levels; steps {before}, {after}");
+    }
+}
+
+/// A series of maps `--frames N+1 --loop T` closes too: frame N's files are frame 0's (the
+/// foam of frame N continued through the series, frame 0's computed from its memory).
+#[test]
+fn a_looping_series_of_maps_closes() {
+    let dir = scratch("ocean_maps_series_loop");
+    let args = ["render", "ocean", "--beaufort", "4", "--maps", "m", "--size", "32x32", "--loop", "53"];
+    let out = run_in(&dir, &[&args[..], &["--frames", "54", "--fps", "1", "--time", "2.5"]].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    for stem in ["height.npy", "displacement.npy", "normal.png", "foam.png", "height.png"] {
+        let (name, ext) = stem.split_once('.').unwrap();
+        let read = |k: u32| std::fs::read(dir.join("m").join(format!("{name}_{k:04}.{ext}"))).unwrap();
+        assert_eq!(read(53), read(0), "{stem}: frame 53 is frame 0");
+        assert_ne!(read(20), read(0), "{stem}: the maps move");
+    }
+}
+
+/// Swell and presets as a user gives them: `spectrum` reports each swell and the total
+/// height, and plots their sum; a preset renders and its numbers are printed.
+#[test]
+fn swell_and_presets_through_the_command_line() {
+    let out = run(&["spectrum", "--beaufort", "4", "--swell", "1.5,12,250", "--json"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("valid JSON");
+    assert_eq!(json["swells"][0]["period_s"], 12);
+    let (sea, total) = (
+        json["significant_wave_height_m"].as_f64().unwrap(),
+        json["total_significant_wave_height_m"].as_f64().unwrap(),
+    );
+    assert!((total - sea.hypot(1.5)).abs() < 0.002, "{sea} {total}");
+    let out = run(&["spectrum", "--preset", "trade-wind", "--spreading", "donelan-banner"]);
+    let text = String::from_utf8(out.stdout).unwrap();
+    for line in ["wind speed: 8 m/s", "spreading: donelan-banner", "swell 1: 1.200 m, 11 s from 30 degrees"] {
+        assert!(text.lines().any(|l| l == line), "missing '{line}' in:\n{text}");
+    }
+    let dir = scratch("ocean_presets");
+    let out = run_in(&dir, &["spectrum", "--beaufort", "4", "--swell", "1.5,12,250", "--out", "sum.png"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    assert_eq!(read_png(&dir.join("sum.png")).dimensions(), (1000, 440));
+    for preset in ["calm-morning", "north-atlantic-gale"] {
+        let out = run_in(&dir, &["render", "ocean", "--preset", preset, "--size", "64x36", "--out", "p.png"]);
+        assert!(out.status.success(), "{preset}: {}", stderr(&out));
+    }
 }

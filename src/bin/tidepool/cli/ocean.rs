@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use clap::Args;
 
 use tidepool::sea::{
-    DEFAULT_CHOPPINESS, DEFAULT_SEA_WIND_M_S, LoopPeriod, SeaSpectrum, SpectrumChoice, SpectrumChoiceError,
-    SpectrumKind, beaufort_speed_m_s, check_choppiness,
+    DEFAULT_CHOPPINESS, DEFAULT_SEA_WIND_M_S, DEFAULT_WIND_FROM_DEG, Jonswap, LoopPeriod, SpectrumChoice,
+    SpectrumChoiceError, SpectrumKind, Spreading, Swell, Swells, beaufort_speed_m_s, check_choppiness,
 };
 use tidepool::{CameraPose, SeaParams};
 
@@ -22,7 +22,10 @@ Examples:
   tidepool render ocean --wind 10 --heightmap sea.npy --size 512x512
   tidepool render ocean --spectrum jonswap --fetch 20 --wind 15 --out fetch.png
   tidepool render ocean --spectrum tma --depth 6 --beaufort 6 --out shallow.png
-  tidepool render ocean --beaufort 6 --loop 80 --frames 160 --fps 20 --out loop.gif
+  tidepool render ocean --beaufort 4 --swell 1.5,12,250 --swell 0.6,16,200
+  tidepool render ocean --preset north-atlantic-gale --size 1280x720 --out gale.png
+  tidepool render ocean --beaufort 6 --spreading donelan-banner --out db.png
+  tidepool render ocean --beaufort 5 --loop 80 --frames 800 --fps 10 --out loop.gif
   tidepool render ocean --beaufort 7 --maps maps/ --size 1024x1024 --extent 500";
 
 const OCEAN_HEIGHTMAP_HELP: &str = "Also write the sea surface height on the --extent patch, sampled at the \
@@ -45,10 +48,65 @@ pub struct WindArgs {
 impl WindArgs {
     /// The wind speed, m/s.
     pub fn speed_m_s(&self) -> f64 {
+        self.given_m_s().unwrap_or(DEFAULT_SEA_WIND_M_S)
+    }
+
+    /// The wind speed given by `--wind` or `--beaufort`, if any.
+    pub fn given_m_s(&self) -> Option<f64> {
         match (self.wind, self.beaufort) {
-            (Some(w), _) => w,
-            (None, Some(b)) => beaufort_speed_m_s(b).unwrap_or(DEFAULT_SEA_WIND_M_S),
-            (None, None) => DEFAULT_SEA_WIND_M_S,
+            (Some(w), _) => Some(w),
+            (None, Some(b)) => beaufort_speed_m_s(b),
+            (None, None) => None,
+        }
+    }
+}
+
+/// A named sea: the wind, its direction, the wind sea's spectrum and the swells, each
+/// documented with its numbers (README, `render ocean --help`). Any flag given as well wins
+/// over the preset's value for it (`--swell` replaces the preset's swells).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum Preset {
+    /// A light air of 2 m/s from 330° over the remains of yesterday's sea: swell 0.4 m,
+    /// 9 s from 240°. Glassy crests, no whitecaps.
+    CalmMorning,
+    /// The north-east trades: 8 m/s from 60° over an unlimited fetch (Pierson-Moskowitz, Hs
+    /// 1.57 m), with a 1.2 m, 11 s swell from 30°; scattered whitecaps.
+    TradeWind,
+    /// A south-westerly gale, 22 m/s from 240° over 500 km of fetch (JONSWAP, gamma 3.3, Hs
+    /// about 8 m), with a 3 m, 14 s swell from 270°: streaks and patches of foam.
+    NorthAtlanticGale,
+    /// A long-period swell on a calm day: 1.5 m/s from 180°, a 1.8 m, 16 s swell from 250°.
+    LongSwell,
+}
+
+impl Preset {
+    /// The wind speed (m/s) and where it comes from (degrees).
+    pub fn wind(self) -> (f64, f64) {
+        match self {
+            Preset::CalmMorning => (2.0, 330.0),
+            Preset::TradeWind => (8.0, 60.0),
+            Preset::NorthAtlanticGale => (22.0, 240.0),
+            Preset::LongSwell => (1.5, 180.0),
+        }
+    }
+
+    /// The wind sea's spectrum.
+    pub fn spectrum(self) -> SpectrumChoice {
+        match self {
+            Preset::NorthAtlanticGale => {
+                SpectrumChoice::Jonswap(Jonswap::new(3.3, Some(500.0)).expect("a valid fetch"))
+            }
+            _ => SpectrumChoice::PiersonMoskowitz,
+        }
+    }
+
+    /// The swells as (height m, period s, from degrees).
+    pub fn swells(self) -> &'static [(f64, f64, f64)] {
+        match self {
+            Preset::CalmMorning => &[(0.4, 9.0, 240.0)],
+            Preset::TradeWind => &[(1.2, 11.0, 30.0)],
+            Preset::NorthAtlanticGale => &[(3.0, 14.0, 270.0)],
+            Preset::LongSwell => &[(1.8, 16.0, 250.0)],
         }
     }
 }
@@ -89,6 +147,18 @@ pub struct SpectrumArgs {
 }
 
 impl SpectrumArgs {
+    /// The checked spectrum (the preset's when no spectrum flag is given); an impossible
+    /// combination names the flag to change.
+    pub fn choice_or(&self, preset: Option<Preset>) -> Result<SpectrumChoice> {
+        let SpectrumKindArgs { spectrum, gamma, fetch } = self.kind;
+        match preset {
+            Some(p) if spectrum.is_none() && gamma.is_none() && fetch.is_none() && self.depth.is_none() => {
+                Ok(p.spectrum())
+            }
+            _ => self.choice(),
+        }
+    }
+
     /// The checked spectrum; an impossible combination names the flag to change.
     pub fn choice(&self) -> Result<SpectrumChoice> {
         let SpectrumKindArgs { spectrum, gamma, fetch } = self.kind;
@@ -108,12 +178,45 @@ impl SpectrumArgs {
     }
 }
 
-/// The sea's shape beyond the wind: spectrum and choppiness.
+/// Swell and the wind sea's spreading (`render ocean`, `spectrum` and `play` alike).
+#[derive(Args, Debug, Clone)]
+pub struct SwellArgs {
+    /// A swell from a distant storm, summed with the wind sea: its significant height (m,
+    /// 0.01..=20), peak period (s, 2..=30) and where it comes FROM (degrees clockwise from
+    /// north). Repeat for up to 4 swells.
+    #[arg(long, value_name = "HEIGHT,PERIOD,DIRECTION", value_parser = parse_swell, allow_hyphen_values = true)]
+    pub swell: Vec<Swell>,
+
+    /// How the wind sea spreads over directions: paper (the seed paper's Mitsuyasu mix),
+    /// mitsuyasu, hasselmann (cos-2s with the published s(f) laws) or donelan-banner (sech²).
+    /// [default: paper]
+    #[arg(long, value_name = "LAW", value_parser = parse_spreading)]
+    pub spreading: Option<Spreading>,
+}
+
+impl SwellArgs {
+    /// The swells given, or the preset's when none is.
+    pub fn swells_or(&self, preset: Option<Preset>) -> Result<Swells> {
+        let list: Vec<Swell> = match preset {
+            Some(p) if self.swell.is_empty() => {
+                p.swells().iter().map(|&(h, t, d)| Swell::new(h, t, d).expect("a preset's swells are valid")).collect()
+            }
+            _ => self.swell.clone(),
+        };
+        Swells::new(&list).map_err(|e| Error::arg("--swell", e.to_string()))
+    }
+}
+
+/// The sea's shape beyond the wind: spectrum, swell, spreading and choppiness.
 #[derive(Args, Debug, Clone)]
 pub struct SeaShapeArgs {
     /// The spectrum.
     #[command(flatten)]
     pub spectrum: SpectrumArgs,
+
+    /// Swell and spreading.
+    #[command(flatten)]
+    pub swell: SwellArgs,
 
     /// Horizontal displacement of the water, 0..=4: 0 moves it only up and down (round crests),
     /// 1 is the physical displacement (sharp crests, foam where waves fold). [default: 1]
@@ -124,11 +227,18 @@ pub struct SeaShapeArgs {
 impl SeaShapeArgs {
     /// The sea of these flags under `wind_m_s` from `wind_from_deg`, seeded with `seed`.
     pub fn params(&self, wind_m_s: f64, wind_from_deg: f64, seed: u64) -> Result<SeaParams> {
+        self.params_or(None, wind_m_s, wind_from_deg, seed)
+    }
+
+    /// [`SeaShapeArgs::params`] with a preset's spectrum and swells where no flag gives them.
+    pub fn params_or(&self, preset: Option<Preset>, wind_m_s: f64, wind_from_deg: f64, seed: u64) -> Result<SeaParams> {
         Ok(SeaParams {
             wind_m_s,
             wind_from_deg,
             seed,
-            spectrum: self.spectrum.choice()?,
+            spectrum: self.spectrum.choice_or(preset)?,
+            spreading: self.swell.spreading.unwrap_or_default(),
+            swells: self.swell.swells_or(preset)?,
             choppiness: self.choppiness.unwrap_or(DEFAULT_CHOPPINESS),
             loop_period: None,
         })
@@ -147,6 +257,10 @@ pub struct PlaySeaArgs {
     #[arg(long = "sea-depth", value_name = "M", value_parser = parse_plain_number, allow_negative_numbers = true)]
     pub sea_depth: Option<f64>,
 
+    /// The ocean's swell and spreading.
+    #[command(flatten)]
+    pub swell: SwellArgs,
+
     /// The ocean's horizontal displacement, 0..=4 (0 round crests, 1 physical). [default: 1]
     #[arg(long, value_name = "L", value_parser = parse_choppiness, allow_negative_numbers = true)]
     pub choppiness: Option<f64>,
@@ -157,15 +271,16 @@ impl PlaySeaArgs {
     pub fn shape(&self) -> SeaShapeArgs {
         SeaShapeArgs {
             spectrum: SpectrumArgs { kind: self.kind.clone(), depth: self.sea_depth, depth_flag: "--sea-depth" },
+            swell: self.swell.clone(),
             choppiness: self.choppiness,
         }
     }
 }
 
-/// Checks `--loop SECONDS` for the sea `params` (the shortest loop depends on its peak period).
+/// Checks `--loop SECONDS` for the sea `params` (the shortest loop depends on its longest
+/// peak period, the wind sea's or a swell's).
 pub fn loop_period(seconds: f64, params: &SeaParams) -> Result<LoopPeriod> {
-    LoopPeriod::new(seconds, &SeaSpectrum::new(params.wind_m_s, params.spectrum))
-        .map_err(|e| Error::arg("--loop", e.to_string()))
+    LoopPeriod::new(seconds, params.longest_peak_period_s()).map_err(|e| Error::arg("--loop", e.to_string()))
 }
 
 /// `tidepool render ocean`.
@@ -173,22 +288,31 @@ pub fn loop_period(seconds: f64, params: &SeaParams) -> Result<LoopPeriod> {
 #[command(after_help = OCEAN_EXAMPLES)]
 #[command(mut_arg("heightmap", |arg| arg.help(OCEAN_HEIGHTMAP_HELP)))]
 pub struct RenderOcean {
+    /// A named sea (wind, direction, spectrum and swell; the flags given as well win):
+    /// calm-morning (2 m/s from 330°, swell 0.4 m 9 s from 240°), trade-wind (8 m/s from
+    /// 60°, swell 1.2 m 11 s from 30°), north-atlantic-gale (22 m/s from 240°, JONSWAP over
+    /// 500 km, swell 3 m 14 s from 270°), long-swell (1.5 m/s from 180°, swell 1.8 m 16 s
+    /// from 250°).
+    #[arg(long, value_name = "NAME", value_enum)]
+    pub preset: Option<Preset>,
+
     /// The wind.
     #[command(flatten)]
     pub wind: WindArgs,
 
     /// Where the wind comes FROM, degrees clockwise from north (meteorological convention);
-    /// the waves travel downwind.
-    #[arg(long, value_name = "DEG", default_value = "330", value_parser = parse_degrees, allow_hyphen_values = true)]
-    pub direction: f64,
+    /// the waves travel downwind. [default: 330]
+    #[arg(long, value_name = "DEG", value_parser = parse_degrees, allow_hyphen_values = true)]
+    pub direction: Option<f64>,
 
     /// Spectrum and choppiness.
     #[command(flatten)]
     pub shape: SeaShapeArgs,
 
-    /// Repeat exactly every SECONDS (at least 10 peak periods, at most 3600): an animation's
-    /// frames then span one loop (frame k at --time + k*SECONDS/--frames), so the GIF or
-    /// animated PNG loops without a jump; with --maps the maps loop too.
+    /// Repeat exactly every SECONDS (at least 10 of the longest peak period, at most 3600):
+    /// frame k of an animation or a map series shows --time + k/--fps, and frame
+    /// SECONDS*fps is frame 0 again, bit for bit. A GIF, animated PNG or series of
+    /// SECONDS*fps frames loops without a jump.
     #[arg(long = "loop", value_name = "SECONDS", value_parser = parse_plain_number, allow_negative_numbers = true)]
     pub loop_seconds: Option<f64>,
 
@@ -239,13 +363,26 @@ pub struct RenderOcean {
 /// `tidepool spectrum`.
 #[derive(Args, Debug)]
 pub struct SpectrumCommand {
+    /// A named sea, as for `render ocean`.
+    #[arg(long, value_name = "NAME", value_enum)]
+    pub preset: Option<Preset>,
+
     /// The wind.
     #[command(flatten)]
     pub wind: WindArgs,
 
+    /// Where the wind comes FROM, degrees (the swells' directions are plotted against it).
+    /// [default: 330]
+    #[arg(long, value_name = "DEG", value_parser = parse_degrees, allow_hyphen_values = true)]
+    pub direction: Option<f64>,
+
     /// The spectrum.
     #[command(flatten)]
     pub spectrum: SpectrumArgs,
+
+    /// Swell and spreading.
+    #[command(flatten)]
+    pub swell: SwellArgs,
 
     /// Print JSON instead of `name: value unit` lines.
     #[arg(long)]
@@ -259,6 +396,23 @@ pub struct SpectrumCommand {
 /// Parses `pm`, `jonswap` or `tma`.
 pub fn parse_spectrum(text: &str) -> Result<SpectrumKind, String> {
     text.parse().map_err(|e: tidepool::ValueError| e.to_string())
+}
+
+/// Parses a spreading law.
+pub fn parse_spreading(text: &str) -> Result<Spreading, String> {
+    text.parse().map_err(|e: tidepool::ValueError| e.to_string())
+}
+
+/// Parses `HEIGHT,PERIOD,DIRECTION`.
+pub fn parse_swell(text: &str) -> Result<Swell, String> {
+    text.parse().map_err(|e: tidepool::ValueError| e.to_string())
+}
+
+/// The wind speed and direction of a command line with an optional preset: each flag given
+/// wins over the preset's value, the preset's over the defaults.
+pub fn wind_of(preset: Option<Preset>, wind: &WindArgs, direction: Option<f64>) -> (f64, f64) {
+    let (preset_speed, preset_from) = preset.map_or((DEFAULT_SEA_WIND_M_S, DEFAULT_WIND_FROM_DEG), Preset::wind);
+    (wind.given_m_s().unwrap_or(preset_speed), direction.unwrap_or(preset_from))
 }
 
 /// Parses any number, `inf` and `nan` included: the library's checks word the refusal.

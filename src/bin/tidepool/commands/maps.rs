@@ -8,8 +8,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use tidepool::SeaParams;
-use tidepool::encode::{human_bytes, sea_maps};
-use tidepool::sea::{PatchSea, SeaSpectrum, check_map_size, check_patch, default_map_extent_m};
+use tidepool::encode::{MapFields, human_bytes, sea_maps};
+use tidepool::sea::{PatchMaps, PatchSea, check_map_size, check_patch, default_map_extent_m};
 
 use super::stats::Stats;
 use crate::cli::ocean::RenderOcean;
@@ -60,8 +60,7 @@ pub fn write(args: &RenderOcean, dir: &Path, params: SeaParams) -> Result<()> {
             .map_err(|e| Error::arg("--size", e.to_string()))?,
         None => DEFAULT_MAP_SIDE,
     };
-    let extent =
-        args.extent.unwrap_or_else(|| default_map_extent_m(&SeaSpectrum::new(params.wind_m_s, params.spectrum)));
+    let extent = args.extent.unwrap_or_else(|| default_map_extent_m(&params));
     check_patch(n, extent)
         .map_err(|e| Error::arg(if e.what() == "map size" { "--size" } else { "--extent" }, e.to_string()))?;
     let frames = args.animation.frames.unwrap_or(1);
@@ -78,21 +77,42 @@ pub fn write(args: &RenderOcean, dir: &Path, params: SeaParams) -> Result<()> {
     let mut patch = PatchSea::new(params, n, extent).map_err(|e| Error::arg("--size", e.to_string()))?;
     std::fs::create_dir_all(dir).map_err(|e| Error::io("cannot create the folder", dir, e))?;
     let started = Instant::now();
-    let mut bytes = 0usize;
     let mut progress = Progress::new("maps", u64::from(frames));
-    for k in 0..frames {
-        let t = args.time
-            + match params.loop_period {
-                Some(period) => period.frame_time(k, frames),
-                None => f64::from(k) / f64::from(args.animation.fps),
-            };
-        let maps = patch.maps(t);
-        for (name, file) in sea_maps(&maps, args.animation.frames.map(|_| k)) {
-            bytes += file.len();
-            files::write_file(&dir.join(name), &file)?;
+    let numbered = args.animation.frames.is_some();
+    // A writer thread encodes and writes frame k while the next frame is computed (each file
+    // is flushed to the device, which would otherwise leave the cores idle); at most two
+    // frames wait, so memory stays bounded.
+    let (send, receive) = std::sync::mpsc::sync_channel::<(u32, PatchMaps)>(2);
+    let bytes = std::thread::scope(|scope| -> Result<usize> {
+        let writer = scope.spawn(move || -> Result<usize> {
+            let mut bytes = 0usize;
+            for (k, maps) in receive {
+                let fields = MapFields {
+                    size: maps.size,
+                    height: &maps.height,
+                    displacement: &maps.displacement,
+                    normal: &maps.normal,
+                    foam: &maps.foam,
+                };
+                for (name, file) in sea_maps(&fields, numbered.then_some(k)) {
+                    bytes += file.len();
+                    files::write_file(&dir.join(name), &file)?;
+                }
+            }
+            Ok(bytes)
+        });
+        for k in 0..frames {
+            // Frame k shows --time + k/fps, counted apart from --time so that a looping
+            // series closes exactly: frame T·fps is frame 0.
+            let maps = patch.maps_after(args.time, f64::from(k) / f64::from(args.animation.fps));
+            if send.send((k, maps)).is_err() {
+                break;
+            }
+            progress.advance(1);
         }
-        progress.advance(1);
-    }
+        drop(send);
+        writer.join().map_err(|_| Error::Usage("the map writer stopped unexpectedly".into()))?
+    })?;
     drop(progress);
     let mut stats = Stats::default();
     stats.record(

@@ -5,19 +5,20 @@ use std::io::IsTerminal;
 
 use tiny_skia::Pixmap;
 
-use tidepool::sea::{LoopPeriod, SEA_TEXTURE_TILE_M};
+use tidepool::sea::SEA_TEXTURE_TILE_M;
 use tidepool::{CameraPose, Downsample, OceanScene, OceanSettings, OceanView, SceneSpec, SeaParams, SeaTexture};
 
-use super::animate::{Animation, AnimationTarget, FrameSource, animate, check_animation_flags, render_frames};
+use super::animate::{AnimationTarget, FrameSource, check_animation_flags, render_frames};
 use super::output::{DEFAULT_PNG_SIZE, OutputPlan, default_ssaa, terminal_pixels, too_large};
 use super::still::{self, Still};
 use crate::cli::Format;
-use crate::cli::ocean::{RenderOcean, loop_period};
+use crate::cli::ocean::{RenderOcean, loop_period, wind_of};
 use crate::error::{Error, Result};
 
 /// The sea of a `render ocean` command line, its loop checked against its own peak period.
 fn sea_params(args: &RenderOcean) -> Result<SeaParams> {
-    let mut params = args.shape.params(args.wind.speed_m_s(), args.direction, args.output.seed)?;
+    let (wind, from) = wind_of(args.preset, &args.wind, args.direction);
+    let mut params = args.shape.params_or(args.preset, wind, from, args.output.seed)?;
     params.loop_period = match args.loop_seconds {
         Some(seconds) => Some(loop_period(seconds, &params)?),
         None => None,
@@ -75,8 +76,9 @@ pub fn render(args: RenderOcean) -> Result<()> {
     still::render(&plan, still)
 }
 
-/// `tidepool render ocean --frames N`: the sea from `--time` on, 1/60 s a step as in the
-/// player; with `--loop T`, N frames spread evenly over one loop.
+/// `tidepool render ocean --frames N`: frame k is the sea at `--time + k/fps`, the time since
+/// `--time` counted apart from it, so that with `--loop T` frame T·fps is frame 0 again bit
+/// for bit (foam included: its memory is the same steps of the same sea).
 fn animate_ocean(args: &RenderOcean, frames: u32) -> Result<()> {
     check_animation_flags(&args.output)?;
     if args.extent.is_some() {
@@ -88,34 +90,28 @@ fn animate_ocean(args: &RenderOcean, frames: u32) -> Result<()> {
     let ssaa = args.ssaa.unwrap_or_else(|| default_ssaa(Format::Png));
     size.check_supersampled(ssaa).map_err(|e| Error::arg("--size", format!("{e} (or lower --ssaa)")))?;
     let settings = settings(args, Format::Png)?;
-    let Some(period) = settings.sea.loop_period else {
-        let spec = SceneSpec::Ocean(settings);
-        return animate(&spec, size, &Animation::plain(frames, fps), &target, " or --ssaa", args.output.stats);
-    };
     let make = || -> Result<Box<dyn FrameSource + '_>> {
         let scene = OceanScene::new(settings.clone(), size.width(), size.height())
             .ok_or_else(|| too_large(size, " or --ssaa"))?;
-        Ok(Box::new(LoopFrames { scene, start_s: settings.start_time_s, period, frames }))
+        Ok(Box::new(OceanFrames { scene, start_s: settings.start_time_s, fps }))
     };
     render_frames(&make, frames, fps, &target, args.output.stats)
 }
 
-/// The frames of one loop: frame k is the sea at `start + k·T/N`, so frame N would be frame 0
-/// again and the animation wraps without a jump.
-struct LoopFrames {
+/// The frames of an ocean animation: frame k is the sea `k/fps` seconds after the start.
+struct OceanFrames {
     scene: OceanScene,
     start_s: f64,
-    period: LoopPeriod,
-    frames: u32,
+    fps: u32,
 }
 
-impl FrameSource for LoopFrames {
+impl FrameSource for OceanFrames {
     fn size(&self) -> (u32, u32) {
         (self.scene.width(), self.scene.height())
     }
 
     fn draw(&mut self, k: u32, out: &mut Pixmap) -> Result<()> {
-        self.scene.set_time(self.start_s + self.period.frame_time(k, self.frames));
+        self.scene.set_clock(self.start_s, f64::from(k) / f64::from(self.fps));
         self.scene.render(out);
         Ok(())
     }

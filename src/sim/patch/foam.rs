@@ -1,0 +1,44 @@
+//! A patch's foam: the model of `sim::foam` on the foam lattice, one FFT pass a foam step.
+
+use super::*;
+use crate::sim::foam::{fir, quantize, taps};
+
+impl PatchFoam {
+    /// Brings the memory up to the foam step after `time` and returns the cover at `time` on
+    /// the foam lattice: (its side, the cover per point).
+    pub(super) fn cover(&mut self, time: SeaTime) -> (usize, Vec<f32>) {
+        let (now, frac) = self.clock.step_at(time);
+        let slots = self.weights.len() + 1;
+        let top = now + 1;
+        let first = match self.top {
+            Some(last) if last <= top => (last + 1).max(top + 1 - slots as i64),
+            _ => top + 1 - slots as i64,
+        };
+        for step in first..=top {
+            self.add_step(step, slots);
+        }
+        self.top = Some(top);
+        let m = self.lattice.n;
+        let (taps_now, taps_next) = (taps(&self.weights, now, slots), taps(&self.weights, now + 1, slots));
+        let cover = self
+            .ring
+            .par_chunks(slots)
+            .map(|history| {
+                let (a, b) = (fir(history, &taps_now), fir(history, &taps_next));
+                a + (b - a) * frac
+            })
+            .collect();
+        (m, cover)
+    }
+
+    /// The source of foam step `step` at every point, into its slot of the ring.
+    fn add_step(&mut self, step: i64, slots: usize) {
+        let waves = self.lattice.waves(self.clock.time_of(step));
+        let (gxx, gyy, gxy) = self.lattice.fold_fields(&waves);
+        let slot = step.rem_euclid(slots as i64) as usize;
+        let (model, resolved) = (self.model, self.resolved_slope);
+        self.ring.par_chunks_mut(slots).enumerate().for_each(|(i, history)| {
+            history[slot] = quantize(model.source([gxx[i], gyy[i], gxy[i]], resolved));
+        });
+    }
+}
