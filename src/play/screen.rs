@@ -558,7 +558,7 @@ impl Screen {
                 Bandwidth::Fixed(rate) => Some(rate as f64),
                 Bandwidth::Auto | Bandwidth::Unlimited => None,
             };
-            let switch = AutoSwitch::new(choice.mode, known);
+            let switch = picture::auto_switch(&choice, support, known);
             if switch.mode() == GraphicsMode::Cells {
                 notice.push(picture::switch_notice(choice.mode, GraphicsMode::Cells, known));
                 drawn = probe::choose(GraphicsRequest::Force(GraphicsMode::Cells), None);

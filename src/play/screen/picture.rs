@@ -19,7 +19,7 @@ use crate::output::graphics::GraphicsMode;
 use crate::output::graphics::geometry::{self, Layout};
 use crate::output::graphics::kitty::{self, KittyOptions, Medium};
 use crate::output::graphics::sixel::{Registers, SixelPalette};
-use crate::output::graphics::stream::crossover::crossover;
+use crate::output::graphics::stream::crossover::{AutoSwitch, crossover};
 use crate::output::graphics::stream::{Budget, PictureStream, Protocol};
 use crate::output::units::write_human_rate;
 
@@ -185,6 +185,18 @@ pub fn switch_notice(pixels: GraphicsMode, to: GraphicsMode, rate: Option<f64>) 
     match to {
         GraphicsMode::Cells => format!("link {link}: half-block cells (truer than {} below {at})", pixels.name()),
         _ => format!("link {link}: pixels again"),
+    }
+}
+
+/// `auto`'s switch between `choice`'s pixels and cells at the link's rate (`known`: a fixed
+/// `--bandwidth`). A kitty that reads the pictures from temporary files is on this machine and
+/// its pictures do not cross the link: it keeps them whatever the rate is measured at (see
+/// [`AutoSwitch::local`]).
+pub fn auto_switch(choice: &GraphicsChoice, support: &GraphicsSupport, known: Option<f64>) -> AutoSwitch {
+    if choice.mode == GraphicsMode::Kitty && support.kitty_temp_file && !choice.tmux_wrap {
+        AutoSwitch::local(choice.mode)
+    } else {
+        AutoSwitch::new(choice.mode, known)
     }
 }
 

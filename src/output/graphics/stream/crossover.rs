@@ -58,6 +58,8 @@ pub struct AutoSwitch {
     /// Since when the rate has been beyond the margin towards the other mode.
     leaning: Option<Instant>,
     last_switch: Option<Instant>,
+    /// The pictures do not cross the link (see [`AutoSwitch::local`]): never leave them.
+    local: bool,
 }
 
 impl AutoSwitch {
@@ -73,7 +75,18 @@ impl AutoSwitch {
     /// link is measured before it is left.
     pub fn new(pixels: GraphicsMode, rate: Option<f64>) -> AutoSwitch {
         let current = rate.map_or(pixels, |r| truer_mode(pixels, Some(r)));
-        AutoSwitch { pixels, current, leaning: None, last_switch: None }
+        AutoSwitch { pixels, current, leaning: None, last_switch: None, local: false }
+    }
+
+    /// Pixels whatever the link's rate, for a terminal whose pictures do not cross the link:
+    /// kitty reading them from temporary files on this machine sends about 130 bytes a picture
+    /// down the pty, so no rate makes cells truer. The rate a local terminal is measured at
+    /// says how fast it reads and draws, not what a picture costs: kitty 0.26 under Xvfb with
+    /// software OpenGL answered late while drawing and was measured at the link's floor
+    /// (2 kB/s), and the plain switch then left its full-size pictures for half-block cells
+    /// crawling in at 2 kB/s (`docs/terminals/pictures-at-a-rate.md`).
+    pub fn local(pixels: GraphicsMode) -> AutoSwitch {
+        AutoSwitch { local: true, ..AutoSwitch::new(pixels, None) }
     }
 
     /// The mode in force.
@@ -86,6 +99,9 @@ impl AutoSwitch {
     /// [`AutoSwitch::HOLD`] and the last switch is [`AutoSwitch::MIN_BETWEEN`] ago. Returns the mode and whether it just changed (the Screen
     /// says so on the status line for a few seconds).
     pub fn update(&mut self, rate: Option<f64>, now: Instant) -> (GraphicsMode, bool) {
+        if self.local {
+            return (self.current, false);
+        }
         // No crossover: cells win at any limited rate, pixels only without a limit.
         let at = crossover(self.pixels).unwrap_or(f64::INFINITY);
         let other = if self.current == self.pixels { GraphicsMode::Cells } else { self.pixels };
@@ -155,5 +171,15 @@ mod tests {
         assert_eq!(auto.update(slow, s(90.0)).0, GraphicsMode::Kitty);
         assert_eq!(auto.update(fast, s(92.0)).0, GraphicsMode::Kitty);
         assert_eq!(auto.update(slow, s(93.0)).0, GraphicsMode::Kitty, "the dip's clock started over");
+    }
+
+    #[test]
+    fn a_local_terminal_keeps_its_pixels_at_any_rate() {
+        let t0 = Instant::now();
+        let mut auto = AutoSwitch::local(GraphicsMode::Kitty);
+        for i in 0..100u32 {
+            let now = t0 + Duration::from_millis(500) * i;
+            assert_eq!(auto.update(Some(2_000.0), now), (GraphicsMode::Kitty, false), "step {i}");
+        }
     }
 }
