@@ -12,3 +12,4 @@ mod openssh;
 mod pty;
 mod session;
 mod two_doors;
+mod walls;

@@ -121,6 +121,7 @@ pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
     let shutdown = CancellationToken::new();
     let hub = Arc::new(Hub {
         outbound: Mutex::new(opts.limits.outbound_bucket()),
+        scene_keys: Mutex::new(opts.limits.all_scene_keys_bucket()),
         limits: opts.limits,
         allow: opts.allow,
         config,

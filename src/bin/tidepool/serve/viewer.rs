@@ -17,7 +17,8 @@ use std::time::Instant;
 use bytes::Bytes;
 use russh::ChannelWriteHalf;
 use russh::server::Msg;
-use tidepool::play::{Flow, Player, Screen, ScreenConfig};
+use tidepool::Action;
+use tidepool::play::{Flow, Player, Request, Screen, ScreenConfig};
 use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
@@ -56,6 +57,22 @@ struct Tally {
     sent: u64,
     skipped: u64,
     bytes: u64,
+    /// Requests sent to the game, and dropped by a rate limit or a full queue.
+    actions: u64,
+    dropped: u64,
+    /// Of the requests sent, scene keys.
+    scene_keys: u64,
+    /// New terminal sizes taken.
+    resizes: u64,
+}
+
+/// How soon a new terminal size that had to wait is tried again.
+const RESIZE_RETRY: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Whether a request costs the game thread more than a stone (a scene key: rain, clear, damping,
+/// pause, wind, `tab`): those have a rate limit of their own, per player and for all.
+fn costs_the_game(request: &Request) -> bool {
+    !matches!(request, Request::RandomStone { .. } | Request::Act(Action::Stone { .. } | Action::Stir { .. }))
 }
 
 /// Runs the player until it leaves, then says goodbye (bounded in time) and frees its place.
@@ -69,8 +86,12 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, *player.seat.fit());
     let mut frames = hub.frames.clone();
     let mut actions = hub.limits.actions_bucket();
+    let mut scene_keys = hub.limits.scene_keys_bucket();
+    let mut resizes = hub.limits.resizes_bucket();
+    // A new terminal size waiting for the resize rate.
+    let mut resize: Option<(u16, u16)> = None;
     let mut requests = Vec::new();
-    let (mut last_input, mut owed) = (now, false);
+    let (mut last_input, mut owed, mut deferred) = (now, false, false);
     let mut tally = Tally::default();
     let mut scene_name = frames.borrow().status.name;
 
@@ -93,8 +114,9 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                     if changed.is_err() { break 'game Leave::Cut; }
                     let state = *terminal.borrow_and_update();
                     if state.closed { break 'game Leave::ClientClosed; }
-                    player.screen.resize(state.size);
+                    resize = Some(state.size);
                 }
+                _ = tokio::time::sleep(RESIZE_RETRY), if resize.is_some() => {}
                 bytes = input.recv() => {
                     let Some(bytes) = bytes else { break 'game Leave::Cut };
                     if player.feed(&bytes, Instant::now()) {
@@ -114,6 +136,16 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 }
             }
             let now = Instant::now();
+            if let Some(size) = resize {
+                if resizes.try_take(1.0, now) {
+                    player.screen.resize(size);
+                    tally.resizes += 1;
+                    resize = None;
+                } else if !deferred {
+                    stats.resizes_deferred.fetch_add(1, Ordering::Relaxed);
+                }
+                deferred = resize.is_some();
+            }
             let shared = frames.borrow().clone();
             scene_name = shared.status.name;
             let turn = player.turn(now, &shared.status, &mut requests);
@@ -121,8 +153,29 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 break 'game Leave::Quit;
             }
             for request in requests.drain(..) {
-                if !actions.try_take(1.0, now) || hub.requests.try_send(request).is_err() {
+                let allowed = if costs_the_game(&request) {
+                    let ok = scene_keys.try_take(1.0, now)
+                        && hub.scene_keys.lock().unwrap_or_else(|p| p.into_inner()).try_take(1.0, now);
+                    if ok {
+                        tally.scene_keys += 1;
+                    } else {
+                        stats.scene_keys_dropped.fetch_add(1, Ordering::Relaxed);
+                    }
+                    ok
+                } else {
+                    let ok = actions.try_take(1.0, now);
+                    if !ok {
+                        stats.actions_dropped.fetch_add(1, Ordering::Relaxed);
+                    }
+                    ok
+                };
+                if !allowed {
+                    tally.dropped += 1;
+                } else if hub.requests.try_send(request).is_err() {
                     stats.actions_dropped.fetch_add(1, Ordering::Relaxed);
+                    tally.dropped += 1;
+                } else {
+                    tally.actions += 1;
                 }
             }
             if turn.layout_changed {
@@ -176,10 +229,15 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     stats.frames_skipped.fetch_add(skipped, Ordering::Relaxed);
     let seen = tally.first.map_or(0, |first| published.saturating_sub(first) + 1);
     eprintln!(
-        "serve: {peer} #{id} left ({}): {} frames sent, {skipped} skipped of {seen} published, {} bytes",
+        "serve: {peer} #{id} left ({}): {} frames sent, {skipped} skipped of {seen} published, {} bytes, \
+         {} actions taken, {} dropped, {} scene keys taken, {} new sizes",
         reason.name(),
         tally.sent,
-        tally.bytes
+        tally.bytes,
+        tally.actions - tally.scene_keys,
+        tally.dropped,
+        tally.scene_keys,
+        tally.resizes
     );
     let mut goodbye = Vec::new();
     player.screen.farewell(&mut goodbye);
