@@ -133,7 +133,8 @@ pub fn run(args: ServeCommand) -> Result<()> {
         tokio::runtime::Builder::new_multi_thread().enable_all().thread_name("tidepool-serve").build().map_err(
             |e| Error::Usage(format!("cannot start the server's threads ({e}); free some memory and try again")),
         )?;
-    let options = server::ServerOptions { listen, host_key: key, allow, limits, game };
+    let options =
+        server::ServerOptions { listen, host_key: key, allow, limits, game, compression: !args.no_compression };
     let interrupted = runtime.block_on(async move {
         let running = server::start(options).await.map_err(|e| match e {
             server::StartError::Bind(e) => {
