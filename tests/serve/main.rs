@@ -3,6 +3,7 @@
 
 mod bad_input;
 mod common;
+mod groups;
 mod limits;
 mod load;
 mod openssh;

@@ -60,7 +60,7 @@ impl Stats {
         format!(
             "{} connections ({} refused at accept, {} handshake timeouts), {} players, {} told the pool is full, \
              {} requests refused, {} frames published, {} sent, {} skipped, {} idle, {} stalled, \
-             {} actions applied, {} dropped, {} scene keys dropped, {} resizes deferred",
+             {} actions applied, {} dropped, {} scene keys dropped, {} resizes deferred, {} group frames encoded",
             get(&self.accepted),
             get(&self.refused_at_accept),
             get(&self.handshake_timeouts),
@@ -76,6 +76,7 @@ impl Stats {
             get(&self.actions_dropped),
             get(&self.scene_keys_dropped),
             get(&self.resizes_deferred),
+            get(&game.group_frames),
         )
     }
 }

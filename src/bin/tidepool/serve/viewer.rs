@@ -18,11 +18,11 @@ use bytes::Bytes;
 use russh::ChannelWriteHalf;
 use russh::server::Msg;
 use tidepool::Action;
-use tidepool::play::{Flow, Player, Request, Screen, ScreenConfig};
+use tidepool::play::{Flow, Membership, Player, Request, Screen, ScreenConfig, Source};
 use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
-use super::game::SharedFrame;
+use super::game::{SharedFrame, Viewing};
 use super::hub::Hub;
 use super::leave::{self, Leave};
 use super::limits::PlayerSlot;
@@ -64,6 +64,8 @@ struct Tally {
     scene_keys: u64,
     /// New terminal sizes taken.
     resizes: u64,
+    /// Frames that were the group's bytes.
+    from_group: u64,
 }
 
 /// How soon a new terminal size that had to wait is tried again.
@@ -83,7 +85,9 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     let screen = Screen::new(screen, terminal.borrow().size, now);
     let mut player =
         Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into())).without_screenshots();
-    hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, *player.seat.fit());
+    let mut membership = Membership::new();
+    let mut viewing = Viewing { fit: *player.seat.fit(), group: None };
+    hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
     let mut frames = hub.frames.clone();
     let mut actions = hub.limits.actions_bucket();
     let mut scene_keys = hub.limits.scene_keys_bucket();
@@ -180,7 +184,12 @@ pub(crate) async fn run(ctx: ViewerCtx) {
             }
             if turn.layout_changed {
                 player.refit(hub.scene_size);
-                hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, *player.seat.fit());
+                membership.reset();
+            }
+            let now_viewing = Viewing { fit: *player.seat.fit(), group: membership.key(&player.screen) };
+            if (now_viewing.fit, now_viewing.group) != (viewing.fit, viewing.group) {
+                viewing = now_viewing;
+                hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
             }
             owed |= turn.urgent || turn.layout_changed;
             // A new shared picture or a key's frame: the game's rate paces the frames.
@@ -197,10 +206,14 @@ pub(crate) async fn run(ctx: ViewerCtx) {
             owed = false;
             // The frame's bytes go to russh as `Bytes`, so a buffer cannot be kept between frames.
             let mut out = Vec::new();
-            let Ok(len) = player.frame(now, &picture, &shared.status, &mut out) else { continue };
+            let feed = viewing.group.and_then(|key| shared.groups.get(&key));
+            let Ok((len, source)) = membership.frame(&mut player, now, &picture, &shared.status, feed, &mut out) else {
+                continue;
+            };
             if len == 0 {
                 continue;
             }
+            let from_group = source == Source::Group;
             hub.outbound.lock().unwrap_or_else(|p| p.into_inner()).owe(len);
             // data_bytes waits for the client's SSH window and for room in russh's queue: that
             // wait is the backpressure. Meanwhile newer pictures replace older ones in the slot.
@@ -211,6 +224,7 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 done = write.data_bytes(Bytes::from(out)) => {
                     if done.is_err() { break 'game Leave::Cut; }
                     tally.sent += 1;
+                    tally.from_group += u64::from(from_group);
                     tally.bytes += len as u64;
                     stats.frames_sent.fetch_add(1, Ordering::Relaxed);
                 }
@@ -229,10 +243,11 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     stats.frames_skipped.fetch_add(skipped, Ordering::Relaxed);
     let seen = tally.first.map_or(0, |first| published.saturating_sub(first) + 1);
     eprintln!(
-        "serve: {peer} #{id} left ({}): {} frames sent, {skipped} skipped of {seen} published, {} bytes, \
+        "serve: {peer} #{id} left ({}): {} frames sent ({} from its group), {skipped} skipped of {seen} published, {} bytes, \
          {} actions taken, {} dropped, {} scene keys taken, {} new sizes",
         reason.name(),
         tally.sent,
+        tally.from_group,
         tally.bytes,
         tally.actions - tally.scene_keys,
         tally.dropped,
