@@ -235,9 +235,36 @@ pub enum Source {
     Own,
 }
 
+/// Why a member left its group's step.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Left {
+    /// An overlay of its own, or another stone size.
+    Overlay,
+    /// The frames that follow its last are no longer in the feed (it waited too long).
+    Missed,
+    /// Another group (a new link class), or none.
+    Key,
+}
+
+/// What a member did, for the log.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct MembershipStats {
+    /// Frames sent that were the group's bytes.
+    pub taken: u64,
+    /// Times it joined its group's step.
+    pub joined: u64,
+    /// Times it left it for an overlay of its own.
+    pub left_for_overlay: u64,
+    /// Times it left it because the feed no longer held the frames it needed.
+    pub left_behind: u64,
+    /// Times it left it for another group (link class) or none.
+    pub left_for_key: u64,
+}
+
 /// A player's place in its group (see the module's documentation).
 #[derive(Debug, Default)]
 pub struct Membership {
+    stats: MembershipStats,
     class: Option<LinkClass>,
     /// The group frame the terminal shows last, while in step.
     pinned: Option<Arc<GroupFrame>>,
@@ -270,6 +297,19 @@ impl Membership {
         self.pinned.is_some()
     }
 
+    /// What it did so far.
+    pub fn stats(&self) -> MembershipStats {
+        self.stats
+    }
+
+    fn count(&mut self, why: Left) {
+        match why {
+            Left::Overlay => self.stats.left_for_overlay += 1,
+            Left::Missed => self.stats.left_behind += 1,
+            Left::Key => self.stats.left_for_key += 1,
+        }
+    }
+
     /// Appends the player's frame for now to `out`: its group's bytes while in step, else its
     /// own encoding of `picture` (of its screen's picture size); `feed` is the group's of its
     /// key ([`Membership::key`]), if there is one. Returns the bytes appended and how they
@@ -289,15 +329,17 @@ impl Membership {
         let view = seat.view(now, status);
         let plain = plain(&view, status);
         if let Some(pinned) = self.pinned.clone() {
-            if plain && let Some(feed) = feed.filter(|_| self.pinned_key == key) {
-                match feed.after(pinned.number) {
-                    Some([]) => return Ok((0, Source::Nothing)),
-                    Some(frames) if frames.iter().map(|f| f.bytes.len()).sum::<usize>() <= screen.budget(now) => {
-                        return self.take(screen, now, picture, status, frames, out);
-                    }
-                    _ => {}
-                }
-            }
+            let why = match feed {
+                _ if !plain => Left::Overlay,
+                Some(feed) if self.pinned_key == key => match feed.after(pinned.number) {
+                    // As many of the frames that follow as the link takes now; none: wait
+                    // (still in step) until it takes one, or the feed no longer holds it.
+                    Some(frames) => return self.take(screen, now, picture, status, frames, out),
+                    None => Left::Missed,
+                },
+                _ => Left::Key,
+            };
+            self.count(why);
             self.leave(screen);
         }
         let Some(feed) = feed else {
@@ -310,12 +352,8 @@ impl Membership {
         }
         // Plain again: the cells of one of the group's frames? Then its later frames follow.
         if let Some(at) = feed.frames.iter().rposition(|f| looks_alike(&f.after, screen.shown())) {
-            let later = &feed.frames[at + 1..];
             self.join(screen, feed.frames[at].clone(), key);
-            if later.is_empty() || later.iter().map(|f| f.bytes.len()).sum::<usize>() > screen.budget(now) {
-                return Ok((0, Source::Nothing));
-            }
-            return self.take(screen, now, picture, status, later, out);
+            return self.take(screen, now, picture, status, &feed.frames[at + 1..], out);
         }
         let Some(model) = &latest.after.frame else {
             return Ok((screen.frame(now, picture, status, &view, out)?, Source::Own));
@@ -328,7 +366,8 @@ impl Membership {
         Ok((len, Source::Own))
     }
 
-    /// Sends the group's `frames` (following the one pinned) and pins the last.
+    /// Sends as many of the group's `frames` (those following the one pinned) as the link takes
+    /// now, and pins the last sent.
     fn take(
         &mut self,
         screen: &mut Screen,
@@ -338,6 +377,17 @@ impl Membership {
         frames: &[Arc<GroupFrame>],
         out: &mut Vec<u8>,
     ) -> io::Result<(usize, Source)> {
+        let budget = screen.budget(now);
+        let mut sum = 0;
+        let fit = frames.iter().take_while(|f| {
+            sum += f.bytes.len();
+            sum <= budget
+        });
+        let frames = &frames[..fit.count()];
+        if frames.is_empty() {
+            return Ok((0, Source::Nothing));
+        }
+        self.stats.taken += 1;
         let joined: Vec<u8>;
         let bytes = match frames {
             [one] => one.bytes.as_slice(),
@@ -353,6 +403,7 @@ impl Membership {
 
     /// In step from `frame` on: the screen's own model and buffers go.
     fn join(&mut self, screen: &mut Screen, frame: Arc<GroupFrame>, key: Option<GroupKey>) {
+        self.stats.joined += 1;
         screen.release();
         self.pinned = Some(frame);
         self.pinned_key = key;
@@ -371,6 +422,9 @@ impl Membership {
     /// The terminal's layout changed (a new size, real pixels): its screen repaints it whole,
     /// so what it showed of the group no longer counts.
     pub fn reset(&mut self) {
+        if self.pinned.is_some() {
+            self.count(Left::Key);
+        }
         self.pinned = None;
         self.pinned_key = None;
     }

@@ -451,8 +451,8 @@ impl Screen {
         }
     }
 
-    /// The rate in effect, bytes a second (`None`: no limit).
-    pub(crate) fn rate(&self) -> Option<f64> {
+    /// The link's rate in effect, bytes a second (`None`: no limit).
+    pub fn rate(&self) -> Option<f64> {
         self.bucket.rate()
     }
 

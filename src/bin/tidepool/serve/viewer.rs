@@ -68,6 +68,9 @@ struct Tally {
     from_group: u64,
 }
 
+/// The frame buffer a player in step with its group keeps at most, in bytes.
+const IN_STEP_BUFFER: usize = 64 * 1024;
+
 /// How soon a new terminal size that had to wait is tried again.
 const RESIZE_RETRY: std::time::Duration = std::time::Duration::from_millis(100);
 
@@ -95,6 +98,7 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     // A new terminal size waiting for the resize rate.
     let mut resize: Option<(u16, u16)> = None;
     let mut requests = Vec::new();
+    let mut out = Vec::new();
     let (mut last_input, mut owed, mut deferred) = (now, false, false);
     let mut tally = Tally::default();
     let mut scene_name = frames.borrow().status.name;
@@ -204,8 +208,10 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 continue;
             }
             owed = false;
-            // The frame's bytes go to russh as `Bytes`, so a buffer cannot be kept between frames.
-            let mut out = Vec::new();
+            // The frame is built in a buffer kept from frame to frame (the screen reserves room
+            // for its largest frame in it) and copied out at its own size: handing the buffer
+            // itself to russh would hold that reservation per frame in flight.
+            out.clear();
             let feed = viewing.group.and_then(|key| shared.groups.get(&key));
             let Ok((len, source)) = membership.frame(&mut player, now, &picture, &shared.status, feed, &mut out) else {
                 continue;
@@ -221,10 +227,15 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 biased;
                 _ = kill.cancelled() => break 'game Leave::Cut,
                 _ = hub.shutdown.cancelled() => break 'game Leave::Shutdown,
-                done = write.data_bytes(Bytes::from(out)) => {
+                done = write.data_bytes(Bytes::copy_from_slice(&out)) => {
                     if done.is_err() { break 'game Leave::Cut; }
                     tally.sent += 1;
                     tally.from_group += u64::from(from_group);
+                    if membership.in_step() && out.capacity() > IN_STEP_BUFFER {
+                        // Room for a whole frame of its own is not needed while the group's
+                        // bytes come: give it back (it comes again if the player leaves).
+                        out = Vec::new();
+                    }
                     tally.bytes += len as u64;
                     stats.frames_sent.fetch_add(1, Ordering::Relaxed);
                 }
@@ -239,12 +250,14 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     hub.fits.lock().unwrap_or_else(|p| p.into_inner()).remove(&id);
     drop(slot); // the place is free as soon as the game ends
     let published = frames.borrow().number;
+    let group = membership.stats();
     let skipped = tally.finish(published);
     stats.frames_skipped.fetch_add(skipped, Ordering::Relaxed);
     let seen = tally.first.map_or(0, |first| published.saturating_sub(first) + 1);
     eprintln!(
         "serve: {peer} #{id} left ({}): {} frames sent ({} from its group), {skipped} skipped of {seen} published, {} bytes, \
-         {} actions taken, {} dropped, {} scene keys taken, {} new sizes",
+         {} actions taken, {} dropped, {} scene keys taken, {} new sizes; link {} B/s; joined its group {} times, \
+         left it {} times for an overlay, {} behind, {} for another group",
         reason.name(),
         tally.sent,
         tally.from_group,
@@ -252,7 +265,12 @@ pub(crate) async fn run(ctx: ViewerCtx) {
         tally.actions - tally.scene_keys,
         tally.dropped,
         tally.scene_keys,
-        tally.resizes
+        tally.resizes,
+        player.screen.rate().map_or(-1, |r| r as i64),
+        group.joined,
+        group.left_for_overlay,
+        group.left_behind,
+        group.left_for_key,
     );
     let mut goodbye = Vec::new();
     player.screen.farewell(&mut goodbye);
