@@ -11,6 +11,9 @@
 //!   terminal's bytes (replies stay in the screen, inputs come out); `Screen::frame` appends a
 //!   frame's bytes.
 //!
+//! - [`Group`]: screens alike enough to share frames, encoded once; a player's [`Membership`]
+//!   takes the group's bytes while its terminal shows the group's model.
+//!
 //! Two doors drive them: [`run`] (and [`play`], for this process's own terminal) puts a host,
 //! a seat and a screen on one terminal; `tidepool serve` runs one host on a thread and a seat
 //! and a screen per SSH channel. A key's route is straight: bytes -> [`Screen::feed`] ->
@@ -56,6 +59,7 @@
 
 pub(crate) mod clock;
 pub(crate) mod fit;
+pub(crate) mod group;
 pub(crate) mod host;
 pub(crate) mod input;
 pub(crate) mod player;
@@ -67,6 +71,7 @@ pub(crate) mod seat;
 pub use crate::term::door::{PlayConfig, TerminalInput, run};
 pub use crate::term::tty::{play, probe_for_picture, restore};
 pub use fit::Fit;
+pub use group::{FEED_FRAMES, Group, GroupFeed, GroupFrame, GroupKey, LinkClass, Membership, MembershipStats, Source};
 pub use host::{Host, HostConfig, Recording, SceneStatus};
 pub use input::Input;
 pub use player::{Player, Turn};

@@ -12,7 +12,7 @@
 //! questions in order: the probe's are counted first, so an answer that arrives after the
 //! probe's deadline is still the probe's and never shifts the link's round trips.
 
-mod compose;
+pub(crate) mod compose;
 pub(crate) mod link;
 mod picture;
 pub mod probe;
@@ -37,10 +37,11 @@ use crate::output::bucket::ByteBucket;
 use crate::output::color::ColorMode;
 use crate::output::cursor::Cursor;
 use crate::output::diff::{EncodeOptions, Shown};
+use crate::output::frame::Frame;
 use crate::output::graphics::GraphicsMode;
 use crate::output::graphics::stream::Budget;
 use crate::output::graphics::stream::crossover::AutoSwitch;
-use crate::output::rate::{RateEncoder, RateOptions, Target};
+use crate::output::rate::{RateEncoder, RateOptions, Report, Target};
 use crate::play::clock::{FramePacer, Meter};
 
 /// How many bytes a second a screen may send.
@@ -74,6 +75,20 @@ pub struct ScreenConfig {
     /// link's questions themselves: the rate is held safe there). A door that cannot tell says
     /// [`LinkPath::Direct`].
     pub link_path: LinkPath,
+}
+
+/// Where a frame's cells come from: composed and encoded here (a lone screen), or shared with
+/// the other screens of a group ([`crate::play::group`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Cells<'a> {
+    /// Composed and encoded here; `figures`: the status line's figures instead of this
+    /// screen's own (a group's, so that its members' status lines are alike).
+    Own { figures: Option<Figures> },
+    /// Encoded here, towards these cells exactly (a group's screen model: catching up with it).
+    Toward(&'a Frame),
+    /// Encoded elsewhere (a group's frames, from the model this screen's terminal shows); the
+    /// screen's own model is left as it was, the group's stands for it.
+    Taken(&'a [u8]),
 }
 
 /// Above this rate approximate cells are not worth their CPU: the link carries exact ones.
@@ -337,6 +352,20 @@ impl Screen {
         seat: &SeatView<'_>,
         out: &mut Vec<u8>,
     ) -> io::Result<usize> {
+        self.frame_from(now, picture, status, seat, Cells::Own { figures: None }, out)
+    }
+
+    /// [`Screen::frame`] with its cells from `cells`: everything else (the byte bucket, the
+    /// link's questions, the meter, the pacer, real pixels) as for any frame.
+    pub(crate) fn frame_from(
+        &mut self,
+        now: Instant,
+        picture: &Pixmap,
+        status: &SceneStatus,
+        seat: &SeatView<'_>,
+        cells: Cells<'_>,
+        out: &mut Vec<u8>,
+    ) -> io::Result<usize> {
         let start = out.len();
         if !self.entered {
             out.extend_from_slice(Self::ENTER);
@@ -364,11 +393,6 @@ impl Screen {
         } else {
             self.bucket.budget()
         };
-        let frame = self.builder.compose(self.term, picture, self.config.color, status, seat, &figures);
-        let target = match self.config.color {
-            ColorMode::TrueColor => Target::new(frame),
-            mode => Target::with_truth(frame, picture, mode),
-        };
         let options = RateOptions {
             approximate: rate.is_some_and(|r| r < APPROXIMATE_BELOW),
             ..RateOptions::from(self.config.encode)
@@ -376,7 +400,26 @@ impl Screen {
         let resized = self.shown.frame.is_none();
         let mut bytes = std::mem::take(&mut self.scratch);
         bytes.clear();
-        let report = self.encoder.encode_into(&mut self.shown, target, budget, options, &mut bytes);
+        let report = match cells {
+            Cells::Own { figures: given } => {
+                let figures = given.unwrap_or(figures);
+                let frame = self.builder.compose(self.term, picture, self.config.color, status, seat, &figures);
+                let target = match self.config.color {
+                    ColorMode::TrueColor => Target::new(frame),
+                    mode => Target::with_truth(frame, picture, mode),
+                };
+                self.encoder.encode_into(&mut self.shown, target, budget, options, &mut bytes)
+            }
+            Cells::Toward(model) => {
+                // Exactly (no colour threshold), so that the model becomes equal, not close.
+                let exact = RateOptions { threshold: 0, ..options };
+                self.encoder.encode_into(&mut self.shown, Target::new(model), budget, exact, &mut bytes)
+            }
+            Cells::Taken(taken) => {
+                bytes.extend_from_slice(taken);
+                Report { bytes: taken.len(), drawn: 0, pending: 0 }
+            }
+        };
         self.bucket.spend(report.bytes);
         if let Some(p) = &mut self.picture {
             let frame = picture::FrameFacts {
@@ -414,6 +457,63 @@ impl Screen {
         self.meter.frame(now, len);
         self.pacer.sent(now);
         Ok(len)
+    }
+
+    /// The bytes a frame may send now (the byte bucket, and on an auto link the window of
+    /// unanswered bytes): whether a group's frame fits this screen's link.
+    pub(crate) fn budget(&mut self, now: Instant) -> usize {
+        if self.auto() {
+            self.bucket.set_rate(self.link.rate());
+        }
+        self.bucket.refill(now);
+        if self.auto() {
+            self.bucket.budget().min(self.link.window_left(now, self.bytes_sent))
+        } else {
+            self.bucket.budget()
+        }
+    }
+
+    /// The link's rate in effect, bytes a second (`None`: no limit).
+    pub fn rate(&self) -> Option<f64> {
+        self.bucket.rate()
+    }
+
+    /// How the screen draws.
+    pub(crate) fn config(&self) -> &ScreenConfig {
+        &self.config
+    }
+
+    /// What the encoder takes the terminal to show.
+    pub(crate) fn shown(&self) -> &Shown {
+        &self.shown
+    }
+
+    /// The terminal shows `shown` (a group's model: this screen leaves the group).
+    pub(crate) fn set_shown(&mut self, shown: &Shown) {
+        self.shown.clone_from(shown);
+    }
+
+    /// Forgets the cursor and the colours in effect, so that the next frame starts with an
+    /// absolute move and explicit colours: a group's frame is then right for every terminal
+    /// whose cells are the group's, wherever its cursor is.
+    pub(crate) fn forget_pen(&mut self) {
+        (self.shown.cursor, self.shown.fg, self.shown.bg) = (Cursor::Unknown, None, None);
+    }
+
+    /// Frees what only a screen that encodes needs (the model, the encoder's and the frame's
+    /// buffers): a group member in step takes its group's bytes instead. They come back, at
+    /// their cost, when it encodes again.
+    pub(crate) fn release(&mut self) {
+        self.shown = Shown::UNKNOWN;
+        self.encoder = RateEncoder::new();
+        self.builder = FrameBuilder::default();
+        self.scratch = Vec::new();
+    }
+
+    /// A screen that writes to no terminal (a group's): no set-up bytes before its first frame.
+    pub(crate) fn without_enter(mut self) -> Screen {
+        self.entered = true;
+        self
     }
 
     /// Whether link questions are still unanswered (a door that is closing waits a little for

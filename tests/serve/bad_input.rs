@@ -41,15 +41,26 @@ fn each_bad_input_is_one_line_naming_the_flag_and_exit_2() {
     let path = |name: &str| dir.path().join(name).to_str().unwrap().to_string();
     let key = path("host_key");
     std::fs::write(path("bad_keys"), "ssh-ed25519 AAAAC3NzaC1lZDI1NTE5AAAAI-not-base64 x\n").unwrap();
+    let player = russh::keys::PrivateKey::random(&mut rand_keys::rng(), russh::keys::Algorithm::Ed25519).unwrap();
+    let line = player.public_key().to_openssh().unwrap();
+    std::fs::write(path("forced_command"), format!("{line}\ncommand=\"/usr/bin/backup\" {line} backups\n")).unwrap();
+    std::fs::write(path("host_name"), format!("from=\"*.example.com\" {line}\n")).unwrap();
     std::fs::write(path("loose_key"), "whatever").unwrap();
     std::fs::set_permissions(path("loose_key"), std::fs::Permissions::from_mode(0o644)).unwrap();
     std::fs::write(path("garbage_key"), "this is not a key\n").unwrap();
     std::fs::set_permissions(path("garbage_key"), std::fs::Permissions::from_mode(0o600)).unwrap();
     let (bad_keys, nope, loose, garbage) = (path("bad_keys"), path("nope"), path("loose_key"), path("garbage_key"));
+    let (forced, host_name) = (path("forced_command"), path("host_name"));
     let taken = std::net::TcpListener::bind("127.0.0.1:0").unwrap();
     let taken_addr = taken.local_addr().unwrap().to_string();
     let cases: Vec<(&str, Vec<&str>, &str)> = vec![
         ("malformed authorized_keys", vec!["--authorized-keys", &bad_keys, "--host-key", &key], "line 1"),
+        ("forced command", vec!["--authorized-keys", &forced, "--host-key", &key], "line 2: option 'command'"),
+        (
+            "host name in from=",
+            vec!["--authorized-keys", &host_name, "--host-key", &key],
+            "line 1: from=: '*.example.com'",
+        ),
         ("missing authorized_keys", vec!["--authorized-keys", &nope, "--host-key", &key], "fix the path"),
         ("loose host key", vec!["--host-key", &loose], "chmod 600"),
         ("garbage host key", vec!["--host-key", &garbage], "not an OpenSSH private key"),

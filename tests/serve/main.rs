@@ -3,6 +3,7 @@
 
 mod bad_input;
 mod common;
+mod groups;
 mod limits;
 mod load;
 mod openssh;
@@ -12,3 +13,4 @@ mod openssh;
 mod pty;
 mod session;
 mod two_doors;
+mod walls;

@@ -48,6 +48,27 @@ fn cell_of(x: f32, y: f32, cols: u32, rows: u32) -> (i32, i32) {
     (((x0 + (x + 0.5) * scale).floor()) as i32, ((y0 + (y + 0.5) * scale).floor() as i32) / 2)
 }
 
+/// The centre of the cells of `t` that look different from `before` (the first cells a stone
+/// changed), in the pixels of a 160x90 scene shown in a `cols x rows` terminal; and how many.
+fn changed_centre(t: &Term, before: &tidepool::terminal::TerminalModel, cols: u32, rows: u32) -> ((f64, f64), usize) {
+    let (pw, ph) = (cols as f64, (2 * (rows - 1)) as f64);
+    let scale = (pw / 160.0).min(ph / 90.0);
+    let (w, h) = ((160.0 * scale).round(), (90.0 * scale).round());
+    let x0 = ((pw - w) / 2.0).floor();
+    let y0 = (((ph - h) / 2.0).floor() as i32 & !1) as f64;
+    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0);
+    for y in 0..rows as usize - 1 {
+        for x in 0..cols as usize {
+            if (2 * y..2 * y + 2).any(|py| before.pixel(x, py) != t.screen.pixel(x, py)) {
+                sx += (x as f64 + 0.5 - x0) / scale;
+                sy += (2.0 * y as f64 + 1.0 - y0) / scale;
+                n += 1;
+            }
+        }
+    }
+    ((sx / n.max(1) as f64, sy / n.max(1) as f64), n)
+}
+
 #[tokio::test]
 async fn a_stone_dropped_by_one_player_rings_at_the_same_spot_on_anothers_screen() {
     // A wide link: every frame is sent exactly and whole, so cells change only with the water.
@@ -60,33 +81,41 @@ async fn a_stone_dropped_by_one_player_rings_at_the_same_spot_on_anothers_screen
     let mut tb = Term::new(open_shell(&b, "xterm-256color", 120, 40).await, 120, 40);
     ta.read_until_status("2 playing").await;
     tb.read_until_status("2 playing").await;
+    ta.read_until_painted().await;
     tb.read_until_painted().await;
     // Still water and no rain: nothing changes until the stone.
-    let before = tb.screen.clone();
-    // Player A clicks cell (30, 8): pixel (30, 16) of its 80x46 picture, scene pixel (60, 32).
+    let (before_a, before_b) = (ta.screen.clone(), tb.screen.clone());
+    // Player A clicks cell (30, 8): pixels (30, 16-17) of its 80x46 picture, about scene pixel
+    // (61, 34).
     ta.ch.data(&b"\x1b[<0;31;9M\x1b[<0;31;9m"[..]).await.unwrap();
-    let (ex, ey) = cell_of(60.0, 32.0, 120, 40);
-    // What the eye sees: a cell's two pixels (the encoder may redraw a cell with another of
-    // its equivalent characters).
-    let changed =
-        |t: &Term, x: usize, y: usize| (2 * y..2 * y + 2).any(|py| before.pixel(x, py) != t.screen.pixel(x, py));
-    tb.read_until(|t| changed(t, ex as usize, ey as usize)).await;
-    tb.read_until(|t| {
-        (0..39).flat_map(|y| (0..120).map(move |x| (x, y))).filter(|&(x, y)| changed(t, x, y)).count() >= 4
-    })
-    .await;
+    let (ex, ey) = cell_of(61.0, 34.0, 120, 40);
+    // The first frame in which the stone shows, on each screen (the same published picture).
+    ta.read_until(|t| changed_centre(t, &before_a, 80, 24).1 >= 4).await;
+    tb.read_until(|t| changed_centre(t, &before_b, 120, 40).1 >= 4).await;
     // Every changed cell of the water is near the stone: the rest of the pool is still.
-    let mut near = 0;
+    let changed =
+        |t: &Term, x: usize, y: usize| (2 * y..2 * y + 2).any(|py| before_b.pixel(x, py) != t.screen.pixel(x, py));
     for y in 0..39 {
         for x in 0..120 {
             if changed(&tb, x, y) {
                 let d = (x as i32 - ex).abs().max(2 * (y as i32 - ey).abs());
                 assert!(d <= 24, "cell {x},{y} changed, {d} cells from the stone at {ex},{ey}");
-                near += 1;
             }
         }
     }
-    assert!(near >= 4, "a ring, not a dot: {near} cells");
+    // Both screens place the ring at the same scene pixels (measured: within half a pixel),
+    // each mapping its cells back through its own letterbox (A's is 0 rows, B's 2). Every
+    // letterbox two rows lower (the click maps through it too) puts them 1.9 pixels apart.
+    let (((xa, ya), na), ((xb, yb), nb)) =
+        (changed_centre(&ta, &before_a, 80, 24), changed_centre(&tb, &before_b, 120, 40));
+    eprintln!(
+        "the ring's centre in scene pixels: {xa:.2},{ya:.2} on A ({na} cells), {xb:.2},{yb:.2} on B ({nb} cells)"
+    );
+    assert!(nb >= 4, "a ring, not a dot: {nb} cells");
+    assert!(
+        (xa - xb).abs() <= 1.25 && (ya - yb).abs() <= 1.25,
+        "A sees the ring at {xa:.2},{ya:.2}, B at {xb:.2},{yb:.2}"
+    );
 }
 
 #[tokio::test]

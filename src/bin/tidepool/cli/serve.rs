@@ -60,15 +60,26 @@ pub struct ServeCommand {
     #[arg(long, value_name = "MS", default_value_t = 20_000)]
     pub stall_timeout_ms: u64,
 
-    /// Shared actions (stones, clicks, drags, scene keys) one player may make per second; the
-    /// rest are dropped.
+    /// Stones, clicks and drags one player may make per second; the rest are dropped.
     #[arg(long, value_name = "N", default_value_t = 30)]
     pub actions_per_second: u64,
+
+    /// Scene keys (rain, clear, damping, pause, wind, tab) one player may press per second; the
+    /// rest are dropped (each costs the shared game thread more than a stone). All players
+    /// together get 8 a second.
+    #[arg(long, value_name = "N", default_value_t = 4)]
+    pub scene_keys_per_second: u64,
 
     /// Bytes per second each player's link gets: auto finds each player's own rate from the
     /// terminal's answers (as `play` does); a number (suffixes k and M) fixes it; unlimited.
     #[arg(long, value_name = "BYTES/s|auto|unlimited", default_value = "auto", value_parser = super::parse_bandwidth)]
     pub client_bandwidth: tidepool::play::Bandwidth,
+
+    /// Do not offer compression. By default a client that asks for it (`ssh -C`) gets
+    /// zlib@openssh.com, which starts after authentication: fewer bytes on its link, about
+    /// 300 kB more server memory and some CPU per such player.
+    #[arg(long)]
+    pub no_compression: bool,
 
     /// Bytes per second for all players together; beyond it frames are skipped.
     #[arg(long, value_name = "BYTES/s", default_value = "16M", value_parser = super::parse_bps)]

@@ -197,8 +197,8 @@ mod tests {
         let p = SeaParams { swells: Swells::new(&[swell]).unwrap(), ..pm(10.0) };
         let t = text(&p);
         assert!(t.contains("swell 1: 2 m, 12 s from 250 degrees\n"), "{t}");
-        // sqrt(2.46² + 2²) = 3.17 m.
-        assert!(t.contains("total significant wave height: 3.171 m\n"), "{t}");
+        // sqrt(2.46² + 2²) = 3.1704 m.
+        assert!(t.contains("total significant wave height: 3.170 m\n"), "{t}");
         assert!(t.contains("significant wave height: 2.460 m\n") && t.contains("spreading: paper\n"), "{t}");
         let j = json(&p);
         assert!(j.contains("\"swells\": [{\"height_m\": 2, \"period_s\": 12, \"from_deg\": 250}]"), "{j}");

@@ -5,6 +5,12 @@
 //!
 //! Players never touch the host: their seats send [`Request`]s through a bounded queue, and the
 //! game applies them before the next step.
+//!
+//! Players whose screens are alike (size, colours, link class: a [`GroupKey`]) share their
+//! frames: for every key that two or more players have, the game encodes the frame once
+//! ([`Group`], in parallel across groups) and publishes the group's last frames with the
+//! pictures; each player takes them while its terminal shows the group's model
+//! ([`tidepool::play::Membership`]). Server CPU then grows with the groups, not the players.
 
 use std::collections::HashMap;
 use std::fmt::Write as _;
@@ -12,7 +18,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use tidepool::play::{Fit, Host, Request, SceneStatus};
+use rayon::prelude::*;
+use tidepool::play::{Fit, Group, GroupFeed, GroupKey, Host, Request, SceneStatus};
 use tiny_skia::Pixmap;
 use tokio::sync::{mpsc, watch};
 
@@ -20,6 +27,11 @@ use super::limits::PlayerSlots;
 
 /// Most requests waiting for the next step, from all players together; more are dropped.
 pub const REQUEST_QUEUE: usize = 1024;
+/// Most groups encoded per frame (the largest first); players of the others encode alone, on
+/// their own tasks. Bounds the game thread's work whatever sizes the players choose.
+pub const MAX_GROUPS: usize = 64;
+/// Players a key needs for a group: one player alone encodes for itself.
+const MIN_MEMBERS: usize = 2;
 /// The longest the game thread sleeps before looking at its stop flag again.
 const MAX_SLEEP: Duration = Duration::from_millis(20);
 
@@ -32,10 +44,21 @@ pub struct SharedFrame {
     pub status: Arc<SceneStatus>,
     /// The scene fitted into each picture size a player's screen asked for.
     pub pictures: HashMap<(u32, u32), Arc<Pixmap>>,
+    /// Each group's last frames.
+    pub groups: HashMap<GroupKey, GroupFeed>,
 }
 
-/// How each player's screen wants the scene (player id → fit); one picture per distinct size.
-pub type Fits = Arc<Mutex<HashMap<u64, Fit>>>;
+/// How a player's screen wants the scene.
+#[derive(Clone, Copy, Debug)]
+pub struct Viewing {
+    /// How the scene fits its picture (one picture per distinct size).
+    pub fit: Fit,
+    /// The group it belongs in, if any.
+    pub group: Option<GroupKey>,
+}
+
+/// Every player's [`Viewing`], by player id.
+pub type Fits = Arc<Mutex<HashMap<u64, Viewing>>>;
 
 /// Counters the tests and the load report read.
 #[derive(Debug, Default)]
@@ -46,6 +69,8 @@ pub struct GameStats {
     pub pictures: AtomicU64,
     /// Requests applied.
     pub requests: AtomicU64,
+    /// Group frames encoded (one per group per frame that changed something).
+    pub group_frames: AtomicU64,
 }
 
 /// What the game thread reads and writes.
@@ -72,6 +97,7 @@ pub fn run(mut host: Host, fps: u32, mut links: GameLinks) {
     let mut next_frame = Instant::now();
     let mut number = 0u64;
     let mut pictures: HashMap<(u32, u32), Arc<Pixmap>> = HashMap::new();
+    let mut groups: HashMap<GroupKey, Group> = HashMap::new();
     while !links.stop.load(Ordering::Relaxed) {
         let now = Instant::now();
         while let Ok(request) = links.requests.try_recv() {
@@ -90,9 +116,10 @@ pub fn run(mut host: Host, fps: u32, mut links: GameLinks) {
             // The count first: a passing message may cover the end of a narrow status line.
             status.detail.clear();
             let _ = write!(status.detail, "{players} playing \u{b7} {}", host.status().detail);
-            let fits: Vec<Fit> = links.fits.lock().unwrap_or_else(|p| p.into_inner()).values().copied().collect();
-            let mut drawn = HashMap::with_capacity(fits.len());
-            for fit in fits {
+            let viewing: Vec<Viewing> =
+                links.fits.lock().unwrap_or_else(|p| p.into_inner()).values().copied().collect();
+            let mut drawn = HashMap::with_capacity(viewing.len());
+            for fit in viewing.iter().map(|v| v.fit) {
                 if drawn.contains_key(&fit.target()) {
                     continue;
                 }
@@ -101,10 +128,14 @@ pub fn run(mut host: Host, fps: u32, mut links: GameLinks) {
                     links.stats.pictures.fetch_add(1, Ordering::Relaxed);
                 }
             }
+            keep_groups(&mut groups, &viewing, now);
+            let encoded = encode_groups(&mut groups, &drawn, &status, now);
+            links.stats.group_frames.fetch_add(encoded, Ordering::Relaxed);
+            let feeds = groups.iter().map(|(key, group)| (*key, group.feed())).collect();
             links.stats.frames.fetch_add(1, Ordering::Relaxed);
             // Never waits: a player still busy with an older picture simply sees a later one.
-            let previous =
-                links.publish.send_replace(Arc::new(SharedFrame { number, status: Arc::new(status), pictures: drawn }));
+            let frame = SharedFrame { number, status: Arc::new(status), pictures: drawn, groups: feeds };
+            let previous = links.publish.send_replace(Arc::new(frame));
             // Last frame's pictures come back for reuse once no player holds them.
             pictures = Arc::try_unwrap(previous).map(|f| f.pictures).unwrap_or_default();
         }
@@ -115,6 +146,43 @@ pub fn run(mut host: Host, fps: u32, mut links: GameLinks) {
         }
     }
     drop(links.publish);
+}
+
+/// Keeps a group for every key at least [`MIN_MEMBERS`] players have (the [`MAX_GROUPS`]
+/// largest), new ones starting at `now`; drops the rest.
+fn keep_groups(groups: &mut HashMap<GroupKey, Group>, viewing: &[Viewing], now: Instant) {
+    let mut members: HashMap<GroupKey, usize> = HashMap::new();
+    for key in viewing.iter().filter_map(|v| v.group) {
+        *members.entry(key).or_default() += 1;
+    }
+    let mut keys: Vec<(usize, GroupKey)> =
+        members.into_iter().filter(|&(_, n)| n >= MIN_MEMBERS).map(|(k, n)| (n, k)).collect();
+    if keys.len() > MAX_GROUPS {
+        // The largest groups save the most; ties by size so the choice is stable.
+        keys.sort_unstable_by_key(|&(n, k)| (std::cmp::Reverse(n), k.term));
+        keys.truncate(MAX_GROUPS);
+    }
+    groups.retain(|key, _| keys.iter().any(|(_, k)| k == key));
+    for (_, key) in keys {
+        groups.entry(key).or_insert_with(|| Group::new(key, now));
+    }
+}
+
+/// Encodes every group's frame, in parallel; returns how many changed something.
+fn encode_groups(
+    groups: &mut HashMap<GroupKey, Group>,
+    pictures: &HashMap<(u32, u32), Arc<Pixmap>>,
+    status: &SceneStatus,
+    now: Instant,
+) -> u64 {
+    let mut work: Vec<&mut Group> = groups.values_mut().collect();
+    work.par_iter_mut()
+        .map(|group| match pictures.get(&group.key().picture_size()) {
+            // A group frame fails only for kitty's temporary file, which cells never write.
+            Some(picture) => u64::from(group.frame(now, picture, status).unwrap_or(false)),
+            None => 0,
+        })
+        .sum()
 }
 
 /// `scene` fitted into a picture of `fit`'s target size, reusing `old` when nobody else holds it.

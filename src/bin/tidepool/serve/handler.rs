@@ -20,6 +20,7 @@ use tidepool::play::{Environment, GraphicsRequest, ProbeOptions, ScreenConfig, W
 use tidepool::terminal::{ColorMode, EncodeOptions};
 use tokio::sync::mpsc;
 
+use super::authorized_keys::Refused;
 use super::hub::Hub;
 use super::limits::{self, clamp_pixels, clamp_size};
 use super::viewer::{self, TerminalState, ViewerCtx};
@@ -47,6 +48,8 @@ pub struct ClientHandler {
     /// The terminal's size in pixels as the client reports it (0 when it does not).
     pixels: (u16, u16),
     shell_requested: bool,
+    /// Whether the key's authorized_keys line allows a pty (`no-pty`, `restrict` take it away).
+    pty_allowed: bool,
     terminal: Option<watch::Sender<TerminalState>>,
     input: Option<mpsc::Sender<Vec<u8>>>,
 }
@@ -72,6 +75,7 @@ impl ClientHandler {
             size: (80, 24),
             pixels: (0, 0),
             shell_requested: false,
+            pty_allowed: true,
             terminal: None,
             input: None,
         }
@@ -95,8 +99,28 @@ impl ClientHandler {
         self.hub.allow.is_none()
     }
 
-    fn listed(&self, key: &russh::keys::PublicKey) -> bool {
-        self.hub.allow.as_ref().is_some_and(|list| list.admits(key))
+    /// Whether `key` may play from this client's address (`log`: say why not).
+    fn listed(&mut self, key: &russh::keys::PublicKey, log: bool) -> bool {
+        let Some(list) = &self.hub.allow else { return false };
+        match list.admit(key, self.peer.ip()) {
+            Ok(grant) => {
+                self.pty_allowed = grant.pty;
+                true
+            }
+            Err(Refused::From(line)) => {
+                if log {
+                    let fingerprint = key.fingerprint(HashAlg::Sha256);
+                    eprintln!(
+                        "serve: {} #{} key {fingerprint} refused: from= of line {line} does not admit {}",
+                        self.peer,
+                        self.id,
+                        self.peer.ip()
+                    );
+                }
+                false
+            }
+            Err(Refused::Unlisted) => false,
+        }
     }
 
     fn closed(&mut self) {
@@ -121,11 +145,11 @@ impl russh::server::Handler for ClientHandler {
     }
 
     async fn auth_publickey_offered(&mut self, _user: &str, offer: PublicKeyOffer<'_>) -> Result<Auth, Self::Error> {
-        Ok(if self.public() || self.listed(offer.public_key) { Auth::Accept } else { Auth::reject() })
+        Ok(if self.public() || self.listed(offer.public_key, true) { Auth::Accept } else { Auth::reject() })
     }
 
     async fn auth_publickey(&mut self, _user: &str, key: VerifiedPublicKey<'_>) -> Result<Auth, Self::Error> {
-        let ok = self.public() || self.listed(key.public_key);
+        let ok = self.public() || self.listed(key.public_key, true);
         if ok {
             eprintln!("serve: {} #{} key {}", self.peer, self.id, key.public_key.fingerprint(HashAlg::Sha256));
         }
@@ -237,6 +261,10 @@ impl russh::server::Handler for ClientHandler {
     ) -> Result<(), Self::Error> {
         if !self.ours(channel) || self.shell_requested || !printable(term) {
             return self.refuse_request("pty-req", channel, session);
+        }
+        if !self.pty_allowed {
+            // As sshd: the session goes on without a terminal (the game still draws, as for `ssh -T`).
+            return self.refuse_request("pty-req (the key's line says no-pty or restrict)", channel, session);
         }
         self.term = Some(term.to_string());
         self.size = clamp_size(cols, rows);

@@ -45,6 +45,10 @@ pub struct Stats {
     pub stall_kicks: AtomicU64,
     /// Requests dropped by the per-player rate or a full queue.
     pub actions_dropped: AtomicU64,
+    /// Scene keys dropped by the per-player or the all-players rate.
+    pub scene_keys_dropped: AtomicU64,
+    /// New terminal sizes that waited for the resize rate.
+    pub resizes_deferred: AtomicU64,
     /// Packets of key bytes dropped because the player's task was behind.
     pub input_dropped: AtomicU64,
 }
@@ -55,7 +59,8 @@ impl Stats {
         let get = |c: &AtomicU64| c.load(Ordering::Relaxed);
         format!(
             "{} connections ({} refused at accept, {} handshake timeouts), {} players, {} told the pool is full, \
-             {} requests refused, {} frames published, {} sent, {} skipped, {} idle, {} stalled",
+             {} requests refused, {} frames published, {} sent, {} skipped, {} idle, {} stalled, \
+             {} actions applied, {} dropped, {} scene keys dropped, {} resizes deferred, {} group frames encoded",
             get(&self.accepted),
             get(&self.refused_at_accept),
             get(&self.handshake_timeouts),
@@ -67,6 +72,11 @@ impl Stats {
             get(&self.frames_skipped),
             get(&self.idle_kicks),
             get(&self.stall_kicks),
+            get(&game.requests),
+            get(&self.actions_dropped),
+            get(&self.scene_keys_dropped),
+            get(&self.resizes_deferred),
+            get(&game.group_frames),
         )
     }
 }
@@ -87,6 +97,8 @@ pub(crate) struct Hub {
     pub requests: mpsc::Sender<Request>,
     /// All players' frames together, bytes a second.
     pub outbound: Mutex<ByteBucket>,
+    /// All players' scene keys together.
+    pub scene_keys: Mutex<ByteBucket>,
     pub stats: Arc<Stats>,
     pub tasks: TaskTracker,
     pub next_id: AtomicU64,

@@ -5,25 +5,51 @@
 //! loop stops draining while the client's window is exhausted, so a client that keeps TCP alive but
 //! never consumes channel data could never be removed. Wrapping the stream makes every read and
 //! write fail once the token is cancelled; the loop then ends with an I/O error and drops the socket.
+//!
+//! It also counts the bytes that cross the socket each way (what the wire carries, after
+//! encryption and compression), for the log.
 
 use std::io;
 use std::pin::Pin;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::task::{Context, Poll};
 
 use tokio::io::{AsyncRead, AsyncWrite, ReadBuf};
 use tokio_util::sync::{CancellationToken, WaitForCancellationFutureOwned};
+
+/// Bytes written to and read from a socket so far.
+#[derive(Debug, Default)]
+pub struct Counts {
+    written: AtomicU64,
+    read: AtomicU64,
+}
+
+impl Counts {
+    /// (written, read).
+    pub fn get(&self) -> (u64, u64) {
+        (self.written.load(Ordering::Relaxed), self.read.load(Ordering::Relaxed))
+    }
+}
 
 /// `inner`, cut when `token` is cancelled.
 pub struct Killable<S> {
     inner: S,
     cancelled: Pin<Box<WaitForCancellationFutureOwned>>,
     token: CancellationToken,
+    counts: Arc<Counts>,
 }
 
 impl<S> Killable<S> {
     /// Wraps `inner`; cancelling `token` (or a parent of it) cuts the stream.
     pub fn new(inner: S, token: CancellationToken) -> Self {
-        Self { inner, cancelled: Box::pin(token.clone().cancelled_owned()), token }
+        let counts = Arc::new(Counts::default());
+        Self { inner, cancelled: Box::pin(token.clone().cancelled_owned()), token, counts }
+    }
+
+    /// The bytes that crossed the socket, updated as they do.
+    pub fn counts(&self) -> Arc<Counts> {
+        self.counts.clone()
     }
 
     fn check(&mut self, cx: &mut Context<'_>) -> io::Result<()> {
@@ -39,7 +65,10 @@ impl<S: AsyncRead + Unpin> AsyncRead for Killable<S> {
         if let Err(e) = self.check(cx) {
             return Poll::Ready(Err(e));
         }
-        Pin::new(&mut self.inner).poll_read(cx, buf)
+        let before = buf.filled().len();
+        let result = Pin::new(&mut self.inner).poll_read(cx, buf);
+        self.counts.read.fetch_add((buf.filled().len() - before) as u64, Ordering::Relaxed);
+        result
     }
 }
 
@@ -48,7 +77,11 @@ impl<S: AsyncWrite + Unpin> AsyncWrite for Killable<S> {
         if let Err(e) = self.check(cx) {
             return Poll::Ready(Err(e));
         }
-        Pin::new(&mut self.inner).poll_write(cx, buf)
+        let result = Pin::new(&mut self.inner).poll_write(cx, buf);
+        if let Poll::Ready(Ok(n)) = result {
+            self.counts.written.fetch_add(n as u64, Ordering::Relaxed);
+        }
+        result
     }
 
     fn poll_flush(mut self: Pin<&mut Self>, cx: &mut Context<'_>) -> Poll<io::Result<()>> {

@@ -36,6 +36,16 @@ pub const MIN_COLS: u16 = 20;
 pub const MIN_ROWS: u16 = 5;
 /// Default actions (key-press batches) a player may make per second; the rest are dropped.
 pub const DEFAULT_ACTIONS_PER_SECOND: u32 = 30;
+/// Default scene keys (rain, clear, damping, pause, wind, `tab`: each costs the one game thread
+/// more than a stone) a player may press per second; the rest are dropped.
+pub const DEFAULT_SCENE_KEYS_PER_SECOND: u32 = 4;
+/// Scene keys per second from all players together (a crowd of players each within their own
+/// limit must not keep the game thread rebuilding scenes).
+pub const SCENE_KEYS_ALL_PLAYERS_PER_SECOND: f64 = 8.0;
+/// New terminal sizes (window-change requests) a player's screen takes per second: each new size
+/// costs the game thread a picture of that size. Sizes that come faster wait, and the newest
+/// is taken when the limit allows (a window dragged by its edge ends at its last size).
+pub const RESIZES_PER_SECOND: f64 = 4.0;
 /// Default total outbound frame bytes per second across all clients.
 pub const DEFAULT_OUTBOUND_BYTES_PER_SECOND: u64 = 16_000_000;
 /// Most players `--max-clients` accepts (memory and CPU are planned per client).
@@ -74,8 +84,10 @@ pub struct Limits {
     pub stall_timeout: Duration,
     /// Delay on each failed authentication.
     pub auth_rejection_time: Duration,
-    /// Per-player input rate.
+    /// Per-player input rate (stones, clicks, drags).
     pub actions_per_second: u32,
+    /// Per-player scene keys (see [`DEFAULT_SCENE_KEYS_PER_SECOND`]).
+    pub scene_keys_per_second: u32,
     /// Server-wide frame byte rate.
     pub outbound_bytes_per_second: u64,
     /// One client's link: found from its own round trips, or fixed.
@@ -92,6 +104,7 @@ impl Default for Limits {
             stall_timeout: DEFAULT_STALL_TIMEOUT,
             auth_rejection_time: DEFAULT_AUTH_REJECTION_TIME,
             actions_per_second: DEFAULT_ACTIONS_PER_SECOND,
+            scene_keys_per_second: DEFAULT_SCENE_KEYS_PER_SECOND,
             outbound_bytes_per_second: DEFAULT_OUTBOUND_BYTES_PER_SECOND,
             client_bandwidth: Bandwidth::Auto,
         }
@@ -104,6 +117,21 @@ impl Limits {
         ByteBucket::limit(f64::from(self.actions_per_second), RATE_BURST)
     }
 
+    /// One player's budget of scene keys: [`Limits::scene_keys_per_second`], a second's burst.
+    pub fn scene_keys_bucket(&self) -> ByteBucket {
+        ByteBucket::limit(f64::from(self.scene_keys_per_second), RATE_BURST)
+    }
+
+    /// All players' scene keys together.
+    pub fn all_scene_keys_bucket(&self) -> ByteBucket {
+        ByteBucket::limit(SCENE_KEYS_ALL_PLAYERS_PER_SECOND, RATE_BURST)
+    }
+
+    /// One player's new terminal sizes.
+    pub fn resizes_bucket(&self) -> ByteBucket {
+        ByteBucket::limit(RESIZES_PER_SECOND, RATE_BURST)
+    }
+
     /// All players' bytes together: [`Limits::outbound_bytes_per_second`], a second's burst.
     pub fn outbound_bucket(&self) -> ByteBucket {
         ByteBucket::limit(self.outbound_bytes_per_second as f64, RATE_BURST)
@@ -113,7 +141,21 @@ impl Limits {
 /// How much of a rate limit may be spent at once (and owed).
 pub const RATE_BURST: Duration = Duration::from_secs(1);
 
-/// Counts open TCP connections, in total and per IP address; enforced at accept.
+/// The prefix an IPv6 client is counted by: one site's /64 (a host picks any address in its /64
+/// at will, so counting single addresses would count nothing).
+pub const IPV6_PREFIX: u8 = 64;
+
+/// Who a connection is counted as, for the per-address limit: an IPv4 address (IPv4-mapped IPv6
+/// included), or an IPv6 address's /64.
+pub fn address_key(ip: IpAddr) -> IpAddr {
+    match ip.to_canonical() {
+        IpAddr::V6(v6) => IpAddr::V6(ipnet::Ipv6Net::new_assert(v6, IPV6_PREFIX).network()),
+        v4 => v4,
+    }
+}
+
+/// Counts open TCP connections, in total and per IP address (per /64 for IPv6); enforced at
+/// accept.
 #[derive(Debug)]
 pub struct ConnTracker {
     max_total: usize,
@@ -148,6 +190,7 @@ impl ConnTracker {
 
     /// Counts a new connection from `ip`, or says why it is refused.
     pub fn admit(self: &Arc<Self>, ip: IpAddr) -> Result<ConnGuard, Refusal> {
+        let ip = address_key(ip);
         let mut inner = self.inner.lock().unwrap_or_else(|p| p.into_inner());
         if inner.total >= self.max_total {
             return Err(Refusal::TooManyConnections);
@@ -257,6 +300,21 @@ mod tests {
             held.push(t.admit(IpAddr::from([10, 0, 0, i as u8])).unwrap());
         }
         assert_eq!(t.admit(b).unwrap_err(), Refusal::TooManyConnections);
+    }
+
+    #[test]
+    fn ipv6_clients_are_counted_by_their_64_and_mapped_ipv4_as_ipv4() {
+        let limits = Limits { max_clients: 100, max_per_address: 2, ..Limits::default() };
+        let t = ConnTracker::new(&limits);
+        let ip = |s: &str| s.parse::<IpAddr>().unwrap();
+        let _a = t.admit(ip("2001:db8:1:2::1")).unwrap();
+        let _b = t.admit(ip("2001:db8:1:2:ffff:ffff:ffff:fffe")).unwrap();
+        assert_eq!(t.admit(ip("2001:db8:1:2:abcd::9")).unwrap_err(), Refusal::TooManyFromAddress, "same /64");
+        let _c = t.admit(ip("2001:db8:1:3::1")).expect("the next /64 is someone else");
+        let _d = t.admit(ip("192.0.2.1")).unwrap();
+        let _e = t.admit(ip("::ffff:192.0.2.1")).unwrap();
+        assert_eq!(t.admit(ip("192.0.2.1")).unwrap_err(), Refusal::TooManyFromAddress, "mapped counts as IPv4");
+        assert_eq!(address_key(ip("192.0.2.1")), ip("192.0.2.1"), "IPv4 addresses are counted one by one");
     }
 
     #[test]

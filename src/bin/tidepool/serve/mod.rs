@@ -1,6 +1,7 @@
 //! `tidepool serve`: one shared scene, many players over SSH.
 //!
-//! Module by module: [`host_key`] (the server's identity), [`authorized_keys`] (who may play),
+//! Module by module: [`host_key`] (the server's identity), [`authorized_keys`] (who may play,
+//! from where: [`address_pattern`]),
 //! [`server`] (accept, limits per address, handshake deadline, shutdown), [`handler`] (what an
 //! SSH connection may ask for: a pty and a shell, nothing else), [`viewer`] (one player: keys
 //! in, frames out: a seat and a screen of the play session), [`game`] (the one simulation: the
@@ -10,6 +11,7 @@
 //! The library stays free of tokio and russh: this module uses its player pieces (the input
 //! parser, the frame builder, the rate-controlled encoder and byte bucket, the sim clock).
 
+pub mod address_pattern;
 pub mod authorized_keys;
 pub mod game;
 pub mod handler;
@@ -76,6 +78,13 @@ pub fn limits(args: &ServeCommand) -> Result<Limits> {
             limits::MAX_ACTIONS_PER_SECOND,
             "actions a second",
         )? as u32,
+        scene_keys_per_second: in_range(
+            "--scene-keys-per-second",
+            args.scene_keys_per_second,
+            1,
+            limits::MAX_ACTIONS_PER_SECOND,
+            "scene keys a second",
+        )? as u32,
         client_bandwidth: args.client_bandwidth,
         outbound_bytes_per_second: args.total_bandwidth.max(1),
         ..Limits::default()
@@ -124,7 +133,8 @@ pub fn run(args: ServeCommand) -> Result<()> {
         tokio::runtime::Builder::new_multi_thread().enable_all().thread_name("tidepool-serve").build().map_err(
             |e| Error::Usage(format!("cannot start the server's threads ({e}); free some memory and try again")),
         )?;
-    let options = server::ServerOptions { listen, host_key: key, allow, limits, game };
+    let options =
+        server::ServerOptions { listen, host_key: key, allow, limits, game, compression: !args.no_compression };
     let interrupted = runtime.block_on(async move {
         let running = server::start(options).await.map_err(|e| match e {
             server::StartError::Bind(e) => {

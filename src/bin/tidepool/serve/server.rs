@@ -1,6 +1,7 @@
 //! The SSH server: binds, accepts with per-address and total limits, runs each connection under
 //! a handshake deadline and a kill switch, and shuts down within a second.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -9,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use russh::keys::PrivateKey;
 use russh::server::Config;
-use russh::{MethodKind, MethodSet, SshId};
+use russh::{MethodKind, MethodSet, Preferred, SshId, compression};
 use tidepool::SceneSpec;
 use tidepool::play::{Host, HostConfig};
 use tokio::net::{TcpListener, TcpStream};
@@ -47,6 +48,8 @@ pub struct ServerOptions {
     pub limits: Limits,
     /// The shared scene.
     pub game: GameOptions,
+    /// Offer `zlib@openssh.com` compression to clients that ask for it.
+    pub compression: bool,
 }
 
 /// A running server.
@@ -73,17 +76,25 @@ impl Running {
     }
 }
 
+/// The compression offered: `zlib@openssh.com` only, which starts after authentication (so no
+/// stranger reaches the decompressor before logging in; plain `zlib` would start at once), and
+/// none. The client's order decides: `ssh -C` asks for zlib first, plain `ssh` for none.
+const COMPRESSION: &[compression::Name] = &[compression::NONE, compression::ZLIB_LEGACY];
+
 /// Builds russh's configuration. Public mode offers none, publickey and keyboard-interactive;
 /// private mode (authorized_keys) offers publickey only. Password is never offered: a public
-/// pool must not invite people to type their real password.
-pub fn russh_config(host_key: PrivateKey, private: bool, limits: &Limits) -> Config {
+/// pool must not invite people to type their real password. `compress`: offer
+/// `zlib@openssh.com`.
+pub fn russh_config(host_key: PrivateKey, private: bool, limits: &Limits, compress: bool) -> Config {
     let methods: &[MethodKind] = if private {
         &[MethodKind::PublicKey]
     } else {
         &[MethodKind::None, MethodKind::PublicKey, MethodKind::KeyboardInteractive]
     };
+    let compression = if compress { COMPRESSION } else { &[compression::NONE] };
     Config {
         server_id: SshId::Standard(SERVER_ID.into()),
+        preferred: Preferred { compression: Cow::Borrowed(compression), ..Preferred::default() },
         methods: MethodSet::from(methods),
         auth_rejection_time: limits.auth_rejection_time,
         // OpenSSH always probes with "none" first: do not make every private-mode login wait.
@@ -132,7 +143,7 @@ pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
     let mut host = opts.game.host().map_err(StartError::Scene)?;
     let listener = TcpListener::bind(opts.listen).await.map_err(StartError::Bind)?;
     let local_addr = listener.local_addr().map_err(StartError::Bind)?;
-    let config = Arc::new(russh_config(opts.host_key, opts.allow.is_some(), &opts.limits));
+    let config = Arc::new(russh_config(opts.host_key, opts.allow.is_some(), &opts.limits, opts.compression));
     let stats = Arc::new(Stats::default());
     let game_stats = Arc::new(GameStats::default());
     let players = PlayerSlots::new(opts.limits.max_clients);
@@ -144,6 +155,7 @@ pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
     let shutdown = CancellationToken::new();
     let hub = Arc::new(Hub {
         outbound: Mutex::new(opts.limits.outbound_bucket()),
+        scene_keys: Mutex::new(opts.limits.all_scene_keys_bucket()),
         limits: opts.limits,
         allow: opts.allow,
         config,
@@ -242,6 +254,7 @@ async fn connection(hub: Arc<Hub>, stream: TcpStream, peer: SocketAddr, guard: C
     let playing = CancellationToken::new();
     let handler = ClientHandler::new(hub.clone(), id, peer, kill.clone(), playing.clone());
     let stream = Killable::new(stream, kill.clone());
+    let counts = stream.counts();
 
     let deadline = {
         let (kill, playing, stats) = (kill.clone(), playing.clone(), hub.stats.clone());
@@ -272,8 +285,10 @@ async fn connection(hub: Arc<Hub>, stream: TcpStream, peer: SocketAddr, guard: C
         }
     };
     let ((), result) = tokio::join!(deadline, session);
-    if let Err(e) = result {
-        eprintln!("serve: {peer} #{id} ended: {e}");
+    let (out, into) = counts.get();
+    match result {
+        Err(e) => eprintln!("serve: {peer} #{id} ended: {e}; {out} bytes out, {into} in on the socket"),
+        Ok(()) => eprintln!("serve: {peer} #{id} closed: {out} bytes out, {into} in on the socket"),
     }
     drop(guard);
 }

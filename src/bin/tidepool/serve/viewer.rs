@@ -17,11 +17,12 @@ use std::time::Instant;
 use bytes::Bytes;
 use russh::ChannelWriteHalf;
 use russh::server::Msg;
-use tidepool::play::{Flow, Player, Screen, ScreenConfig};
+use tidepool::Action;
+use tidepool::play::{Flow, Membership, Player, Request, Screen, ScreenConfig, Source};
 use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
-use super::game::SharedFrame;
+use super::game::{SharedFrame, Viewing};
 use super::hub::Hub;
 use super::leave::{self, Leave};
 use super::limits::PlayerSlot;
@@ -56,6 +57,27 @@ struct Tally {
     sent: u64,
     skipped: u64,
     bytes: u64,
+    /// Requests sent to the game, and dropped by a rate limit or a full queue.
+    actions: u64,
+    dropped: u64,
+    /// Of the requests sent, scene keys.
+    scene_keys: u64,
+    /// New terminal sizes taken.
+    resizes: u64,
+    /// Frames that were the group's bytes.
+    from_group: u64,
+}
+
+/// The frame buffer a player in step with its group keeps at most, in bytes.
+const IN_STEP_BUFFER: usize = 64 * 1024;
+
+/// How soon a new terminal size that had to wait is tried again.
+const RESIZE_RETRY: std::time::Duration = std::time::Duration::from_millis(100);
+
+/// Whether a request costs the game thread more than a stone (a scene key: rain, clear, damping,
+/// pause, wind, `tab`): those have a rate limit of their own, per player and for all.
+fn costs_the_game(request: &Request) -> bool {
+    !matches!(request, Request::RandomStone { .. } | Request::Act(Action::Stone { .. } | Action::Stir { .. }))
 }
 
 /// Runs the player until it leaves, then says goodbye (bounded in time) and frees its place.
@@ -66,11 +88,18 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     let screen = Screen::new(screen, terminal.borrow().size, now);
     let mut player =
         Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into())).without_screenshots();
-    hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, *player.seat.fit());
+    let mut membership = Membership::new();
+    let mut viewing = Viewing { fit: *player.seat.fit(), group: None };
+    hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
     let mut frames = hub.frames.clone();
     let mut actions = hub.limits.actions_bucket();
+    let mut scene_keys = hub.limits.scene_keys_bucket();
+    let mut resizes = hub.limits.resizes_bucket();
+    // A new terminal size waiting for the resize rate.
+    let mut resize: Option<(u16, u16)> = None;
     let mut requests = Vec::new();
-    let (mut last_input, mut owed) = (now, false);
+    let mut out = Vec::new();
+    let (mut last_input, mut owed, mut deferred) = (now, false, false);
     let mut tally = Tally::default();
     let mut scene_name = frames.borrow().status.name;
 
@@ -93,8 +122,9 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                     if changed.is_err() { break 'game Leave::Cut; }
                     let state = *terminal.borrow_and_update();
                     if state.closed { break 'game Leave::ClientClosed; }
-                    player.screen.resize(state.size);
+                    resize = Some(state.size);
                 }
+                _ = tokio::time::sleep(RESIZE_RETRY), if resize.is_some() => {}
                 bytes = input.recv() => {
                     let Some(bytes) = bytes else { break 'game Leave::Cut };
                     if player.feed(&bytes, Instant::now()) {
@@ -114,6 +144,16 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 }
             }
             let now = Instant::now();
+            if let Some(size) = resize {
+                if resizes.try_take(1.0, now) {
+                    player.screen.resize(size);
+                    tally.resizes += 1;
+                    resize = None;
+                } else if !deferred {
+                    stats.resizes_deferred.fetch_add(1, Ordering::Relaxed);
+                }
+                deferred = resize.is_some();
+            }
             let shared = frames.borrow().clone();
             scene_name = shared.status.name;
             let turn = player.turn(now, &shared.status, &mut requests);
@@ -121,13 +161,39 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 break 'game Leave::Quit;
             }
             for request in requests.drain(..) {
-                if !actions.try_take(1.0, now) || hub.requests.try_send(request).is_err() {
+                let allowed = if costs_the_game(&request) {
+                    let ok = scene_keys.try_take(1.0, now)
+                        && hub.scene_keys.lock().unwrap_or_else(|p| p.into_inner()).try_take(1.0, now);
+                    if ok {
+                        tally.scene_keys += 1;
+                    } else {
+                        stats.scene_keys_dropped.fetch_add(1, Ordering::Relaxed);
+                    }
+                    ok
+                } else {
+                    let ok = actions.try_take(1.0, now);
+                    if !ok {
+                        stats.actions_dropped.fetch_add(1, Ordering::Relaxed);
+                    }
+                    ok
+                };
+                if !allowed {
+                    tally.dropped += 1;
+                } else if hub.requests.try_send(request).is_err() {
                     stats.actions_dropped.fetch_add(1, Ordering::Relaxed);
+                    tally.dropped += 1;
+                } else {
+                    tally.actions += 1;
                 }
             }
             if turn.layout_changed {
                 player.refit(hub.scene_size);
-                hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, *player.seat.fit());
+                membership.reset();
+            }
+            let now_viewing = Viewing { fit: *player.seat.fit(), group: membership.key(&player.screen) };
+            if (now_viewing.fit, now_viewing.group) != (viewing.fit, viewing.group) {
+                viewing = now_viewing;
+                hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
             }
             owed |= turn.urgent || turn.layout_changed;
             // A new shared picture or a key's frame: the game's rate paces the frames.
@@ -142,12 +208,18 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 continue;
             }
             owed = false;
-            // The frame's bytes go to russh as `Bytes`, so a buffer cannot be kept between frames.
-            let mut out = Vec::new();
-            let Ok(len) = player.frame(now, &picture, &shared.status, &mut out) else { continue };
+            // The frame is built in a buffer kept from frame to frame (the screen reserves room
+            // for its largest frame in it) and copied out at its own size: handing the buffer
+            // itself to russh would hold that reservation per frame in flight.
+            out.clear();
+            let feed = viewing.group.and_then(|key| shared.groups.get(&key));
+            let Ok((len, source)) = membership.frame(&mut player, now, &picture, &shared.status, feed, &mut out) else {
+                continue;
+            };
             if len == 0 {
                 continue;
             }
+            let from_group = source == Source::Group;
             hub.outbound.lock().unwrap_or_else(|p| p.into_inner()).owe(len);
             // data_bytes waits for the client's SSH window and for room in russh's queue: that
             // wait is the backpressure. Meanwhile newer pictures replace older ones in the slot.
@@ -155,9 +227,15 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 biased;
                 _ = kill.cancelled() => break 'game Leave::Cut,
                 _ = hub.shutdown.cancelled() => break 'game Leave::Shutdown,
-                done = write.data_bytes(Bytes::from(out)) => {
+                done = write.data_bytes(Bytes::copy_from_slice(&out)) => {
                     if done.is_err() { break 'game Leave::Cut; }
                     tally.sent += 1;
+                    tally.from_group += u64::from(from_group);
+                    if membership.in_step() && out.capacity() > IN_STEP_BUFFER {
+                        // Room for a whole frame of its own is not needed while the group's
+                        // bytes come: give it back (it comes again if the player leaves).
+                        out = Vec::new();
+                    }
                     tally.bytes += len as u64;
                     stats.frames_sent.fetch_add(1, Ordering::Relaxed);
                 }
@@ -172,14 +250,27 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     hub.fits.lock().unwrap_or_else(|p| p.into_inner()).remove(&id);
     drop(slot); // the place is free as soon as the game ends
     let published = frames.borrow().number;
+    let group = membership.stats();
     let skipped = tally.finish(published);
     stats.frames_skipped.fetch_add(skipped, Ordering::Relaxed);
     let seen = tally.first.map_or(0, |first| published.saturating_sub(first) + 1);
     eprintln!(
-        "serve: {peer} #{id} left ({}): {} frames sent, {skipped} skipped of {seen} published, {} bytes",
+        "serve: {peer} #{id} left ({}): {} frames sent ({} from its group), {skipped} skipped of {seen} published, {} bytes, \
+         {} actions taken, {} dropped, {} scene keys taken, {} new sizes; link {} B/s; joined its group {} times, \
+         left it {} times for an overlay, {} behind, {} for another group",
         reason.name(),
         tally.sent,
-        tally.bytes
+        tally.from_group,
+        tally.bytes,
+        tally.actions - tally.scene_keys,
+        tally.dropped,
+        tally.scene_keys,
+        tally.resizes,
+        player.screen.rate().map_or(-1, |r| r as i64),
+        group.joined,
+        group.left_for_overlay,
+        group.left_behind,
+        group.left_for_key,
     );
     let mut goodbye = Vec::new();
     player.screen.farewell(&mut goodbye);
