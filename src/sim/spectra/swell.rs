@@ -114,7 +114,7 @@ impl FromStr for Swell {
     }
 }
 
-/// Up to [`MAX_SWELLS`] swells (a `Copy` list, so a sea's parameters stay plain values).
+/// Up to 4 swells (a `Copy` list, so a sea's parameters stay plain values).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Swells {
     list: [Option<Swell>; MAX_SWELLS],
@@ -124,7 +124,7 @@ impl Swells {
     /// No swell.
     pub const NONE: Swells = Swells { list: [None; MAX_SWELLS] };
 
-    /// The swells of `list` (at most [`MAX_SWELLS`]).
+    /// The swells of `list` (at most 4).
     pub fn new(list: &[Swell]) -> Result<Swells, ValueError> {
         if list.len() > MAX_SWELLS {
             return Err(ValueError::new(
