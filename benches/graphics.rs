@@ -25,11 +25,11 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use tidepool::graphics::geometry::{SCALED_CAP, layout};
 use tidepool::graphics::iterm2::Iterm2Encoder;
 use tidepool::graphics::kitty::{KittyEncoder, KittyOptions, Medium, temp_dir};
 use tidepool::graphics::sixel::{SixelEncoder, SixelPalette};
 use tidepool::graphics::{GraphicsMode, push_rgb};
+use tidepool::graphics::{SCALED_CAP, layout};
 use tidepool::{Damping, PoolScene, PoolSettings, Scene, Stone};
 use tiny_skia::Pixmap;
 

@@ -30,10 +30,10 @@ use std::time::{Duration, Instant};
 
 use base64::Engine;
 use criterion::Criterion;
-use tidepool::graphics::geometry::{SCALED_CAP, layout};
 use tidepool::graphics::kitty::KittyOptions;
 use tidepool::graphics::sixel::{Registers, SixelPalette};
 use tidepool::graphics::{Budget, GraphicsMode, PictureStream, Protocol, kitty, kitty_decode};
+use tidepool::graphics::{SCALED_CAP, layout};
 use tidepool::terminal::{
     ByteBucket, Color, ColorMode, Frame, Luma, RateEncoder, RateOptions, Shown, Target, TerminalModel,
 };

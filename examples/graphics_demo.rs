@@ -15,11 +15,11 @@
 use std::io::{self, Write};
 use std::time::{Duration, Instant};
 
-use tidepool::graphics::geometry::{SCALED_CAP, layout};
 use tidepool::graphics::iterm2::Iterm2Encoder;
 use tidepool::graphics::kitty::{self, KittyEncoder, KittyOptions, Medium};
 use tidepool::graphics::sixel::{SixelEncoder, SixelPalette, dithered_rgb};
 use tidepool::graphics::{GraphicsMode, push_rgb};
+use tidepool::graphics::{SCALED_CAP, layout};
 use tidepool::play::GraphicsRequest;
 use tiny_skia::{Color, FilterQuality, Pixmap, PixmapPaint, Rect, Transform};
 

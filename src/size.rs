@@ -9,7 +9,7 @@ pub const MAX_SIDE: u32 = 16_384;
 /// The most pixels tidepool renders in one picture (including any supersampling).
 pub const MAX_PIXELS: u64 = 64 * 1024 * 1024;
 
-/// A picture size in pixels, within [`MAX_SIDE`] and [`MAX_PIXELS`].
+/// A picture size in pixels, within `MAX_SIDE` and `MAX_PIXELS`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Size {
     width: u32,
@@ -58,7 +58,7 @@ impl Size {
         u64::from(self.width) * u64::from(self.height)
     }
 
-    /// Refuses pictures over [`MAX_PIXELS`] once supersampled `ssaa x ssaa`.
+    /// Refuses pictures over `MAX_PIXELS` once supersampled `ssaa x ssaa`.
     pub fn check_supersampled(self, ssaa: u32) -> Result<(), ValueError> {
         let pixels = self.pixels() * u64::from(ssaa) * u64::from(ssaa);
         if pixels > MAX_PIXELS {

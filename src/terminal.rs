@@ -8,7 +8,7 @@ pub use crate::output::bucket::ByteBucket;
 pub use crate::output::color::{Color, ColorMode};
 pub use crate::output::diff::{EncodeOptions, SYNC_BEGIN, SYNC_END, Shown, encode, encode_into};
 pub use crate::output::frame::{Cell, Frame};
-pub use crate::output::quality::{EXACT_PSNR_DB, Quality, measure, screen_luma};
+pub use crate::output::quality::{Quality, measure, screen_luma};
 pub use crate::output::rate::{RateEncoder, RateOptions, Report, Strategy, Target, UNLIMITED};
 pub use crate::output::ssim::{Luma, SsimReference, ssim};
 pub use crate::output::vt::TerminalModel;

@@ -4,9 +4,8 @@
 //! `FromStr` instead; these are the plain numbers.
 
 pub use crate::numbers::finite as parse_number;
-pub use crate::scene::pool::{MAX_GRID, MAX_STEPS_PER_SECOND, parse_grid, parse_steps_per_second};
-pub use crate::sim::breeze::{DEFAULT_LEVEL as DEFAULT_BREEZE, MAX_LEVEL as MAX_BREEZE, parse_level as parse_breeze};
+pub use crate::scene::pool::{parse_grid, parse_steps_per_second};
+pub use crate::sim::breeze::{DEFAULT_LEVEL as DEFAULT_BREEZE, parse_level as parse_breeze};
 pub use crate::sim::lake::{parse_octaves, parse_persistence};
 pub use crate::sim::rain::parse_rate as parse_rain_rate;
 pub use crate::sim::wind::{parse_lake_wind, parse_sea_wind};
-pub use crate::size::{MAX_PIXELS, MAX_SIDE};

@@ -55,7 +55,7 @@ pub fn file_names(frame: Option<u32>) -> [String; 6] {
     ]
 }
 
-/// Every file of `maps` as (name, bytes), in [`file_names`]' order.
+/// Every file of `maps` as (name, bytes), in `file_names`' order.
 ///
 /// # Panics
 /// When a field does not hold `size x size` values (a programming error).

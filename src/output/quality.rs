@@ -30,7 +30,7 @@ pub struct Quality {
 }
 
 impl Quality {
-    /// The peak signal-to-noise ratio in dB, [`EXACT_PSNR_DB`] when the picture is exact.
+    /// The peak signal-to-noise ratio in dB, `EXACT_PSNR_DB` when the picture is exact.
     pub fn psnr(&self) -> f64 {
         psnr(self.mse)
     }

@@ -139,6 +139,22 @@ impl Fit {
         (step(cell_w, self.scene.0, w), step(cell_h, self.scene.1, h))
     }
 
+    /// `scene` fitted into a picture of the target's size, in `old`'s pixels when it has that
+    /// size (a shared scene's pictures are reused from frame to frame).
+    pub fn fitted(&self, scene: &Pixmap, old: Option<Pixmap>) -> Option<Pixmap> {
+        let (w, h) = self.target();
+        let mut picture = match old {
+            Some(p) if (p.width(), p.height()) == (w, h) => p,
+            _ => Pixmap::new(w, h)?,
+        };
+        if self.one_to_one() {
+            picture.data_mut().copy_from_slice(scene.data());
+        } else {
+            self.draw(scene, &mut picture);
+        }
+        Some(picture)
+    }
+
     /// Draws `scene` (of the scene's size) into `out` (of the target's size): scaled, centred,
     /// bars around it. Whole-number growth stays sharp; anything else is filtered.
     pub fn draw(&self, scene: &Pixmap, out: &mut Pixmap) {

@@ -24,12 +24,13 @@
 //! of the group's stream, its class's rate), not one player's. Real-pixel screens (kitty,
 //! sixel, iTerm2) keep their own picture streams: they draw alone.
 
-use std::collections::VecDeque;
+use std::collections::{HashMap, VecDeque};
 use std::hash::{Hash, Hasher};
 use std::io;
 use std::sync::Arc;
 use std::time::Instant;
 
+use rayon::prelude::*;
 use tiny_skia::Pixmap;
 
 use super::host::SceneStatus;
@@ -222,6 +223,59 @@ impl Group {
     /// The last frames, for the members.
     pub fn feed(&self) -> GroupFeed {
         GroupFeed { key: self.key, frames: self.frames.iter().cloned().collect() }
+    }
+}
+
+/// The groups of one shared scene: one for every key that at least [`Groups::MIN_MEMBERS`]
+/// players have, the [`Groups::MAX`] largest. The game keeps them from frame to frame.
+#[derive(Debug, Default)]
+pub struct Groups {
+    groups: HashMap<GroupKey, Group>,
+}
+
+impl Groups {
+    /// Most groups encoded per frame (the largest first); players of the others encode alone,
+    /// on their own tasks. Bounds the game's work whatever sizes the players choose.
+    pub const MAX: usize = 64;
+    /// Players a key needs for a group: one player alone encodes for itself.
+    pub const MIN_MEMBERS: usize = 2;
+
+    /// Keeps a group for every key of `keys` (one a player) that enough players have, new
+    /// ones starting at `now`; drops the rest.
+    pub fn keep(&mut self, keys: impl IntoIterator<Item = GroupKey>, now: Instant) {
+        let mut members: HashMap<GroupKey, usize> = HashMap::new();
+        for key in keys {
+            *members.entry(key).or_default() += 1;
+        }
+        let mut keys: Vec<(usize, GroupKey)> =
+            members.into_iter().filter(|&(_, n)| n >= Self::MIN_MEMBERS).map(|(k, n)| (n, k)).collect();
+        if keys.len() > Self::MAX {
+            // The largest groups save the most; ties by size so the choice is stable.
+            keys.sort_unstable_by_key(|&(n, k)| (std::cmp::Reverse(n), k.term));
+            keys.truncate(Self::MAX);
+        }
+        self.groups.retain(|key, _| keys.iter().any(|(_, k)| k == key));
+        for (_, key) in keys {
+            self.groups.entry(key).or_insert_with(|| Group::new(key, now));
+        }
+    }
+
+    /// Encodes every group's frame from the picture of its size in `pictures`, in parallel;
+    /// returns how many changed something.
+    pub fn encode(&mut self, pictures: &HashMap<(u32, u32), Arc<Pixmap>>, status: &SceneStatus, now: Instant) -> u64 {
+        let mut work: Vec<&mut Group> = self.groups.values_mut().collect();
+        work.par_iter_mut()
+            .map(|group| match pictures.get(&group.key().picture_size()) {
+                // A group frame fails only for kitty's temporary file, which cells never write.
+                Some(picture) => u64::from(group.frame(now, picture, status).unwrap_or(false)),
+                None => 0,
+            })
+            .sum()
+    }
+
+    /// Every group's last frames, to publish.
+    pub fn feeds(&self) -> HashMap<GroupKey, GroupFeed> {
+        self.groups.iter().map(|(key, group)| (*key, group.feed())).collect()
     }
 }
 

@@ -71,7 +71,7 @@ pub(crate) mod seat;
 pub use crate::term::door::{PlayConfig, TerminalInput, run};
 pub use crate::term::tty::{play, probe_for_picture, restore};
 pub use fit::Fit;
-pub use group::{FEED_FRAMES, Group, GroupFeed, GroupFrame, GroupKey, LinkClass, Membership, MembershipStats, Source};
+pub use group::{GroupFeed, GroupKey, Groups, Membership, Source};
 pub use host::{Host, HostConfig, Recording, SceneStatus};
 pub use input::Input;
 pub use player::{Player, Turn};

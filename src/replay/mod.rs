@@ -20,12 +20,12 @@
 //! the constructor the command line uses, and every count is bounded ([`Limits`]).
 //!
 //! The player keeps the file in memory while playing and saves it whole when the session ends
-//! ([`Recorder`]), so a replay on disk is always complete; a file without its `end` line is
+//! (its recorder), so a replay on disk is always complete; a file without its `end` line is
 //! reported as truncated.
 
 mod recorder;
 
-pub use recorder::Recorder;
+pub(crate) use recorder::Recorder;
 
 use std::path::{Path, PathBuf};
 
@@ -43,7 +43,7 @@ use crate::sim::ripple::Damping;
 use crate::size::Size;
 
 /// The replay format this tidepool writes and reads.
-pub const FORMAT: u64 = 1;
+pub(crate) const FORMAT: u64 = 1;
 
 /// What a replay may hold. Hostile or damaged files are refused by these limits at once,
 /// instead of allocating gigabytes or simulating for ever.
@@ -82,7 +82,7 @@ impl Default for Limits {
 /// The first line of a replay.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Header {
-    /// The format number, [`FORMAT`].
+    /// The format number (1 today).
     #[serde(rename = "tidepool_replay")]
     pub format: u64,
     /// The tidepool version that recorded it (informational).
@@ -197,6 +197,16 @@ pub struct Replay {
 }
 
 impl Replay {
+    /// The replay as a file holds it: the header line, then one line an event (what
+    /// [`parse`] reads back to an equal replay).
+    pub fn to_text(&self) -> String {
+        let mut text = header_line(&self.header) + "\n";
+        for entry in &self.entries {
+            text += &(event_line(entry) + "\n");
+        }
+        text
+    }
+
     /// The step of the `end` line.
     pub fn end_step(&self) -> u64 {
         self.entries.last().map_or(0, |e| e.step)
@@ -244,12 +254,12 @@ impl Replay {
 }
 
 /// One header line, as written.
-pub fn header_line(header: &Header) -> String {
+pub(crate) fn header_line(header: &Header) -> String {
     serde_json::to_string(header).expect("a header always serializes")
 }
 
 /// One event line, as written.
-pub fn event_line(entry: &Entry) -> String {
+pub(crate) fn event_line(entry: &Entry) -> String {
     serde_json::to_string(entry).expect("an event always serializes")
 }
 
@@ -259,7 +269,7 @@ pub fn read(path: &Path) -> Result<Replay> {
 }
 
 /// [`read`] with other limits.
-pub fn read_with(path: &Path, limits: &Limits) -> Result<Replay> {
+pub(crate) fn read_with(path: &Path, limits: &Limits) -> Result<Replay> {
     let fail = |line: usize, message: String| Error::Replay { path: path.to_owned(), line, message };
     let size = std::fs::metadata(path).map_err(|e| Error::io("cannot read", path, e))?.len();
     if size > limits.max_bytes {

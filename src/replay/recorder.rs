@@ -46,11 +46,6 @@ impl Recorder {
         self.step = self.step.max(step);
     }
 
-    /// The latest step seen.
-    pub fn step(&self) -> u64 {
-        self.step
-    }
-
     /// Adds the end line and saves the file (once; later calls do nothing).
     pub fn finish(&mut self, step: u64) -> Result<()> {
         if self.finished {
@@ -59,11 +54,6 @@ impl Recorder {
         self.record(step, Event::End);
         self.finished = true;
         self.storage.save(&self.path, self.text.as_bytes())
-    }
-
-    /// The file it saves.
-    pub fn path(&self) -> &Path {
-        &self.path
     }
 }
 

@@ -25,11 +25,11 @@ pub struct PoolSettings {
     pub breeze: f64,
     /// How the breeze moves the water: the first breeze's short wavelets, or gusts.
     pub breeze_style: BreezeStyle,
-    /// Simulation cells per picture pixel along each axis, `1..=`[`MAX_GRID`]: 1 is the
+    /// Simulation cells per picture pixel along each axis, `1..=``MAX_GRID`: 1 is the
     /// papers' pool (its cells are its pixels); a finer grid moves the waves `1/grid` pixels a
     /// step and draws each pixel as the mean of its cells.
     pub grid: u32,
-    /// Simulation steps per second of real time, `1..=`[`MAX_STEPS_PER_SECOND`] (the player's
+    /// Simulation steps per second of real time, `1..=``MAX_STEPS_PER_SECOND` (the player's
     /// pace; animations follow it): waves move `0.7/grid` pixels a step.
     pub steps_per_second: u32,
     /// Seed of the rain.
@@ -74,7 +74,7 @@ pub fn check_steps_per_second(steps: u64) -> std::result::Result<u32, crate::err
     }
 }
 
-/// Parses a pace: a whole number of simulation steps a second, `1..=`[`MAX_STEPS_PER_SECOND`].
+/// Parses a pace: a whole number of simulation steps a second, `1..=``MAX_STEPS_PER_SECOND`.
 pub fn parse_steps_per_second(text: &str) -> std::result::Result<u32, crate::error::ValueError> {
     let steps: u64 = text.trim().parse().map_err(|_| {
         crate::error::ValueError::new("steps per second", format!("'{text}' is not a whole number of steps, e.g. 30"))
@@ -125,7 +125,7 @@ fn units_for(style: BreezeStyle) -> u32 {
 /// The finest simulation grid, in cells per pixel along each axis.
 pub const MAX_GRID: u32 = 4;
 
-/// Parses a grid: a whole number of simulation cells per picture pixel, `1..=`[`MAX_GRID`].
+/// Parses a grid: a whole number of simulation cells per picture pixel, `1..=``MAX_GRID`.
 pub fn parse_grid(text: &str) -> std::result::Result<u32, crate::error::ValueError> {
     let grid: u64 = text.trim().parse().map_err(|_| {
         crate::error::ValueError::new("grid", format!("'{text}' is not a whole number of cells per pixel, e.g. 2"))

@@ -67,7 +67,7 @@ impl std::str::FromStr for BreezeStyle {
     }
 }
 
-/// Parses a breeze level, `0..=`[`MAX_LEVEL`] (0 is the papers' still water).
+/// Parses a breeze level, `0..=``MAX_LEVEL` (0 is the papers' still water).
 pub fn parse_level(text: &str) -> Result<f64, crate::error::ValueError> {
     check_level(crate::numbers::finite(text, "breeze", "1")?)
 }

@@ -30,7 +30,7 @@ pub struct LoopPeriod {
 impl LoopPeriod {
     /// The loop of `seconds` for a sea whose longest peak period is `peak_period_s` (None: a
     /// calm; [`crate::SeaParams::longest_peak_period_s`]): finite, positive, at most an hour and
-    /// at least [`MIN_PEAK_PERIODS`] peak periods (a calm: at least 1 s).
+    /// at least 10 peak periods (a calm: at least 1 s).
     pub fn new(seconds: f64, peak_period_s: Option<f64>) -> Result<LoopPeriod, ValueError> {
         if !seconds.is_finite() || seconds <= 0.0 {
             return Err(ValueError::new(

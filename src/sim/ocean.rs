@@ -120,7 +120,9 @@ pub const SWELL_BAND: (f64, f64) = (0.75, 1.8);
 /// deviations of its cos-2s spread).
 pub const SWELL_HALF_WIDTH_RAD: f64 = 50.0 * std::f64::consts::PI / 180.0;
 
-/// Monahan's whitecap fraction 3.84e-6·U^3.41 for a wind of `wind_m_s`, capped at 1.
+/// Monahan's whitecap fraction 3.84e-6·U^3.41 for a wind of `wind_m_s`, capped at 1: what the
+/// simulated foam is checked against (never told to the model).
+#[cfg(test)]
 pub fn whitecap_fraction(wind_m_s: f64) -> f64 {
     (3.84e-6 * wind_m_s.max(0.0).powf(3.41)).min(1.0)
 }
@@ -130,7 +132,7 @@ pub fn cox_munk_slope_variance(wind_m_s: f64) -> f64 {
     0.003 + 0.00512 * wind_m_s.max(0.0)
 }
 
-/// Checks a choppiness: finite, 0..=[`MAX_CHOPPINESS`].
+/// Checks a choppiness: finite, 0..=4.
 pub fn check_choppiness(value: f64) -> Result<f64, ValueError> {
     if !value.is_finite() || !(0.0..=MAX_CHOPPINESS).contains(&value) {
         return Err(ValueError::new(

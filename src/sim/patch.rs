@@ -161,7 +161,7 @@ pub fn check_map_size(width: usize, height: usize) -> Result<usize, ValueError> 
 /// How many peak wavelengths a map spans when no extent is given.
 pub const DEFAULT_MAP_WAVELENGTHS: f64 = 10.0;
 
-/// The default side of a map of the sea `params` describes, m ([`DEFAULT_MAP_WAVELENGTHS`]
+/// The default side of a map of the sea `params` describes, m (10
 /// peak wavelengths of the wind sea, and at least four of the longest swell's; 100 m for a
 /// calm without swell).
 pub fn default_extent_m(params: &SeaParams) -> f64 {

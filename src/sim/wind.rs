@@ -12,7 +12,7 @@ pub const DEFAULT_WIND_FROM_DEG: f64 = 330.0;
 /// The strongest wind the lake takes, m/s (a storm; beyond it a lake is all spray).
 pub const MAX_LAKE_WIND_M_S: f64 = 30.0;
 
-/// Parses the sea's wind speed, `0..=`[`MAX_SEA_WIND_M_S`] m/s.
+/// Parses the sea's wind speed, 0..=60 m/s.
 pub fn parse_sea_wind(text: &str) -> Result<f64, ValueError> {
     check_sea_wind(crate::numbers::finite(text, "wind speed", "10")?)
 }

@@ -7,9 +7,9 @@
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use tidepool::graphics::geometry::{SCALED_CAP, layout};
 use tidepool::graphics::kitty::{IMAGE_ID, KittyEncoder, KittyOptions};
 use tidepool::graphics::{Budget, GraphicsMode, Part, PictureStream, Protocol, push_rgb, resample};
+use tidepool::graphics::{SCALED_CAP, layout};
 use tiny_skia::Pixmap;
 
 const DECODER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/kitty_decode.py");

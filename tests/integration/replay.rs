@@ -39,10 +39,7 @@ fn a_replay_recorded_by_0_1_0_renders_bit_identically() {
 #[test]
 fn the_new_writer_reads_back_what_the_old_one_wrote() {
     let replay = tidepool::replay::read(&fixture("replay-v0.1.0.jsonl")).unwrap();
-    let mut text = tidepool::replay::header_line(&replay.header) + "\n";
-    for entry in &replay.entries {
-        text += &(tidepool::replay::event_line(entry) + "\n");
-    }
+    let text = replay.to_text();
     assert_eq!(tidepool::replay::parse(Path::new("rewritten"), &text).unwrap(), replay);
 }
 

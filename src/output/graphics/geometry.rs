@@ -40,7 +40,7 @@ pub struct Layout {
 }
 
 /// The layout for a terminal of `term` cells (columns, rows) with cells of `cell_px` pixels
-/// (`None`: unknown, [`DEFAULT_CELL_PX`] is assumed), the largest sixel image `sixel_max`, and
+/// (`None`: unknown, 8x16 is assumed), the largest sixel image `sixel_max`, and
 /// `cap` for scaling protocols ([`SCALED_CAP`]). Sizes are at least one pixel and one cell.
 pub fn layout(
     mode: GraphicsMode,

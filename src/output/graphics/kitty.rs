@@ -248,12 +248,7 @@ fn push_command(out: &mut Vec<u8>, command: &[u8], tmux: bool) {
 }
 
 /// Appends `data` base64-encoded in chunks: the first with `keys`, the rest with
-/// `more_keys` and `q=2`; `m=1` on all but the last.
-pub fn push_chunked(out: &mut Vec<u8>, keys: &str, more_keys: &str, data: &[u8], tmux: bool) {
-    push_chunked_bytes(out, keys.as_bytes(), more_keys.as_bytes(), data, tmux);
-}
-
-/// [`push_chunked`] for keys as bytes. Without tmux every chunk is written in place (the
+/// `more_keys` and `q=2`; `m=1` on all but the last. Without tmux every chunk is written in place (the
 /// base64 straight into `out`); inside tmux each chunk is built once and wrapped.
 fn push_chunked_bytes(out: &mut Vec<u8>, keys: &[u8], more_keys: &[u8], data: &[u8], tmux: bool) {
     let chunks = data.len().div_ceil(CHUNK_RAW).max(1);

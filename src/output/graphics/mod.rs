@@ -86,6 +86,7 @@ pub fn push_rgb(pixmap: &Pixmap, out: &mut Vec<u8>) {
 }
 
 /// The pixmap's pixels as straight RGB (see [`push_rgb`]).
+#[cfg(test)]
 pub fn rgb(pixmap: &Pixmap) -> Vec<u8> {
     let mut out = Vec::new();
     push_rgb(pixmap, &mut out);

@@ -69,8 +69,8 @@ pub struct SixelPalette {
 }
 
 impl SixelPalette {
-    /// The largest cube that fits in `registers` (clamped to [`MIN_REGISTERS`]..=
-    /// [`MAX_REGISTERS`]): levels are added green, red, blue in turn while they fit, so 256
+    /// The largest cube that fits in `registers` (clamped to 8..=
+    /// 256): levels are added green, red, blue in turn while they fit, so 256
     /// registers give 6x7x6, 64 give 4x4x4, 16 give 2x4x2.
     pub fn for_registers(registers: u16) -> SixelPalette {
         let n = u32::from(registers.clamp(MIN_REGISTERS, MAX_REGISTERS));
@@ -170,17 +170,10 @@ pub enum Registers {
     /// its few colours instead of the whole palette (3.7 kB at 256 registers).
     PerImage,
     /// Each register is defined once, the first time any image uses it, and kept: only for a
-    /// terminal whose images share their registers ([`SHARED_REGISTERS_ON`] sent first, and the
-    /// terminal said it knows the mode). [`SixelEncoder::forget_registers`] starts over.
+    /// terminal whose images share their registers (xterm after `ESC [ ? 1070 l`, which the player
+    /// does not send: it draws `PerImage`). [`SixelEncoder::forget_registers`] starts over.
     Shared,
 }
-
-/// Makes xterm's sixel images share one set of colour registers (DEC private mode 1070 off:
-/// "use private color registers for each graphic" is on by default), so registers defined once
-/// stay defined for later images ([`Registers::Shared`]).
-pub const SHARED_REGISTERS_ON: &[u8] = b"\x1b[?1070l";
-/// Undoes [`SHARED_REGISTERS_ON`] (for the terminal's restore).
-pub const SHARED_REGISTERS_OFF: &[u8] = b"\x1b[?1070h";
 
 /// The encoder, with the dithered picture the terminal shows.
 #[derive(Debug)]
@@ -269,7 +262,7 @@ impl SixelEncoder {
     }
 
     /// Cuts images so that none takes more than `bytes` (tmux buffers at most 1 MiB of one
-    /// sequence and drops a longer one: [`TMUX_MAX_IMAGE_BYTES`]), and wraps them for tmux
+    /// sequence and drops a longer one: `TMUX_MAX_IMAGE_BYTES`), and wraps them for tmux
     /// passthrough when `tmux`. An image is cut between bands that start on a text row, so each
     /// piece starts at a cell.
     pub fn set_max_image_bytes(&mut self, bytes: Option<usize>, tmux: bool) {

@@ -26,6 +26,7 @@ pub fn push_wrapped(out: &mut Vec<u8>, inner: &[u8]) {
 }
 
 /// `inner` wrapped for tmux passthrough.
+#[cfg(test)]
 pub fn wrap(inner: &[u8]) -> Vec<u8> {
     let mut out = Vec::new();
     push_wrapped(&mut out, inner);

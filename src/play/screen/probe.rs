@@ -135,7 +135,7 @@ pub struct ProbeOptions {
     /// The window size.
     pub winsize: WinSize,
     /// A temporary file holding one RGB pixel (3 bytes) whose name carries
-    /// [`kitty::TEMP_FILE_MARKER`], for the file-medium query; `None` skips that query (always
+    /// `TEMP_FILE_MARKER`, for the file-medium query; `None` skips that query (always
     /// over SSH). The caller writes it before and removes it after the probe if the terminal
     /// did not.
     pub kitty_file: Option<std::path::PathBuf>,

@@ -8,7 +8,7 @@
 //!
 //! Players whose screens are alike (size, colours, link class: a [`GroupKey`]) share their
 //! frames: for every key that two or more players have, the game encodes the frame once
-//! ([`Group`], in parallel across groups) and publishes the group's last frames with the
+//! ([`Groups`], in parallel across groups) and publishes the group's last frames with the
 //! pictures; each player takes them while its terminal shows the group's model
 //! ([`tidepool::play::Membership`]). Server CPU then grows with the groups, not the players.
 
@@ -18,8 +18,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use rayon::prelude::*;
-use tidepool::play::{Fit, Group, GroupFeed, GroupKey, Host, Request, SceneStatus};
+use tidepool::play::{Fit, GroupFeed, GroupKey, Groups, Host, Request, SceneStatus};
 use tiny_skia::Pixmap;
 use tokio::sync::{mpsc, watch};
 
@@ -27,11 +26,6 @@ use super::limits::PlayerSlots;
 
 /// Most requests waiting for the next step, from all players together; more are dropped.
 pub const REQUEST_QUEUE: usize = 1024;
-/// Most groups encoded per frame (the largest first); players of the others encode alone, on
-/// their own tasks. Bounds the game thread's work whatever sizes the players choose.
-pub const MAX_GROUPS: usize = 64;
-/// Players a key needs for a group: one player alone encodes for itself.
-const MIN_MEMBERS: usize = 2;
 /// The longest the game thread sleeps before looking at its stop flag again.
 const MAX_SLEEP: Duration = Duration::from_millis(20);
 
@@ -97,7 +91,7 @@ pub fn run(mut host: Host, fps: u32, mut links: GameLinks) {
     let mut next_frame = Instant::now();
     let mut number = 0u64;
     let mut pictures: HashMap<(u32, u32), Arc<Pixmap>> = HashMap::new();
-    let mut groups: HashMap<GroupKey, Group> = HashMap::new();
+    let mut groups = Groups::default();
     while !links.stop.load(Ordering::Relaxed) {
         let now = Instant::now();
         while let Ok(request) = links.requests.try_recv() {
@@ -123,15 +117,17 @@ pub fn run(mut host: Host, fps: u32, mut links: GameLinks) {
                 if drawn.contains_key(&fit.target()) {
                     continue;
                 }
-                if let Some(picture) = draw(&fit, &scene, pictures.remove(&fit.target())) {
-                    drawn.insert(fit.target(), picture);
+                // Last frame's picture of this size, when no player holds it any more.
+                let old = pictures.remove(&fit.target()).and_then(|p| Arc::try_unwrap(p).ok());
+                if let Some(picture) = fit.fitted(&scene, old) {
+                    drawn.insert(fit.target(), Arc::new(picture));
                     links.stats.pictures.fetch_add(1, Ordering::Relaxed);
                 }
             }
-            keep_groups(&mut groups, &viewing, now);
-            let encoded = encode_groups(&mut groups, &drawn, &status, now);
+            groups.keep(viewing.iter().filter_map(|v| v.group), now);
+            let encoded = groups.encode(&drawn, &status, now);
             links.stats.group_frames.fetch_add(encoded, Ordering::Relaxed);
-            let feeds = groups.iter().map(|(key, group)| (*key, group.feed())).collect();
+            let feeds = groups.feeds();
             links.stats.frames.fetch_add(1, Ordering::Relaxed);
             // Never waits: a player still busy with an older picture simply sees a later one.
             let frame = SharedFrame { number, status: Arc::new(status), pictures: drawn, groups: feeds };
@@ -146,56 +142,4 @@ pub fn run(mut host: Host, fps: u32, mut links: GameLinks) {
         }
     }
     drop(links.publish);
-}
-
-/// Keeps a group for every key at least [`MIN_MEMBERS`] players have (the [`MAX_GROUPS`]
-/// largest), new ones starting at `now`; drops the rest.
-fn keep_groups(groups: &mut HashMap<GroupKey, Group>, viewing: &[Viewing], now: Instant) {
-    let mut members: HashMap<GroupKey, usize> = HashMap::new();
-    for key in viewing.iter().filter_map(|v| v.group) {
-        *members.entry(key).or_default() += 1;
-    }
-    let mut keys: Vec<(usize, GroupKey)> =
-        members.into_iter().filter(|&(_, n)| n >= MIN_MEMBERS).map(|(k, n)| (n, k)).collect();
-    if keys.len() > MAX_GROUPS {
-        // The largest groups save the most; ties by size so the choice is stable.
-        keys.sort_unstable_by_key(|&(n, k)| (std::cmp::Reverse(n), k.term));
-        keys.truncate(MAX_GROUPS);
-    }
-    groups.retain(|key, _| keys.iter().any(|(_, k)| k == key));
-    for (_, key) in keys {
-        groups.entry(key).or_insert_with(|| Group::new(key, now));
-    }
-}
-
-/// Encodes every group's frame, in parallel; returns how many changed something.
-fn encode_groups(
-    groups: &mut HashMap<GroupKey, Group>,
-    pictures: &HashMap<(u32, u32), Arc<Pixmap>>,
-    status: &SceneStatus,
-    now: Instant,
-) -> u64 {
-    let mut work: Vec<&mut Group> = groups.values_mut().collect();
-    work.par_iter_mut()
-        .map(|group| match pictures.get(&group.key().picture_size()) {
-            // A group frame fails only for kitty's temporary file, which cells never write.
-            Some(picture) => u64::from(group.frame(now, picture, status).unwrap_or(false)),
-            None => 0,
-        })
-        .sum()
-}
-
-/// `scene` fitted into a picture of `fit`'s target size, reusing `old` when nobody else holds it.
-fn draw(fit: &Fit, scene: &Pixmap, old: Option<Arc<Pixmap>>) -> Option<Arc<Pixmap>> {
-    let (w, h) = fit.target();
-    let mut picture = match old.map(Arc::try_unwrap) {
-        Some(Ok(p)) if (p.width(), p.height()) == (w, h) => p,
-        _ => Pixmap::new(w, h)?,
-    };
-    if fit.one_to_one() {
-        picture.data_mut().copy_from_slice(scene.data());
-    } else {
-        fit.draw(scene, &mut picture);
-    }
-    Some(Arc::new(picture))
 }

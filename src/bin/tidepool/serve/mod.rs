@@ -14,6 +14,7 @@
 pub mod address_pattern;
 pub mod authorized_keys;
 pub mod game;
+mod gate;
 pub mod handler;
 pub mod host_key;
 mod hub;
@@ -21,6 +22,7 @@ pub mod killable;
 pub mod leave;
 pub mod limits;
 pub mod server;
+mod tally;
 pub mod viewer;
 
 use std::net::SocketAddr;

@@ -17,15 +17,16 @@ use std::time::Instant;
 use bytes::Bytes;
 use russh::ChannelWriteHalf;
 use russh::server::Msg;
-use tidepool::Action;
-use tidepool::play::{Flow, Membership, Player, Request, Screen, ScreenConfig, Source};
+use tidepool::play::{Flow, Membership, Player, Screen, ScreenConfig, Source};
 use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
-use super::game::{SharedFrame, Viewing};
+use super::game::Viewing;
+use super::gate::RequestGate;
 use super::hub::Hub;
 use super::leave::{self, Leave};
 use super::limits::PlayerSlot;
+use super::tally::Tally;
 
 /// What the connection's handler tells the player task about its terminal.
 #[derive(Debug, Clone, Copy)]
@@ -49,36 +50,11 @@ pub(crate) struct ViewerCtx {
     pub slot: PlayerSlot,
 }
 
-/// What one player's game did, for the log.
-#[derive(Default)]
-struct Tally {
-    first: Option<u64>,
-    last: u64,
-    sent: u64,
-    skipped: u64,
-    bytes: u64,
-    /// Requests sent to the game, and dropped by a rate limit or a full queue.
-    actions: u64,
-    dropped: u64,
-    /// Of the requests sent, scene keys.
-    scene_keys: u64,
-    /// New terminal sizes taken.
-    resizes: u64,
-    /// Frames that were the group's bytes.
-    from_group: u64,
-}
-
 /// The frame buffer a player in step with its group keeps at most, in bytes.
 const IN_STEP_BUFFER: usize = 64 * 1024;
 
 /// How soon a new terminal size that had to wait is tried again.
 const RESIZE_RETRY: std::time::Duration = std::time::Duration::from_millis(100);
-
-/// Whether a request costs the game thread more than a stone (a scene key: rain, clear, damping,
-/// pause, wind, `tab`): those have a rate limit of their own, per player and for all.
-fn costs_the_game(request: &Request) -> bool {
-    !matches!(request, Request::RandomStone { .. } | Request::Act(Action::Stone { .. } | Action::Stir { .. }))
-}
 
 /// Runs the player until it leaves, then says goodbye (bounded in time) and frees its place.
 pub(crate) async fn run(ctx: ViewerCtx) {
@@ -92,8 +68,7 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     let mut viewing = Viewing { fit: *player.seat.fit(), group: None };
     hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
     let mut frames = hub.frames.clone();
-    let mut actions = hub.limits.actions_bucket();
-    let mut scene_keys = hub.limits.scene_keys_bucket();
+    let mut gate = RequestGate::new(&hub.limits);
     let mut resizes = hub.limits.resizes_bucket();
     // A new terminal size waiting for the resize rate.
     let mut resize: Option<(u16, u16)> = None;
@@ -161,30 +136,7 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 break 'game Leave::Quit;
             }
             for request in requests.drain(..) {
-                let allowed = if costs_the_game(&request) {
-                    let ok = scene_keys.try_take(1.0, now)
-                        && hub.scene_keys.lock().unwrap_or_else(|p| p.into_inner()).try_take(1.0, now);
-                    if ok {
-                        tally.scene_keys += 1;
-                    } else {
-                        stats.scene_keys_dropped.fetch_add(1, Ordering::Relaxed);
-                    }
-                    ok
-                } else {
-                    let ok = actions.try_take(1.0, now);
-                    if !ok {
-                        stats.actions_dropped.fetch_add(1, Ordering::Relaxed);
-                    }
-                    ok
-                };
-                if !allowed {
-                    tally.dropped += 1;
-                } else if hub.requests.try_send(request).is_err() {
-                    stats.actions_dropped.fetch_add(1, Ordering::Relaxed);
-                    tally.dropped += 1;
-                } else {
-                    tally.actions += 1;
-                }
+                tally.request(gate.send(request, &hub, now));
             }
             if turn.layout_changed {
                 player.refit(hub.scene_size);
@@ -250,45 +202,10 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     hub.fits.lock().unwrap_or_else(|p| p.into_inner()).remove(&id);
     drop(slot); // the place is free as soon as the game ends
     let published = frames.borrow().number;
-    let group = membership.stats();
-    let skipped = tally.finish(published);
-    stats.frames_skipped.fetch_add(skipped, Ordering::Relaxed);
-    let seen = tally.first.map_or(0, |first| published.saturating_sub(first) + 1);
-    eprintln!(
-        "serve: {peer} #{id} left ({}): {} frames sent ({} from its group), {skipped} skipped of {seen} published, {} bytes, \
-         {} actions taken, {} dropped, {} scene keys taken, {} new sizes; link {} B/s; joined its group {} times, \
-         left it {} times for an overlay, {} behind, {} for another group",
-        reason.name(),
-        tally.sent,
-        tally.from_group,
-        tally.bytes,
-        tally.actions - tally.scene_keys,
-        tally.dropped,
-        tally.scene_keys,
-        tally.resizes,
-        player.screen.rate().map_or(-1, |r| r as i64),
-        group.joined,
-        group.left_for_overlay,
-        group.left_behind,
-        group.left_for_key,
-    );
+    stats.frames_skipped.fetch_add(tally.skipped(published), Ordering::Relaxed);
+    let rate = player.screen.rate();
+    eprintln!("{}", tally.report(peer, id, reason, published, rate, &membership));
     let mut goodbye = Vec::new();
     player.screen.farewell(&mut goodbye);
     leave::say_goodbye(reason, scene_name, goodbye, &write, &kill).await;
-}
-
-impl Tally {
-    /// A frame of `shared` is being drawn: pictures published since the last one were skipped.
-    fn count(&mut self, shared: &SharedFrame) {
-        self.first.get_or_insert(shared.number);
-        if self.last != 0 && shared.number > self.last + 1 {
-            self.skipped += shared.number - self.last - 1;
-        }
-        self.last = self.last.max(shared.number);
-    }
-
-    /// The pictures skipped in all, with those published after the last one drawn.
-    fn finish(&self, published: u64) -> u64 {
-        self.skipped + if self.last != 0 { published.saturating_sub(self.last) } else { 0 }
-    }
 }

@@ -49,7 +49,7 @@ pub fn truer_mode(pixels: GraphicsMode, rate: Option<f64>) -> GraphicsMode {
     }
 }
 
-/// `auto`'s mode over time: [`truer_mode`] with hysteresis. Clock-injected, so tests run on
+/// `auto`'s mode over time: `truer_mode` with hysteresis. Clock-injected, so tests run on
 /// made-up time.
 #[derive(Clone, Debug)]
 pub struct AutoSwitch {
