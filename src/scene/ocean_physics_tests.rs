@@ -4,8 +4,6 @@
 //! seam, and loops that close without a jump. Run with `--nocapture` for the tables:
 //! `cargo test --release --lib ocean_physics -- --nocapture`.
 
-use rustfft::FftPlanner;
-use rustfft::num_complex::Complex64;
 use tiny_skia::Pixmap;
 
 use crate::render::ocean::{OceanRenderer, OceanView};
@@ -44,19 +42,7 @@ fn surface(params: SeaParams, size: usize, extent_m: f64, t: f64) -> PatchMaps {
 /// Fourier mode's |FFT|² goes to the two bins around its exact |k|, linearly.
 fn deposit_spectrum(m: &PatchMaps, extent_m: f64, dk: f64, bins: &mut [f64]) {
     let n = m.size;
-    let mut data: Vec<Complex64> = m.height.iter().map(|&h| Complex64::new(f64::from(h), 0.0)).collect();
-    let fft = FftPlanner::new().plan_fft_forward(n);
-    for _ in 0..2 {
-        for row in data.chunks_mut(n) {
-            fft.process(row);
-        }
-        let copy = data.clone();
-        for r in 0..n {
-            for c in 0..n {
-                data[c * n + r] = copy[r * n + c];
-            }
-        }
-    }
+    let data = crate::sim::spectra::measured::fft2(&m.height, n);
     let lattice = 2.0 * std::f64::consts::PI / extent_m;
     let signed = |i: usize| if i < n / 2 { i as f64 } else { i as f64 - n as f64 };
     for r in 0..n {

@@ -543,7 +543,7 @@ impl SeaSpectrum {
 
 #[cfg(test)]
 #[path = "spectra_tests.rs"]
-mod measured;
+pub(crate) mod measured;
 
 #[cfg(test)]
 mod tests {

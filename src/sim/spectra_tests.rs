@@ -51,8 +51,9 @@ fn mean_abs_cosine(law: Spreading, r: f64, wind: f64, fp: f64) -> f64 {
     (0..n).map(|i| -PI + (i as f64 + 0.5) * dt).map(|t| d(t) * t.cos().abs() * dt).sum()
 }
 
-/// The inverse 2-D FFT of a real n x n field, rows then columns.
-fn fft2(values: &[f32], n: usize) -> Vec<Complex64> {
+/// The 2-D FFT of a real n x n field, rows then columns (for power spectra: the sign of the
+/// exponent does not matter).
+pub(crate) fn fft2(values: &[f32], n: usize) -> Vec<Complex64> {
     let mut data: Vec<Complex64> = values.iter().map(|&v| Complex64::new(f64::from(v), 0.0)).collect();
     let fft = FftPlanner::new().plan_fft_forward(n);
     for _ in 0..2 {
