@@ -11,7 +11,7 @@
 //!   terminal's bytes (replies stay in the screen, inputs come out); `Screen::frame` appends a
 //!   frame's bytes.
 //!
-//! - [`Group`]: screens alike enough to share frames, encoded once; a player's [`Membership`]
+//! - [`Groups`]: screens alike enough to share frames, encoded once per group; a player's [`Membership`]
 //!   takes the group's bytes while its terminal shows the group's model.
 //!
 //! Two doors drive them: [`run`] (and [`play`], for this process's own terminal) puts a host,
