@@ -34,12 +34,12 @@ from harness import LINKS, RELAY_SSH, Lab, stop
 CROPS = {"kitty": "960x640+0+0", "xterm": "730x530+0+0"}
 TERMINALS = {
     # The window sizes of scripts/real_terminals.sh (kitty 960x640 at 9x18 cells, xterm 120x40).
-    "kitty": lambda cmd: [
-        "env", "LIBGL_ALWAYS_SOFTWARE=1", "GALLIUM_DRIVER=softpipe",
+    "kitty": lambda cmd, driver="softpipe": [
+        "env", "LIBGL_ALWAYS_SOFTWARE=1", f"GALLIUM_DRIVER={driver}",
         "kitty", "-o", "initial_window_width=960", "-o", "initial_window_height=640", "-o", "remember_window_size=no",
         *cmd,
     ],
-    "xterm": lambda cmd: [
+    "xterm": lambda cmd, driver=None: [
         "xterm", "-ti", "vt340", "-xrm", "XTerm*numColorRegisters: 256", "-xrm", "XTerm*maxGraphicSize: 2000x2000",
         "-geometry", "120x40+0+0", "-e", *cmd,
     ],
@@ -55,6 +55,8 @@ def main():
     parser.add_argument("--seconds", type=float, default=8.0, help="how long each terminal plays before its screenshot (default 8, at most 120)")
     parser.add_argument("--out", default="target/terminals_over_link", help="where the screenshots go")
     parser.add_argument("--tag", default="", help="appended to the screenshots' names")
+    parser.add_argument("--kitty-driver", default="softpipe", choices=("softpipe", "llvmpipe"), help="Mesa's software driver under kitty (default softpipe: llvmpipe draws kitty's ghost status line)")
+    parser.add_argument("--logs", metavar="DIR", help="keep each terminal's own output as DIR/TERMINAL-over-LINK[-TAG].log, and both directions between it and ssh (util-linux script -B, advanced timing) as .raw and .timing")
     parser.add_argument("--display", default=":79", help="the Xvfb display to start (default :79)")
     parser.add_argument("--timeout", type=float, default=300.0, help="the whole run ends after this many seconds (default 300)")
     args = parser.parse_args()
@@ -74,7 +76,9 @@ def main():
     tidepool = os.path.abspath(args.tidepool)
     if not os.access(tidepool, os.X_OK):
         sys.exit(f"terminals.py: no tidepool binary at {tidepool}: cargo build --release, or --tidepool PATH")
-    os.makedirs(args.out, exist_ok=True)
+    for directory in (args.out, args.logs):
+        if directory:
+            os.makedirs(directory, exist_ok=True)
     tag = f"-{args.tag}" if args.tag else ""
 
     def out_of_time(*_):
@@ -98,8 +102,14 @@ def main():
         ssh = lab.ns(lab.client_ns, *lab.ssh_command(RELAY_SSH, play))
         for name in names:
             shot = os.path.join(args.out, f"{name}-over-{args.link}{tag}.png")
-            log = open(os.path.join(lab.dir, f"{name}.log"), "wb")
-            term = subprocess.Popen(TERMINALS[name](ssh), env=env, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT)
+            log = open(os.path.join(args.logs or lab.dir, f"{name}-over-{args.link}{tag}.log"), "wb")
+            client = ssh
+            if args.logs:
+                # What reaches the terminal, with timings (util-linux `script`), for a later look.
+                base = os.path.join(args.logs, f"{name}-over-{args.link}{tag}")
+                # Both directions (-B) with advanced timing: the terminal's answers are in it too.
+                client = ["script", "-q", "-f", "-m", "advanced", "-T", f"{base}.timing", "-B", f"{base}.raw", "-c", shlex.join(ssh)]
+            term = subprocess.Popen(TERMINALS[name](client, args.kitty_driver), env=env, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT)
             time.sleep(args.seconds)
             subprocess.run(["import", "-window", "root", "-crop", CROPS[name], "+repage", shot], env=env, check=False, timeout=30)
             print(f"{name}: {shot}", flush=True)
