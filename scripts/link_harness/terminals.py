@@ -20,6 +20,7 @@ Needs root, what harness.py needs, and Debian's xvfb, kitty, xterm and imagemagi
 
 import argparse
 import os
+import re
 import shlex
 import shutil
 import signal
@@ -68,6 +69,10 @@ def main():
     for name in names:
         if name not in TERMINALS:
             sys.exit(f"terminals.py: unknown terminal {name!r}: one of {', '.join(TERMINALS)}")
+    if args.tag and not re.fullmatch(r"[A-Za-z0-9_.-]{1,40}", args.tag):
+        sys.exit("terminals.py: --tag takes letters, digits, '.', '_' and '-' (at most 40)")
+    if not re.fullmatch(r":[0-9]{1,4}", args.display):
+        sys.exit("terminals.py: --display takes an X display such as :79")
     if not 1 <= args.seconds <= 120:
         sys.exit("terminals.py: --seconds must be between 1 and 120")
     for tool in ("Xvfb", "import", *names):
