@@ -205,7 +205,7 @@ class Terminal:
     """A pseudo-terminal driven as a user's terminal: it answers DA1 at once, keeps a pyte
     screen, and records when each status line first appeared and when bytes arrived."""
 
-    def __init__(self, cmd, env):
+    def __init__(self, cmd, env, raw_path=None):
         self.pid, self.fd = pty.fork()
         if self.pid == 0:
             try:
@@ -216,6 +216,10 @@ class Terminal:
         self.screen = pyte.Screen(COLS, ROWS)
         self.stream = pyte.ByteStream(self.screen)
         self.lock = threading.Lock()
+        # Held while the parser changes the screen, so a shot copies a whole parsed state.
+        self.screen_lock = threading.Lock()
+        # Every byte read, as read (--keep-logs), for ansi_view.py or a replay.
+        self.raw = open(raw_path, "wb") if raw_path else None
         self.arrivals = []  # (time, bytes)
         self.statuses = []  # (time, text)
         self.changes = []  # times the screen changed
@@ -240,6 +244,8 @@ class Terminal:
             if not data:
                 break
             now = time.monotonic()
+            if self.raw:
+                self.raw.write(data)
             # Answer DA1 at once, as a terminal does once it has read the question.
             window = self.tail + data
             questions = window.count(DA1_QUESTION) - self.tail.count(DA1_QUESTION)
@@ -262,10 +268,12 @@ class Terminal:
                 time.sleep(0.002)
                 continue
             for arrived, data in batch:
-                self.stream.feed(data)
-                if self.screen.dirty:
+                with self.screen_lock:
+                    self.stream.feed(data)
+                    dirty = bool(self.screen.dirty)
                     self.screen.dirty.clear()
-                    status = self.status_text()
+                    status = self.status_text() if dirty else last_status
+                if dirty:
                     with self.lock:
                         self.changes.append(arrived)
                         if status != last_status:
@@ -276,6 +284,13 @@ class Terminal:
         # The player's status line is its last row (tmux runs with its own status off).
         lines = self.screen.display
         return lines[-1] + "\n" + lines[-2]
+
+    def copy_screen(self):
+        """The screen as the parser last left it (plain tuples, see screen_shots.py)."""
+        from screen_shots import copy_screen
+
+        with self.screen_lock:
+            return copy_screen(self.screen)
 
     def write(self, data):
         try:
@@ -306,7 +321,10 @@ class Terminal:
                 os.waitpid(self.pid, 0)
             except (ProcessLookupError, ChildProcessError):
                 pass
+        self.reader.join(timeout=1)
         os.close(self.fd)
+        if self.raw:
+            self.raw.close()
 
 
 def client_command(lab, mode, play_args):
@@ -345,17 +363,48 @@ def percentile(values, p):
     return values[round((len(values) - 1) * p)]
 
 
-def measure(lab, mode, capacity, play_args, presses, warm_up):
+# Shots (--shots): after the warm-up, one stone, then the screen copied this often for this long;
+# the PNG is the copy SHOT_PNG_AT seconds after the stone.
+SHOT_INTERVAL, SHOT_SECONDS, SHOT_PNG_AT = 0.2, 5.0, 3.0
+
+
+def take_shots(term):
+    """One stone, then copies of the screen every SHOT_INTERVAL s for SHOT_SECONDS s (painted
+    after the row, so the painting does not compete with the terminal's reader)."""
+    term.write(b" ")
+    stone = time.monotonic()
+    frames = []
+    for i in range(int(SHOT_SECONDS / SHOT_INTERVAL) + 1):
+        time.sleep(max(0.0, stone + i * SHOT_INTERVAL - time.monotonic()))
+        frames.append(term.copy_screen())
+    return frames
+
+
+def save_shots(frames, directory, name):
+    import screen_shots
+
+    png = os.path.join(directory, f"{name}.png")
+    gif = os.path.join(directory, f"{name}.gif")
+    screen_shots.save_png(frames[round(SHOT_PNG_AT / SHOT_INTERVAL)], png)
+    screen_shots.save_gif(frames, gif, SHOT_INTERVAL)
+    return png, gif
+
+
+def measure(lab, mode, capacity, play_args, presses, warm_up, shots=None, keep=None, name=""):
     env = dict(os.environ, TERM="xterm-256color", COLORTERM="truecolor", LANG="C.UTF-8", LC_ALL="C.UTF-8")
     env.pop("TMUX", None)
     env.pop("SSH_CONNECTION", None)
-    term = Terminal(client_command(lab, mode, play_args), env)
+    raw = os.path.join(keep, f"{name}.raw") if keep else None
+    term = Terminal(client_command(lab, mode, play_args), env, raw)
+    shot_frames = None
     try:
         start = time.monotonic()
         # Busy water: a stone every half second besides the rain and the breeze.
         while time.monotonic() - start < warm_up:
             term.write(b" ")
             time.sleep(0.5)
+        if shots:
+            shot_frames = take_shots(term)
         measuring = time.monotonic()
         with term.lock:
             bytes_before = sum(n for _, n in term.arrivals)
@@ -410,6 +459,9 @@ def measure(lab, mode, capacity, play_args, presses, warm_up):
         term.write(b"q")
         time.sleep(0.3)
         term.close()
+        if shot_frames:
+            for path in save_shots(shot_frames, shots, name):
+                print(f"  shot: {path}", file=sys.stderr, flush=True)
 
 
 def bursts(changes, gap=0.010):
@@ -449,6 +501,9 @@ def main():
     parser.add_argument("--warm-up", type=float, default=6.0, help="seconds of busy water before timing (default 6)")
     parser.add_argument("--play-args", default="--seed 5 --color truecolor", help="arguments for `tidepool play` (default: --seed 5 --color truecolor)")
     parser.add_argument("--timeout", type=float, default=1200.0, help="the whole run ends after this many seconds (default 1200)")
+    parser.add_argument("--shots", metavar="DIR", help="after each row's warm-up: a stone, then the screen as a PNG 3 s later and a 5 s GIF, as DIR/MODE-LINK[-TAG].png/.gif (needs pillow)")
+    parser.add_argument("--shot-tag", default="", help="appended to the shots' names (e.g. before, after)")
+    parser.add_argument("--keep-logs", metavar="DIR", help="keep every byte the terminal read (DIR/MODE-LINK[-TAG].raw) and the run's sshd, serve and relay logs (DIR/logs-TAG/)")
     args = parser.parse_args()
     if os.geteuid() != 0:
         sys.exit("link_harness: needs root (network namespaces, tc, sshd)")
@@ -472,6 +527,18 @@ def main():
     def out_of_time(*_):
         raise TimeoutError(f"the run took longer than --timeout {args.timeout:.0f} s")
 
+    for directory in (args.shots, args.keep_logs):
+        if directory:
+            os.makedirs(directory, exist_ok=True)
+    if args.shots:
+        try:
+            import PIL  # noqa: F401
+        except ImportError:
+            sys.exit("link_harness: --shots needs pillow: pip install pillow")
+    if args.shot_tag and not re.fullmatch(r"[A-Za-z0-9_.-]{1,40}", args.shot_tag):
+        sys.exit("link_harness: --shot-tag takes letters, digits, '.', '_' and '-' (at most 40)")
+    tag = f"-{args.shot_tag}" if args.shot_tag else ""
+
     signal.signal(signal.SIGALRM, out_of_time)
     signal.signal(signal.SIGTERM, out_of_time)
     signal.alarm(int(args.timeout))
@@ -487,7 +554,7 @@ def main():
             rate, capacity, rtt = LINKS[name]
             lab.shape(rate, rtt)
             for mode in modes:
-                result = measure(lab, mode, capacity, args.play_args, args.presses, args.warm_up)
+                result = measure(lab, mode, capacity, args.play_args, args.presses, args.warm_up, args.shots, args.keep_logs, f"{mode}-{name}{tag}")
                 line = row_text(name, mode, result)
                 rows.append(line)
                 print(line, flush=True)
@@ -495,6 +562,8 @@ def main():
         print(f"load average before: {load_before[0]:.2f}, after: {load_after[0]:.2f} ({os.cpu_count()} cores)")
     finally:
         signal.alarm(0)
+        if args.keep_logs:
+            shutil.copytree(lab.dir, os.path.join(args.keep_logs, f"logs{tag or '-run'}"), ignore=shutil.ignore_patterns("*key*", "authorized_keys", "known_hosts"), dirs_exist_ok=True)
         lab.close()
 
 
