@@ -422,6 +422,7 @@ impl Screen {
             }
         };
         self.bucket.spend(report.bytes);
+        let mut spent = report.bytes;
         if let Some(p) = &mut self.picture {
             let frame = picture::FrameFacts {
                 resized,
@@ -441,6 +442,10 @@ impl Screen {
                 self.bucket.spend(sent);
                 self.shown.cursor = Cursor::Unknown;
             }
+            spent += sent;
+        }
+        if self.auto() {
+            self.link.frame_sent(spent, budget);
         }
         // Room for the largest frame at once (the scratch buffer has it), so the caller's
         // buffers stop growing after the first frames: steady frames allocate nothing.

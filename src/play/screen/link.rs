@@ -199,6 +199,10 @@ struct Question {
     /// Unanswered for longer than the loss timeout: counted as congestion once, its bytes
     /// taken as delivered; it keeps its place for its late answer.
     overdue: bool,
+    /// Every frame since the question before it left most of its budget unspent: the player,
+    /// not the link, set the pace, so its answer says little of the link (see
+    /// [`LinkControl::frame_sent`]).
+    app_limited: bool,
 }
 
 /// The questions in flight, oldest first (a fixed array: steady-state frames allocate nothing).
@@ -307,6 +311,8 @@ pub struct LinkControl {
     asked_up_to: u64,
     /// The SSH socket's queue inside a multiplexer, once the player reads it.
     outer: Option<Outer>,
+    /// Every frame since the last question left most of its budget unspent.
+    spare_since_question: bool,
     /// Answers to foreign questions seen, and answers nobody asked for.
     foreign_answers: u64,
     stray_answers: u64,
@@ -349,6 +355,7 @@ impl LinkControl {
             acknowledged: 0,
             asked_up_to: 0,
             outer: None,
+            spare_since_question: true,
             foreign_answers: 0,
             stray_answers: 0,
         }
@@ -374,7 +381,21 @@ impl LinkControl {
     /// player has written, that frame included.
     pub fn probed(&mut self, now: Instant, bytes_sent: u64) {
         self.asked_up_to = self.asked_up_to.max(bytes_sent);
-        self.questions.push(Question { asked: now, bytes: bytes_sent, foreign: false, overdue: false });
+        let app_limited = std::mem::replace(&mut self.spare_since_question, true);
+        self.questions.push(Question { asked: now, bytes: bytes_sent, foreign: false, overdue: false, app_limited });
+    }
+
+    /// A frame went out that spent `spent` of the `budget` it was given. A sender that leaves
+    /// most of its budget unspent (calm water; a picture stream on a small rung) sets the pace
+    /// itself: what the terminal takes then is the sender's rate, not the link's, and a late
+    /// answer is the terminal's own delay (a software-rendered kitty drawing), not a queue.
+    /// Such intervals never lower the rate on a short queue, and never set what the link was
+    /// seen to deliver (measured over SSH: kitty's pictures on their lowest rung, 5.4 kB/s
+    /// read as the link on a 250 kB/s link, and `auto` left pixels for cells).
+    pub fn frame_sent(&mut self, spent: usize, budget: usize) {
+        if spent.saturating_mul(2) >= budget {
+            self.spare_since_question = false;
+        }
     }
 
     /// The terminal answered at `now`: the oldest question is the one answered; a link
@@ -389,7 +410,7 @@ impl LinkControl {
             self.foreign_answers += 1;
             return Change::Hold;
         }
-        let (sent, bytes) = (question.asked, question.bytes);
+        let (sent, bytes, app_limited) = (question.asked, question.bytes, question.app_limited);
         let first = !self.answered;
         self.answered = true;
         self.silent = false;
@@ -403,7 +424,7 @@ impl LinkControl {
         .map(|(since, b)| (now.saturating_duration_since(since).as_secs_f64(), b))
         .filter(|&(dt, b)| dt > 0.0 && b > 0)
         .map(|(dt, b)| b as f64 / dt);
-        if let Some(rate) = took.filter(|_| self.last_answer.is_some()) {
+        if let Some(rate) = took.filter(|_| self.last_answer.is_some() && !app_limited) {
             self.delivered = Some(rate);
         }
         self.last_answer = Some((now, bytes));
@@ -453,7 +474,10 @@ impl LinkControl {
         // falls a round trip sooner).
         let not_draining = last_queue.is_none_or(|last| queue >= last);
         let confirmed = last_queue.is_some_and(|last| last > high) || queue > 2 * QUEUE_HIGH_MIN;
-        if queue > high && not_draining && confirmed {
+        // A sender that left its budget unspent cannot have built a queue of a few marks: only
+        // a deep one lowers the rate then.
+        let caused = !app_limited || queue > 2 * high;
+        if queue > high && not_draining && confirmed && caused {
             // A queue of several marks drains faster: at 15 % under the link, a second of
             // queue would take six to go.
             self.fall(now, if queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE });
@@ -604,7 +628,13 @@ impl LinkControl {
     pub fn expect_foreign(&mut self, now: Instant, count: usize) {
         // (Called by the Screen when the probe's questions go out.)
         for _ in 0..count {
-            if !self.questions.push(Question { asked: now, bytes: 0, foreign: true, overdue: false }) {
+            if !self.questions.push(Question {
+                asked: now,
+                bytes: 0,
+                foreign: true,
+                overdue: false,
+                app_limited: false,
+            }) {
                 break;
             }
         }

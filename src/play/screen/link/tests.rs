@@ -33,11 +33,25 @@ struct Link {
     probe_lead: Option<Duration>,
     /// Whether the probe's answer ever comes.
     probe_answered: bool,
+    /// Two answers in every four come this much later than the link makes them (a terminal
+    /// busy drawing: kitty under a software renderer).
+    late_pairs: Option<Duration>,
+    /// The share of each frame's budget the sender spends (a picture stream on a small rung
+    /// spends part of it; 1: all it may).
+    spend_share: f64,
 }
 
 impl Link {
     fn far(capacity: f64, rtt: Duration) -> Link {
-        Link { capacity, rtt, answers: Answers::FarEnd, probe_lead: None, probe_answered: true }
+        Link {
+            capacity,
+            rtt,
+            answers: Answers::FarEnd,
+            probe_lead: None,
+            probe_answered: true,
+            late_pairs: None,
+            spend_share: 1.0,
+        }
     }
 }
 
@@ -100,6 +114,7 @@ fn simulate(path: LinkPath, link: Link, seconds: f64, demand: impl Fn(f64) -> f6
         }
     }
     let mut next_frame = t0;
+    let mut asked = 0u32;
     let end = at(seconds);
     while next_frame < end {
         // Answers due before the next frame, each at its own time.
@@ -117,13 +132,17 @@ fn simulate(path: LinkPath, link: Link, seconds: f64, demand: impl Fn(f64) -> f6
         control.tick(now);
         let t = now.duration_since(t0).as_secs_f64();
         let rate = control.rate().unwrap_or(MAX_RATE);
-        let bytes = (rate / FPS).min(demand(t)).min(control.window_left(now, sent) as f64).floor();
+        let budget = (rate / FPS).min(control.window_left(now, sent) as f64);
+        let bytes = (budget * link.spend_share).min(demand(t)).floor();
+        control.frame_sent(bytes as usize, budget as usize);
         sent += bytes as u64;
         drained = drained.max(now) + Duration::from_secs_f64(bytes / link.capacity);
         if control.probe_due() && (bytes > 0.0 || control.unasked(sent)) {
             control.probed(now, sent);
+            asked += 1;
+            let late = link.late_pairs.filter(|_| asked % 4 < 2).unwrap_or_default();
             let answer = match link.answers {
-                Answers::FarEnd => Some(drained + link.rtt),
+                Answers::FarEnd => Some(drained + link.rtt + late),
                 Answers::Local => Some(now + ms(1)),
                 Answers::Never => None,
             };
@@ -475,4 +494,21 @@ fn a_small_first_frame_on_a_slow_far_link_does_not_run_the_rate_away() {
     assert!(p90 <= 0.3 + 2.0 / FPS, "the queue's p90 after 2 s is {:.0} ms", p90 * 1e3);
     let used = run.throughput(32_000.0, 5.0, 20.0) / 32_000.0;
     assert!(used >= 0.8, "only {:.0} % of the link used", used * 100.0);
+}
+
+#[test]
+fn a_sender_that_leaves_its_budget_unspent_is_not_taken_for_the_link() {
+    // A 2 Mbit/s link of 20 ms and a terminal that answers two questions in four 45 ms late
+    // (a software-rendered kitty drawing), while the sender spends a third of each frame's
+    // budget (its pictures on a small rung, as the stream picks them from the rate). The late
+    // answers are the terminal's, not a queue: the rate must not follow the sender down (it
+    // did: 5.4 kB/s, and `auto` left kitty for cells on a link five times above the crossover).
+    let link = Link { late_pairs: Some(ms(45)), spend_share: 0.33, ..Link::far(250_000.0, ms(20)) };
+    let run = simulate(LinkPath::Direct, link, 10.0, busy);
+    let mean = run.mean_rate(3.0);
+    assert!(mean > 100_000.0, "the rate followed the sender down: {mean:.0} B/s");
+    // The same link filled by a sender that spends its whole budget still finds the link.
+    let full = simulate(LinkPath::Direct, Link::far(250_000.0, ms(20)), 10.0, busy);
+    let got = full.throughput(250_000.0, 3.0, 10.0);
+    assert!(got > 0.8 * 250_000.0, "{got:.0} B/s");
 }
