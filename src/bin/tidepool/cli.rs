@@ -15,7 +15,7 @@ pub mod lake;
 pub mod ocean;
 pub mod pool;
 
-pub use pool::{PLAYER_DAMPING, PoolArgs, PoolDefaults};
+pub use pool::{PoolArgs, PoolDefaults};
 #[cfg(feature = "serve")]
 pub mod serve;
 
@@ -137,7 +137,7 @@ pub struct LiveSceneArgs {
 /// grid of two cells a pixel, 30 steps a second; see [`PoolDefaults::PLAYER`]), the papers'
 /// damping.
 #[derive(Args, Debug, Clone)]
-#[command(after_help = PLAY_KEYS, mut_arg("damping", |a| a.default_value(PLAYER_DAMPING)))]
+#[command(after_help = PLAY_KEYS)]
 pub struct PlayCommand {
     /// The scene to start with (`tab` switches while playing).
     #[arg(value_enum, default_value = "pool")]

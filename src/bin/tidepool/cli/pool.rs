@@ -6,9 +6,6 @@ use tidepool::{BreezeStyle, CausticsLook, Damping, Refraction, Sun, values};
 
 use super::*;
 
-/// The player's default `--damping`.
-pub const PLAYER_DAMPING: &str = "5";
-
 /// The pool flags' defaults where `render` and the live scenes (`play`, `serve`) differ.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PoolDefaults {

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use clap::Args;
 use tidepool::Size;
 
-use super::{PLAYER_DAMPING, PlayScene, parse_size};
+use super::{PlayScene, parse_size};
 
 const SERVE_HELP: &str = "\
 Everyone who connects plays in the same water: stones, clicks, drags and the scene keys (wind,
@@ -21,7 +21,7 @@ Examples:
 
 /// `tidepool serve`.
 #[derive(Args, Debug, Clone)]
-#[command(after_help = SERVE_HELP, mut_arg("damping", |a| a.default_value(PLAYER_DAMPING)))]
+#[command(after_help = SERVE_HELP)]
 pub struct ServeCommand {
     /// Address and port to listen on; anything beyond localhost must be asked for
     /// (`0.0.0.0:2222`). Port 0 picks a free port (printed at start).

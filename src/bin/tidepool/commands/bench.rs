@@ -82,7 +82,6 @@ fn scenes(ssaa: u32) -> [(&'static str, SceneSpec); 3] {
             breeze_style: player.breeze_style,
             grid: player.grid,
             steps_per_second: player.steps_per_second,
-            damping: crate::cli::PLAYER_DAMPING.parse().expect("the player's damping"),
             ..pool
         };
     }
