@@ -327,7 +327,7 @@ pub struct RenderPool {
     /// Re-simulate a session recorded with `tidepool play --record FILE` and render its last
     /// step (or --steps N): identical to a screenshot taken at that step. The replay fixes the
     /// size, seed, stones and water flags.
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "grid", "breeze_style", "steps_per_second", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["size", "seed", "stones", "rain", "damping", "breeze", "grid", "breeze_style", "steps_per_second", "refraction", "no_shading", "no_caustics", "depth", "sun", "background"])]
     pub replay: Option<PathBuf>,
 
     /// An animation instead of one picture.
@@ -535,6 +535,7 @@ mod tests {
             &["--grid", "2"],
             &["--steps-per-second", "30"],
             &["--breeze-style", "gusts"],
+            &["--breeze", "3"],
         ] {
             let err = parse(&[&["--replay", "r.jsonl"][..], flag].concat()).unwrap_err();
             assert_eq!(err.kind(), clap::error::ErrorKind::ArgumentConflict, "{flag:?}");
