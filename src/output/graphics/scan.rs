@@ -47,20 +47,32 @@ pub fn changed_box(
     bpp: usize,
     rows: std::ops::Range<u32>,
 ) -> Option<(u32, u32, u32, u32)> {
-    let stride = width as usize * bpp;
-    let (mut top, mut bottom, mut left, mut right) = (u32::MAX, 0, usize::MAX, 0);
-    for y in rows {
-        let at = y as usize * stride;
-        let (a, b) = (&old[at..at + stride], &new[at..at + stride]);
-        let Some(first) = first_difference(a, b) else { continue };
+    changed_in(old, new, width as usize * bpp, bpp, (0, rows.start, width, rows.end.saturating_sub(rows.start)))
+}
+
+/// [`changed_box`] within `area` `(x, y, w, h)` of pictures `stride` bytes a row.
+pub fn changed_in(
+    old: &[u8],
+    new: &[u8],
+    stride: usize,
+    bpp: usize,
+    area: (u32, u32, u32, u32),
+) -> Option<(u32, u32, u32, u32)> {
+    let (x, y, w, h) = area;
+    let (mut top, mut bottom, mut left, mut right) = (u32::MAX, 0, u32::MAX, 0);
+    for row in y..y + h {
+        let a = row as usize * stride + x as usize * bpp;
+        let b = a + w as usize * bpp;
+        let (p, q) = (&old[a..b], &new[a..b]);
+        let Some(first) = first_difference(p, q) else { continue };
         // Only the part after the first difference is left to search from the back.
-        let last = first + last_difference(&a[first..], &b[first..]).unwrap_or(0);
-        top = top.min(y);
-        bottom = y;
-        left = left.min(first / bpp);
-        right = right.max(last / bpp);
+        let last = first + last_difference(&p[first..], &q[first..]).unwrap_or(0);
+        top = top.min(row);
+        bottom = row;
+        left = left.min(x + (first / bpp) as u32);
+        right = right.max(x + (last / bpp) as u32);
     }
-    (top != u32::MAX).then(|| (left as u32, top, (right - left + 1) as u32, bottom - top + 1))
+    (top != u32::MAX).then(|| (left, top, right - left + 1, bottom - top + 1))
 }
 
 #[cfg(test)]

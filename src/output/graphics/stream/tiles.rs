@@ -50,7 +50,7 @@ impl PictureStream {
             }
             let cell = (x, y, tw.min(w - x), bh);
             let shown = &self.shown.as_ref()?.1;
-            let Some((left, _, bw, _)) = changed_in(shown, &self.candidate, stride, bpp, cell) else { continue };
+            let Some((left, _, bw, _)) = scan::changed_in(shown, &self.candidate, stride, bpp, cell) else { continue };
             // Only the changed columns (whole cells for sixel), all of the tile's rows.
             let x0 = left / ux * ux;
             let mut width = ((left + bw).div_ceil(ux) * ux).min(cell.0 + cell.2) - x0;
@@ -83,29 +83,4 @@ impl PictureStream {
         }
         None
     }
-}
-
-/// The box `(x, y, w, h)` around the pixels that differ between `old` and `new` (`stride` bytes
-/// a row, `bpp` a pixel) within `area`, or `None` when they are equal there.
-fn changed_in(
-    old: &[u8],
-    new: &[u8],
-    stride: usize,
-    bpp: usize,
-    area: (u32, u32, u32, u32),
-) -> Option<(u32, u32, u32, u32)> {
-    let (x, y, w, h) = area;
-    let (mut top, mut bottom, mut left, mut right) = (u32::MAX, 0, u32::MAX, 0);
-    for row in y..y + h {
-        let a = row as usize * stride + x as usize * bpp;
-        let b = a + w as usize * bpp;
-        let (p, q) = (&old[a..b], &new[a..b]);
-        let Some(first) = scan::first_difference(p, q) else { continue };
-        let last = first + scan::last_difference(&p[first..], &q[first..]).unwrap_or(0);
-        top = top.min(row);
-        bottom = row;
-        left = left.min(x + (first / bpp) as u32);
-        right = right.max(x + (last / bpp) as u32);
-    }
-    (top != u32::MAX).then(|| (left, top, right - left + 1, bottom - top + 1))
 }
