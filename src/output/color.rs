@@ -19,7 +19,7 @@ use crate::output::halfblock::Rgb;
 use crate::output::vt::xterm_256;
 
 /// How many colours the terminal shows.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum ColorMode {
     /// 24-bit colour: `ESC[38;2;r;g;bm` (what most terminals show today).
     #[default]

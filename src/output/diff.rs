@@ -29,7 +29,7 @@ pub const SYNC_BEGIN: &[u8] = b"\x1b[?2026h";
 pub const SYNC_END: &[u8] = b"\x1b[?2026l";
 
 /// How frames are encoded.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct EncodeOptions {
     /// A colour that changed by at most this much in every channel is not re-sent (0: exact).
     pub threshold: u8,

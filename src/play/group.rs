@@ -25,7 +25,7 @@
 //! sixel, iTerm2) keep their own picture streams: they draw alone.
 
 use std::collections::{HashMap, VecDeque};
-use std::hash::{Hash, Hasher};
+use std::hash::Hash;
 use std::io;
 use std::sync::Arc;
 use std::time::Instant;
@@ -90,7 +90,7 @@ impl LinkClass {
 }
 
 /// What screens must share to share frames.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct GroupKey {
     /// Terminal size in cells.
     pub term: (u16, u16),
@@ -102,17 +102,6 @@ pub struct GroupKey {
     pub fps: u32,
     /// The link's class.
     pub class: LinkClass,
-}
-
-impl Hash for GroupKey {
-    fn hash<H: Hasher>(&self, state: &mut H) {
-        let color = match self.color {
-            ColorMode::TrueColor => 0u8,
-            ColorMode::Palette256 => 1,
-            ColorMode::Palette16 => 2,
-        };
-        (self.term, color, self.encode.threshold, self.encode.sync, self.fps, self.class).hash(state);
-    }
 }
 
 impl GroupKey {

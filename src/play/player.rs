@@ -93,7 +93,6 @@ impl Player {
                 break;
             }
         }
-        self.inputs.clear();
         Turn { flow, layout_changed, urgent }
     }
 

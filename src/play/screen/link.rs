@@ -56,7 +56,6 @@
 use std::time::{Duration, Instant};
 
 mod socket;
-#[allow(unused_imports, reason = "read by the player loop's rewrite (issue 21)")]
 pub use socket::ssh_send_queue;
 
 /// The question: primary device attributes.
