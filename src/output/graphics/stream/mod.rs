@@ -13,7 +13,7 @@
 //!
 //! 1. Make one stream per terminal and mode: [`PictureStream::new`] with the layout
 //!    ([`crate::output::graphics::geometry::layout`]) and the protocol's [`Protocol`] settings
-//!    from the probe. After a resize make a new one ([`PictureStream::resize`]).
+//!    from the probe. After a resize make a new one.
 //! 2. Each frame, after the cells (the status line goes first), call [`PictureStream::prepare`]
 //!    with the scene's picture (any size up to the layout's picture: the pool renders within
 //!    the player's scene cap, and the stream never sends more pixels than it is given), the
@@ -62,7 +62,7 @@ use crate::output::graphics::geometry::Layout;
 use crate::output::graphics::kitty::{self, KittyOptions, Medium};
 use crate::output::graphics::pack::{Packing, pack};
 use crate::output::graphics::sixel::{Registers, SixelEncoder, SixelPalette, TMUX_MAX_IMAGE_BYTES};
-use crate::output::graphics::{GraphicsMode, iterm2, scan};
+use crate::output::graphics::{iterm2, scan};
 
 /// The share of a picture interval's bytes a picture may take: the rest is left for the status
 /// line and the cells' own changes.
@@ -105,14 +105,6 @@ pub enum Protocol {
 }
 
 impl Protocol {
-    fn mode(&self) -> GraphicsMode {
-        match self {
-            Protocol::Kitty(_) => GraphicsMode::Kitty,
-            Protocol::Sixel { .. } => GraphicsMode::Sixel,
-            Protocol::Iterm2 { .. } => GraphicsMode::Iterm2,
-        }
-    }
-
     /// The most pictures a second: kitty and iTerm2 scale in the terminal and keep up with the
     /// player's 30 frames; sixel pictures are drawn pixel for pixel and cost several times more
     /// to encode and to draw, so 15.
@@ -277,30 +269,14 @@ impl PictureStream {
         stream
     }
 
-    /// A new layout (a resize): the ladder is rebuilt and the next picture is sent whole.
-    pub fn resize(&mut self, layout: Layout) {
-        self.forget_pending();
-        *self = PictureStream::new(self.protocol.clone(), layout);
-    }
-
     /// The layout in force.
     pub fn layout(&self) -> &Layout {
         &self.layout
     }
 
-    /// The resolution ladder, largest first (built for the last picture's size).
-    pub fn rungs(&self) -> &[(u32, u32)] {
-        &self.rungs
-    }
-
     /// What the stream did last.
     pub fn state(&self) -> State {
         self.state
-    }
-
-    /// The protocol's mode.
-    pub fn mode(&self) -> GraphicsMode {
-        self.protocol.mode()
     }
 
     /// Forgets what the terminal shows: the next picture is sent whole.

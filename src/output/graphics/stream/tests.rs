@@ -1,5 +1,6 @@
 use super::*;
 use crate::output::bucket::ByteBucket;
+use crate::output::graphics::GraphicsMode;
 use crate::output::graphics::geometry::{SCALED_CAP, layout};
 use crate::output::graphics::kitty::KittyOptions;
 use crate::output::graphics::kitty_decode;
