@@ -417,7 +417,10 @@ impl Screen {
                 self.encoder.encode_into(&mut self.shown, Target::new(model), budget, exact, &mut bytes)
             }
             Cells::Taken(taken) => {
-                bytes.extend_from_slice(taken);
+                // Straight to the caller: the group's bytes never pass through the scratch
+                // buffer, which a member in step has freed (it would grow back to a group
+                // frame's size, and the caller's buffer with it).
+                out.extend_from_slice(taken);
                 Report { bytes: taken.len(), drawn: 0, pending: 0 }
             }
         };
