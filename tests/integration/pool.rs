@@ -55,3 +55,30 @@ fn ansi_output_matches_the_png_pixel_for_pixel() {
     let text = golden::decode_ansi(&std::fs::read(dir.join("same.ans")).unwrap());
     golden::compare("ansi_matches_png", &png, &text, Tolerance { channel: 0, max_fraction: 0.0 });
 }
+
+/// The player's pool flags as a user gives them to `render pool` (a finer grid, the pace, gusts)
+/// reach the scene: the picture is the library's with those settings, bit for bit, and not the
+/// default pool's.
+#[test]
+fn grid_pace_and_gusts_given_on_the_command_line_reach_the_scene() {
+    use crate::goldens::{picture, rgba};
+    use tidepool::{BreezeStyle, PoolSettings, SceneSpec};
+    let dir = scratch("pool_cli_grid_pace_gusts");
+    let flags = ["--size", "96x64", "--steps", "40", "--breeze", "1"];
+    let coherent = ["--grid", "2", "--steps-per-second", "30", "--breeze-style", "gusts", "--out", "coherent.png"];
+    let out = run_in(&dir, &[&["render", "pool"][..], &flags, &coherent].concat());
+    assert!(out.status.success(), "{}", stderr(&out));
+    let (script, _) = tidepool::pool_showcase(96, 64);
+    let settings = PoolSettings {
+        breeze: 1.0,
+        breeze_style: BreezeStyle::Gusts,
+        grid: 2,
+        steps_per_second: 30,
+        ..PoolSettings::default()
+    };
+    let file = read_png(&dir.join("coherent.png"));
+    assert!(file == rgba(&picture(&SceneSpec::Pool(settings), 96, 64, &script, 40)), "the flags' pool");
+    let plain = run_in(&dir, &[&["render", "pool"][..], &flags, &["--out", "plain.png"]].concat());
+    assert!(plain.status.success(), "{}", stderr(&plain));
+    assert!(read_png(&dir.join("plain.png")) != file, "the flags changed the picture");
+}
