@@ -128,13 +128,10 @@ fn socket_bytes_out(log: &[String]) -> u64 {
     before.split_whitespace().last().unwrap().parse().unwrap()
 }
 
-#[test]
-fn openssh_with_compression_gets_zlib_after_authentication_and_the_same_pool() {
-    if !ssh_available() {
-        eprintln!("NOTICE: ssh not found; skipped the OpenSSH test");
-        return;
-    }
-    let s = Server::start(TEST_FLAGS);
+/// An OpenSSH client asking for compression (`-C`) from a server started with `server_flags`:
+/// the compression the key exchange settled on, and whether the pool said goodbye.
+fn compression_asked_of(server_flags: &[&str]) -> (String, bool) {
+    let s = Server::start(server_flags);
     let home = tempfile::tempdir().unwrap();
     let mut ssh = Ssh::spawn(s.port, home.path(), &["-C", "localhost"]);
     ssh.wait_for("1 playing");
@@ -143,8 +140,22 @@ fn openssh_with_compression_gets_zlib_after_authentication_and_the_same_pool() {
     assert_eq!(ssh.finish(), 0);
     let text = ssh.text();
     let kex = text.lines().find(|l| l.contains("kex: server->client cipher")).unwrap_or("").trim().to_string();
+    (kex, text.contains("bye from the pool"))
+}
+
+#[test]
+fn openssh_with_compression_gets_zlib_after_authentication_and_the_same_pool() {
+    if !ssh_available() {
+        eprintln!("NOTICE: ssh not found; skipped the OpenSSH test");
+        return;
+    }
+    let (kex, bye) = compression_asked_of(TEST_FLAGS);
     assert!(kex.ends_with("compression: zlib@openssh.com"), "{kex}");
-    assert!(text.contains("bye from the pool"));
+    assert!(bye);
+    // `--no-compression`: the same client's request is not granted.
+    let (kex, bye) = compression_asked_of(&[TEST_FLAGS, &["--no-compression"]].concat());
+    assert!(kex.ends_with("compression: none"), "--no-compression: {kex}");
+    assert!(bye);
 }
 
 /// One session of `secs` seconds in a `size` terminal with rain, with `extra` ssh flags: the
