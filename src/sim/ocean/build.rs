@@ -66,18 +66,17 @@ impl Sea {
             }
             tail = Some(Self::tail(&spectrum, f_hi, downwind, &params));
         }
+        let slope = |c: &Component| 0.5 * (c.amplitude_m * c.wavenumber).powi(2);
         let swells = params.swell_spectra();
         let mut swell_slope = 0.0;
         for (n, swell) in swells.iter().enumerate() {
             let before = components.len();
             Self::swell_components(swell, &spectrum, &params, n as u64, &mut components);
-            swell_slope +=
-                components[before..].iter().map(|c| 0.5 * (c.amplitude_m * c.wavenumber).powi(2)).sum::<f64>();
+            swell_slope += components[before..].iter().map(slope).sum::<f64>();
         }
         components.sort_by(|a, b| a.wavenumber.total_cmp(&b.wavenumber));
         let lanes = Lanes::new(&components);
         let wavelength = components.iter().map(|c| (2.0 * PI / c.wavenumber) as f32).collect();
-        let slope = |c: &Component| 0.5 * (c.amplitude_m * c.wavenumber).powi(2);
         let total_slope: f64 = components.iter().map(slope).sum();
         let fold_index: Vec<usize> =
             (0..components.len()).filter(|&i| slope(&components[i]) >= FOLD_NEGLIGIBLE * total_slope).collect();
@@ -85,8 +84,7 @@ impl Sea {
         let fold = Lanes::new(&kept);
         let fold_wavelength = kept.iter().map(|c| (2.0 * PI / c.wavenumber) as f32).collect();
         let slope_total = (cox_munk_slope_variance(spectrum.wind_m_s()) + swell_slope) as f32;
-        let to = (params.wind_from_deg + 180.0).to_radians();
-        let downwind = [to.sin() as f32, to.cos() as f32];
+        let downwind = [downwind.sin() as f32, downwind.cos() as f32];
         Sea {
             params,
             spectrum,
