@@ -25,6 +25,11 @@ struct Shot {
     time_s: f64,
 }
 
+/// A gallery picture: 640x360, two samples a pixel, at time 0.
+fn gallery(name: &'static str, params: SeaParams, sun: (f32, f32)) -> Shot {
+    Shot { name, params, sun, size: (640, 360), ssaa: 2, time_s: 0.0 }
+}
+
 fn render(shot: &Shot) -> Pixmap {
     let view = OceanView {
         camera: CameraPose::DEFAULT,
@@ -73,68 +78,31 @@ fn main() {
     let b = |n: u8| beaufort_speed_m_s(n).expect("a Beaufort number");
     let fetch = Jonswap::new(3.3, Some(15.0)).expect("valid");
     let shots = [
-        Shot {
-            name: "sea-beaufort-3.png",
-            params: chop(b(3), 330.0),
-            sun: (15.0, 22.0),
-            size: (640, 360),
-            ssaa: 2,
-            time_s: 0.0,
-        },
-        Shot {
-            name: "sea-beaufort-6.png",
-            params: chop(b(6), 60.0),
-            sun: (15.0, 22.0),
-            size: (640, 360),
-            ssaa: 2,
-            time_s: 0.0,
-        },
-        Shot {
-            name: "sea-beaufort-9.png",
-            params: chop(b(9), 330.0),
-            sun: (200.0, 12.0),
-            size: (640, 360),
-            ssaa: 2,
-            time_s: 0.0,
-        },
-        Shot {
-            name: "sea-beaufort-10.png",
-            params: chop(b(10), 330.0),
-            sun: (15.0, 22.0),
-            size: (640, 360),
-            ssaa: 2,
-            time_s: 0.0,
-        },
-        Shot {
-            name: "sea-swell.png",
-            params: SeaParams {
+        gallery("sea-beaufort-3.png", chop(b(3), 330.0), (15.0, 22.0)),
+        gallery("sea-beaufort-6.png", chop(b(6), 60.0), (15.0, 22.0)),
+        gallery("sea-beaufort-9.png", chop(b(9), 330.0), (200.0, 12.0)),
+        gallery("sea-beaufort-10.png", chop(b(10), 330.0), (15.0, 22.0)),
+        gallery(
+            "sea-swell.png",
+            SeaParams {
                 swells: Swells::new(&[Swell::new(1.5, 12.0, 250.0).expect("valid")]).expect("one swell"),
                 ..chop(b(4), 330.0)
             },
-            sun: (15.0, 22.0),
-            size: (640, 360),
-            ssaa: 2,
-            time_s: 0.0,
-        },
-        Shot {
-            name: "sea-jonswap-fetch-15km.png",
-            params: SeaParams { spectrum: SpectrumChoice::Jonswap(fetch), ..chop(15.0, 330.0) },
-            sun: (15.0, 22.0),
-            size: (640, 360),
-            ssaa: 2,
-            time_s: 0.0,
-        },
-        Shot {
-            name: "sea-tma-4m.png",
-            params: SeaParams {
+            (15.0, 22.0),
+        ),
+        gallery(
+            "sea-jonswap-fetch-15km.png",
+            SeaParams { spectrum: SpectrumChoice::Jonswap(fetch), ..chop(15.0, 330.0) },
+            (15.0, 22.0),
+        ),
+        gallery(
+            "sea-tma-4m.png",
+            SeaParams {
                 spectrum: SpectrumChoice::Tma(Jonswap::default(), Depth::new(4.0).expect("valid")),
                 ..chop(12.0, 330.0)
             },
-            sun: (15.0, 22.0),
-            size: (640, 360),
-            ssaa: 2,
-            time_s: 0.0,
-        },
+            (15.0, 22.0),
+        ),
     ];
     for shot in &shots {
         save(&dir, shot.name, &render(shot));
