@@ -53,11 +53,13 @@
 
 mod candidates;
 mod emit;
+mod variants;
 
 use tiny_skia::Pixmap;
 
-use self::candidates::{Item, LabMemo, MAX_VARIANTS, Measure, Palette, Weighing};
+use self::candidates::{Item, MAX_VARIANTS, Measure, Weighing};
 use self::emit::{EXACT, Pen, Plan, Room, SKIP};
+use self::variants::{LabMemo, Palette};
 use crate::output::color::{Color, ColorMode};
 use crate::output::diff::{EncodeOptions, SYNC_BEGIN, SYNC_END, Shown};
 use crate::output::frame::{Cell, Frame};
@@ -226,58 +228,20 @@ impl RateEncoder {
         let wanted = target.frame;
         let (cols, rows) = (wanted.cols(), wanted.rows());
         let cells = cols * rows;
-        self.choice.resize(cells, SKIP);
-        self.variants.resize(cells, [Cell::BLANK; MAX_VARIANTS]);
-        self.candidate.resize(cells, false);
-        self.fresh.resize(cells, 0);
-        self.pick.resize(cells, false);
-        self.measures.resize(cells, Measure::default());
-        self.palettes.resize(cells, (0, Palette::default()));
-        self.shown_lab.resize(cells);
-        self.truth_lab.resize(cells);
-        // Room for the largest frame once, so that frames growing past the ones before never
-        // reallocate in the steady state.
-        let most = cells * MAX_CELL_BYTES + CLEAR.len() + SYNC_BEGIN.len() + SYNC_END.len();
-        for buffer in [&mut self.best.0, &mut self.attempt.0, &mut *out] {
-            buffer.reserve(most.saturating_sub(buffer.len()));
-        }
-        for drawn in [&mut self.best.1, &mut self.attempt.1] {
-            drawn.reserve(cells.saturating_sub(drawn.len()));
-        }
+        self.prepare(cells, out);
         let overhead = if options.sync { SYNC_BEGIN.len() + SYNC_END.len() } else { 0 };
         let mut pen = Pen { cursor: shown.cursor, fg: shown.fg, bg: shown.bg };
         let known = shown.frame.as_ref().is_some_and(|f| f.cols() == cols && f.rows() == rows);
         let mut prefix: &[u8] = &[];
         if !known {
-            // Paint everything when it fits, exactly as today's encoder does.
-            self.choice.fill(EXACT);
-            self.attempt.0.clear();
-            self.attempt.1.clear();
-            let plan = Plan { shown: wanted, wanted, choice: &self.choice, variants: &self.variants };
-            let end = plan.emit(pen, None, &mut self.attempt.0, &mut self.attempt.1);
-            let markers = if cells > 1 { overhead } else { 0 };
-            if self.attempt.0.len().saturating_add(markers) <= budget {
-                let start = out.len();
-                wrap(out, options.sync && cells > 1, &[], &self.attempt.0);
-                match &mut shown.frame {
-                    Some(f) => f.clone_from(wanted),
-                    None => shown.frame = Some(wanted.clone()),
+            match self.start_unknown(shown, wanted, budget, options, out) {
+                Unknown::Done(report) => return report,
+                Unknown::Cleared => {
+                    pen.fg = Some(Color::Default);
+                    pen.bg = Some(Color::Default);
+                    prefix = CLEAR;
                 }
-                (shown.cursor, shown.fg, shown.bg) = (end.cursor, end.fg, end.bg);
-                return Report { bytes: out.len() - start, drawn: cells, pending: 0 };
             }
-            if budget < overhead + CLEAR.len() {
-                return Report { bytes: 0, drawn: 0, pending: cells };
-            }
-            // Too big for the budget: clear the screen so that what it shows is known, and
-            // paint it over the next frames.
-            match &mut shown.frame {
-                Some(f) => f.reset(cols, rows),
-                None => shown.frame = Some(Frame::new(cols, rows)),
-            }
-            pen.fg = Some(Color::Default);
-            pen.bg = Some(Color::Default);
-            prefix = CLEAR;
         }
         let frame = shown.frame.as_mut().expect("known or just cleared");
         let room = if budget == UNLIMITED {
@@ -320,6 +284,77 @@ impl RateEncoder {
         (shown.cursor, shown.fg, shown.bg) = (end.cursor, end.fg, end.bg);
         Report { bytes: out.len() - start, drawn, pending: candidates - exact }
     }
+
+    /// Sizes the per-cell scratch for `cells` cells, and reserves room for the largest frame
+    /// once, so that frames growing past the ones before never reallocate in the steady state.
+    fn prepare(&mut self, cells: usize, out: &mut Vec<u8>) {
+        self.choice.resize(cells, SKIP);
+        self.variants.resize(cells, [Cell::BLANK; MAX_VARIANTS]);
+        self.candidate.resize(cells, false);
+        self.fresh.resize(cells, 0);
+        self.pick.resize(cells, false);
+        self.measures.resize(cells, Measure::default());
+        self.palettes.resize(cells, (0, Palette::default()));
+        self.shown_lab.resize(cells);
+        self.truth_lab.resize(cells);
+        let most = cells * MAX_CELL_BYTES + CLEAR.len() + SYNC_BEGIN.len() + SYNC_END.len();
+        for buffer in [&mut self.best.0, &mut self.attempt.0, &mut *out] {
+            buffer.reserve(most.saturating_sub(buffer.len()));
+        }
+        for drawn in [&mut self.best.1, &mut self.attempt.1] {
+            drawn.reserve(cells.saturating_sub(drawn.len()));
+        }
+    }
+
+    /// A screen whose contents are unknown (the first frame, or a new size): the whole frame
+    /// when it fits the budget, exactly as the plain encoder paints it; else nothing when not
+    /// even a clear fits; else the screen is taken as cleared, to be painted over the next
+    /// frames (the caller sends the clear in front of this frame's cells).
+    fn start_unknown(
+        &mut self,
+        shown: &mut Shown,
+        wanted: &Frame,
+        budget: usize,
+        options: RateOptions,
+        out: &mut Vec<u8>,
+    ) -> Unknown {
+        let (cols, rows) = (wanted.cols(), wanted.rows());
+        let cells = cols * rows;
+        let overhead = if options.sync { SYNC_BEGIN.len() + SYNC_END.len() } else { 0 };
+        let pen = Pen { cursor: shown.cursor, fg: shown.fg, bg: shown.bg };
+        self.choice.fill(EXACT);
+        self.attempt.0.clear();
+        self.attempt.1.clear();
+        let plan = Plan { shown: wanted, wanted, choice: &self.choice, variants: &self.variants };
+        let end = plan.emit(pen, None, &mut self.attempt.0, &mut self.attempt.1);
+        let markers = if cells > 1 { overhead } else { 0 };
+        if self.attempt.0.len().saturating_add(markers) <= budget {
+            let start = out.len();
+            wrap(out, options.sync && cells > 1, &[], &self.attempt.0);
+            match &mut shown.frame {
+                Some(f) => f.clone_from(wanted),
+                None => shown.frame = Some(wanted.clone()),
+            }
+            (shown.cursor, shown.fg, shown.bg) = (end.cursor, end.fg, end.bg);
+            return Unknown::Done(Report { bytes: out.len() - start, drawn: cells, pending: 0 });
+        }
+        if budget < overhead + CLEAR.len() {
+            return Unknown::Done(Report { bytes: 0, drawn: 0, pending: cells });
+        }
+        match &mut shown.frame {
+            Some(f) => f.reset(cols, rows),
+            None => shown.frame = Some(Frame::new(cols, rows)),
+        }
+        Unknown::Cleared
+    }
+}
+
+/// What became of a frame on a screen whose contents were unknown.
+enum Unknown {
+    /// The frame was sent whole, or nothing fitted: this is the frame's report.
+    Done(Report),
+    /// The screen is taken as cleared (a clear goes in front of the frame's cells).
+    Cleared,
 }
 
 impl RateEncoder {
