@@ -103,9 +103,20 @@ pub fn run(args: BenchArgs) -> Result<()> {
         Simd::detect(),
         budget.as_secs_f64()
     );
-    let mut rows = Vec::new();
+    let mut rows = simulation_rows(budget, threads);
+    let terminal = (args.terminal.width() as u16, (args.terminal.height() / 2 + 1) as u16);
+    let verdicts = player_rows(budget, terminal, &mut rows);
+    let Some(text) = text_row(budget, terminal)? else { return Ok(()) };
+    rows.push(text);
+    picture_rows(budget, &mut rows);
+    print(&rows, terminal, &verdicts);
+    Ok(())
+}
 
-    // The simulation: the papers' loop, then tidepool one step at a time and blocked.
+/// The simulation: the papers' loop, then tidepool one step at a time and blocked, on one
+/// thread and on `threads`.
+fn simulation_rows(budget: Duration, threads: usize) -> Vec<Row> {
+    let mut rows = Vec::new();
     let side = 1024usize;
     let cells = (side * side) as f64;
     let start = rough_pool(side, side);
@@ -135,10 +146,17 @@ pub fn run(args: BenchArgs) -> Result<()> {
             rate: format!("{r:.2} G cell-updates/s ({:.1}x the papers' loop)", r / base),
         });
     }
+    rows
+}
 
-    // The player's frame for every scene, at the terminal size: the play session's own host,
-    // seat and screen, on a made-up clock of 30 frames a second (every frame is drawn).
-    let (cols, rows_cells) = (args.terminal.width() as u16, (args.terminal.height() / 2 + 1) as u16);
+/// The player's frame for every scene, at the terminal size: the play session's own host,
+/// seat and screen, on a made-up clock of 30 frames a second (every frame is drawn). Returns
+/// each scene's median frame and its share of a core at 30 fps.
+fn player_rows(
+    budget: Duration,
+    (cols, rows_cells): (u16, u16),
+    rows: &mut Vec<Row>,
+) -> Vec<(&'static str, Duration, f64)> {
     let mut verdicts = Vec::new();
     for (name, spec) in scenes(1) {
         let t0 = Instant::now();
@@ -183,22 +201,30 @@ pub fn run(args: BenchArgs) -> Result<()> {
         });
         verdicts.push((name, median, core));
     }
+    verdicts
+}
+
+/// A whole frame of half-block text, for a resize or a first frame (`None` when the
+/// terminal's pool cannot be made).
+fn text_row(budget: Duration, (cols, rows_cells): (u16, u16)) -> Result<Option<Row>> {
     let (w, h) = (u32::from(cols), 2 * u32::from(rows_cells - 1));
-    // A whole frame of text, for a resize or a first frame.
-    let Ok(mut pool) = scenes(1)[0].1.build(w, h) else { return Ok(()) };
+    let Ok(mut pool) = scenes(1)[0].1.build(w, h) else { return Ok(None) };
     pool.advance(30);
     let frame = pool.snapshot()?;
     let text_median = median_time(budget, || {
         black_box(halfblock(black_box(&frame)));
     });
-    rows.push(Row {
+    Ok(Some(Row {
         stage: "half-block text, a whole frame".into(),
         size: format!("{w}x{h}"),
         median: text_median,
         rate: tidepool::encode::human_bytes(halfblock(&frame).len() as u64),
-    });
+    }))
+}
 
-    // Pictures at full HD (the ocean and the lake at 2x2 supersampling, as `render` does).
+/// Pictures at full HD (the ocean and the lake at 2x2 supersampling, as `render` does), and
+/// the PNG encoding of the pool's.
+fn picture_rows(budget: Duration, rows: &mut Vec<Row>) {
     for (name, spec) in scenes(2) {
         let Ok(mut scene) = spec.build(1920, 1080) else { continue };
         let mut picture = Pixmap::new(1920, 1080).expect("a full-HD picture");
@@ -225,15 +251,17 @@ pub fn run(args: BenchArgs) -> Result<()> {
             });
         }
     }
+}
 
+/// The table, then the verdict for the player in this terminal.
+fn print(rows: &[Row], (cols, rows_cells): (u16, u16), verdicts: &[(&str, Duration, f64)]) {
     println!("{:<58} {:>16} {:>11}   rate", "stage", "size", "median");
-    for row in &rows {
+    for row in rows {
         println!("{:<58} {:>16} {:>8.3} ms   {}", row.stage, row.size, ms(row.median), row.rate);
     }
     println!("\nthe player in a {cols}x{rows_cells}-cell terminal (frames at 30 fps, simulation in real time):");
-    for (name, median, core) in verdicts {
+    for &(name, median, core) in verdicts {
         let fits = if ms(median) < 1000.0 / 60.0 { "60 fps would fit" } else { "60 fps would not fit" };
         println!("  {name:<6} {:>7.2} ms a frame, {core:>5.1} % of one core at 30 fps; {fits}", ms(median));
     }
-    Ok(())
 }
