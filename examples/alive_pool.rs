@@ -52,9 +52,9 @@ fn parse() -> Result<Options, String> {
         let number = |v: &str| v.parse::<f64>().map_err(|e| format!("{key}: {e}"));
         match key {
             "size" => o.size = value.parse().map_err(|e| format!("size: {e}"))?,
-            "breeze" => o.settings.breeze = tidepool::values::parse_breeze(value).map_err(|e| e.to_string())?,
+            "breeze" => o.settings.breeze = PoolSettings::check_breeze(number(value)?).map_err(|e| e.to_string())?,
             "damping" => o.settings.damping = value.parse().map_err(|e| format!("damping: {e}"))?,
-            "rain" => o.settings.rain_rate = tidepool::values::parse_rain_rate(value).map_err(|e| e.to_string())?,
+            "rain" => o.settings.rain_rate = PoolSettings::check_rain(number(value)?).map_err(|e| e.to_string())?,
             "seed" => o.settings.seed = number(value)? as u64,
             "seconds" => o.seconds = number(value)? as u64,
             "every" => o.every = (number(value)? as u64).max(1),

@@ -24,6 +24,7 @@
 //! that draws any scene, `widget`).
 #![warn(missing_docs)]
 
+mod checks;
 mod error;
 mod numbers;
 mod output;
@@ -43,7 +44,6 @@ pub mod play;
 pub mod replay;
 pub mod sea;
 pub mod terminal;
-pub mod values;
 #[cfg(feature = "ratatui")]
 pub mod widget;
 

@@ -1,7 +1,8 @@
 //! The command line: clap definitions (raw flags) and the parsers that validate each value.
 //!
 //! The value parsers are the library's own checks (`Stone::from_str`, `Damping::from_str`,
-//! [`tidepool::values`]): each returns a message that names what is wrong and how to fix it;
+//! `PoolSettings::check_rain`, ...; the plain numbers are read in [`values`]): each returns a
+//! message that names what is wrong and how to fix it;
 //! clap puts the flag in front (`invalid value '0x0' for '--size <WxH>': ...`) and exits with
 //! status 2. Checks that involve several flags live in [`crate::commands`].
 
@@ -9,13 +10,15 @@ use std::path::PathBuf;
 use std::str::FromStr;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use tidepool::{BreezeStyle, CausticsLook, Damping, Refraction, SceneKind, Size, Stone, Sun, ValueError, values};
+use tidepool::{BreezeStyle, CausticsLook, Damping, Refraction, SceneKind, Size, Stone, Sun, ValueError};
 
 pub mod lake;
 pub mod ocean;
 pub mod pool;
+pub mod values;
 
 pub use pool::{PoolArgs, PoolDefaults};
+pub use values::{parse_breeze, parse_grid, parse_rate, parse_steps_per_second};
 #[cfg(feature = "serve")]
 pub mod serve;
 
@@ -436,29 +439,9 @@ pub fn parse_sun(text: &str) -> Result<Sun, String> {
     check(text)
 }
 
-/// Parses a rain rate, drops per step.
-pub fn parse_rate(text: &str) -> Result<f64, String> {
-    values::parse_rain_rate(text).map_err(|e| e.to_string())
-}
-
-/// Parses a breeze level, 0..=4.
-pub fn parse_breeze(text: &str) -> Result<f64, String> {
-    values::parse_breeze(text).map_err(|e| e.to_string())
-}
-
 /// Parses a breeze style: `gusts` or `wavelets`.
 pub fn parse_breeze_style(text: &str) -> Result<BreezeStyle, String> {
     check(text)
-}
-
-/// Parses a pace, 1..=240 simulation steps a second.
-pub fn parse_steps_per_second(text: &str) -> Result<u32, String> {
-    values::parse_steps_per_second(text).map_err(|e| e.to_string())
-}
-
-/// Parses a grid, 1..=4 simulation cells per pixel.
-pub fn parse_grid(text: &str) -> Result<u32, String> {
-    values::parse_grid(text).map_err(|e| e.to_string())
 }
 
 /// Parses a refraction factor (finite, 0..=100) or `auto`.

@@ -5,6 +5,7 @@ use clap::{Args, ValueEnum};
 use tidepool::NoiseKind;
 
 use super::OutputArgs;
+use super::values::{parse_lake_wind, parse_octaves, parse_persistence};
 
 const LAKE_EXAMPLES: &str = "\
 Examples:
@@ -77,31 +78,4 @@ pub struct RenderLake {
     /// An animation instead of one picture (it starts at --time).
     #[command(flatten)]
     pub animation: super::AnimationArgs,
-}
-
-/// Parses the lake's wind, 0..=30 m/s.
-pub fn parse_lake_wind(text: &str) -> Result<f64, String> {
-    tidepool::values::parse_lake_wind(text).map_err(|e| e.to_string())
-}
-
-/// Parses an octave count, 1..=12.
-pub fn parse_octaves(text: &str) -> Result<u32, String> {
-    tidepool::values::parse_octaves(text).map_err(|e| e.to_string())
-}
-
-/// Parses a persistence, 0..=1.
-pub fn parse_persistence(text: &str) -> Result<f64, String> {
-    tidepool::values::parse_persistence(text).map_err(|e| e.to_string())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_lakes_parsers_are_the_librarys() {
-        assert!(parse_lake_wind("31").unwrap_err().contains("0..=30 m/s"));
-        assert_eq!(parse_octaves("12"), Ok(12));
-        assert!(parse_persistence("2").unwrap_err().contains("rougher"));
-    }
 }

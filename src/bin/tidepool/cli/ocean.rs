@@ -13,6 +13,7 @@ use tidepool::{CameraPose, SeaParams};
 use crate::error::{Error, Result};
 
 use super::OutputArgs;
+use super::values::number;
 
 const OCEAN_EXAMPLES: &str = "\
 Examples:
@@ -425,10 +426,6 @@ pub fn parse_choppiness(text: &str) -> Result<f64, String> {
     check_choppiness(parse_plain_number(text)?).map_err(|e| e.to_string())
 }
 
-fn number(text: &str, what: &'static str, example: &str) -> Result<f64, String> {
-    tidepool::values::parse_number(text, what, example).map_err(|e| e.to_string())
-}
-
 fn in_range(v: f64, lo: f64, hi: f64, what: &str, unit: &str) -> Result<f64, String> {
     if v < lo || v > hi {
         return Err(format!("the {what} {v} is outside {lo}..={hi} {unit}"));
@@ -438,7 +435,7 @@ fn in_range(v: f64, lo: f64, hi: f64, what: &str, unit: &str) -> Result<f64, Str
 
 /// Parses a wind speed 0..=60 m/s.
 pub fn parse_wind(text: &str) -> Result<f64, String> {
-    tidepool::values::parse_sea_wind(text).map_err(|e| e.to_string())
+    super::values::parse_sea_wind(text)
 }
 
 /// Parses an angle in degrees, wrapped into 0..360.

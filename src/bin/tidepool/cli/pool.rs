@@ -2,7 +2,7 @@
 //! and the defaults where they differ.
 
 use clap::Args;
-use tidepool::{BreezeStyle, CausticsLook, Damping, Refraction, Sun, values};
+use tidepool::{BreezeStyle, CausticsLook, Damping, PoolSettings, Refraction, Sun};
 
 use super::*;
 
@@ -31,7 +31,7 @@ impl PoolDefaults {
     /// frame instead of 1.4 pixels (`tests/integration/coherence.rs`, `benches/codec.rs`).
     pub const PLAYER: PoolDefaults = PoolDefaults {
         rain: 0.01,
-        breeze: values::DEFAULT_BREEZE,
+        breeze: PoolSettings::LIGHT_BREEZE,
         breeze_style: BreezeStyle::Gusts,
         grid: 2,
         steps_per_second: 30,
