@@ -59,7 +59,8 @@ async fn players_of_one_size_get_byte_identical_frames_and_one_who_opens_help_dr
         "most of B's frames are A's: {common} of {}",
         of_b.len()
     );
-    assert!(of_c.iter().filter(|f| of_a.contains(*f)).count() * 10 >= of_c.len() * 8, "and C's");
+    let common = of_c.iter().filter(|f| of_a.contains(*f)).count();
+    assert!(of_c.len() >= 10 && common * 10 >= of_c.len() * 8, "and C's: {common} of {} are A's", of_c.len());
     // C opens the help: its frames are its own.
     tc.ch.data(&b"?"[..]).await.unwrap();
     let mark_a = ta.raw.len();
