@@ -3,9 +3,11 @@
 //! counting allocator checks it, across every thread (rayon's workers and the frame writer).
 //! The player runs for real here, through `tidepool::play::run` on a fake terminal: this is
 //! also the proof that the loop runs on any byte stream.
-//! The ocean is the exception it measures: tiny-skia's `fill_path` builds each triangle's edge
-//! list in a fresh `Vec` (there is no way to hand it a buffer), so an ocean frame allocates
-//! about once per triangle drawn, and nothing else.
+//! The ocean is the exception it measures: its foam makes four small vectors anew for every
+//! picture (`FoamClock::weights` and the two `taps` of `FoamTracker::update`,
+//! `src/sim/foam.rs`: the memory's weights as f64 and f32, the taps of this step and the
+//! next; about 1.3 kB together), whatever the size of the picture or its mesh (the mesh itself
+//! is drawn into reused buffers). So an ocean frame may allocate [`OCEAN_PER_FRAME`] times.
 //! This binary holds a single test so no other test's allocations are counted.
 
 use std::alloc::{GlobalAlloc, Layout, System};
@@ -46,6 +48,13 @@ static ALLOCATOR: Counting = Counting;
 const WARM_UP: usize = 10;
 /// Frames counted.
 const COUNTED: usize = 60;
+/// The ocean's allocations a frame: the foam's four vectors (measured: 240 in 60 frames in
+/// eight runs of nine, 244 in one, at 160x48 cells and 5,055 triangles).
+const OCEAN_PER_FRAME: usize = 4;
+/// Allocations the ocean's 60 frames may make beyond four a frame: one picture drawn for every
+/// tenth frame on top of its own (the one run above the measure drew one extra picture, four
+/// allocations). A frame that allocated once per triangle would make thousands.
+const OCEAN_HEADROOM: usize = OCEAN_PER_FRAME * COUNTED / 10;
 
 #[test]
 fn frames_allocate_nothing_after_warm_up() {
@@ -59,15 +68,10 @@ fn frames_allocate_nothing_after_warm_up() {
     let lake = SceneSpec::Lake(LakeSettings::default());
     assert_eq!(player_frames(lake), 0, "lake player frames: no allocation");
     let ocean = SceneSpec::Ocean(OceanSettings::default());
-    let triangles: usize = {
-        let mut scene = ocean.build(160, 94).unwrap();
-        scene.snapshot().unwrap();
-        let describe = scene.describe();
-        describe.split(", ").find_map(|p| p.strip_suffix(" triangles")?.parse().ok()).expect("a triangle count")
-    };
-    let per_frame = player_frames(ocean) as f64 / COUNTED as f64;
-    eprintln!("ocean player frames: {per_frame:.0} allocations a frame, {triangles} triangles");
-    assert!(per_frame <= triangles as f64, "ocean: {per_frame} allocations a frame for {triangles} triangles");
+    let allocations = player_frames(ocean);
+    let most = OCEAN_PER_FRAME * COUNTED + OCEAN_HEADROOM;
+    eprintln!("ocean player frames: {allocations} allocations in {COUNTED} frames (at most {most})");
+    assert!(allocations <= most, "ocean: {allocations} allocations in {COUNTED} frames, more than {most}");
     lake_frames_after_a_wind_change();
 }
 
