@@ -274,3 +274,26 @@ fn completions_and_man_pages_come_from_the_real_flags() {
     assert!(std::fs::read_to_string(dir.join("tidepool-render-pool.1")).unwrap().contains("caustics"));
     assert_eq!(run_in(&dir, &["man", "--out-dir", "nope"]).status.code(), Some(2));
 }
+
+/// The README's test command builds `serve`: its tests (`tests/serve/`, a test binary cargo
+/// leaves out without the feature) and the docs' `tidepool serve` flags are checked only
+/// then. A plain `cargo test` fails here, saying so, instead of passing without them.
+#[cfg(not(feature = "serve"))]
+#[test]
+fn the_tests_run_with_the_server_built() {
+    panic!(
+        "tidepool serve is not built, so its tests (tests/serve/) did not run: use the README's test command, `cargo test --all-features`"
+    );
+}
+
+/// Without the feature, `tidepool serve` says how to get a build with the server, in one line,
+/// with status 2 (not clap's "unrecognized subcommand").
+#[cfg(not(feature = "serve"))]
+#[test]
+fn serve_without_the_feature_says_how_to_build_it() {
+    let output = run(&["serve", "--listen", "0.0.0.0:2222"]);
+    assert_eq!(output.status.code(), Some(2));
+    let text = stderr(&output);
+    assert!(text.contains("cargo run --release --features serve -- serve"), "{text}");
+    assert_eq!(text.lines().count(), 1, "{text}");
+}

@@ -53,12 +53,25 @@ pub enum Command {
     /// Host one shared pool over SSH: everyone who connects plays in the same water.
     #[cfg(feature = "serve")]
     Serve(serve::ServeCommand),
+    /// Host one shared pool over SSH (not in this build: it needs `--features serve`).
+    #[cfg(not(feature = "serve"))]
+    Serve(ServeNotBuilt),
     /// Measure how fast this machine runs tidepool, stage by stage (a few seconds).
     Bench(BenchArgs),
     /// Print shell completions: `tidepool completions bash > ~/.local/share/bash-completion/completions/tidepool`.
     Completions(CompletionsArgs),
     /// Print the manual page (roff), or write one page per command into a folder.
     Man(ManArgs),
+}
+
+/// `tidepool serve` in a build without the feature: whatever follows is taken, and the command
+/// says how to get a build with the server (rather than clap's "unrecognized subcommand").
+#[cfg(not(feature = "serve"))]
+#[derive(Args, Debug)]
+pub struct ServeNotBuilt {
+    /// The server's flags (not read: there is no server in this build).
+    #[arg(trailing_var_arg = true, allow_hyphen_values = true, hide = true)]
+    pub flags: Vec<String>,
 }
 
 /// `tidepool completions`.

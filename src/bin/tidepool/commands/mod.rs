@@ -47,6 +47,12 @@ pub fn run(cli: Cli) -> Result<()> {
         Some(Command::Play(play)) => play::run(play),
         #[cfg(feature = "serve")]
         Some(Command::Serve(_)) => unreachable!("served above, before the signal handlers"),
+        #[cfg(not(feature = "serve"))]
+        Some(Command::Serve(_)) => Err(crate::error::Error::Usage(
+            "this tidepool was built without `serve` (the SSH server is a feature, to keep the first build short): \
+             run `cargo run --release --features serve -- serve`, or install it with `cargo install --path . --features serve`"
+                .into(),
+        )),
         None => match <Cli as clap::Parser>::try_parse_from(["tidepool", "play"]) {
             Ok(Cli { command: Some(Command::Play(play)) }) => play::run(play),
             _ => unreachable!("`tidepool play` with no flags always parses"),
