@@ -1,4 +1,4 @@
-//! Renders the ocean pictures of the README's gallery through the library's public API:
+//! Renders the ocean pictures of the guide's gallery (docs/GUIDE.md) through the library's public API:
 //!
 //! ```sh
 //! cargo run --release --example ocean_gallery -- docs/gallery

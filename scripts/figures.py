@@ -1,10 +1,10 @@
 #!/usr/bin/env python3
-"""Regenerates README's figure tables from one measuring run, so figures cannot drift apart.
+"""Regenerates the guide's figure tables (docs/GUIDE.md) from one measuring run, so figures cannot drift apart.
 
-    scripts/figures.sh            # benchmarks, timings and memory, then README rewritten
-    scripts/figures.py --readme-only   # rewrite from the last run's results (target/figures.json)
+    scripts/figures.sh            # benchmarks, timings and memory, then docs/GUIDE.md rewritten
+    scripts/figures.py --tables-only   # rewrite from the last run's results (target/figures.json)
 
-Every table lives in README between `<!-- figures:NAME -->` and `<!-- /figures -->`. This
+Every table lives in docs/GUIDE.md between `<!-- figures:NAME -->` and `<!-- /figures -->`. This
 script owns those blocks: it writes each table with the machine, the date, the load average
 during the run and the command that measured each row. Ratios (tidepool against the papers'
 loop, two threads against one, the ocean with foam against without) come from the same run,
@@ -213,30 +213,30 @@ def provenance(r):
 BLOCKS = {"speed": speed_table, "ocean": ocean_table, "bytes": bytes_block}
 
 
-def rewrite_readme(r):
-    path = ROOT / "README.md"
+def rewrite_guide(r):
+    path = ROOT / "docs" / "GUIDE.md"
     text = path.read_text()
     for name, make in BLOCKS.items():
         pattern = re.compile(rf"(<!-- figures:{name} -->\n).*?(<!-- /figures -->)", re.S)
         if not pattern.search(text):
-            raise SystemExit(f"figures: README has no <!-- figures:{name} --> block")
+            raise SystemExit(f"figures: docs/GUIDE.md has no <!-- figures:{name} --> block")
         body = make(r) + "\n\n" + provenance(r) + "\n"
         text = pattern.sub(lambda m: m[1] + body + m[2], text)
     tmp = path.with_suffix(".md.tmp")
     tmp.write_text(text)
     tmp.replace(path)
-    print(f"figures: README.md rewritten ({', '.join(BLOCKS)})", file=sys.stderr)
+    print(f"figures: docs/GUIDE.md rewritten ({', '.join(BLOCKS)})", file=sys.stderr)
 
 
 def main():
-    if "--readme-only" in sys.argv[1:]:
+    if "--tables-only" in sys.argv[1:]:
         if not RESULTS.exists():
             raise SystemExit("figures: no earlier run in target/figures.json; run scripts/figures.sh first")
         results = json.loads(RESULTS.read_text())
     else:
         results = measure()
         RESULTS.write_text(json.dumps(results, indent=1))
-    rewrite_readme(results)
+    rewrite_guide(results)
 
 
 if __name__ == "__main__":

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Regenerates the README's gallery (docs/gallery/) with the commands shown in the README.
+# Regenerates the gallery (docs/gallery/) with the commands shown beside each picture in
+# docs/GUIDE.md (the README shows four of them).
 # Needs tmux for the player screenshot (skipped with a note when it is missing).
 set -euo pipefail
 cd "$(dirname "$0")/.."

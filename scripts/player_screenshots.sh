@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The player screenshots README shows (docs/images/player-{80x24,160x48,240x70}.png): the pool
+# The player screenshots the README and the guide show (docs/images/player-{80x24,160x48,240x70}.png): the pool
 # with the player's defaults in a tmux pane of that size, 4 s of warm-up, two `space` stones
 # half a second apart, then a second for the rings; the pane captured with its colours and
 # painted by examples/terminal_screenshot.rs.

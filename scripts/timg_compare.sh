@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The committed alive-pool session (tests/fixtures/alive-160x48.jsonl) played by timg, for the
-# README's bandwidth comparison: tidepool renders the session's exact frames (160x94 pixels,
+# The guide's bandwidth comparison (docs/GUIDE.md): tidepool renders the session's exact frames (160x94 pixels,
 # 30 fps, as the player showed them), ffmpeg packs them losslessly (FFV1), and timg plays the
 # video in a 160x48 pseudo-terminal with half blocks in truecolor, as the player draws; the
 # bytes it writes are counted. The player's own figure for the same frames is the codec

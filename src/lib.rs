@@ -67,3 +67,10 @@ pub use sim::ripple::{Damping, RipplePool, Stone};
 pub use simd::Simd;
 pub use size::Size;
 pub use storage::Storage;
+
+/// The rust code of the README and the guide, compiled and run as doctests, so that what a
+/// newcomer copies from them builds.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+#[doc = include_str!("../docs/GUIDE.md")]
+struct DocsExamples;

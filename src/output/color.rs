@@ -4,7 +4,7 @@
 //!   `-direct`, means 24-bit colour; a `TERM` naming 256 colours (or any other modern `TERM`)
 //!   means the xterm 256-colour palette; `linux`, `vt100`/`vt220`, `ansi` and `dumb` mean 16.
 //!   SSH does not forward `COLORTERM` by default and tmux hides it unless told, so `--color`
-//!   always overrides the guess (see the README).
+//!   always overrides the guess (see docs/GUIDE.md, "Truecolor over SSH and in tmux").
 //! - The 256-colour palette is matched against the real xterm levels (0, 95, 135, 175, 215, 255
 //!   for the cube; 8..=238 step 10 for the grey ramp), with the midpoints as thresholds, not the
 //!   divide-by-43 shortcut, which picks the wrong level for a third of the values.

@@ -5,7 +5,7 @@
 //! bytes and the new [`Shown`]. Nothing here touches a terminal, so every choice is tested
 //! against the terminal model in [`crate::output::vt`].
 //!
-//! What it does, cheapest first (the numbers are a 160x48 pool with rain, see the README):
+//! What it does, cheapest first (the numbers are a 160x48 pool with rain, see docs/GUIDE.md):
 //! - Only cells that changed are sent; a cell within `threshold` of what is shown counts as
 //!   unchanged and the shown colour is kept, so slow drifts still add up to a change.
 //! - The cursor takes the shortest move ([`crate::output::cursor`]); a short gap whose cells

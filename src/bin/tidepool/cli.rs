@@ -168,7 +168,7 @@ pub struct PlayCommand {
     pub fps: u32,
 
     /// Colours: truecolor (24-bit), 256 (xterm palette), 16, or auto (from COLORTERM and
-    /// TERM; SSH and tmux may hide truecolor support, see the README).
+    /// TERM; SSH and tmux may hide truecolor support, see docs/GUIDE.md).
     #[arg(long, value_enum, value_name = "MODE", default_value = "auto")]
     pub color: ColorChoice,
 

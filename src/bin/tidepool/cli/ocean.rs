@@ -63,7 +63,7 @@ impl WindArgs {
 }
 
 /// A named sea: the wind, its direction, the wind sea's spectrum and the swells, each
-/// documented with its numbers (README, `render ocean --help`). Any flag given as well wins
+/// documented with its numbers (docs/GUIDE.md, `render ocean --help`). Any flag given as well wins
 /// over the preset's value for it (`--swell` replaces the preset's swells).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub enum Preset {
