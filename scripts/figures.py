@@ -101,7 +101,7 @@ def measure():
     memory = {scene: peak_rss_of([str(BIN), "render", scene, "--size", "1920x1080"]) for scene in ["ocean", "lake", "pool"]}
     wall = wall_median(["render", "pool", "--size", "1024x1024", "--steps", "2000"])
     loads.append(load())
-    frame_bytes = {"still": bytes_per_frame(None), "alive": bytes_per_frame(" ")}
+    frame_bytes = {"still": bytes_per_frame(None), "alive": bytes_per_frame("--bandwidth unlimited")}
     loads.append(load())
     return {
         "machine": machine(),
@@ -163,7 +163,7 @@ def speed_table(r):
         ("half-block text 160x48 cells: full frame / diff frame", f"{us(c['output/halfblock/full_frame_160x48'])} / {us(c['output/halfblock/diff_frame_160x48'])}", "`cargo bench --bench encoder`"),
         ("player frame 160x48 cells: two pool steps, render, encode", f"{us(player)} (~{1e9 / player:,.0f} fps)", "same"),
         ("PNG encode 1920x1080", ms(c["output/png/encode_1920x1080"]), "`cargo bench --bench pool -- output/png`"),
-        ("player bytes per frame, 160x48, a stone a second: still water between stones / the alive defaults", f"{r['bytes_per_frame']['still']['percent']:.1f} % / {r['bytes_per_frame']['alive']['percent']:.1f} % of a naive redraw", "`cargo test --release --test integration bytes_per_frame -- --ignored --nocapture` (`MEASURE_ARGS=' '` for the defaults)"),
+        ("player bytes per frame, 160x48, a stone a second: still water between stones / the alive defaults", f"{r['bytes_per_frame']['still']['percent']:.1f} % / {r['bytes_per_frame']['alive']['percent']:.1f} % of a naive redraw", "`cargo test --release --test integration bytes_per_frame -- --ignored --nocapture` (`MEASURE_ARGS='--bandwidth unlimited'` for the defaults)"),
         ("peak memory, `render ocean` / `render lake` / `render pool` at 1920x1080", f"{mem['ocean']:.0f} MB / {mem['lake']:.0f} MB / {mem['pool']:.0f} MB", "`/usr/bin/time -f %M tidepool render ocean --size 1920x1080`"),
     ]
     return table(["what", "figure", "reproduce with"], rows)
@@ -186,7 +186,7 @@ def ocean_table(r):
 
 def bytes_block(r):
     lines = ["```sh", "cargo test --release --test integration bytes_per_frame -- --ignored --nocapture"]
-    for name, label in [("still", "no breeze, rain 0.02, damping 4"), ("alive", "the defaults: MEASURE_ARGS=' '")]:
+    for name, label in [("still", "no breeze, rain 0.02, damping 4"), ("alive", "the defaults: MEASURE_ARGS='--bandwidth unlimited'")]:
         b = r["bytes_per_frame"][name]
         lines.append(
             f"# {label}: {b['bytes']:,} bytes/frame at {b['fps']:.0f} frames/s = {b['percent']:.1f}% of the naive"
