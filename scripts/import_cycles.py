@@ -1,8 +1,65 @@
 #!/usr/bin/env python3
-"""Finds import circles between the crate's modules: an edge A -> B when file A names crate::B or
-super::B outside comments and tests; a parent and its own children may use each other.
-Usage: scripts/import_cycles.py src src/bin/tidepool   (prints each circle; exit 1 if any)"""
+"""Checks the crate's imports, file by file and folder by folder.
+
+1. Import circles between modules: an edge A -> B when file A names crate::B or super::B outside
+   comments and tests; a parent and its own children may use each other.
+2. The layers (ARCHITECTURE.md, "The layers"), by top-level folder of src/: a folder never
+   imports the folders LAYERS lists for it (any file in it, any depth, `crate::x` or
+   `crate::{x, ..}`). The rule that matters most: the play session (src/play/) imports no door
+   (src/term/; the SSH door lives in the binary and cannot be named).
+
+Usage: scripts/import_cycles.py src src/bin/tidepool   (prints each problem; exit 1 if any)"""
 import os,re,sys
+
+# folder -> the folders it must never import. Lower layers know nothing of the ones above them:
+# simulation < rendering < scenes < output encoders < the play session < the terminal door.
+DOORS = {"term", "tty"}
+LAYERS = {
+    "sim": {"render", "scene", "output", "play"} | DOORS,
+    "render": {"scene", "output", "play"} | DOORS,
+    "output": {"scene", "play"} | DOORS,
+    "scene": {"play"} | DOORS,
+    "play": DOORS,
+    "encode": {"play"} | DOORS,
+    "graphics": {"play"} | DOORS,
+    "sea": {"play"} | DOORS,
+    "terminal": {"play"} | DOORS,
+    "replay": {"play"} | DOORS,
+}
+
+def code_of(path):
+    """The file's text without its test module and its comment lines."""
+    s=open(path).read()
+    s=re.sub(r'#\[cfg\(test\)\]\s*mod tests\s*\{.*', '', s, flags=re.S)
+    # Comment lines blanked, not removed, so that line numbers stay the file's.
+    return '\n'.join('' if l.strip().startswith('//') else l for l in s.split('\n'))
+
+def crate_roots(code):
+    """The top-level modules a file names through `crate::`, with the line of each."""
+    found=[]
+    for m in re.finditer(r'\bcrate::(\{[^}]*\}|[a-z_0-9]+)', code):
+        line=code.count('\n',0,m.start())+1
+        names=m.group(1)
+        if names.startswith('{'):
+            for part in re.split(r'[,{}\s]+', names):
+                if part: found.append((part.split('::')[0], line))
+        else:
+            found.append((names, line))
+    return found
+
+def layer_problems(root):
+    """Each import that crosses a layer the wrong way: (file, line, folder, imported)."""
+    problems=[]
+    for d,_,fs in os.walk(root):
+        for f in fs:
+            if not f.endswith('.rs'): continue
+            path=os.path.join(d,f)
+            top=os.path.relpath(path,root).split(os.sep)[0]
+            top=top[:-3] if top.endswith('.rs') else top
+            forbidden=LAYERS.get(top,set())
+            for name,line in crate_roots(code_of(path)):
+                if name in forbidden: problems.append((path,line,top,name))
+    return problems
 def modpath(root, path):
     rel=os.path.relpath(path, root)[:-3]
     parts=rel.split(os.sep)
@@ -13,9 +70,7 @@ def analyse(root):
     mods={modpath(root,f):f for f in files}
     edges={}
     for m,f in mods.items():
-        s=open(f).read()
-        s=re.sub(r'#\[cfg\(test\)\]\s*mod tests\s*\{.*', '', s, flags=re.S)
-        s='\n'.join(l for l in s.split('\n') if not l.strip().startswith('//'))
+        s=code_of(f)
         targets=set()
         for mm in re.finditer(r'\b(crate|super)((?:::[a-z_0-9]+)+)', s):
             base=mm.group(1); path=mm.group(2).split('::')[1:]
@@ -50,4 +105,7 @@ for root in sys.argv[1:]:
     for comp in analyse(root):
         found = True
         print(root, "import circle:", " <-> ".join(sorted("::".join(c) for c in comp)))
+    for path,line,top,name in layer_problems(root):
+        found = True
+        print(f"{path}:{line}: src/{top}/ imports crate::{name}, a layer above it (ARCHITECTURE.md, The layers)")
 sys.exit(1 if found else 0)

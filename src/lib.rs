@@ -20,7 +20,7 @@
 //! ```
 //!
 //! Features: `cli` (default: the `tidepool` binary), `player` (the play session and the
-//! interactive terminal player, [`play`]), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
+//! interactive terminal player, [`tty`]), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
 //! that draws any scene, `widget`).
 #![warn(missing_docs)]
 
@@ -46,6 +46,15 @@ pub mod sea;
 pub mod terminal;
 #[cfg(feature = "ratatui")]
 pub mod widget;
+
+/// This process's own terminal (feature `player`): the door that puts a play session on a
+/// terminal. It lives beside [`play`], not inside it, because the session imports no door
+/// (`scripts/import_cycles.py` checks it).
+#[cfg(feature = "player")]
+pub mod tty {
+    pub use crate::term::door::{PlayConfig, TerminalInput, run};
+    pub use crate::term::tty::{play, probe_for_picture, restore};
+}
 
 pub use error::{Error, Result, ValueError};
 pub use render::background::{load as load_image, pool_floor};

@@ -14,7 +14,7 @@
 //! - [`Groups`]: screens alike enough to share frames, encoded once per group; a player's [`Membership`]
 //!   takes the group's bytes while its terminal shows the group's model.
 //!
-//! Two doors drive them: [`run`] (and [`play`], for this process's own terminal) puts a host,
+//! Two doors drive them: [`crate::tty::run`] (and [`crate::tty::play`], for this process's own terminal) puts a host,
 //! a seat and a screen on one terminal; `tidepool serve` runs one host on a thread and a seat
 //! and a screen per SSH channel. A key's route is straight: bytes -> [`Screen::feed`] ->
 //! [`Input`] -> [`Seat::handle`] -> [`Request`] -> [`Host::apply`] -> the scene.
@@ -68,8 +68,6 @@ pub(crate) mod request;
 pub(crate) mod screen;
 pub(crate) mod seat;
 
-pub use crate::term::door::{PlayConfig, TerminalInput, run};
-pub use crate::term::tty::{play, probe_for_picture, restore};
 pub use fit::Fit;
 pub use group::{GroupFeed, GroupKey, Groups, Membership, Source};
 pub use host::{Host, HostConfig, Recording, SceneStatus};

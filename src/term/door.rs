@@ -210,7 +210,7 @@ pub fn run_door(
 
 /// Runs a session on any terminal until the person quits (or the input closes, or
 /// `config.quit` is set), reading `input` and writing to `output`: the door an embedding
-/// program (or a test) uses for a byte stream of its own. [`crate::play::play`] is the door of
+/// program (or a test) uses for a byte stream of its own. [`crate::tty::play`] is the door of
 /// this process's terminal.
 pub fn run(
     input: &mut dyn TerminalInput,

@@ -30,9 +30,9 @@ pub struct Inline {
 }
 
 impl Inline {
-    /// Asks the terminal (see `tidepool::play::probe_for_picture`); `None` for cells.
+    /// Asks the terminal (see `tidepool::tty::probe_for_picture`); `None` for cells.
     pub fn probe(request: Request) -> Option<Inline> {
-        let (choice, support) = tidepool::play::probe_for_picture(request.into());
+        let (choice, support) = tidepool::tty::probe_for_picture(request.into());
         if choice.mode == GraphicsMode::Cells {
             return None;
         }

@@ -7,8 +7,9 @@ use std::io::IsTerminal;
 use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
-use tidepool::play::{Bandwidth, HostConfig, PlayConfig, Recording, ScreenConfig};
+use tidepool::play::{Bandwidth, HostConfig, Recording, ScreenConfig};
 use tidepool::terminal::{ColorMode, EncodeOptions};
+use tidepool::tty::PlayConfig;
 
 use crate::cli::{ColorChoice, PlayCommand};
 use crate::error::{Error, Result};
@@ -80,7 +81,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
     };
     let config = PlayConfig { host, screen, greeting: color_hint(command.color, color), quit: Arc::clone(&quit) };
     let _stop_on_signal = crate::signals::StopOnSignal::new(quit);
-    tidepool::play::play(config).map_err(|e| match e {
+    tidepool::tty::play(config).map_err(|e| match e {
         tidepool::Error::TooLarge { what, width, height } => {
             Error::Usage(format!("cannot allocate a {width}x{height} {what}; use a smaller terminal"))
         }
