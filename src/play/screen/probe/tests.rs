@@ -359,7 +359,6 @@ mod through_the_screen {
     #[test]
     fn the_first_deadline_covers_a_far_terminal_and_da1_ends_the_wait_at_once() {
         // A terminal a 300 ms round trip away (another continent): pixels from the first frame.
-        assert!(PROBE_BUDGET >= Duration::from_millis(400), "{PROBE_BUDGET:?}");
         let t0 = Instant::now();
         let mut s = screen(t0);
         let inputs = run(&mut s, t0, &[(300, &[KITTY, DA1].concat())], 300);
