@@ -35,7 +35,7 @@ use tiny_skia::Pixmap;
 
 use super::host::SceneStatus;
 use super::player::Player;
-use super::screen::compose::Figures;
+use super::screen::compose::{Figures, half_block_picture};
 use super::screen::probe::GraphicsRequest;
 use super::screen::{Bandwidth, Cells, LinkPath, Screen, ScreenConfig};
 use super::seat::{DEFAULT_STONE_RADIUS, SeatView};
@@ -107,8 +107,7 @@ pub struct GroupKey {
 impl GroupKey {
     /// The picture a group of this key draws, in pixels (as its members' screens take it).
     pub fn picture_size(&self) -> (u32, u32) {
-        let (cols, rows) = (u32::from(self.term.0), u32::from(self.term.1));
-        (cols.max(3), (2 * rows.saturating_sub(1)).max(3))
+        half_block_picture(self.term)
     }
 }
 

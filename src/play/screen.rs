@@ -24,7 +24,7 @@ use std::time::{Duration, Instant};
 
 use tiny_skia::Pixmap;
 
-use self::compose::{Figures, FrameBuilder, big_enough};
+use self::compose::{Figures, FrameBuilder, big_enough, half_block_picture};
 pub use self::link::LinkPath;
 use self::link::{Change, LinkControl};
 use self::picture::Picture;
@@ -316,7 +316,7 @@ impl Screen {
     pub fn picture_size(&self) -> (u32, u32) {
         match &self.picture {
             Some(p) => p.scene_size(),
-            None => (u32::from(self.term.0).max(3), (2 * u32::from(self.term.1).saturating_sub(1)).max(3)),
+            None => half_block_picture(self.term),
         }
     }
 

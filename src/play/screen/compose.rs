@@ -36,6 +36,13 @@ pub fn big_enough((cols, rows): (u16, u16)) -> bool {
     cols >= MIN_SIZE.0 && rows >= MIN_SIZE.1
 }
 
+/// The half-block picture of a `cols x rows` terminal, in pixels: a pixel a column, two a row,
+/// above the status line (at least 3x3, so a scene always has an inside). Screens and groups
+/// both size their pictures by it, so a group's frame is a member's.
+pub fn half_block_picture((cols, rows): (u16, u16)) -> (u32, u32) {
+    (u32::from(cols).max(3), (2 * u32::from(rows).saturating_sub(1)).max(3))
+}
+
 /// Builds frames, reusing its buffers.
 #[derive(Debug)]
 pub struct FrameBuilder {
