@@ -120,16 +120,14 @@ pub const SWELL_BAND: (f64, f64) = (0.75, 1.8);
 /// deviations of its cos-2s spread).
 pub const SWELL_HALF_WIDTH_RAD: f64 = 50.0 * std::f64::consts::PI / 180.0;
 
-/// Monahan's whitecap fraction 3.84e-6·U^3.41 for a wind of `wind_m_s`, capped at 1: what the
-/// simulated foam is checked against (never told to the model).
-#[cfg(test)]
-pub fn whitecap_fraction(wind_m_s: f64) -> f64 {
-    (3.84e-6 * wind_m_s.max(0.0).powf(3.41)).min(1.0)
-}
+/// Cox and Munk's mean square slope at zero wind (both axes): the slope of waves the local
+/// wind did not raise (their clean-surface intercept).
+pub const CALM_SLOPE_VARIANCE: f64 = 0.003;
 
-/// The Cox–Munk mean square slope (both axes together) of a sea under `wind_m_s`.
+/// The Cox–Munk mean square slope (both axes together) of a sea under `wind_m_s`:
+/// `0.003 + 0.00512·U` (clean surface).
 pub fn cox_munk_slope_variance(wind_m_s: f64) -> f64 {
-    0.003 + 0.00512 * wind_m_s.max(0.0)
+    CALM_SLOPE_VARIANCE + 0.00512 * wind_m_s.max(0.0)
 }
 
 /// Checks a choppiness: finite, 0..=4.
