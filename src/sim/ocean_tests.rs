@@ -3,6 +3,8 @@
 
 use super::*;
 use crate::sim::dispersion;
+use crate::sim::ocean::frame::HEIGHT;
+use crate::sim::surface::SurfaceSample;
 use crate::sim::looping::LoopPeriod;
 use crate::sim::spectra::{Depth, Jonswap};
 
