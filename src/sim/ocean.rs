@@ -79,9 +79,9 @@ use super::trig::fast_sincos;
 mod build;
 mod fold;
 mod frame;
+pub(crate) use fold::{FOLD_ROWS, PhaseRows};
 pub use frame::SeaFrame;
 use frame::resolution_weight;
-pub(crate) use fold::{FOLD_ROWS, PhaseRows};
 
 /// Lowest frequency of the sines, as a multiple of fp.
 pub const BAND_LOW: f64 = 0.5;

@@ -24,6 +24,8 @@ pub struct SeaFrame<'a> {
 pub(crate) struct Sums {
     pub(crate) h: f32,
     slope: f32,
+    /// Σ a²/2·k²·φ², φ the phase step between samples: what a mesh loses of `slope`.
+    loss: f32,
     dx: f32,
     dy: f32,
     b_re: f32,
@@ -76,29 +78,33 @@ impl SeaFrame<'_> {
                 (lane(&l.kx, base), lane(&l.ky, base), lane(&l.amp, base), lane(&self.phase, base));
             if PASS == HEIGHT {
                 for i in 0..LANES {
-                    let a = resolution_weight(footprint.phase_step(kx[i], ky[i])) * amp[i] * live[i];
+                    let step = footprint.phase_step(kx[i], ky[i]);
+                    let a = resolution_weight(step) * amp[i] * live[i];
                     acc[0][i] += a * fast_cos(kx[i] * x + ky[i] * y + phase[i]);
-                    let a2 = 0.5 * a * a;
-                    acc[2][i] += a2 * (kx[i] * kx[i] + ky[i] * ky[i]);
+                    let slope = 0.5 * a * a * (kx[i] * kx[i] + ky[i] * ky[i]);
+                    acc[2][i] += slope;
+                    acc[1][i] += slope * step * step;
                 }
             } else {
                 let (ux, uy, sk) = (lane(&l.ux, base), lane(&l.uy, base), lane(&l.sqrt_k, base));
                 for i in 0..LANES {
-                    let a = resolution_weight(footprint.phase_step(kx[i], ky[i])) * amp[i] * live[i];
+                    let step = footprint.phase_step(kx[i], ky[i]);
+                    let a = resolution_weight(step) * amp[i] * live[i];
                     let (s, c) = fast_sincos(kx[i] * x + ky[i] * y + phase[i]);
                     acc[0][i] += a * c;
                     acc[3][i] += a * s * ux[i];
                     acc[4][i] += a * s * uy[i];
                     acc[5][i] += a * c * sk[i];
                     acc[6][i] += a * s * sk[i];
-                    let a2 = 0.5 * a * a;
-                    acc[2][i] += a2 * (kx[i] * kx[i] + ky[i] * ky[i]);
+                    let slope = 0.5 * a * a * (kx[i] * kx[i] + ky[i] * ky[i]);
+                    acc[2][i] += slope;
+                    acc[1][i] += slope * step * step;
                 }
             }
             base += LANES;
         }
         let s = |k: usize| acc[k].iter().sum::<f32>();
-        Sums { h: s(0), slope: s(2), dx: s(3), dy: s(4), b_re: s(5), b_im: s(6) }
+        Sums { h: s(0), loss: s(1), slope: s(2), dx: s(3), dy: s(4), b_re: s(5), b_im: s(6) }
     }
 
     /// Samples the surface at the resting point (east, north) metres for a sample standing
@@ -120,7 +126,8 @@ impl SeaFrame<'_> {
                 let gx = (x - self.tail_offset[0]) / cell;
                 let gy = (y - self.tail_offset[1]) / cell;
                 h += tail.field.sample(gx, gy, octave);
-                resolved_slope += tail.octave_slope[octave as usize];
+                // The octave's slope is measured per axis; the sines' is both axes together.
+                resolved_slope += 2.0 * tail.octave_slope[octave as usize];
             }
         }
         let unresolved = (sea.slope_total - resolved_slope).max(0.1 * sea.slope_total) * 0.5;
@@ -129,6 +136,7 @@ impl SeaFrame<'_> {
             displacement_m: [-chop * s.dx, -chop * s.dy],
             foam: 0.0,
             unresolved_slope_variance: unresolved,
+            mesh_slope_loss: s.loss,
         }
     }
 

@@ -8,7 +8,7 @@ use tidepool::sea::{
     DEFAULT_CHOPPINESS, DEFAULT_SEA_WIND_M_S, DEFAULT_WIND_FROM_DEG, Jonswap, LoopPeriod, SpectrumChoice,
     SpectrumChoiceError, SpectrumKind, Spreading, Swell, Swells, beaufort_speed_m_s, check_choppiness,
 };
-use tidepool::{CameraPose, SeaParams};
+use tidepool::{CameraPose, SeaParams, SeaShading};
 
 use crate::error::{Error, Result};
 
@@ -18,6 +18,7 @@ const OCEAN_EXAMPLES: &str = "\
 Examples:
   tidepool render ocean                              # ocean.png, 640x360, a 10 m/s breeze
   tidepool render ocean --beaufort 8 --direction 200 --size 1280x720 --out gale.png
+  tidepool render ocean --shading smooth --out smooth.png   # no facets
   tidepool render ocean --out - --size 160x96        # in this terminal
   tidepool render ocean --wind 10 --heightmap sea.npy --size 512x512
   tidepool render ocean --spectrum jonswap --fetch 20 --wind 15 --out fetch.png
@@ -264,6 +265,11 @@ pub struct PlaySeaArgs {
     /// The ocean's horizontal displacement, 0..=4 (0 round crests, 1 physical). [default: 1]
     #[arg(long, value_name = "L", value_parser = parse_choppiness, allow_negative_numbers = true)]
     pub choppiness: Option<f64>,
+
+    /// How the ocean's mesh is lit: flat (one colour per spade triangle, the faceted sea of
+    /// the design) or smooth (shaded at the vertices and blended across each triangle).
+    #[arg(long, value_name = "MODE", value_parser = parse_shading, default_value_t = SeaShading::default())]
+    pub shading: SeaShading,
 }
 
 impl PlaySeaArgs {
@@ -325,6 +331,12 @@ pub struct RenderOcean {
     /// The sun: azimuth (degrees clockwise from north) and elevation (0..=90 degrees).
     #[arg(long, value_name = "AZ,EL", default_value = "15,22", value_parser = parse_sun, allow_hyphen_values = true)]
     pub sun: (f64, f64),
+
+    /// How the mesh is lit: flat (one colour per spade triangle, the faceted sea of the design;
+    /// --ssaa averages its far crests) or smooth (shaded at the vertices and blended across
+    /// each triangle). The sun's glitter and the foam are drawn per pixel in both.
+    #[arg(long, value_name = "MODE", value_parser = parse_shading, default_value_t = SeaShading::default())]
+    pub shading: SeaShading,
 
     /// The camera: height above the sea in metres (0.5..=10000), tilt below the horizontal in
     /// degrees (-45..=89), horizontal field of view in degrees (5..=150) and heading in
@@ -395,6 +407,11 @@ pub struct SpectrumCommand {
 
 /// Parses `pm`, `jonswap` or `tma`.
 pub fn parse_spectrum(text: &str) -> Result<SpectrumKind, String> {
+    text.parse().map_err(|e: tidepool::ValueError| e.to_string())
+}
+
+/// Parses `flat` or `smooth`.
+pub fn parse_shading(text: &str) -> Result<SeaShading, String> {
     text.parse().map_err(|e: tidepool::ValueError| e.to_string())
 }
 

@@ -43,6 +43,7 @@ fn settings(args: &RenderOcean, format: Format) -> Result<OceanSettings> {
             sun_elevation_deg: args.sun.1 as f32,
             ssaa: args.ssaa.unwrap_or_else(|| default_ssaa(format)),
             downsample: Downsample::Box,
+            shading: args.shading,
         },
         texture,
         start_time_s: args.time,
