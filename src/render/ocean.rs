@@ -36,10 +36,11 @@ use streaks::Streaks;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum SeaShading {
     /// One normal and one colour per spade triangle: the design's faceted sea (supersampling
-    /// averages the far crests' saw-tooth).
-    Flat,
-    /// Shaded at the vertices and interpolated across each face: no facets, soft far crests.
+    /// averages the far crests' saw-tooth). The default: pictures are supersampled.
     #[default]
+    Flat,
+    /// Shaded at the vertices and interpolated across each face: no facets, soft far crests;
+    /// the better look at a terminal's few pixels without supersampling.
     Smooth,
 }
 
@@ -118,7 +119,7 @@ pub struct OceanView {
 
 impl Default for OceanView {
     /// The default camera, the sun ahead and to the right, 22° up (its glitter path lies on
-    /// the water in view), no supersampling.
+    /// the water in view), no supersampling, flat shading.
     fn default() -> Self {
         OceanView {
             camera: CameraPose::DEFAULT,

@@ -8,14 +8,15 @@ use crate::common::{read_npy, read_png, run, run_in, scratch, stderr};
 fn the_command_line_draws_the_librarys_seas() {
     use crate::goldens::{picture, rgba};
     use tidepool::sea::beaufort_speed_m_s;
-    use tidepool::{OceanSettings, OceanView, SceneSpec, SeaParams};
+    use tidepool::{OceanSettings, OceanView, SceneSpec, SeaParams, SeaShading};
     let dir = scratch("ocean_cli_is_the_library");
     let out = run_in(
         &dir,
         &["render", "ocean", "--beaufort", "8", "--direction", "200", "--size", "192x108", "--out", "sea.png"],
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    let spec = |ssaa, time| {
+    // Pictures are flat-shaded by default, text smooth (see `the_help_names_the_shading_it_draws`).
+    let spec = |ssaa, time, shading| {
         SceneSpec::Ocean(OceanSettings {
             sea: SeaParams {
                 wind_m_s: beaufort_speed_m_s(8).unwrap(),
@@ -23,12 +24,14 @@ fn the_command_line_draws_the_librarys_seas() {
                 seed: 1,
                 ..SeaParams::default()
             },
-            view: OceanView { ssaa, ..OceanView::default() },
+            view: OceanView { ssaa, shading, ..OceanView::default() },
             start_time_s: time,
             ..OceanSettings::default()
         })
     };
-    assert!(read_png(&dir.join("sea.png")) == rgba(&picture(&spec(2, 0.0), 192, 108, &[], 0)));
+    let flat = picture(&spec(2, 0.0, SeaShading::Flat), 192, 108, &[], 0);
+    assert!(read_png(&dir.join("sea.png")) == rgba(&flat));
+    assert!(flat != picture(&spec(2, 0.0, SeaShading::Smooth), 192, 108, &[], 0), "the shadings differ");
     let out = run_in(
         &dir,
         &[
@@ -47,8 +50,53 @@ fn the_command_line_draws_the_librarys_seas() {
         ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    let text = tidepool::encode::halfblock(&picture(&spec(1, 4.0), 80, 48, &[], 0));
+    let text = tidepool::encode::halfblock(&picture(&spec(1, 4.0, SeaShading::Smooth), 80, 48, &[], 0));
     assert_eq!(std::fs::read(dir.join("sea.ans")).unwrap(), text);
+}
+
+/// The shading's help text names the defaults the commands draw: `render ocean --help` says
+/// which shading pictures and text get, and a picture and a text drawn without `--shading`
+/// are the same bytes as with the word the help printed (and not the other).
+#[test]
+fn the_help_names_the_shading_it_draws() {
+    let help = run(&["render", "ocean", "--help"]);
+    assert!(help.status.success(), "{}", stderr(&help));
+    let words = String::from_utf8_lossy(&help.stdout).split_whitespace().collect::<Vec<_>>().join(" ");
+    let at = words.find("--shading <MODE>").expect("render ocean --help lists --shading");
+    let entry = &words[at..];
+    let default = &entry[entry.find("[default: ").expect("--shading shows its default") + 10..];
+    let default = &default[..default.find(']').expect("a closed [default: ...]")];
+    // "[default: flat for pictures, smooth for text]"
+    let word_for = |medium: &str| -> String {
+        let part = default.split(',').find(|p| p.contains(medium)).unwrap_or_else(|| panic!("{default}: {medium}"));
+        part.split_whitespace().next().expect("a word").to_string()
+    };
+    let dir = scratch("ocean_shading_help");
+    for (medium, file) in [("pictures", "sea.png"), ("text", "sea.ans")] {
+        let word = word_for(medium);
+        assert!(word == "flat" || word == "smooth", "{medium}: '{word}'");
+        let draw = |name: &str, shading: Option<&str>| {
+            let mut args = vec!["render", "ocean", "--size", "96x54", "--beaufort", "7", "--out", name];
+            if let Some(s) = shading {
+                args.extend(["--shading", s]);
+            }
+            let out = run_in(&dir, &args);
+            assert!(out.status.success(), "{}", stderr(&out));
+            std::fs::read(dir.join(name)).unwrap()
+        };
+        let ext = file.rsplit('.').next().unwrap();
+        let plain = draw(file, None);
+        assert!(plain == draw(&format!("named.{ext}"), Some(&word)), "{medium}: the default is not '{word}'");
+        let opposite = if word == "flat" { "smooth" } else { "flat" };
+        assert!(plain != draw(&format!("opposite.{ext}"), Some(opposite)), "{medium}: '{opposite}' draws the same");
+    }
+    let play = run(&["play", "--help"]);
+    let play_text = String::from_utf8_lossy(&play.stdout).split_whitespace().collect::<Vec<_>>().join(" ");
+    let at = play_text.find("--shading <MODE>").expect("play --help lists --shading");
+    assert!(play_text[at..].contains("[default: smooth]"), "play draws the ocean smooth");
+    let bad = run(&["render", "ocean", "--shading", "gouraud"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(stderr(&bad).contains("--shading") && stderr(&bad).contains("flat"), "{}", stderr(&bad));
 }
 
 #[test]

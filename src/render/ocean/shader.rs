@@ -7,7 +7,9 @@
 //!   (the displaced triangle), shaded once at its centroid ([`shade_water`]): the sea is a
 //!   mosaic of facets, as the paper's mesh. Near the horizon a mesh row spans a whole crest, so
 //!   the faces between two rows alternate between its front and back slopes; supersampling
-//!   (`--ssaa`) averages that saw-tooth into the crest's mean.
+//!   (`--ssaa`) averages that saw-tooth into the crest's mean. The haze is the air's, not the
+//!   facet's: it is mixed in per pixel from the vertices' distances (one haze per face made
+//!   the first row under the horizon a saw-tooth of near and far triangles).
 //! - **Smooth** ([`SeaShading::Smooth`]): each vertex gets a normal (the area-weighted mean of
 //!   its faces' normals), is shaded once and encoded to sRGB levels; each pixel interpolates
 //!   its face's three levels (Gouraud shading in sRGB: three adds and three casts a pixel), so
@@ -104,6 +106,9 @@ pub struct SeaShader {
     /// Smooth shading: sRGB levels (+0.5) of the water and of full foam at each vertex.
     water: Vec<Rgb>,
     foam_rgb: Vec<Rgb>,
+    /// Flat shading: the haze's sRGB levels (+0.5) at each vertex and how much of the water's
+    /// colour it keeps there.
+    haze: Vec<[f32; 4]>,
     /// Foam cover, its fresh share, texture coordinates per vertex: aged foam's along and
     /// across the wind (warped, [`Streaks`]), and fresh foam's; and aged foam's density.
     foam_uv: Vec<[f32; 7]>,
@@ -193,13 +198,15 @@ impl SeaShader {
         self.foam_rgb.resize(n, [0.0; 3]);
         self.foam_uv.resize(n, [0.0; 7]);
         self.glitter.resize(n, [0.0; 9]);
+        self.haze.resize(n, [0.0; 4]);
         self.water
             .par_iter_mut()
             .zip(self.foam_rgb.par_iter_mut())
             .zip(self.foam_uv.par_iter_mut())
             .zip(self.glitter.par_iter_mut())
+            .zip(self.haze.par_iter_mut())
             .enumerate()
-            .for_each(|(i, (((water, foam_rgb), foam_uv), glitter))| {
+            .for_each(|(i, ((((water, foam_rgb), foam_uv), glitter), haze))| {
                 let p = world[i];
                 let to_eye = sub(eye, p);
                 let distance_m = length(to_eye);
@@ -226,6 +233,11 @@ impl SeaShader {
                     };
                 }
                 let keep = (-distance_m / shading.look.haze_m).exp();
+                if !smooth {
+                    let away = shading.environment.radiance(normalize([-v[0], -v[1], 0.0]));
+                    let [r, g, b] = levels(away);
+                    *haze = [r, g, b, keep];
+                }
                 let fp = footprints[i];
                 let area = (fp.across[0] * fp.along[1] - fp.across[1] * fp.along[0]).abs() / (spacing * spacing);
                 let s2 = slope + shading.look.base_slope_variance;
@@ -273,10 +285,11 @@ impl SeaShader {
                     let centroid = scale(add(add(world[a], world[b]), world[c]), 1.0 / 3.0);
                     let to_eye = sub(eye, centroid);
                     let distance_m = length(to_eye);
+                    // The haze is mixed in per pixel (see the module docs).
                     let facet = Facet {
                         normal,
                         to_eye: scale(to_eye, 1.0 / distance_m.max(1e-6)),
-                        distance_m,
+                        distance_m: 0.0,
                         albedo: shading.texture.sample(centroid[0], centroid[1], metres),
                         foam: 0.0,
                         slope_variance: (corners[0][3] + corners[1][3] + corners[2][3]) / 3.0
@@ -313,7 +326,8 @@ impl SeaShader {
         let rows = out.height() as usize;
         let texture = FoamTexture::shared();
         let srgb = SrgbTable::shared();
-        let (faces, water, foam_rgb, foam_uv) = (&self.faces, &self.water, &self.foam_rgb, &self.foam_uv);
+        let (faces, water, foam_rgb, foam_uv, haze) =
+            (&self.faces, &self.water, &self.foam_rgb, &self.foam_uv, &self.haze);
         out.data_mut().par_chunks_mut(BAND_ROWS * width * 4).enumerate().for_each(|(band, bytes)| {
             let y0 = (band * BAND_ROWS) as f32;
             let band_rows = (rows - band * BAND_ROWS).min(BAND_ROWS);
@@ -337,6 +351,7 @@ impl SeaShader {
                     None
                 };
                 let glints = if face.glints { self.glitter_planes(face, pts) } else { None };
+                let hazes = face.flat.and_then(|_| Planes::<4>::new(pts, [haze[a], haze[b], haze[c]]));
                 let (level, detail) = (face.level as usize, face.detail);
                 for_each_span(width, band_rows, pts, |y, x0, x1| {
                     let row = &mut bytes[(y * width + x0) * 4..(y * width + x1 + 1) * 4];
@@ -344,6 +359,7 @@ impl SeaShader {
                     let mut c = colour.at(px, py);
                     let mut fm = foam.as_ref().map(|p| p.at(px, py));
                     let mut gl = glints.as_ref().map(|p| p.at(px, py));
+                    let mut hz = hazes.as_ref().map(|p| p.at(px, py));
                     for (k, out) in row.chunks_exact_mut(4).enumerate() {
                         let mut rgb = c;
                         if let Some(g) = &gl {
@@ -355,6 +371,9 @@ impl SeaShader {
                         if let Some(f) = &fm {
                             rgb = foam_over(rgb, f, texture, level, detail);
                         }
+                        if let Some(h) = &hz {
+                            rgb = mix([h[0], h[1], h[2]], rgb, h[3].clamp(0.0, 1.0));
+                        }
                         // Levels carry +0.5, so the cast rounds (and saturates).
                         out.copy_from_slice(&[rgb[0] as u8, rgb[1] as u8, rgb[2] as u8, 255]);
                         c = colour.step(c);
@@ -363,6 +382,9 @@ impl SeaShader {
                         }
                         if let (Some(g), Some(p)) = (gl.as_mut(), glints.as_ref()) {
                             *g = p.step(*g);
+                        }
+                        if let (Some(h), Some(p)) = (hz.as_mut(), hazes.as_ref()) {
+                            *h = p.step(*h);
                         }
                     }
                 });
@@ -377,6 +399,8 @@ impl SeaShader {
         if face.flat.is_some() {
             for k in &mut corners {
                 k[6..9].copy_from_slice(&face.normal);
+                // Flat faces take the haze per pixel, after the glitter.
+                k[4] = 1.0;
             }
         }
         Planes::<9>::new(pts, corners)

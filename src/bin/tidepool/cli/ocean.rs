@@ -266,9 +266,10 @@ pub struct PlaySeaArgs {
     #[arg(long, value_name = "L", value_parser = parse_choppiness, allow_negative_numbers = true)]
     pub choppiness: Option<f64>,
 
-    /// How the ocean's mesh is lit: flat (one colour per spade triangle, the faceted sea of
-    /// the design) or smooth (shaded at the vertices and blended across each triangle).
-    #[arg(long, value_name = "MODE", value_parser = parse_shading, default_value_t = SeaShading::default())]
+    /// How the ocean's mesh is lit: smooth (shaded at the vertices and blended across each
+    /// triangle) or flat (one colour per spade triangle, the faceted sea of the design; at a
+    /// terminal's few pixels, without supersampling, its triangles are a mosaic of blocks).
+    #[arg(long, value_name = "MODE", value_parser = parse_shading, default_value_t = PLAY_SHADING)]
     pub shading: SeaShading,
 }
 
@@ -335,8 +336,9 @@ pub struct RenderOcean {
     /// How the mesh is lit: flat (one colour per spade triangle, the faceted sea of the design;
     /// --ssaa averages its far crests) or smooth (shaded at the vertices and blended across
     /// each triangle). The sun's glitter and the foam are drawn per pixel in both.
-    #[arg(long, value_name = "MODE", value_parser = parse_shading, default_value_t = SeaShading::default())]
-    pub shading: SeaShading,
+    /// [default: flat for pictures, smooth for text]
+    #[arg(long, value_name = "MODE", value_parser = parse_shading)]
+    pub shading: Option<SeaShading>,
 
     /// The camera: height above the sea in metres (0.5..=10000), tilt below the horizontal in
     /// degrees (-45..=89), horizontal field of view in degrees (5..=150) and heading in
@@ -408,6 +410,16 @@ pub struct SpectrumCommand {
 /// Parses `pm`, `jonswap` or `tma`.
 pub fn parse_spectrum(text: &str) -> Result<SpectrumKind, String> {
     text.parse().map_err(|e: tidepool::ValueError| e.to_string())
+}
+
+/// `play`'s shading: its frames are a terminal's few pixels without supersampling, where flat
+/// triangles are a mosaic of blocks (docs/sea/README.md).
+pub const PLAY_SHADING: SeaShading = SeaShading::Smooth;
+
+/// `render ocean`'s shading for an output `format`: flat (the design's faceted sea) for
+/// pictures, which are supersampled, smooth for text, which is not.
+pub fn default_shading(format: super::Format) -> SeaShading {
+    if format == super::Format::Png { SeaShading::Flat } else { SeaShading::Smooth }
 }
 
 /// Parses `flat` or `smooth`.
