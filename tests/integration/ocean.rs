@@ -319,6 +319,60 @@ fn maps_tile_across_their_edges_and_loop_in_time() {
     assert_eq!(std::fs::read(dir.join("afile")).unwrap(), b"keep me");
 }
 
+/// Runs `scripts/check_exr_maps.py` (the OpenEXR Python bindings reading the maps) on `args`;
+/// fails loudly when python3 or the reader is missing.
+fn independent_exr_check(args: &[&std::path::Path]) -> String {
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/check_exr_maps.py");
+    let out = std::process::Command::new("python3")
+        .arg(&script)
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("python3 is needed to read the EXR maps independently: {e}"));
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert_ne!(out.status.code(), Some(2), "the independent EXR reader is missing: {text}");
+    assert!(out.status.success(), "{text}");
+    text
+}
+
+/// `--map-format exr` writes half-float OpenEXR maps beside the .npy and PNG files; read back
+/// by an independent reader (OpenEXR's Python bindings) they equal the .npy fields within
+/// half precision and the PNGs within their 8-bit step, they tile, and a loop later they are
+/// the same bytes.
+#[test]
+fn exr_maps_read_back_by_an_independent_reader() {
+    let dir = scratch("ocean_maps_exr");
+    let out =
+        run_in(&dir, &["render", "ocean", "--maps", "m", "--size", "64x64", "--wind", "12", "--map-format", "exr"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir.join("m")).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    names.sort();
+    let want = [
+        "displacement.exr",
+        "displacement.npy",
+        "displacement.png",
+        "foam.exr",
+        "foam.png",
+        "height.exr",
+        "height.npy",
+        "height.png",
+        "normal.exr",
+        "normal.png",
+    ];
+    assert_eq!(names, want);
+    let text = independent_exr_check(&[&dir.join("m")]);
+    assert!(text.contains("within half precision"), "{text}");
+    // A loop of 100 s (Beaufort 6, foam included): the maps at --time 100 are those at 0.
+    for (folder, time) in [("t0", "0"), ("t100", "100")] {
+        let args = ["render", "ocean", "--maps", folder, "--size", "32x32", "--loop", "100", "--time", time];
+        let out = run_in(&dir, &[&args[..], &["--map-format", "exr", "--beaufort", "6"]].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    independent_exr_check(&[&dir.join("t0"), std::path::Path::new("--same"), &dir.join("t100")]);
+    let out = run_in(&dir, &["render", "ocean", "--size", "32x32", "--map-format", "exr", "--out", "x.png"]);
+    assert_eq!(out.status.code(), Some(2), "--map-format without --maps is refused");
+}
+
 /// The frames of `render ocean ARGS --size 64x36 --ssaa 1 --frames N+1 --fps F --loop T` in
 /// `dir` (N = T·F), as pictures.
 fn loop_frames(dir: &std::path::Path, args: &[&str], period: u32, fps: u32) -> Vec<image::RgbaImage> {

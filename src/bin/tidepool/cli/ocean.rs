@@ -329,6 +329,12 @@ pub struct RenderOcean {
     #[arg(long, value_name = "DIR")]
     pub maps: Option<PathBuf>,
 
+    /// The maps' files: png (the .npy and PNG files above) or exr (those, and beside them
+    /// height.exr, displacement.exr, normal.exr and foam.exr in half floats: metres and unit
+    /// vectors as Blender bakes and Unreal and Unity import them). [default: png]
+    #[arg(long, value_name = "FORMAT", value_enum, requires = "maps")]
+    pub map_format: Option<MapFormat>,
+
     /// The sun: azimuth (degrees clockwise from north) and elevation (0..=90 degrees).
     #[arg(long, value_name = "AZ,EL", default_value = "15,22", value_parser = parse_sun, allow_hyphen_values = true)]
     pub sun: (f64, f64),
@@ -372,6 +378,16 @@ pub struct RenderOcean {
     /// An animation instead of one picture (it starts at --time).
     #[command(flatten)]
     pub animation: super::AnimationArgs,
+}
+
+/// The files `--maps` writes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum MapFormat {
+    /// Float .npy and 16-bit and 8-bit PNG.
+    #[default]
+    Png,
+    /// Those, and half-float OpenEXR.
+    Exr,
 }
 
 /// `tidepool spectrum`.
