@@ -42,7 +42,8 @@ use super::foam::{FoamClock, FoamModel};
 mod foam;
 mod sampling;
 use super::ocean::{EULER_ITERATIONS, Sea, SeaParams, SeaTime, sizing_wavelength_m};
-use sampling::{Bilinear, cubic, sincos_turns, transpose_square};
+use super::trig::fast_sincos;
+use sampling::{Bilinear, cubic, round_even, sincos_turns, transpose_square};
 
 /// Smallest and largest lattice side.
 pub const PATCH_SIZE_RANGE: (usize, usize) = (8, 4096);
@@ -268,14 +269,16 @@ impl Lattice {
         self.amp.iter().zip(&self.k).map(|(a, k)| 0.5 * f64::from(a.norm_sqr()) * f64::from(*k).powi(2)).sum()
     }
 
-    /// The rotation e^(-iωt) of lattice wave `i` at `time`.
+    /// The rotation e^(-iωt) of lattice wave `i` at `time`: the turns reduced exactly in f64
+    /// (to the nearest whole turn, ±½), the sine and cosine of what is left in f32.
     fn rotation(&self, i: usize, time: SeaTime) -> Complex32 {
         let turns = match time {
-            SeaTime::Seconds(t) => (self.omega[i] * t / (2.0 * PI)).rem_euclid(1.0),
+            SeaTime::Seconds(t) => self.omega[i] * t / (2.0 * PI),
             SeaTime::Ticks(u) => f64::from(self.harmonic[i].wrapping_mul(u as u32)) / 4_294_967_296.0,
         };
-        let (s, c) = sincos_turns(-turns);
-        Complex32::new(c as f32, s as f32)
+        let left = turns - round_even(turns);
+        let (s, c) = fast_sincos((-left * 2.0 * PI) as f32);
+        Complex32::new(c, s)
     }
 
     /// Every lattice wave at `time`: a·e^(iφ)·e^(-iωt).
@@ -286,14 +289,22 @@ impl Lattice {
             .collect()
     }
 
-    /// The inverse 2-D FFT of `buf` in place (rows, transpose, rows, transpose), rows in
-    /// parallel: the same result on any number of cores.
-    fn ifft2(&self, buf: &mut [Complex32]) {
+    /// The inverse 2-D FFT, in place, of a spectrum laid out transposed (`buf[kx·n + ky]`, see
+    /// [`Lattice::transposed`]): along ky on rows, one transpose, along kx on rows, which
+    /// leaves the field in row-major order (one transpose fewer than from the natural layout).
+    /// Rows in parallel: the same result on any number of cores.
+    fn ifft2_transposed(&self, buf: &mut [Complex32]) {
         let n = self.n;
-        for _ in 0..2 {
-            buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
-            transpose_square(buf, n);
-        }
+        buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
+        transpose_square(buf, n);
+        buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
+    }
+
+    /// The lattice index (row-major, row = ky) of position `j` of a transposed spectrum.
+    #[inline(always)]
+    fn transposed(&self, j: usize) -> usize {
+        let n = self.n;
+        (j % n) * n + j / n
     }
 
     /// Two real fields from one complex transform. `coefficients(i, w)` gives, for the
@@ -309,7 +320,8 @@ impl Lattice {
         let n = self.n;
         let mut buf: Vec<Complex32> = (0..n * n)
             .into_par_iter()
-            .map(|i| {
+            .map(|j| {
+                let i = self.transposed(j);
                 let (r, c) = (i / n, i % n);
                 let mirror = ((n - r) % n) * n + (n - c) % n;
                 let (f, g) = coefficients(i, waves[i]);
@@ -319,7 +331,7 @@ impl Lattice {
                 sf + Complex32::new(0.0, 1.0) * sg
             })
             .collect();
-        self.ifft2(&mut buf);
+        self.ifft2_transposed(&mut buf);
         (buf.iter().map(|c| c.re).collect(), buf.iter().map(|c| c.im).collect())
     }
 
@@ -390,15 +402,20 @@ impl PatchSea {
         // The displacement per unit λ is -Σ a·û·sin θ = re Σ (i·û·w)·e^(ik·x); slopes re Σ (i·k·w)·e^(ik·x).
         let (h, dx) = l.real_fields(&waves, |i, w| (w, i_unit * w * unit(i).0));
         let (dy, hx) = l.real_fields(&waves, |i, w| (i_unit * w * unit(i).1, i_unit * w * l.kx[i]));
-        let (hy, _) = l.real_fields(&waves, |i, w| (i_unit * w * l.ky[i], Complex32::new(0.0, 0.0)));
-        let (gxx, gyy, gxy) = l.fold_fields(&waves);
+        // The displacement's gradient per unit λ, each times -1: g_ab = Σ a·(k_a·k_b/k)·cos θ.
+        let (k, kx, ky) = (l.k.as_slice(), l.kx.as_slice(), l.ky.as_slice());
+        let (hy, gxy) = l.real_fields(&waves, |i, w| (i_unit * w * ky[i], w * (kx[i] * ky[i] / k[i])));
+        let (gxx, gyy) = l.real_fields(&waves, |i, w| (w * (kx[i] * kx[i] / k[i]), w * (ky[i] * ky[i] / k[i])));
         // B = Σ a·√k·e^(iθ): the waves themselves, a complex field.
         let n = self.size;
         let mut b: Vec<Complex32> = (0..n * n)
             .into_par_iter()
-            .map(|i| if l.amp[i].norm_sqr() == 0.0 { Complex32::new(0.0, 0.0) } else { waves[i] * unit(i).2.sqrt() })
+            .map(|j| {
+                let i = l.transposed(j);
+                if l.amp[i].norm_sqr() == 0.0 { Complex32::new(0.0, 0.0) } else { waves[i] * unit(i).2.sqrt() }
+            })
             .collect();
-        l.ifft2(&mut b);
+        l.ifft2_transposed(&mut b);
         (Lagrangian { h, dx, dy, hx, hy, gxx, gyy, gxy }, b)
     }
 
@@ -437,6 +454,12 @@ impl PatchSea {
         let h_l: Vec<f32> = (0..n * n).map(|i| lag.h[i] + 0.5 * lambda * b[i].norm_sqr()).collect();
         let displacement: Vec<[f32; 3]> =
             (0..n * n).map(|i| [lambda * lag.dx[i], lambda * lag.dy[i], h_l[i]]).collect();
+        // The fields read together, side by side: the displacement in lattice units (the Euler
+        // iterations read it four times a texel), and the slopes and gradient at the end.
+        let to_cell = lambda / cell;
+        let carried: Vec<[f32; 2]> = (0..n * n).map(|i| [lag.dx[i] * to_cell, lag.dy[i] * to_cell]).collect();
+        let gradients: Vec<[f32; 5]> =
+            (0..n * n).map(|i| [lag.hx[i], lag.hy[i], lag.gxx[i], lag.gyy[i], lag.gxy[i]]).collect();
         let mut height = vec![0.0f32; n * n];
         let mut normal = vec![[0.0f32; 3]; n * n];
         let mut foam = vec![0.0f32; n * n];
@@ -446,14 +469,11 @@ impl PatchSea {
                     // Lattice units: column c is x = c, row r is y = -r (north up).
                     let (mut px, mut py) = (c as f32, r as f32);
                     for _ in 0..EULER_ITERATIONS {
-                        let at = Bilinear::new(n, px, py);
-                        let (dxv, dyv) = (at.of(&lag.dx) * lambda / cell, at.of(&lag.dy) * lambda / cell);
+                        let [dxv, dyv] = Bilinear::new(n, px, py).of_all(&carried);
                         (px, py) = (c as f32 - dxv, r as f32 + dyv);
                     }
                     height[c] = cubic(&h_l, n, px, py);
-                    let at = Bilinear::new(n, px, py);
-                    let (hx, hy) = (at.of(&lag.hx), at.of(&lag.hy));
-                    let (gxx, gyy, gxy) = (at.of(&lag.gxx), at.of(&lag.gyy), at.of(&lag.gxy));
+                    let [hx, hy, gxx, gyy, gxy] = Bilinear::new(n, px, py).of_all(&gradients);
                     // ∇D = -λ·g; the Eulerian gradient is (I + ∇D)^-T ∇h.
                     let (a, d, bc) = (1.0 - lambda * gxx, 1.0 - lambda * gyy, -lambda * gxy);
                     let det = a * d - bc * bc;
