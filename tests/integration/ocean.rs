@@ -373,6 +373,43 @@ fn exr_maps_read_back_by_an_independent_reader() {
     assert_eq!(out.status.code(), Some(2), "--map-format without --maps is refused");
 }
 
+/// The maps (EXR, .npy and PNG) and a picture of the sea are the same bytes on the portable
+/// path with one thread and on the widest SIMD tier this CPU has with three: the patch's FFT is
+/// rustfft's scalar planner and its sine tidepool's own, so no tier changes a bit.
+#[test]
+fn maps_and_pictures_are_the_same_bytes_on_every_simd_tier() {
+    let dir = scratch("ocean_simd_tiers");
+    let mut outputs = Vec::new();
+    for (tier, threads) in [("portable", "1"), ("", "3")] {
+        let name = format!("t{threads}");
+        let args = ["render", "ocean", "--maps", &name, "--size", "64x64", "--beaufort", "8", "--map-format", "exr"];
+        let picture = format!("{name}.png");
+        let shot = ["render", "ocean", "--beaufort", "8", "--size", "96x54", "--out", &picture];
+        let mut files = Vec::new();
+        for command in [&args[..], &shot[..]] {
+            let out = crate::common::tidepool()
+                .current_dir(&dir)
+                .env("TIDEPOOL_SIMD", tier)
+                .env("RAYON_NUM_THREADS", threads)
+                .args(command)
+                .output()
+                .unwrap();
+            assert!(out.status.success(), "{command:?}: {}", stderr(&out));
+        }
+        let mut names: Vec<_> = std::fs::read_dir(dir.join(&name)).unwrap().map(|e| e.unwrap().path()).collect();
+        names.sort();
+        for path in names {
+            files.push((path.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&path).unwrap()));
+        }
+        files.push(("the picture".to_string(), std::fs::read(dir.join(&picture)).unwrap()));
+        outputs.push(files);
+    }
+    assert_eq!(outputs[0].len(), 11, "ten maps and a picture");
+    for (a, b) in outputs[0].iter().zip(&outputs[1]) {
+        assert!(a == b, "{:?} differs between the portable path on one thread and the widest tier on three", a.0);
+    }
+}
+
 /// The frames of `render ocean ARGS --size 64x36 --ssaa 1 --frames N+1 --fps F --loop T` in
 /// `dir` (N = T·F), as pictures.
 fn loop_frames(dir: &std::path::Path, args: &[&str], period: u32, fps: u32) -> Vec<image::RgbaImage> {
