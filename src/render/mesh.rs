@@ -87,13 +87,19 @@ pub struct MeshTopology {
 
 /// A small deterministic hash to jitter the lattice (the same picture every run).
 fn jitter(row: i32, col: i32, salt: u32) -> f32 {
-    let mut h = (row as u32).wrapping_mul(0x9E37_79B1) ^ (col as u32).wrapping_mul(0x85EB_CA77) ^ salt;
+    let h = mix32((row as u32).wrapping_mul(0x9E37_79B1) ^ (col as u32).wrapping_mul(0x85EB_CA77) ^ salt);
+    (h >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+}
+
+/// The finishing mix of a 32-bit integer hash (xor-shifts and odd multipliers): every input
+/// bit reaches every output bit. Shared by the lattice's jitter and the foam streaks' noise.
+pub(crate) fn mix32(mut h: u32) -> u32 {
     h ^= h >> 15;
     h = h.wrapping_mul(0x2C1B_3C6D);
     h ^= h >> 12;
     h = h.wrapping_mul(0x297A_2D39);
     h ^= h >> 15;
-    (h >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+    h
 }
 
 impl MeshTopology {

@@ -119,12 +119,9 @@ fn floor(x: f32) -> f32 {
 
 /// A lattice value in -1..=1 (before its field's mean is taken off).
 fn lattice(i: u32, j: u32, seed: u32) -> f32 {
-    let mut h = i.wrapping_mul(0x9e37_79b1) ^ j.wrapping_mul(0x85eb_ca77) ^ seed.wrapping_mul(0xc2b2_ae3d);
-    h ^= h >> 15;
-    h = h.wrapping_mul(0x2c1b_3c6d);
-    h ^= h >> 12;
-    h = h.wrapping_mul(0x297a_2d39);
-    h ^= h >> 15;
+    let h = crate::render::mesh::mix32(
+        i.wrapping_mul(0x9e37_79b1) ^ j.wrapping_mul(0x85eb_ca77) ^ seed.wrapping_mul(0xc2b2_ae3d),
+    );
     (h >> 8) as f32 / (1u32 << 23) as f32 - 1.0
 }
 
