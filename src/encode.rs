@@ -7,7 +7,7 @@ pub use crate::output::apng::ApngWriter;
 #[cfg(feature = "animation")]
 pub use crate::output::gif::{GifPalette, GifWriter};
 pub use crate::output::halfblock::encode as halfblock;
-pub use crate::output::maps::{MapFields, encode_maps as sea_maps};
+pub use crate::output::maps::{MapFields, encode_exr_maps as sea_maps_exr, encode_maps as sea_maps};
 pub use crate::output::png::encode as png;
 pub use crate::output::units::human_bytes;
 pub use crate::render::background::decode as decode_image;

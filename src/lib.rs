@@ -60,7 +60,7 @@ pub use error::{Error, Result, ValueError};
 pub use render::background::{load as load_image, pool_floor};
 pub use render::camera::CameraPose;
 pub use render::caustics::CausticsLook;
-pub use render::ocean::OceanView;
+pub use render::ocean::{OceanView, SeaShading};
 pub use render::pool::{PoolLook, Refraction, Sun};
 pub use render::supersample::Downsample;
 pub use render::texture::SeaTexture;

@@ -11,10 +11,22 @@
 //! | `normal.png` | 8-bit RGB | unit normal of the height surface, OpenGL convention: R = east (+X), G = north (+Y, up the image), B = up; 128 = 0 |
 //! | `foam.png` | 8-bit grey | foam cover, 0 = none, 255 = full |
 //!
+//! With `--map-format exr`, beside those, OpenEXR files of half floats (16-bit, scan lines,
+//! ZIP-compressed: what Blender's ocean bake writes and Unreal and Unity import as vector
+//! displacement), in metres and unit vectors, unscaled ([`encode_exr_maps`]):
+//!
+//! | file | channels | content |
+//! |---|---|---|
+//! | `height.exr` | Y | Eulerian height, m |
+//! | `displacement.exr` | R, G, B | where the water resting at each texel is carried: east, north, up, m |
+//! | `normal.exr` | R, G, B | unit normal (east, north, up), -1..=1 |
+//! | `foam.exr` | Y | foam cover 0..=1 |
+//!
 //! Row 0 is the north edge, columns run east; texel (r, c) is the point at (c, -r)·extent/N.
 //! The maps are periodic: texel N is texel 0, so they tile without a seam. DirectX-style
 //! engines (Unreal) want the normal map's green flipped.
 
+use exr::prelude::{Encoding, Image, SpecificChannels, WritableImage, f16};
 use image::ImageEncoder;
 use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use rayon::prelude::*;
@@ -78,6 +90,59 @@ pub fn encode_maps(maps: &MapFields<'_>, frame: Option<u32>) -> Vec<(String, Vec
         })
         .collect();
     file_names(frame).into_iter().zip(files).collect()
+}
+
+/// The OpenEXR files of `maps` as (name, bytes): height, displacement, normal and foam in half
+/// floats; with `frame`, each name gets `_NNNN` before its extension.
+///
+/// # Panics
+/// When a field does not hold `size x size` values (a programming error).
+pub fn encode_exr_maps(maps: &MapFields<'_>, frame: Option<u32>) -> Vec<(String, Vec<u8>)> {
+    let n = maps.size;
+    for len in [maps.height.len(), maps.displacement.len(), maps.normal.len(), maps.foam.len()] {
+        assert_eq!(len, n * n, "every map holds size x size values");
+    }
+    let name = |stem: &str| match frame {
+        Some(k) => format!("{stem}_{k:04}.exr"),
+        None => format!("{stem}.exr"),
+    };
+    let files: Vec<Vec<u8>> = (0..4)
+        .into_par_iter()
+        .map(|i| match i {
+            0 => exr_grey(n, maps.height),
+            1 => exr_rgb(n, maps.displacement),
+            2 => exr_rgb(n, maps.normal),
+            _ => exr_grey(n, maps.foam),
+        })
+        .collect();
+    ["height", "displacement", "normal", "foam"].iter().map(|s| name(s)).zip(files).collect()
+}
+
+/// The EXR encoding of the maps: ZIP over 16 scan lines, top row first (lossless, and read by
+/// every EXR reader).
+const EXR_ENCODING: Encoding = Encoding::SMALL_LOSSLESS;
+
+/// A one-channel (Y) half-float EXR of an `n x n` field.
+fn exr_grey(n: usize, values: &[f32]) -> Vec<u8> {
+    let channels = SpecificChannels::build()
+        .with_channel("Y")
+        .with_pixel_fn(|p: exr::math::Vec2<usize>| (f16::from_f32(values[p.y() * n + p.x()]),));
+    let mut out = std::io::Cursor::new(Vec::new());
+    let image = Image::from_encoded_channels((n, n), EXR_ENCODING, channels);
+    image.write().non_parallel().to_buffered(&mut out).expect("encoding an EXR into memory cannot fail");
+    out.into_inner()
+}
+
+/// A three-channel (R, G, B) half-float EXR of an `n x n` vector field.
+fn exr_rgb(n: usize, values: &[[f32; 3]]) -> Vec<u8> {
+    let channels = SpecificChannels::rgb(|p: exr::math::Vec2<usize>| {
+        let [r, g, b] = values[p.y() * n + p.x()];
+        (f16::from_f32(r), f16::from_f32(g), f16::from_f32(b))
+    });
+    let mut out = std::io::Cursor::new(Vec::new());
+    let image = Image::from_encoded_channels((n, n), EXR_ENCODING, channels);
+    image.write().non_parallel().to_buffered(&mut out).expect("encoding an EXR into memory cannot fail");
+    out.into_inner()
 }
 
 /// An `n x n` map as PNG with fast compression (maps are noisy; the best compression saved

@@ -17,10 +17,12 @@
 //!    near once (painter's order for a height field seen from above: the horizontal distance
 //!    of a triangle does not change when heights do). Kept while the camera does not move.
 //! 3. **Per frame**, one of two ways:
-//!    - **shaded at the vertices** ([`crate::render::smooth::SmoothShader`], the ocean): sample
-//!      the surface at every point (on all cores), displace, project, shade each vertex and
-//!      interpolate across each face; one colour per face made a mosaic at terminal size and a
-//!      saw-tooth along far crests;
+//!    - **the ocean's pass** ([`crate::render::ocean::shader::SeaShader`]): sample the surface
+//!      at every point (on all cores), displace, project, and either shade each spade triangle
+//!      once with its own normal (`--shading flat`, the design's faceted look; supersampling
+//!      averages the far crests' saw-tooth) or shade each vertex and interpolate across the
+//!      face (`--shading smooth`, which keeps a terminal's few pixels from turning into a
+//!      mosaic); glitter and foam are drawn per pixel in both;
 //!    - **face numbers** ([`MeshRenderer::draw_ids`], the lake): each pixel gets the number of
 //!      the face it shows ([`FaceIds`]) and [`MeshRenderer::facet`] gives that face's
 //!      [`Facet`], for a renderer that shades per pixel.
@@ -33,10 +35,10 @@
 //! # The two users
 //!
 //! ```text
-//! // The ocean (crate::render::ocean): shaded vertices, foam per pixel.
+//! // The ocean (crate::render::ocean): flat or smooth faces, glitter and foam per pixel.
 //! sky.draw(&camera, far_sea_colour, &mut big);
 //! mesh.prepare(&camera, spacing_px * ssaa as f32);              // no-op if nothing moved
-//! smooth.draw(mesh.topology(), &sea_frame, foam, layout, &shading, &mut big);
+//! shader.draw(mesh.topology(), &sea_frame, foam, &pass, &mut big);   // pass: flat | smooth
 //! supersample::downsample(&big, ssaa, Downsample::Box, &mut out);
 //!
 //! // The lake (crate::render::lake): face numbers, then a per-pixel mirror.
@@ -85,13 +87,19 @@ pub struct MeshTopology {
 
 /// A small deterministic hash to jitter the lattice (the same picture every run).
 fn jitter(row: i32, col: i32, salt: u32) -> f32 {
-    let mut h = (row as u32).wrapping_mul(0x9E37_79B1) ^ (col as u32).wrapping_mul(0x85EB_CA77) ^ salt;
+    let h = mix32((row as u32).wrapping_mul(0x9E37_79B1) ^ (col as u32).wrapping_mul(0x85EB_CA77) ^ salt);
+    (h >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+}
+
+/// The finishing mix of a 32-bit integer hash (xor-shifts and odd multipliers): every input
+/// bit reaches every output bit. Shared by the lattice's jitter and the foam streaks' noise.
+pub(crate) fn mix32(mut h: u32) -> u32 {
     h ^= h >> 15;
     h = h.wrapping_mul(0x2C1B_3C6D);
     h ^= h >> 12;
     h = h.wrapping_mul(0x297A_2D39);
     h ^= h >> 15;
-    (h >> 8) as f32 / (1u32 << 24) as f32 - 0.5
+    h
 }
 
 impl MeshTopology {
@@ -184,7 +192,8 @@ impl MeshTopology {
     }
 }
 
-/// Draws a water surface as a flat-shaded mesh; keeps the triangulation while the camera stays.
+/// Triangulates a water surface and keeps the triangulation while the camera stays; draws it as
+/// face numbers (the lake) or hands its topology to the ocean's flat or smooth pass.
 #[derive(Debug, Default)]
 pub struct MeshRenderer {
     topology: Option<MeshTopology>,

@@ -21,7 +21,6 @@ pub mod raster;
 pub mod shade;
 pub mod shore;
 pub mod sky;
-pub mod smooth;
 pub mod supersample;
 pub mod texture;
 pub mod vec3;

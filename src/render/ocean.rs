@@ -1,9 +1,10 @@
 //! The ocean renderer: sky, then the sea mesh, at `ssaa` times the size, filtered down.
 //!
 //! The sea is sampled at the mesh's vertices (displaced sideways by its choppiness), its foam
-//! followed at those resting points through time ([`FoamTracker`]: a still picture warms it
-//! up, a stream of frames continues it), and drawn with smooth shading and per-pixel foam
-//! ([`super::smooth`]).
+//! followed at those resting points through time ([`FoamTracker`]: a still picture computes
+//! the foam's whole memory, a stream of frames continues it), and drawn flat (one normal per
+//! spade triangle, the design's look) or smooth ([`SeaShading`]), with the sun's glitter and
+//! the foam per pixel ([`shader`], [`glitter`], [`streaks`]).
 //!
 //! The mesh density is tied to the output resolution ([`mesh_spacing_px`]): about 3 output
 //! pixels between samples for a terminal frame (so its few pixels still show facets), growing
@@ -18,11 +19,61 @@ use super::foam_texture::FOAM_TILE_ACROSS_M;
 use super::mesh::{MeshRenderer, Shading};
 use super::shade::{Facet, WaterLook, shade_facet};
 use super::sky::Sky;
-use super::smooth::{FoamLayout, SmoothShader};
 use super::supersample::{Downsample, downsample};
 use super::texture::SeaTexture;
 use crate::sim::foam::FoamTracker;
 use crate::sim::ocean::{Sea, SeaFrame, SeaTime, cox_munk_slope_variance};
+
+pub mod glitter;
+pub mod shader;
+pub mod streaks;
+
+use glitter::Glitter;
+use shader::{FoamLayout, SeaPass, SeaShader};
+use streaks::Streaks;
+
+/// How the sea's mesh is lit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum SeaShading {
+    /// One normal and one colour per spade triangle: the design's faceted sea (supersampling
+    /// averages the far crests' saw-tooth). The default: pictures are supersampled.
+    #[default]
+    Flat,
+    /// Shaded at the vertices and interpolated across each face: no facets, soft far crests;
+    /// the better look at a terminal's few pixels without supersampling.
+    Smooth,
+}
+
+impl SeaShading {
+    /// The name the command line uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            SeaShading::Flat => "flat",
+            SeaShading::Smooth => "smooth",
+        }
+    }
+}
+
+impl std::fmt::Display for SeaShading {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for SeaShading {
+    type Err = crate::ValueError;
+
+    fn from_str(text: &str) -> Result<SeaShading, crate::ValueError> {
+        match text.trim() {
+            "flat" => Ok(SeaShading::Flat),
+            "smooth" => Ok(SeaShading::Smooth),
+            other => Err(crate::ValueError::new(
+                "shading",
+                format!("'{other}' is not a shading: flat (one colour per triangle) or smooth (interpolated)"),
+            )),
+        }
+    }
+}
 
 /// How fast foam drifts downwind with the surface water, as a fraction of the wind speed
 /// (the wind drift of the top centimetres, about 3 %).
@@ -62,11 +113,13 @@ pub struct OceanView {
     pub ssaa: u32,
     /// The filter that brings a supersampled picture down.
     pub downsample: Downsample,
+    /// Flat or smooth shading of the mesh.
+    pub shading: SeaShading,
 }
 
 impl Default for OceanView {
     /// The default camera, the sun ahead and to the right, 22° up (its glitter path lies on
-    /// the water in view), no supersampling.
+    /// the water in view), no supersampling, flat shading.
     fn default() -> Self {
         OceanView {
             camera: CameraPose::DEFAULT,
@@ -74,6 +127,7 @@ impl Default for OceanView {
             sun_elevation_deg: 22.0,
             ssaa: 1,
             downsample: Downsample::Box,
+            shading: SeaShading::default(),
         }
     }
 }
@@ -87,13 +141,25 @@ pub fn mesh_spacing_px(width: u32, height: u32) -> f32 {
 }
 
 /// The ocean's densest mesh, output pixels between samples: a terminal frame (160x94) gets a
-/// vertex every 2.4 pixels, so the smooth shading has the short waves to show (at 3.2 its few
-/// pixels were smoothed flat; 1.6 looked a little crisper but cost twice as much).
+/// vertex every 2.4 pixels, so either shading has the short waves to show (at 3.2 smooth
+/// shading's few pixels were smoothed flat; 1.6 looked a little crisper but cost twice as
+/// much).
 pub const MIN_SPACING_PX: f32 = 2.4;
 
 /// The ocean's mesh spacing: √(W·H)/180 within [`MIN_SPACING_PX`]..=8 (1080p: every 8 pixels).
 pub fn ocean_spacing_px(width: u32, height: u32) -> f32 {
     ((f64::from(width) * f64::from(height)).sqrt() / 180.0).clamp(f64::from(MIN_SPACING_PX), 8.0) as f32
+}
+
+/// The seed of a moment's sparkles: the sea's seed and the moment, in sixtieths of a second
+/// (or 2²⁶ steps to a loop, so a loop's frame N·T sparkles as its frame 0).
+pub fn glitter_seed(sea: &Sea, time: SeaTime) -> u32 {
+    let moment = match time {
+        SeaTime::Ticks(u) => (u as u32 >> 6) as u64,
+        SeaTime::Seconds(t) => (t * 60.0).floor() as i64 as u64,
+    };
+    let seed = sea.params().seed;
+    ((seed ^ (seed >> 32)) as u32) ^ (moment as u32).wrapping_mul(0x9e37_79b9) ^ ((moment >> 32) as u32)
 }
 
 /// Draws a sea into pictures of one size, keeping its mesh and buffers between frames.
@@ -107,7 +173,7 @@ pub struct OceanRenderer {
     texture: SeaTexture,
     look: WaterLook,
     mesh: MeshRenderer,
-    smooth: SmoothShader,
+    shader: SeaShader,
     foam: FoamTracker,
     supersampled: Option<Pixmap>,
 }
@@ -130,9 +196,10 @@ impl OceanRenderer {
             camera: Camera::new(view.camera, rw, rh),
             sky: Sky::new(view.sun_azimuth_deg, view.sun_elevation_deg),
             texture,
-            look: WaterLook::default(),
+            // The sea's unresolved slope variance already holds all of Cox–Munk's.
+            look: WaterLook { base_slope_variance: 0.0, ..WaterLook::default() },
             mesh: MeshRenderer::new(),
-            smooth: SmoothShader::new(),
+            shader: SeaShader::new(),
             foam: FoamTracker::new(),
             supersampled,
         })
@@ -197,8 +264,9 @@ impl OceanRenderer {
     /// Draws `frame` into `out`, which must be `width x height`.
     ///
     /// Foam continues from the previous frame when the sea and camera are the same and time
-    /// moved on; otherwise it is warmed up ([`crate::sim::foam::FoamClock::warm_up_steps`]),
-    /// so a frame's picture does not depend on the frames drawn before it.
+    /// moved on by less than the foam's memory; otherwise the memory is computed whole
+    /// ([`FoamTracker::update`]). Either way the foam is the same bits, so a frame's picture
+    /// does not depend on the frames drawn before it.
     ///
     /// # Panics
     /// When `out` has another size (a programming error).
@@ -212,21 +280,52 @@ impl OceanRenderer {
         let below = self.far_sea(sea.params().wind_m_s);
         let Some(topology) = self.mesh.topology() else { return };
         let foam = self.foam.update(sea, topology.points(), topology.footprints(), frame.time());
-        let layout = FoamLayout {
-            downwind: sea.downwind(),
-            drift_m: foam_drift_m(sea, frame.time()),
-            streak: foam_streak(sea.params().wind_m_s),
+        let streak = foam_streak(sea.params().wind_m_s);
+        let layout = FoamLayout { downwind: sea.downwind(), drift_m: foam_drift_m(sea, frame.time()), streak };
+        let light = self.sky.light();
+        let pass = SeaPass {
+            mode: self.view.shading,
+            shading: Shading { environment: &self.sky, light, look: self.look, texture: &self.texture },
+            glitter: Glitter::new(
+                &self.look,
+                light.sun_dir,
+                light.sun,
+                glitter_seed(sea, frame.time()),
+                self.view.ssaa,
+            ),
+            layout,
+            streaks: Streaks::new(streak, sea.params().seed),
         };
-        let shading =
-            Shading { environment: &self.sky, light: self.sky.light(), look: self.look, texture: &self.texture };
         let target = self.supersampled.as_mut().unwrap_or(out);
         self.sky.draw(&self.camera, below, target);
-        self.smooth.draw(topology, frame, foam, layout, &shading, target);
+        self.shader.draw(topology, frame, foam, &pass, target);
         if let Some(big) = &self.supersampled {
             downsample(big, self.view.ssaa, self.view.downsample, out);
         }
     }
 }
+
+#[cfg(test)]
+impl OceanRenderer {
+    /// Draws `frame` and returns the mean glitter at every rendering pixel (a multiple of the
+    /// sun's colour, before sparkles, haze and tone mapping): what a measurement of the
+    /// glitter's spread reads.
+    pub(crate) fn mean_glitter(&mut self, frame: &SeaFrame<'_>) -> Vec<f32> {
+        let mut out = Pixmap::new(self.width, self.height).expect("a valid size");
+        self.render(frame, &mut out);
+        let light = self.sky.light();
+        let glitter = Glitter::new(&self.look, light.sun_dir, light.sun, 0, self.view.ssaa);
+        self.shader.mean_glitter(&glitter, self.camera.width() as usize, self.camera.height() as usize)
+    }
+
+    /// The water's look.
+    pub(crate) fn look(&self) -> WaterLook {
+        self.look
+    }
+}
+
+#[cfg(test)]
+mod glitter_tests;
 
 #[cfg(test)]
 mod tests {

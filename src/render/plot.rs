@@ -7,7 +7,8 @@ use font8x8::UnicodeFonts;
 use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 
 use crate::sim::ocean::SeaParams;
-use crate::sim::spectra::SpectrumChoice;
+use crate::sim::spectra::swell::SwellSpectrum;
+use crate::sim::spectra::{SeaSpectrum, SpectrumChoice};
 use crate::sim::spectrum::PiersonMoskowitz;
 
 /// Plot width, px.
@@ -176,86 +177,19 @@ pub fn sea_spectrum_plot(params: &SeaParams) -> Pixmap {
     out.fill(Color::WHITE);
     let sea = params.wind_spectrum();
     let swells = params.swell_spectra();
-    let (u, hs) = (label(sea.wind_m_s()), params.significant_height_m());
-    let mut heading = match sea.choice() {
-        SpectrumChoice::PiersonMoskowitz => format!("Pierson-Moskowitz sea, U = {u} m/s, Hs = {hs:.2} m"),
-        SpectrumChoice::Jonswap(j) | SpectrumChoice::Tma(j, _) => {
-            let fetch = j.fetch_km().map_or("unlimited".to_string(), |f| format!("{} km", label(f)));
-            let depth = sea.depth_m().map_or(String::new(), |d| format!(", h = {} m", label(d)));
-            let name = if sea.depth_m().is_some() { "TMA" } else { "JONSWAP" };
-            format!("{name}, U = {u} m/s, gamma {}, fetch {fetch}{depth}, Hs = {hs:.2} m", label(j.gamma()))
-        }
-    };
-    if !swells.is_empty() {
-        heading = heading.replace(", Hs", " + swell, Hs");
-    }
+    let (heading, swell_line) = sea_heading(params, &sea, &swells);
     draw_text(&mut out, 20, 12, &heading, INK);
-    let swell_text: Vec<String> = swells
-        .iter()
-        .map(|s| {
-            let w = s.swell();
-            format!("{} m {} s from {}", label(w.height_m()), label(w.period_s()), label(w.from_deg()))
-        })
-        .collect();
-    if !swell_text.is_empty() {
-        draw_text(&mut out, 20, 34, &format!("swell {}", swell_text.join(", ")), INK);
+    if let Some(line) = swell_line {
+        draw_text(&mut out, 20, 34, &line, INK);
     }
     let peaks = sea.peak_hz().into_iter().chain(swells.iter().map(|s| s.peak_hz()));
     let Some(f_top) = peaks.reduce(f64::max) else {
         draw_text(&mut out, 20, 200, "calm: no wind, no waves (E = 0 everywhere)", INK);
         return out;
     };
-    let n = 400;
-    let f_at = |i: usize| 3.0 * f_top * i as f64 / n as f64;
-    let energy: Vec<(f64, f64)> = (0..=n)
-        .map(|i| (f_at(i), sea.energy(f_at(i)) + swells.iter().map(|s| s.energy(f_at(i))).sum::<f64>()))
-        .collect();
-    let parts: Vec<Vec<(f64, f64)>> = if swells.is_empty() {
-        Vec::new()
-    } else {
-        std::iter::once((0..=n).map(|i| (f_at(i), sea.energy(f_at(i)))).collect())
-            .chain(swells.iter().map(|s| (0..=n).map(|i| (f_at(i), s.energy(f_at(i)))).collect()))
-            .collect()
-    };
+    let (energy, parts) = energy_curves(&sea, &swells, f_top);
     let e_max = energy.iter().map(|p| p.1).fold(0.0, f64::max);
-    let downwind = (params.wind_from_deg + 180.0).to_radians();
-    let (spread, title): (Vec<(f64, f64)>, String) = match (sea.peak_hz(), swells.is_empty()) {
-        (Some(fm), true) => {
-            let law = match sea.spreading_exponent(fm) {
-                Some(s) => format!("s = {s:.2}"),
-                None => "sech2".to_string(),
-            };
-            let curve = (0..=n)
-                .map(|i| {
-                    let deg = -180.0 + 360.0 * i as f64 / n as f64;
-                    (deg, sea.spread(fm, deg.to_radians()))
-                })
-                .collect();
-            (curve, format!("D(theta) at fm, {} {law}", sea.spreading().name()))
-        }
-        _ => {
-            // ∫E(f, θ)df/m0 by the midpoint rule over 0..6 times the highest peak.
-            let (steps, df) = (600, 6.0 * f_top / 600.0);
-            let m0 = params.m0().max(1e-300);
-            let curve = (0..=n)
-                .map(|i| {
-                    let deg = -180.0 + 360.0 * i as f64 / n as f64;
-                    let theta = deg.to_radians();
-                    let e: f64 = (0..steps)
-                        .map(|j| {
-                            let f = (j as f64 + 0.5) * df;
-                            let bearing = downwind + theta;
-                            sea.directional_energy(f, theta)
-                                + swells.iter().map(|s| s.directional_energy(f, bearing - s.bearing_rad())).sum::<f64>()
-                        })
-                        .sum::<f64>()
-                        * df;
-                    (deg, e / m0)
-                })
-                .collect();
-            (curve, "energy by direction (sum)".to_string())
-        }
-    };
+    let (spread, title) = spread_curve(params, &sea, &swells, f_top);
     let d_max = spread.iter().map(|p| p.1).fold(0.0, f64::max);
     let left = Panel {
         rect: Rect::from_ltrb(120.0, 110.0, 470.0, 360.0).unwrap(),
@@ -272,6 +206,97 @@ pub fn sea_spectrum_plot(params: &SeaParams) -> Pixmap {
     };
     right.draw(&mut out, (&title, "theta to the wind, degrees", "1/rad"), &spread, &[]);
     out
+}
+
+/// Points on each curve of the sea's plots.
+const CURVE_POINTS: usize = 400;
+
+/// The plot's heading (spectrum, wind, JONSWAP's parameters, Hs) and its swell line, if any.
+fn sea_heading(params: &SeaParams, sea: &SeaSpectrum, swells: &[SwellSpectrum]) -> (String, Option<String>) {
+    let (u, hs) = (label(sea.wind_m_s()), params.significant_height_m());
+    let mut heading = match sea.choice() {
+        SpectrumChoice::PiersonMoskowitz => format!("Pierson-Moskowitz sea, U = {u} m/s, Hs = {hs:.2} m"),
+        SpectrumChoice::Jonswap(j) | SpectrumChoice::Tma(j, _) => {
+            let fetch = j.fetch_km().map_or("unlimited".to_string(), |f| format!("{} km", label(f)));
+            let depth = sea.depth_m().map_or(String::new(), |d| format!(", h = {} m", label(d)));
+            let name = if sea.depth_m().is_some() { "TMA" } else { "JONSWAP" };
+            format!("{name}, U = {u} m/s, gamma {}, fetch {fetch}{depth}, Hs = {hs:.2} m", label(j.gamma()))
+        }
+    };
+    if swells.is_empty() {
+        return (heading, None);
+    }
+    heading = heading.replace(", Hs", " + swell, Hs");
+    let swell_text: Vec<String> = swells
+        .iter()
+        .map(|s| {
+            let w = s.swell();
+            format!("{} m {} s from {}", label(w.height_m()), label(w.period_s()), label(w.from_deg()))
+        })
+        .collect();
+    (heading, Some(format!("swell {}", swell_text.join(", "))))
+}
+
+/// E(f) of the whole sea over 0..3 times the highest peak, and with swell each system's own.
+#[allow(clippy::type_complexity)]
+fn energy_curves(sea: &SeaSpectrum, swells: &[SwellSpectrum], f_top: f64) -> (Vec<(f64, f64)>, Vec<Vec<(f64, f64)>>) {
+    let n = CURVE_POINTS;
+    let f_at = |i: usize| 3.0 * f_top * i as f64 / n as f64;
+    let energy = (0..=n)
+        .map(|i| (f_at(i), sea.energy(f_at(i)) + swells.iter().map(|s| s.energy(f_at(i))).sum::<f64>()))
+        .collect();
+    let parts = if swells.is_empty() {
+        Vec::new()
+    } else {
+        std::iter::once((0..=n).map(|i| (f_at(i), sea.energy(f_at(i)))).collect())
+            .chain(swells.iter().map(|s| (0..=n).map(|i| (f_at(i), s.energy(f_at(i)))).collect()))
+            .collect()
+    };
+    (energy, parts)
+}
+
+/// The right panel's curve and title: the wind sea's spreading at its peak, or with swell the
+/// energy by direction of the whole sea.
+fn spread_curve(
+    params: &SeaParams,
+    sea: &SeaSpectrum,
+    swells: &[SwellSpectrum],
+    f_top: f64,
+) -> (Vec<(f64, f64)>, String) {
+    let n = CURVE_POINTS;
+    let degrees = |i: usize| -180.0 + 360.0 * i as f64 / n as f64;
+    match (sea.peak_hz(), swells.is_empty()) {
+        (Some(fm), true) => {
+            let law = match sea.spreading_exponent(fm) {
+                Some(s) => format!("s = {s:.2}"),
+                None => "sech2".to_string(),
+            };
+            let curve = (0..=n).map(|i| (degrees(i), sea.spread(fm, degrees(i).to_radians()))).collect();
+            (curve, format!("D(theta) at fm, {} {law}", sea.spreading().name()))
+        }
+        _ => {
+            // ∫E(f, θ)df/m0 by the midpoint rule over 0..6 times the highest peak.
+            let downwind = (params.wind_from_deg + 180.0).to_radians();
+            let (steps, df) = (600, 6.0 * f_top / 600.0);
+            let m0 = params.m0().max(1e-300);
+            let curve = (0..=n)
+                .map(|i| {
+                    let theta = degrees(i).to_radians();
+                    let e: f64 = (0..steps)
+                        .map(|j| {
+                            let f = (j as f64 + 0.5) * df;
+                            let bearing = downwind + theta;
+                            sea.directional_energy(f, theta)
+                                + swells.iter().map(|s| s.directional_energy(f, bearing - s.bearing_rad())).sum::<f64>()
+                        })
+                        .sum::<f64>()
+                        * df;
+                    (degrees(i), e / m0)
+                })
+                .collect();
+            (curve, "energy by direction (sum)".to_string())
+        }
+    }
 }
 
 #[cfg(test)]

@@ -1,4 +1,7 @@
-//! Flat shading of one water facet: one colour per triangle from its face normal.
+//! The light of one point of water: its body, the sky it reflects, the sun's glint, foam and
+//! haze. The ocean evaluates it once per mesh face (flat shading) or per vertex (smooth
+//! shading) without the glint, which it evaluates per pixel (`render::ocean`'s glitter); the
+//! lake takes [`fresnel`] and [`glint`] for its per-pixel mirror.
 //!
 //! The paper lights its sea mesh with ambient + diffuse + specular and stretches a sea photo
 //! over it; tidepool keeps those terms and adds what makes water read as water:
@@ -16,7 +19,7 @@
 //! σ² is the slope variance the mesh cannot show (small near the camera, where facets carry the
 //! waves; large far away, where they are filtered out), so the sun makes sharp sparkles on near
 //! facets and a broad glitter path towards the horizon, as on a real sea. Colours are linear
-//! RGB floats; [`to_srgb8`] tone-maps and encodes them once per triangle.
+//! RGB floats; [`to_srgb8`](super::light::to_srgb8) tone-maps and encodes them.
 
 use super::light::{Light, Rgb, mix};
 use super::sky::Environment;
@@ -41,7 +44,9 @@ pub struct WaterLook {
     pub diffuse: f32,
     /// The sun's irradiance relative to the sky's radiance (the glint's strength).
     pub sun_irradiance: f32,
-    /// Slope variance (per axis) always added to the glint: capillary waves no mesh shows.
+    /// Slope variance (per axis) always added to [`glint`]'s: the capillary waves the lake's
+    /// noise does not carry (the ocean's unresolved slope variance already holds Cox–Munk's
+    /// whole total, so its glitter adds none).
     pub base_slope_variance: f32,
     /// Foam's albedo.
     pub foam: Rgb,
@@ -100,13 +105,21 @@ pub fn glint(look: &WaterLook, light: &Light, n: Vec3, v: Vec3, slope_variance: 
     g.min(50.0)
 }
 
-/// The colour of one facet, linear RGB.
+/// A facet's colour without the sun's glint, and the share of a glint the haze would leave.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct WaterShade {
+    /// Linear RGB, everything but the glint.
+    pub colour: Rgb,
+    /// 1 - haze: a glint adds `glint·sun·keep` to `colour` (on water without foam).
+    pub keep: f32,
+}
+
+/// The colour of one facet without the sun's glint, linear RGB.
 #[inline]
-pub fn shade_facet<E: Environment + ?Sized>(look: &WaterLook, light: &Light, env: &E, f: &Facet) -> Rgb {
+pub fn shade_water<E: Environment + ?Sized>(look: &WaterLook, light: &Light, env: &E, f: &Facet) -> WaterShade {
     let n = f.normal;
     let v = f.to_eye;
-    let l = light.sun_dir;
-    let n_dot_l = dot(n, l).max(0.0);
+    let n_dot_l = dot(n, light.sun_dir).max(0.0);
     // Unresolved roughness: of the small facets inside this one, those tilted towards the eye
     // are seen most, so reflect with the normal tilted that way by one standard deviation.
     // This is what keeps a rough sea darker than the sky at the horizon.
@@ -123,18 +136,23 @@ pub fn shade_facet<E: Environment + ?Sized>(look: &WaterLook, light: &Light, env
     let lit = |c: f32, i: usize| c * (look.ambient * light.sky[i] + look.diffuse * light.sun[i] * n_dot_l);
     let body = [lit(f.albedo[0], 0), lit(f.albedo[1], 1), lit(f.albedo[2], 2)];
     let mut colour = mix(body, sky, fr);
-    if l[2] > 0.0 {
-        let g = glint(look, light, n, v, f.slope_variance);
-        colour = [colour[0] + g * light.sun[0], colour[1] + g * light.sun[1], colour[2] + g * light.sun[2]];
-    }
     if f.foam > 0.0 {
         let foam = [0, 1, 2].map(|i| look.foam[i] * (look.ambient * light.sky[i] + light.sun[i] * n_dot_l));
         // Foam is a froth of bubbles over water, never a solid sheet: at most 85 % cover.
         colour = mix(colour, foam, 0.85 * f.foam.min(1.0));
     }
-    let haze = 1.0 - (-f.distance_m / look.haze_m).exp();
+    let keep = (-f.distance_m / look.haze_m).exp();
     let away = normalize([-v[0], -v[1], 0.0]);
-    mix(colour, env.radiance(away), haze)
+    WaterShade { colour: mix(env.radiance(away), colour, keep), keep }
+}
+
+/// The colour of one facet, linear RGB: [`shade_water`] with the glint of its normal and its
+/// unresolved slope variance (under foam, dimmed by the foam's cover).
+#[inline]
+pub fn shade_facet<E: Environment + ?Sized>(look: &WaterLook, light: &Light, env: &E, f: &Facet) -> Rgb {
+    let WaterShade { colour, keep } = shade_water(look, light, env, f);
+    let g = glint(look, light, f.normal, f.to_eye, f.slope_variance) * keep * (1.0 - 0.85 * f.foam.clamp(0.0, 1.0));
+    [colour[0] + g * light.sun[0], colour[1] + g * light.sun[1], colour[2] + g * light.sun[2]]
 }
 
 #[cfg(test)]

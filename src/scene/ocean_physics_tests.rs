@@ -10,7 +10,7 @@ use crate::render::ocean::{OceanRenderer, OceanView};
 use crate::render::texture::SeaTexture;
 use crate::sim::foam::{FoamModel, FoamTracker};
 use crate::sim::looping::LoopPeriod;
-use crate::sim::ocean::{DEFAULT_CHOPPINESS, Sea, SeaParams, whitecap_fraction};
+use crate::sim::ocean::{DEFAULT_CHOPPINESS, Sea, SeaParams};
 use crate::sim::patch::{PatchMaps, PatchSea};
 use crate::sim::sea_state::beaufort_speed_m_s;
 use crate::sim::spectra::{Depth, Jonswap, SeaSpectrum, SpectrumChoice};
@@ -177,18 +177,75 @@ pub(crate) fn mean_cover(sea: &Sea, seconds: f64, rate: f64) -> f64 {
     sum / count as f64
 }
 
+/// Monahan and O'Muircheartaigh's (1980) whitecap fraction `3.84e-6·U^3.41`, capped at 1:
+/// what the foam gain was set against (at 10 m/s).
+fn whitecap_fraction(wind_m_s: f64) -> f64 {
+    (3.84e-6 * wind_m_s.max(0.0).powf(3.41)).min(1.0)
+}
+
+/// Callaghan, de Leeuw, Cohen and O'Dowd (2008), GRL 35, L23609: whitecap coverage from 2006 MAP
+/// campaign images in the North East Atlantic, valid from 3.70 to 23.09 m/s, as a fraction:
+/// `3.18e-5·(U - 3.70)³` up to 11.25 m/s and `4.82e-6·(U + 1.98)³` from 9.25 m/s (their two
+/// overlapping groups; the branches cross at 10.18 m/s, where this switches).
+fn callaghan_2008(wind_m_s: f64) -> f64 {
+    if wind_m_s <= 3.70 {
+        0.0
+    } else if wind_m_s <= 10.18 {
+        3.18e-5 * (wind_m_s - 3.70).powi(3)
+    } else {
+        4.82e-6 * (wind_m_s + 1.98).powi(3)
+    }
+}
+
+/// The model's mean foam cover under `wind_m_s` (seed 11, 1600 resting points 20 peak
+/// wavelengths across, 30 s at 5 moments a second), measured once per wind for all tests.
+fn model_cover(wind_m_s: f64) -> f64 {
+    static COVERS: std::sync::Mutex<Vec<(u64, f64)>> = std::sync::Mutex::new(Vec::new());
+    let key = wind_m_s.to_bits();
+    if let Some(&(_, c)) = COVERS.lock().expect("not poisoned").iter().find(|(k, _)| *k == key) {
+        return c;
+    }
+    let sea = Sea::new(SeaParams { wind_m_s, choppiness: DEFAULT_CHOPPINESS, seed: 11, ..SeaParams::default() });
+    let cover = mean_cover(&sea, 30.0, 5.0);
+    COVERS.lock().expect("not poisoned").push((key, cover));
+    cover
+}
+
+/// The foam gain was set so that the cover at 10 m/s is Monahan and O'Muircheartaigh's
+/// (1980) 0.99 %: this holds it there (within 5 %), and prints the model against Monahan from
+/// Beaufort 3 to 10 (their fit beyond 17 m/s is beyond their data).
 #[test]
-fn foam_covers_monahans_fraction_from_beaufort_4_to_10() {
-    println!("Beaufort | U m/s | Monahan W | foam cover | ratio | model's expected cover");
-    for b in [4u8, 6, 8, 10] {
+fn foam_gain_meets_monahan_at_10_m_s() {
+    let cover = model_cover(10.0);
+    let want = whitecap_fraction(10.0);
+    println!("Monahan | U m/s | W | foam cover | ratio");
+    for b in 3u8..=10 {
+        let wind = beaufort_speed_m_s(b).unwrap();
+        let (c, w) = (model_cover(wind), whitecap_fraction(wind));
+        println!("B{b} | {wind:5.2} | {w:.5} | {c:.5} | {:.2}", c / w);
+    }
+    println!("10 m/s | {want:.5} | {cover:.5} | {:.3}", cover / want);
+    assert!((cover / want - 1.0).abs() < 0.05, "10 m/s: {cover} vs Monahan {want}");
+}
+
+/// The model against a whitecap data set that did not set it: Callaghan et al. (2008), within
+/// a factor of 2 at the Beaufort numbers inside its range from Beaufort 4 to 9 (6.7 to
+/// 22.6 m/s). Beaufort 3 (4.4 m/s) is printed, not held: there the fit's cubic is a few
+/// tenths of a m/s above its zero at 3.70 m/s, and the model is above it (see ALGORITHMS.md
+/// §A.3).
+#[test]
+fn foam_covers_callaghans_whitecaps_from_beaufort_4_to_9() {
+    println!("Callaghan 2008 | U m/s | W | foam cover | ratio | model's expected cover");
+    for b in 3u8..=9 {
         let wind = beaufort_speed_m_s(b).unwrap();
         let sea =
             Sea::new(SeaParams { wind_m_s: wind, choppiness: DEFAULT_CHOPPINESS, seed: 11, ..SeaParams::default() });
-        let cover = mean_cover(&sea, 30.0, 5.0);
-        let want = whitecap_fraction(wind);
+        let (cover, want) = (model_cover(wind), callaghan_2008(wind));
         let expected = FoamModel::of(&sea).expected_cover();
-        println!("{b:8} | {wind:5.2} | {want:9.5} | {cover:10.5} | {:5.2} | {expected:.5}", cover / want);
-        assert!(cover / want > 0.5 && cover / want < 2.0, "Beaufort {b}: {cover} vs Monahan {want}");
+        println!("B{b} | {wind:5.2} | {want:.5} | {cover:.5} | {:.2} | {expected:.5}", cover / want);
+        if b >= 4 {
+            assert!(cover / want > 0.5 && cover / want < 2.0, "Beaufort {b}: {cover} vs Callaghan {want}");
+        }
     }
 }
 

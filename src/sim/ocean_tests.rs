@@ -4,7 +4,9 @@
 use super::*;
 use crate::sim::dispersion;
 use crate::sim::looping::LoopPeriod;
+use crate::sim::ocean::frame::HEIGHT;
 use crate::sim::spectra::{Depth, Jonswap};
+use crate::sim::surface::SurfaceSample;
 
 fn sea(wind: f64) -> Sea {
     Sea::new(SeaParams { wind_m_s: wind, wind_from_deg: 270.0, seed: 42, ..SeaParams::default() })

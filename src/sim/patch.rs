@@ -42,7 +42,8 @@ use super::foam::{FoamClock, FoamModel};
 mod foam;
 mod sampling;
 use super::ocean::{EULER_ITERATIONS, Sea, SeaParams, SeaTime, sizing_wavelength_m};
-use sampling::{Bilinear, cubic, sincos_turns, transpose_square};
+use super::trig::fast_sincos;
+use sampling::{Bilinear, cubic, round_even, sincos_turns, transpose_square};
 
 /// Smallest and largest lattice side.
 pub const PATCH_SIZE_RANGE: (usize, usize) = (8, 4096);
@@ -184,15 +185,18 @@ impl Lattice {
         let dk = 2.0 * PI / extent_m;
         let mut rng = ChaCha8Rng::seed_from_u64(params.seed ^ 0x9a7c);
         let mut lattice = Lattice::empty(n, extent_m);
-        for r in 0..n {
-            for c in 0..n {
-                let i = r * n + c;
-                let phase: f64 = rng.random();
-                let (mc, mr) = (signed(c, n), signed(r, n));
-                let (kx, ky) = (f64::from(lattice.kx[i]), f64::from(lattice.ky[i]));
+        // The phases in the lattice's order from one stream, then each point on its own (on
+        // all cores: the same values whatever their number).
+        let phases: Vec<f64> = (0..n * n).map(|_| rng.random()).collect();
+        let (kx, ky, looping) = (&lattice.kx, &lattice.ky, params.loop_period);
+        let waves: Vec<(Complex32, f64, u32)> = (0..n * n)
+            .into_par_iter()
+            .map(|i| {
+                let (mc, mr) = (signed(i % n, n), signed(i / n, n));
+                let (kx, ky) = (f64::from(kx[i]), f64::from(ky[i]));
                 let k = kx.hypot(ky);
                 if k == 0.0 || mc.unsigned_abs() as usize == n / 2 || mr.unsigned_abs() as usize == n / 2 {
-                    continue;
+                    return (Complex32::new(0.0, 0.0), 0.0, 0);
                 }
                 let w = dispersion::angular_frequency(k, depth);
                 let f = w / (2.0 * PI);
@@ -203,14 +207,19 @@ impl Lattice {
                 }
                 let density = directional * dispersion::group_speed(k, depth) / (2.0 * PI) / k;
                 let a = (2.0 * density * dk * dk).sqrt();
-                let (s, co) = sincos_turns(phase);
-                lattice.amp[i] = Complex32::new((a * co) as f32, (a * s) as f32);
-                lattice.omega[i] = w;
-                if let Some(p) = params.loop_period {
-                    lattice.harmonic[i] = (f * p.seconds()).round().max(1.0) as u32;
-                    lattice.omega[i] = 2.0 * PI * f64::from(lattice.harmonic[i]) / p.seconds();
+                let (s, co) = sincos_turns(phases[i]);
+                let amp = Complex32::new((a * co) as f32, (a * s) as f32);
+                match looping {
+                    Some(p) => {
+                        let harmonic = (f * p.seconds()).round().max(1.0) as u32;
+                        (amp, 2.0 * PI * f64::from(harmonic) / p.seconds(), harmonic)
+                    }
+                    None => (amp, w, 0),
                 }
-            }
+            })
+            .collect();
+        for (i, (amp, omega, harmonic)) in waves.into_iter().enumerate() {
+            (lattice.amp[i], lattice.omega[i], lattice.harmonic[i]) = (amp, omega, harmonic);
         }
         lattice
     }
@@ -268,14 +277,16 @@ impl Lattice {
         self.amp.iter().zip(&self.k).map(|(a, k)| 0.5 * f64::from(a.norm_sqr()) * f64::from(*k).powi(2)).sum()
     }
 
-    /// The rotation e^(-iωt) of lattice wave `i` at `time`.
+    /// The rotation e^(-iωt) of lattice wave `i` at `time`: the turns reduced exactly in f64
+    /// (to the nearest whole turn, ±½), the sine and cosine of what is left in f32.
     fn rotation(&self, i: usize, time: SeaTime) -> Complex32 {
         let turns = match time {
-            SeaTime::Seconds(t) => (self.omega[i] * t / (2.0 * PI)).rem_euclid(1.0),
+            SeaTime::Seconds(t) => self.omega[i] * t / (2.0 * PI),
             SeaTime::Ticks(u) => f64::from(self.harmonic[i].wrapping_mul(u as u32)) / 4_294_967_296.0,
         };
-        let (s, c) = sincos_turns(-turns);
-        Complex32::new(c as f32, s as f32)
+        let left = turns - round_even(turns);
+        let (s, c) = fast_sincos((-left * 2.0 * PI) as f32);
+        Complex32::new(c, s)
     }
 
     /// Every lattice wave at `time`: a·e^(iφ)·e^(-iωt).
@@ -286,14 +297,22 @@ impl Lattice {
             .collect()
     }
 
-    /// The inverse 2-D FFT of `buf` in place (rows, transpose, rows, transpose), rows in
-    /// parallel: the same result on any number of cores.
-    fn ifft2(&self, buf: &mut [Complex32]) {
+    /// The inverse 2-D FFT, in place, of a spectrum laid out transposed (`buf[kx·n + ky]`, see
+    /// [`Lattice::transposed`]): along ky on rows, one transpose, along kx on rows, which
+    /// leaves the field in row-major order (one transpose fewer than from the natural layout).
+    /// Rows in parallel: the same result on any number of cores.
+    fn ifft2_transposed(&self, buf: &mut [Complex32]) {
         let n = self.n;
-        for _ in 0..2 {
-            buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
-            transpose_square(buf, n);
-        }
+        buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
+        transpose_square(buf, n);
+        buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
+    }
+
+    /// The lattice index (row-major, row = ky) of position `j` of a transposed spectrum.
+    #[inline(always)]
+    fn transposed(&self, j: usize) -> usize {
+        let n = self.n;
+        (j % n) * n + j / n
     }
 
     /// Two real fields from one complex transform. `coefficients(i, w)` gives, for the
@@ -309,7 +328,8 @@ impl Lattice {
         let n = self.n;
         let mut buf: Vec<Complex32> = (0..n * n)
             .into_par_iter()
-            .map(|i| {
+            .map(|j| {
+                let i = self.transposed(j);
                 let (r, c) = (i / n, i % n);
                 let mirror = ((n - r) % n) * n + (n - c) % n;
                 let (f, g) = coefficients(i, waves[i]);
@@ -319,11 +339,14 @@ impl Lattice {
                 sf + Complex32::new(0.0, 1.0) * sg
             })
             .collect();
-        self.ifft2(&mut buf);
+        self.ifft2_transposed(&mut buf);
         (buf.iter().map(|c| c.re).collect(), buf.iter().map(|c| c.im).collect())
     }
 
     /// The displacement's gradient per unit λ, each times -1: g_ab = Σ a·(k_a·k_b/k)·cos θ.
+    /// (Pairing g_xy with the next step's in one transform would save a quarter of a foam
+    /// memory's transforms, but round differently from a step computed alone, and a series
+    /// must give the same bits as a set computed from nothing.)
     fn fold_fields(&self, waves: &[Complex32]) -> (Vec<f32>, Vec<f32>, Vec<f32>) {
         let coef = |i: usize| {
             let (kx, ky, k) = (self.kx[i], self.ky[i], self.k[i]);
@@ -390,15 +413,20 @@ impl PatchSea {
         // The displacement per unit λ is -Σ a·û·sin θ = re Σ (i·û·w)·e^(ik·x); slopes re Σ (i·k·w)·e^(ik·x).
         let (h, dx) = l.real_fields(&waves, |i, w| (w, i_unit * w * unit(i).0));
         let (dy, hx) = l.real_fields(&waves, |i, w| (i_unit * w * unit(i).1, i_unit * w * l.kx[i]));
-        let (hy, _) = l.real_fields(&waves, |i, w| (i_unit * w * l.ky[i], Complex32::new(0.0, 0.0)));
-        let (gxx, gyy, gxy) = l.fold_fields(&waves);
+        // The displacement's gradient per unit λ, each times -1: g_ab = Σ a·(k_a·k_b/k)·cos θ.
+        let (k, kx, ky) = (l.k.as_slice(), l.kx.as_slice(), l.ky.as_slice());
+        let (hy, gxy) = l.real_fields(&waves, |i, w| (i_unit * w * ky[i], w * (kx[i] * ky[i] / k[i])));
+        let (gxx, gyy) = l.real_fields(&waves, |i, w| (w * (kx[i] * kx[i] / k[i]), w * (ky[i] * ky[i] / k[i])));
         // B = Σ a·√k·e^(iθ): the waves themselves, a complex field.
         let n = self.size;
         let mut b: Vec<Complex32> = (0..n * n)
             .into_par_iter()
-            .map(|i| if l.amp[i].norm_sqr() == 0.0 { Complex32::new(0.0, 0.0) } else { waves[i] * unit(i).2.sqrt() })
+            .map(|j| {
+                let i = l.transposed(j);
+                if l.amp[i].norm_sqr() == 0.0 { Complex32::new(0.0, 0.0) } else { waves[i] * unit(i).2.sqrt() }
+            })
             .collect();
-        l.ifft2(&mut b);
+        l.ifft2_transposed(&mut b);
         (Lagrangian { h, dx, dy, hx, hy, gxx, gyy, gxy }, b)
     }
 
@@ -437,6 +465,12 @@ impl PatchSea {
         let h_l: Vec<f32> = (0..n * n).map(|i| lag.h[i] + 0.5 * lambda * b[i].norm_sqr()).collect();
         let displacement: Vec<[f32; 3]> =
             (0..n * n).map(|i| [lambda * lag.dx[i], lambda * lag.dy[i], h_l[i]]).collect();
+        // The fields read together, side by side: the displacement in lattice units (the Euler
+        // iterations read it four times a texel), and the slopes and gradient at the end.
+        let to_cell = lambda / cell;
+        let carried: Vec<[f32; 2]> = (0..n * n).map(|i| [lag.dx[i] * to_cell, lag.dy[i] * to_cell]).collect();
+        let gradients: Vec<[f32; 5]> =
+            (0..n * n).map(|i| [lag.hx[i], lag.hy[i], lag.gxx[i], lag.gyy[i], lag.gxy[i]]).collect();
         let mut height = vec![0.0f32; n * n];
         let mut normal = vec![[0.0f32; 3]; n * n];
         let mut foam = vec![0.0f32; n * n];
@@ -446,14 +480,11 @@ impl PatchSea {
                     // Lattice units: column c is x = c, row r is y = -r (north up).
                     let (mut px, mut py) = (c as f32, r as f32);
                     for _ in 0..EULER_ITERATIONS {
-                        let at = Bilinear::new(n, px, py);
-                        let (dxv, dyv) = (at.of(&lag.dx) * lambda / cell, at.of(&lag.dy) * lambda / cell);
+                        let [dxv, dyv] = Bilinear::new(n, px, py).of_all(&carried);
                         (px, py) = (c as f32 - dxv, r as f32 + dyv);
                     }
                     height[c] = cubic(&h_l, n, px, py);
-                    let at = Bilinear::new(n, px, py);
-                    let (hx, hy) = (at.of(&lag.hx), at.of(&lag.hy));
-                    let (gxx, gyy, gxy) = (at.of(&lag.gxx), at.of(&lag.gyy), at.of(&lag.gxy));
+                    let [hx, hy, gxx, gyy, gxy] = Bilinear::new(n, px, py).of_all(&gradients);
                     // ∇D = -λ·g; the Eulerian gradient is (I + ∇D)^-T ∇h.
                     let (a, d, bc) = (1.0 - lambda * gxx, 1.0 - lambda * gyy, -lambda * gxy);
                     let det = a * d - bc * bc;
@@ -509,6 +540,21 @@ mod tests {
         }
         assert!(worst <= 1, "the maps differ from their waves by {worst} levels at the seam");
         assert!(maps.height.iter().any(|h| h.abs() > 0.3), "a sea with waves");
+    }
+
+    /// A series of maps (foam continued one step at a time) and a set computed from nothing at
+    /// the same moment are the same bits, foam included.
+    #[test]
+    fn a_series_and_a_set_from_nothing_are_the_same_bits() {
+        let params = SeaParams { wind_m_s: 15.0, seed: 6, ..SeaParams::default() };
+        let mut series = PatchSea::new(params, 64, 300.0).unwrap();
+        for k in 0..40 {
+            series.maps(3.0 + f64::from(k) / 7.0);
+        }
+        let t = 3.0 + 40.0 / 7.0;
+        let (a, b) = (series.maps(t), PatchSea::new(params, 64, 300.0).unwrap().maps(t));
+        assert!(a.foam.iter().any(|&f| f > 0.01), "a sea with foam");
+        assert!(a == b, "a series and a set from nothing differ");
     }
 
     #[test]

@@ -65,6 +65,11 @@ pub struct SurfaceSample {
     /// Slope variance (per axis) of the waves too short for the footprint; the renderer
     /// spreads the sun's glint by it.
     pub unresolved_slope_variance: f32,
+    /// Σ a²/2·k²·φ² over the waves the footprint keeps (both axes), φ each wave's phase step
+    /// between neighbouring samples: a mesh between the samples loses part of their slope
+    /// (flat triangles about φ²/12 of each wave's, smooth shading about φ²/2), which the
+    /// renderer adds back to the unresolved slope variance. 0 for surfaces that do not say.
+    pub mesh_slope_loss: f32,
 }
 
 /// A water surface a renderer can sample: heights in metres over the (east, north) plane.

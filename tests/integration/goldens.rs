@@ -5,7 +5,7 @@
 use tidepool::sea::beaufort_speed_m_s;
 use tidepool::{
     Event, LakeParams, LakeSettings, OceanSettings, OceanView, PoolLook, PoolSettings, Refraction, SceneSpec, Script,
-    SeaParams, Stone, Sun,
+    SeaParams, SeaShading, Stone, Sun,
 };
 use tiny_skia::Pixmap;
 
@@ -84,31 +84,39 @@ fn caustics_throw_rings_of_light_on_the_floor() {
     assert!(brighter > 100 && darker > 100, "brighter {brighter}, darker {darker}");
 }
 
-/// The sea of `render ocean --beaufort B --direction D` (seed 1, the default camera and sun).
-fn sea(beaufort: u8, direction: f64, ssaa: u32, time_s: f64) -> SceneSpec {
+/// The sea of `render ocean --beaufort B --direction D --shading S` (seed 1, the default
+/// camera and sun).
+fn sea(beaufort: u8, direction: f64, ssaa: u32, time_s: f64, shading: SeaShading) -> SceneSpec {
     let wind = beaufort_speed_m_s(beaufort).unwrap();
     SceneSpec::Ocean(OceanSettings {
         sea: SeaParams { wind_m_s: wind, wind_from_deg: direction, seed: 1, ..SeaParams::default() },
-        view: OceanView { ssaa, ..OceanView::default() },
+        view: OceanView { ssaa, shading, ..OceanView::default() },
         start_time_s: time_s,
         ..OceanSettings::default()
     })
 }
 
+/// Beaufort 3 and 8, flat (the pictures' default) and smooth.
 #[test]
-fn seas_at_beaufort_3_and_8() {
+fn seas_at_beaufort_3_and_8_flat_and_smooth() {
     let mut goldens = Goldens::new();
-    for (beaufort, direction) in [(3, 330.0), (8, 200.0)] {
-        let p = picture(&sea(beaufort, direction, 2, 0.0), 192, 108, &[], 0);
-        goldens.png(&format!("ocean_b{beaufort}"), &rgba(&p), Tolerance::default());
+    for shading in [SeaShading::Flat, SeaShading::Smooth] {
+        for (beaufort, direction) in [(3, 330.0), (8, 200.0)] {
+            let p = picture(&sea(beaufort, direction, 2, 0.0, shading), 192, 108, &[], 0);
+            goldens.png(&format!("ocean_b{beaufort}_{shading}"), &rgba(&p), Tolerance::default());
+        }
     }
 }
 
+/// Beaufort 6 as half-block text, smooth (the text's default) and flat.
 #[test]
 fn a_sea_as_half_block_text() {
-    let text = tidepool::encode::halfblock(&picture(&sea(6, 330.0, 1, 4.0), 80, 48, &[], 0));
-    assert_eq!(String::from_utf8_lossy(&text).lines().count(), 24, "two pixel rows per line");
-    golden::check_ansi("ocean_small", &text, Tolerance::default());
+    let mut goldens = Goldens::new();
+    for (name, shading) in [("ocean_small", SeaShading::Smooth), ("ocean_small_flat", SeaShading::Flat)] {
+        let text = tidepool::encode::halfblock(&picture(&sea(6, 330.0, 1, 4.0, shading), 80, 48, &[], 0));
+        assert_eq!(String::from_utf8_lossy(&text).lines().count(), 24, "two pixel rows per line");
+        goldens.ansi(name, &text, Tolerance::default());
+    }
 }
 
 /// The lake of `render lake --wind W --time T` (seed 1, default noise).

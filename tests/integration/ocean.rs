@@ -8,14 +8,15 @@ use crate::common::{read_npy, read_png, run, run_in, scratch, stderr};
 fn the_command_line_draws_the_librarys_seas() {
     use crate::goldens::{picture, rgba};
     use tidepool::sea::beaufort_speed_m_s;
-    use tidepool::{OceanSettings, OceanView, SceneSpec, SeaParams};
+    use tidepool::{OceanSettings, OceanView, SceneSpec, SeaParams, SeaShading};
     let dir = scratch("ocean_cli_is_the_library");
     let out = run_in(
         &dir,
         &["render", "ocean", "--beaufort", "8", "--direction", "200", "--size", "192x108", "--out", "sea.png"],
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    let spec = |ssaa, time| {
+    // Pictures are flat-shaded by default, text smooth (see `the_help_names_the_shading_it_draws`).
+    let spec = |ssaa, time, shading| {
         SceneSpec::Ocean(OceanSettings {
             sea: SeaParams {
                 wind_m_s: beaufort_speed_m_s(8).unwrap(),
@@ -23,12 +24,14 @@ fn the_command_line_draws_the_librarys_seas() {
                 seed: 1,
                 ..SeaParams::default()
             },
-            view: OceanView { ssaa, ..OceanView::default() },
+            view: OceanView { ssaa, shading, ..OceanView::default() },
             start_time_s: time,
             ..OceanSettings::default()
         })
     };
-    assert!(read_png(&dir.join("sea.png")) == rgba(&picture(&spec(2, 0.0), 192, 108, &[], 0)));
+    let flat = picture(&spec(2, 0.0, SeaShading::Flat), 192, 108, &[], 0);
+    assert!(read_png(&dir.join("sea.png")) == rgba(&flat));
+    assert!(flat != picture(&spec(2, 0.0, SeaShading::Smooth), 192, 108, &[], 0), "the shadings differ");
     let out = run_in(
         &dir,
         &[
@@ -47,8 +50,53 @@ fn the_command_line_draws_the_librarys_seas() {
         ],
     );
     assert!(out.status.success(), "{}", stderr(&out));
-    let text = tidepool::encode::halfblock(&picture(&spec(1, 4.0), 80, 48, &[], 0));
+    let text = tidepool::encode::halfblock(&picture(&spec(1, 4.0, SeaShading::Smooth), 80, 48, &[], 0));
     assert_eq!(std::fs::read(dir.join("sea.ans")).unwrap(), text);
+}
+
+/// The shading's help text names the defaults the commands draw: `render ocean --help` says
+/// which shading pictures and text get, and a picture and a text drawn without `--shading`
+/// are the same bytes as with the word the help printed (and not the other).
+#[test]
+fn the_help_names_the_shading_it_draws() {
+    let help = run(&["render", "ocean", "--help"]);
+    assert!(help.status.success(), "{}", stderr(&help));
+    let words = String::from_utf8_lossy(&help.stdout).split_whitespace().collect::<Vec<_>>().join(" ");
+    let at = words.find("--shading <MODE>").expect("render ocean --help lists --shading");
+    let entry = &words[at..];
+    let default = &entry[entry.find("[default: ").expect("--shading shows its default") + 10..];
+    let default = &default[..default.find(']').expect("a closed [default: ...]")];
+    // "[default: flat for pictures, smooth for text]"
+    let word_for = |medium: &str| -> String {
+        let part = default.split(',').find(|p| p.contains(medium)).unwrap_or_else(|| panic!("{default}: {medium}"));
+        part.split_whitespace().next().expect("a word").to_string()
+    };
+    let dir = scratch("ocean_shading_help");
+    for (medium, file) in [("pictures", "sea.png"), ("text", "sea.ans")] {
+        let word = word_for(medium);
+        assert!(word == "flat" || word == "smooth", "{medium}: '{word}'");
+        let draw = |name: &str, shading: Option<&str>| {
+            let mut args = vec!["render", "ocean", "--size", "96x54", "--beaufort", "7", "--out", name];
+            if let Some(s) = shading {
+                args.extend(["--shading", s]);
+            }
+            let out = run_in(&dir, &args);
+            assert!(out.status.success(), "{}", stderr(&out));
+            std::fs::read(dir.join(name)).unwrap()
+        };
+        let ext = file.rsplit('.').next().unwrap();
+        let plain = draw(file, None);
+        assert!(plain == draw(&format!("named.{ext}"), Some(&word)), "{medium}: the default is not '{word}'");
+        let opposite = if word == "flat" { "smooth" } else { "flat" };
+        assert!(plain != draw(&format!("opposite.{ext}"), Some(opposite)), "{medium}: '{opposite}' draws the same");
+    }
+    let play = run(&["play", "--help"]);
+    let play_text = String::from_utf8_lossy(&play.stdout).split_whitespace().collect::<Vec<_>>().join(" ");
+    let at = play_text.find("--shading <MODE>").expect("play --help lists --shading");
+    assert!(play_text[at..].contains("[default: smooth]"), "play draws the ocean smooth");
+    let bad = run(&["render", "ocean", "--shading", "gouraud"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(stderr(&bad).contains("--shading") && stderr(&bad).contains("flat"), "{}", stderr(&bad));
 }
 
 #[test]
@@ -269,6 +317,97 @@ fn maps_tile_across_their_edges_and_loop_in_time() {
     assert_eq!(out.status.code(), Some(2));
     assert!(stderr(&out).contains("--maps: 'afile' is a file"), "{}", stderr(&out));
     assert_eq!(std::fs::read(dir.join("afile")).unwrap(), b"keep me");
+}
+
+/// Runs `scripts/check_exr_maps.py` (the OpenEXR Python bindings reading the maps) on `args`;
+/// fails loudly when python3 or the reader is missing.
+fn independent_exr_check(args: &[&std::path::Path]) -> String {
+    let script = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scripts/check_exr_maps.py");
+    let out = std::process::Command::new("python3")
+        .arg(&script)
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("python3 is needed to read the EXR maps independently: {e}"));
+    let text = format!("{}{}", String::from_utf8_lossy(&out.stdout), String::from_utf8_lossy(&out.stderr));
+    assert_ne!(out.status.code(), Some(2), "the independent EXR reader is missing: {text}");
+    assert!(out.status.success(), "{text}");
+    text
+}
+
+/// `--map-format exr` writes half-float OpenEXR maps beside the .npy and PNG files; read back
+/// by an independent reader (OpenEXR's Python bindings) they equal the .npy fields within
+/// half precision and the PNGs within their 8-bit step, they tile, and a loop later they are
+/// the same bytes.
+#[test]
+fn exr_maps_read_back_by_an_independent_reader() {
+    let dir = scratch("ocean_maps_exr");
+    let out =
+        run_in(&dir, &["render", "ocean", "--maps", "m", "--size", "64x64", "--wind", "12", "--map-format", "exr"]);
+    assert!(out.status.success(), "{}", stderr(&out));
+    let mut names: Vec<String> =
+        std::fs::read_dir(dir.join("m")).unwrap().map(|e| e.unwrap().file_name().into_string().unwrap()).collect();
+    names.sort();
+    let want = [
+        "displacement.exr",
+        "displacement.npy",
+        "displacement.png",
+        "foam.exr",
+        "foam.png",
+        "height.exr",
+        "height.npy",
+        "height.png",
+        "normal.exr",
+        "normal.png",
+    ];
+    assert_eq!(names, want);
+    let text = independent_exr_check(&[&dir.join("m")]);
+    assert!(text.contains("within half precision"), "{text}");
+    // A loop of 100 s (Beaufort 6, foam included): the maps at --time 100 are those at 0.
+    for (folder, time) in [("t0", "0"), ("t100", "100")] {
+        let args = ["render", "ocean", "--maps", folder, "--size", "32x32", "--loop", "100", "--time", time];
+        let out = run_in(&dir, &[&args[..], &["--map-format", "exr", "--beaufort", "6"]].concat());
+        assert!(out.status.success(), "{}", stderr(&out));
+    }
+    independent_exr_check(&[&dir.join("t0"), std::path::Path::new("--same"), &dir.join("t100")]);
+    let out = run_in(&dir, &["render", "ocean", "--size", "32x32", "--map-format", "exr", "--out", "x.png"]);
+    assert_eq!(out.status.code(), Some(2), "--map-format without --maps is refused");
+}
+
+/// The maps (EXR, .npy and PNG) and a picture of the sea are the same bytes on the portable
+/// path with one thread and on the widest SIMD tier this CPU has with three: the patch's FFT is
+/// rustfft's scalar planner and its sine tidepool's own, so no tier changes a bit.
+#[test]
+fn maps_and_pictures_are_the_same_bytes_on_every_simd_tier() {
+    let dir = scratch("ocean_simd_tiers");
+    let mut outputs = Vec::new();
+    for (tier, threads) in [("portable", "1"), ("", "3")] {
+        let name = format!("t{threads}");
+        let args = ["render", "ocean", "--maps", &name, "--size", "64x64", "--beaufort", "8", "--map-format", "exr"];
+        let picture = format!("{name}.png");
+        let shot = ["render", "ocean", "--beaufort", "8", "--size", "96x54", "--out", &picture];
+        let mut files = Vec::new();
+        for command in [&args[..], &shot[..]] {
+            let out = crate::common::tidepool()
+                .current_dir(&dir)
+                .env("TIDEPOOL_SIMD", tier)
+                .env("RAYON_NUM_THREADS", threads)
+                .args(command)
+                .output()
+                .unwrap();
+            assert!(out.status.success(), "{command:?}: {}", stderr(&out));
+        }
+        let mut names: Vec<_> = std::fs::read_dir(dir.join(&name)).unwrap().map(|e| e.unwrap().path()).collect();
+        names.sort();
+        for path in names {
+            files.push((path.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&path).unwrap()));
+        }
+        files.push(("the picture".to_string(), std::fs::read(dir.join(&picture)).unwrap()));
+        outputs.push(files);
+    }
+    assert_eq!(outputs[0].len(), 11, "ten maps and a picture");
+    for (a, b) in outputs[0].iter().zip(&outputs[1]) {
+        assert!(a == b, "{:?} differs between the portable path on one thread and the widest tier on three", a.0);
+    }
 }
 
 /// The frames of `render ocean ARGS --size 64x36 --ssaa 1 --frames N+1 --fps F --loop T` in

@@ -311,7 +311,8 @@ pub struct RenderCommand {
 pub enum RenderScene {
     /// The ripple pool: stones and rain on water over a tiled floor.
     Pool(RenderPool),
-    /// The ocean: a wind-driven Pierson–Moskowitz sea under a sky, as a flat-shaded mesh.
+    /// The ocean: a wind-driven Pierson–Moskowitz sea under a sky, a spade-triangulated mesh,
+    /// flat- or smooth-shaded (--shading).
     Ocean(ocean::RenderOcean),
     /// The lake: Perlin-noise water mirroring its wooded shore; wind breaks the mirror.
     Lake(lake::RenderLake),

@@ -35,7 +35,7 @@ pub(super) fn sincos_turns(turns: f64) -> (f64, f64) {
 /// 1.5·2⁵² leaves no fraction bits. Exact, and no call into libm (baseline x86-64 has no
 /// rounding instruction).
 #[inline(always)]
-fn round_even(x: f64) -> f64 {
+pub(super) fn round_even(x: f64) -> f64 {
     const MAGIC: f64 = 6_755_399_441_055_744.0;
     (x + MAGIC) - MAGIC
 }
@@ -95,6 +95,17 @@ impl Bilinear {
             tx: x - x0 as f32,
             ty: y - y0 as f32,
         }
+    }
+
+    /// Every component of a field of `N` values a point, at once.
+    #[inline(always)]
+    pub(super) fn of_all<const N: usize>(&self, f: &[[f32; N]]) -> [f32; N] {
+        let (a, b, c, d) = (&f[self.i00], &f[self.i01], &f[self.i10], &f[self.i11]);
+        std::array::from_fn(|k| {
+            let top = a[k] + (b[k] - a[k]) * self.tx;
+            let bottom = c[k] + (d[k] - c[k]) * self.tx;
+            top + (bottom - top) * self.ty
+        })
     }
 
     #[inline(always)]

@@ -8,7 +8,7 @@ use tidepool::sea::{
     DEFAULT_CHOPPINESS, DEFAULT_SEA_WIND_M_S, DEFAULT_WIND_FROM_DEG, Jonswap, LoopPeriod, SpectrumChoice,
     SpectrumChoiceError, SpectrumKind, Spreading, Swell, Swells, beaufort_speed_m_s, check_choppiness,
 };
-use tidepool::{CameraPose, SeaParams};
+use tidepool::{CameraPose, SeaParams, SeaShading};
 
 use crate::error::{Error, Result};
 
@@ -19,6 +19,7 @@ const OCEAN_EXAMPLES: &str = "\
 Examples:
   tidepool render ocean                              # ocean.png, 640x360, a 10 m/s breeze
   tidepool render ocean --beaufort 8 --direction 200 --size 1280x720 --out gale.png
+  tidepool render ocean --shading smooth --out smooth.png   # no facets
   tidepool render ocean --out - --size 160x96        # in this terminal
   tidepool render ocean --wind 10 --heightmap sea.npy --size 512x512
   tidepool render ocean --spectrum jonswap --fetch 20 --wind 15 --out fetch.png
@@ -265,6 +266,12 @@ pub struct PlaySeaArgs {
     /// The ocean's horizontal displacement, 0..=4 (0 round crests, 1 physical). [default: 1]
     #[arg(long, value_name = "L", value_parser = parse_choppiness, allow_negative_numbers = true)]
     pub choppiness: Option<f64>,
+
+    /// How the ocean's mesh is lit: smooth (shaded at the vertices and blended across each
+    /// triangle) or flat (one colour per spade triangle, the faceted sea of the design; at a
+    /// terminal's few pixels, without supersampling, its triangles are a mosaic of blocks).
+    #[arg(long, value_name = "MODE", value_parser = parse_shading, default_value_t = PLAY_SHADING)]
+    pub shading: SeaShading,
 }
 
 impl PlaySeaArgs {
@@ -323,9 +330,22 @@ pub struct RenderOcean {
     #[arg(long, value_name = "DIR")]
     pub maps: Option<PathBuf>,
 
+    /// The maps' files: png (the .npy and PNG files above) or exr (those, and beside them
+    /// height.exr, displacement.exr, normal.exr and foam.exr in half floats: metres and unit
+    /// vectors as Blender bakes and Unreal and Unity import them). [default: png]
+    #[arg(long, value_name = "FORMAT", value_enum, requires = "maps")]
+    pub map_format: Option<MapFormat>,
+
     /// The sun: azimuth (degrees clockwise from north) and elevation (0..=90 degrees).
     #[arg(long, value_name = "AZ,EL", default_value = "15,22", value_parser = parse_sun, allow_hyphen_values = true)]
     pub sun: (f64, f64),
+
+    /// How the mesh is lit: flat (one colour per spade triangle, the faceted sea of the design;
+    /// --ssaa averages its far crests) or smooth (shaded at the vertices and blended across
+    /// each triangle). The sun's glitter and the foam are drawn per pixel in both.
+    /// [default: flat for pictures, smooth for text]
+    #[arg(long, value_name = "MODE", value_parser = parse_shading)]
+    pub shading: Option<SeaShading>,
 
     /// The camera: height above the sea in metres (0.5..=10000), tilt below the horizontal in
     /// degrees (-45..=89), horizontal field of view in degrees (5..=150) and heading in
@@ -359,6 +379,16 @@ pub struct RenderOcean {
     /// An animation instead of one picture (it starts at --time).
     #[command(flatten)]
     pub animation: super::AnimationArgs,
+}
+
+/// The files `--maps` writes.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, clap::ValueEnum)]
+pub enum MapFormat {
+    /// Float .npy and 16-bit and 8-bit PNG.
+    #[default]
+    Png,
+    /// Those, and half-float OpenEXR.
+    Exr,
 }
 
 /// `tidepool spectrum`.
@@ -396,6 +426,21 @@ pub struct SpectrumCommand {
 
 /// Parses `pm`, `jonswap` or `tma`.
 pub fn parse_spectrum(text: &str) -> Result<SpectrumKind, String> {
+    text.parse().map_err(|e: tidepool::ValueError| e.to_string())
+}
+
+/// `play`'s shading: its frames are a terminal's few pixels without supersampling, where flat
+/// triangles are a mosaic of blocks (docs/sea/README.md).
+pub const PLAY_SHADING: SeaShading = SeaShading::Smooth;
+
+/// `render ocean`'s shading for an output `format`: flat (the design's faceted sea) for
+/// pictures, which are supersampled, smooth for text, which is not.
+pub fn default_shading(format: super::Format) -> SeaShading {
+    if format == super::Format::Png { SeaShading::Flat } else { SeaShading::Smooth }
+}
+
+/// Parses `flat` or `smooth`.
+pub fn parse_shading(text: &str) -> Result<SeaShading, String> {
     text.parse().map_err(|e: tidepool::ValueError| e.to_string())
 }
 

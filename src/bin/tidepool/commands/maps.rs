@@ -8,11 +8,11 @@ use std::path::Path;
 use std::time::Instant;
 
 use tidepool::SeaParams;
-use tidepool::encode::{MapFields, human_bytes, sea_maps};
+use tidepool::encode::{MapFields, human_bytes, sea_maps, sea_maps_exr};
 use tidepool::sea::{PatchMaps, PatchSea, check_map_size, check_patch, default_map_extent_m};
 
 use super::stats::Stats;
-use crate::cli::ocean::RenderOcean;
+use crate::cli::ocean::{MapFormat, RenderOcean};
 use crate::error::{Error, Result};
 use crate::files;
 use crate::progress::Progress;
@@ -52,7 +52,10 @@ pub fn write(args: &RenderOcean, dir: &Path, params: SeaParams) -> Result<()> {
         return Err(Error::arg("--heightmap", "--maps writes height.npy and height.png already; drop --heightmap"));
     }
     if args.output.format.is_some() {
-        return Err(Error::arg("--format", "maps are .npy and .png files; drop --format"));
+        return Err(Error::arg(
+            "--format",
+            "maps are .npy, .png (and with --map-format exr, .exr) files; drop --format",
+        ));
     }
     check_folder(dir)?;
     let n = match args.output.size {
@@ -79,6 +82,7 @@ pub fn write(args: &RenderOcean, dir: &Path, params: SeaParams) -> Result<()> {
     let started = Instant::now();
     let mut progress = Progress::new("maps", u64::from(frames));
     let numbered = args.animation.frames.is_some();
+    let exr = args.map_format.unwrap_or_default() == MapFormat::Exr;
     // A writer thread encodes and writes frame k while the next frame is computed (each file
     // is flushed to the device, which would otherwise leave the cores idle); at most two
     // frames wait, so memory stays bounded.
@@ -94,7 +98,9 @@ pub fn write(args: &RenderOcean, dir: &Path, params: SeaParams) -> Result<()> {
                     normal: &maps.normal,
                     foam: &maps.foam,
                 };
-                for (name, file) in sea_maps(&fields, numbered.then_some(k)) {
+                let frame = numbered.then_some(k);
+                let exr_files = if exr { sea_maps_exr(&fields, frame) } else { Vec::new() };
+                for (name, file) in sea_maps(&fields, frame).into_iter().chain(exr_files) {
                     bytes += file.len();
                     files::write_file(&dir.join(name), &file)?;
                 }

@@ -12,7 +12,7 @@ use super::animate::{AnimationTarget, FrameSource, check_animation_flags, render
 use super::output::{DEFAULT_PNG_SIZE, OutputPlan, default_ssaa, terminal_pixels, too_large};
 use super::still::{self, Still};
 use crate::cli::Format;
-use crate::cli::ocean::{RenderOcean, loop_period, wind_of};
+use crate::cli::ocean::{RenderOcean, default_shading, loop_period, wind_of};
 use crate::error::{Error, Result};
 
 /// The sea of a `render ocean` command line, its loop checked against its own peak period.
@@ -43,6 +43,7 @@ fn settings(args: &RenderOcean, format: Format) -> Result<OceanSettings> {
             sun_elevation_deg: args.sun.1 as f32,
             ssaa: args.ssaa.unwrap_or_else(|| default_ssaa(format)),
             downsample: Downsample::Box,
+            shading: args.shading.unwrap_or_else(|| default_shading(format)),
         },
         texture,
         start_time_s: args.time,

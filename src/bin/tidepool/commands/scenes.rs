@@ -27,6 +27,7 @@ pub fn specs(first: PlayScene, flags: &LiveSceneArgs) -> Result<Vec<SceneSpec>> 
             sun_azimuth_deg: flags.pool.sun.map_or(default_view.sun_azimuth_deg, |s| s.azimuth_deg()),
             sun_elevation_deg: flags.pool.sun.map_or(default_view.sun_elevation_deg, |s| s.elevation_deg()),
             ssaa: 1,
+            shading: flags.sea.shading,
             ..default_view
         },
         ..OceanSettings::default()
