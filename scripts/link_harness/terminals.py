@@ -28,7 +28,8 @@ import subprocess
 import sys
 import time
 
-from harness import LINKS, RELAY_SSH, Lab, stop
+from harness import LINKS
+from lab import Lab, stop
 
 # The part of the 1600x1000 root window each terminal's window covers (no window manager: both
 # open at the top left).
@@ -60,6 +61,8 @@ def main():
     parser.add_argument("--logs", metavar="DIR", help="keep each terminal's own output as DIR/TERMINAL-over-LINK[-TAG].log, and both directions between it and ssh (util-linux script -B, advanced timing) as .raw and .timing")
     parser.add_argument("--display", default=":79", help="the Xvfb display to start (default :79)")
     parser.add_argument("--timeout", type=float, default=300.0, help="the whole run ends after this many seconds (default 300)")
+    parser.add_argument("--names", help="the namespaces are NAMESc and NAMESs (default tp<pid>)")
+    parser.add_argument("--subnet", default="10.213.0", help="the veth pair's /24, three octets (default 10.213.0)")
     args = parser.parse_args()
     if os.geteuid() != 0:
         sys.exit("terminals.py: needs root (network namespaces, tc, sshd)")
@@ -92,7 +95,7 @@ def main():
     signal.signal(signal.SIGALRM, out_of_time)
     signal.signal(signal.SIGTERM, out_of_time)
     signal.alarm(int(args.timeout))
-    lab = Lab(tidepool, args.timeout)
+    lab = Lab(tidepool, args.timeout, names=args.names, subnet=args.subnet)
     xvfb = None
     try:
         lab.setup()
@@ -104,7 +107,7 @@ def main():
         for var in ("TMUX", "SSH_CONNECTION", "SSH_TTY", "KITTY_WINDOW_ID", "TERM_PROGRAM"):
             env.pop(var, None)
         play = f"{shlex.quote(tidepool)} play {args.play_args}"
-        ssh = lab.ns(lab.client_ns, *lab.ssh_command(RELAY_SSH, play))
+        ssh = lab.ns(lab.client_ns, *lab.ssh_command(remote=play))
         for name in names:
             shot = os.path.join(args.out, f"{name}-over-{args.link}{tag}.png")
             log = open(os.path.join(args.logs or lab.dir, f"{name}-over-{args.link}{tag}.log"), "wb")
