@@ -55,7 +55,7 @@ CONFIGS = {
     # every 50 ms all through the row.
     "stock": {
         "links": ("2mbit", "2mbit-20ms", "2mbit-150ms", "256kbit-300ms"),
-        "modes": ("ssh", "screen", "tmux", "serve", "kitty", "xterm", "tmux-attach", "screen-attach"),
+        "modes": ("ssh", "screen", "tmux", "serve", "kitty", "xterm", "tmux-passthrough", "tmux-attach", "screen-attach"),
         # The rows run unless --modes names others (the -attach rows: see attach_command).
         "default": ("ssh", "screen", "tmux", "serve", "kitty", "xterm"),
     },
@@ -112,6 +112,8 @@ def stock_command(lab, mode, play_args):
             "set status off \\; set -as terminal-features ',*:RGB'"
         ),
     }
+    # The same tmux with its passthrough allowed (off by default since tmux 3.3).
+    remote["tmux-passthrough"] = remote["tmux"] + " \\; set -g allow-passthrough on"
     if mode == "serve":
         return lab.ns(lab.client_ns, *lab.ssh_command(port=SERVE_PORT, stock=True))
     if mode.endswith("-attach"):
@@ -253,6 +255,7 @@ def measure(lab, config, mode, capacity, args, display, name):
             shot_frames = take_shots(term, args.shots, name)
         measuring = time.monotonic()
         latencies, missed = [], 0
+        keys = []  # (pressed, shown or None), CLOCK_MONOTONIC: the clock the player's Instant reads
         size_up = True
         for _ in range(args.presses):
             if not stones:
@@ -268,6 +271,7 @@ def measure(lab, config, mode, capacity, args, display, name):
                 if shown:
                     break
                 time.sleep(0.005)
+            keys.append((at, shown))
             if shown:
                 latencies.append(shown - at)
                 size_up = not size_up
@@ -285,6 +289,11 @@ def measure(lab, config, mode, capacity, args, display, name):
             # Bytes read but not yet parsed: the emulator's lag (it must keep up for the
             # timings to mean anything).
             unparsed = sum(len(d) for _, d in term.pending)
+        if keep:
+            with open(os.path.join(keep, f"{name}.keys.csv"), "w") as f:
+                f.write("pressed,shown,ms\n")
+                for at, shown in keys:
+                    f.write(f"{at:.4f},{shown or 0:.4f},{(shown - at) * 1e3 if shown else -1:.0f}\n")
         seconds = end - measuring
         gaps = [b - a for a, b in zip([measuring] + changes, changes + [end])]
         frames = len(syncs) if syncs else bursts(changes)
