@@ -18,12 +18,12 @@ from tap import RECORD
 TERMINALS = {
     # kitty with Mesa's softpipe (llvmpipe draws a ghost status line: scripts/kitty_ghost.sh),
     # 960x640; xterm as a VT340 (sixel) with 256 colour registers, 120x40.
-    "kitty": lambda cmd: [
-        "env", "LIBGL_ALWAYS_SOFTWARE=1", "GALLIUM_DRIVER=softpipe",
+    "kitty": lambda cmd, driver="softpipe": [
+        "env", "LIBGL_ALWAYS_SOFTWARE=1", f"GALLIUM_DRIVER={driver}",
         "kitty", "-o", "initial_window_width=960", "-o", "initial_window_height=640", "-o", "remember_window_size=no",
         *cmd,
     ],
-    "xterm": lambda cmd: [
+    "xterm": lambda cmd, driver=None: [
         "xterm", "-ti", "vt340", "-xrm", "XTerm*numColorRegisters: 256", "-xrm", "XTerm*maxGraphicSize: 2000x2000",
         "-geometry", "120x40+0+0", "-e", *cmd,
     ],

@@ -30,23 +30,7 @@ import time
 
 from harness import LINKS
 from lab import Lab, stop
-
-# The part of the 1600x1000 root window each terminal's window covers (no window manager: both
-# open at the top left).
-CROPS = {"kitty": "960x640+0+0", "xterm": "730x530+0+0"}
-TERMINALS = {
-    # The window sizes of scripts/real_terminals.sh (kitty 960x640 at 9x18 cells, xterm 120x40).
-    "kitty": lambda cmd, driver="softpipe": [
-        "env", "LIBGL_ALWAYS_SOFTWARE=1", f"GALLIUM_DRIVER={driver}",
-        "kitty", "-o", "initial_window_width=960", "-o", "initial_window_height=640", "-o", "remember_window_size=no",
-        *cmd,
-    ],
-    "xterm": lambda cmd, driver=None: [
-        "xterm", "-ti", "vt340", "-xrm", "XTerm*numColorRegisters: 256", "-xrm", "XTerm*maxGraphicSize: 2000x2000",
-        "-geometry", "120x40+0+0", "-e", *cmd,
-    ],
-}
-
+from real_terminal import CROPS, TERMINALS
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
