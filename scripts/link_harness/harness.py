@@ -226,7 +226,8 @@ def measure(lab, config, mode, capacity, args, display, name):
     keep = args.keep_logs
     raw = os.path.join(keep, f"{name}.raw") if keep else None
     ports = (22, 2222, SERVE_PORT)
-    path_log = PathLog(lab, os.path.join(keep or lab.dir, f"{name}.path.csv"), ports)
+    candidates = mode if args.candidates and mode.startswith(("tmux", "screen")) else None
+    path_log = PathLog(lab, os.path.join(keep or lab.dir, f"{name}.path.csv"), ports, candidates)
     first = attach_first(lab, mode, args.stock_play_args) if mode.endswith("-attach") else None
     # Another flow on the link (--cross-traffic): a bulk download over its own SSH connection.
     bulk = None
@@ -298,7 +299,8 @@ def measure(lab, config, mode, capacity, args, display, name):
         gaps = [b - a for a, b in zip([measuring] + changes, changes + [end])]
         frames = len(syncs) if syncs else bursts(changes)
         said = re.search(r"(\d+) fps \u00b7 ([\d.]+ [kMG]?B/s)", status)
-        hint = re.search(r"([^\n·]*set --bandwidth[^\n]*)", status)
+        # The hint stands apart at the line's right end (after a run of spaces).
+        hint = re.search(r"\s{2,}(\S[^\n]*--bandwidth[^\n]*?)\s*$", status.split("\n")[0])
         return {
             "latencies": latencies,
             "missed": missed,
@@ -379,6 +381,7 @@ def parse_args():
     parser.add_argument("--display", default=":79", help="the Xvfb display of the kitty and xterm rows (default :79)")
     parser.add_argument("--redraw-at", type=float, action="append", help="stock tmux and screen rows: make the multiplexer redraw its whole screen this many seconds into the warm-up (tmux refresh-client, screen redisplay; repeatable)")
     parser.add_argument("--cross-traffic", action="store_true", help="stock rows: another flow on the link, a bulk download over a second SSH connection all through the row")
+    parser.add_argument("--candidates", action="store_true", help="tmux and screen rows: also log what else a program inside could read (tmux's #{client_written}, sshd's /proc/PID/io and memory) in the .path.csv")
     parser.add_argument("--congestion", help="TCP congestion control inside the two namespaces (default: the machine's, e.g. bbr; cubic is Linux's own default)")
     parser.add_argument("--stock-user", default="tplink", help="the stock configuration's test user, made for the run if missing (default tplink)")
     return parser.parse_args()

@@ -61,10 +61,16 @@ def established(table, ports):
 
 
 class PathLog:
-    """Samples the server namespace while a row runs; `stop` returns a one-line summary."""
+    """Samples the server namespace while a row runs; `stop` returns a one-line summary.
+    `candidates` (tmux and screen rows, `--candidates`): every 500 ms also what else a program
+    inside the multiplexer could read, as the test user: tmux's count of bytes written to its
+    client (`#{client_written}`), whether sshd's session process lets it read its byte counts
+    (`/proc/PID/io`), and that process's resident memory (`/proc/PID/status`, which anyone
+    reads: it grows with sshd's buffer)."""
 
-    def __init__(self, lab, path, ports):
+    def __init__(self, lab, path, ports, candidates=None):
         self.lab, self.path, self.ports = lab, path, set(ports)
+        self.candidates = candidates
         self.out = open(path, "w")
         self.out.write("time,tx_queues,player_wchar,sshd_rchar,sshd_wchar,ss\n")
         self.done = False
@@ -106,10 +112,25 @@ class PathLog:
             ss = ""
             if count % SS_EVERY == 0:
                 ss = self.ss()
+                if self.candidates:
+                    ss += " " + self.candidate_sample()
             count += 1
             qtext = " ".join(f"{p}>{r}:{q}" for p, r, q in queues)
             self.out.write(f"{now:.3f},{qtext},{player},{sshd[0]},{sshd[1]},{ss}\n")
             time.sleep(max(0.0, now + SAMPLE - time.monotonic()))
+
+    def candidate_sample(self):
+        user = ["runuser", "-u", self.lab.stock_user, "--"]
+        out = []
+        if self.candidates.startswith("tmux"):
+            written = subprocess.run(self.lab.ns(self.lab.server_ns, *user, "tmux", "-L", "x", "list-clients", "-F", "#{client_written}"), timeout=5, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True).stdout.split()
+            out.append(f"client_written:{'/'.join(written) or '-'}")
+        if self.sshd:
+            io = subprocess.run([*user, "cat", f"/proc/{self.sshd}/io"], timeout=5, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True).stdout
+            out.append("io_as_user:" + ("readable" if "rchar" in io else io.strip().split(":")[-1].strip().replace(" ", "_")))
+            rss = re.search(r"VmRSS:\s+(\d+)", read(f"/proc/{self.sshd}/status"))
+            out.append(f"sshd_rss_kB:{rss.group(1) if rss else '-'}")
+        return " ".join(out)
 
     def ss(self):
         try:
