@@ -55,9 +55,9 @@ CONFIGS = {
     # every 50 ms all through the row.
     "stock": {
         "links": ("2mbit", "2mbit-20ms", "2mbit-150ms", "256kbit-300ms"),
-        "modes": ("ssh", "screen", "tmux", "serve", "kitty", "xterm", "tmux-passthrough", "tmux-attach", "screen-attach"),
+        "modes": ("ssh", "screen", "tmux", "mosh", "serve", "kitty", "xterm", "tmux-passthrough", "tmux-attach", "screen-attach"),
         # The rows run unless --modes names others (the -attach rows: see attach_command).
-        "default": ("ssh", "screen", "tmux", "serve", "kitty", "xterm"),
+        "default": ("ssh", "screen", "tmux", "mosh", "serve", "kitty", "xterm"),
     },
 }
 # The stock configuration's busy water: a stone this often, all through the row.
@@ -116,6 +116,13 @@ def stock_command(lab, mode, play_args):
     remote["tmux-passthrough"] = remote["tmux"] + " \\; set -g allow-passthrough on"
     if mode == "serve":
         return lab.ns(lab.client_ns, *lab.ssh_command(port=SERVE_PORT, stock=True))
+    if mode == "mosh":
+        # `mosh host -- tidepool play` over the stock sshd (its ssh the system's client with the
+        # test user's key); mosh-server on the lab's UDP port, which the UDP relay forwards
+        # where a round trip is added.
+        *ssh, host = lab.ssh_command(stock=True, tty=False)
+        ssh_text = " ".join(shlex.quote(a) for a in ssh)
+        return lab.ns(lab.client_ns, "mosh", f"--ssh={ssh_text}", f"--port={MOSH_PORT}", "--predict=never", host, "--", *shlex.split(play))
     if mode.endswith("-attach"):
         attach = {"tmux-attach": "tmux -L x attach", "screen-attach": "screen -r x"}[mode]
         return lab.ns(lab.client_ns, *lab.ssh_command(remote=attach, stock=True))
@@ -366,7 +373,7 @@ def parse_args():
     parser.add_argument("--tidepool", default=os.path.join(HERE, "..", "..", "target", "release", "tidepool"), help="the binary to measure (default: this checkout's target/release/tidepool)")
     parser.add_argument("--config", default="lab,stock", help="configurations to run, of lab, stock (default both)")
     parser.add_argument("--links", help=f"links to run, of {', '.join(LINKS)} (default: each configuration's own)")
-    parser.add_argument("--modes", help="clients to run (default: each configuration's own: lab ssh,tmux,mosh,serve; stock ssh,screen,tmux,serve,kitty,xterm)")
+    parser.add_argument("--modes", help="clients to run (default: each configuration's own: lab ssh,tmux,mosh,serve; stock ssh,screen,tmux,mosh,serve,kitty,xterm)")
     parser.add_argument("--presses", type=int, default=12, help="status-line keys timed per row (default 12)")
     parser.add_argument("--warm-up", type=float, default=6.0, help="seconds of busy water before timing (default 6)")
     parser.add_argument("--play-args", default="--seed 5 --color truecolor", help="arguments for `tidepool play` in the lab rows (default: --seed 5 --color truecolor)")
