@@ -2,336 +2,76 @@
 """The player over a real, shaped link: key -> effect, bytes at the terminal, frames.
 
 Builds two network namespaces joined by a veth pair, shapes both ends with `tc ... tbf`, adds
-round trip with a delaying relay (TCP, and UDP for mosh: `relay.py`), runs its own sshd in
-the server namespace (its own config and host key, root with a key made for the run, a test
-port) and drives the client (OpenSSH's `ssh`, or `mosh`) in a pseudo-terminal that it reads
-as the terminal: a pyte screen, DA1 answered like a real terminal. For each row it presses a
-key that changes the status line (`+`/`-`, the stone size) every ~1.5 s while the water is
-busy and times how long until the status line shows it.
+round trip with a delaying relay where a row asks for one (TCP, and UDP for mosh: `relay.py`),
+and reaches the far namespace two ways (see README.md): the *lab* configuration (an sshd of its
+own, root, port 2222, always behind the relay) and the *stock* configuration (Debian's sshd as
+shipped on port 22, a test user, the multiplexer started by the ssh command). The client
+(OpenSSH's `ssh`, or `mosh`) runs in a pseudo-terminal that the harness reads as the terminal (a
+pyte screen, DA1 answered like a real terminal), or in a real kitty or xterm under Xvfb. For
+each row it presses a key that changes the status line (`+`/`-`, the stone size) every ~1.5 s
+while the water is busy and times how long until the status line shows it.
 
-Needs root, Debian's iproute2, openssh-server, mosh and tmux, and pyte (see README.md).
-Everything is torn down at the end (processes it started, by id; the namespaces; the
-temporary folder); the run is bounded by --timeout. Traffic stays inside the namespaces it
+Needs root, Debian's iproute2, openssh-server, mosh, tmux and screen, and pyte (see README.md).
+Everything is torn down at the end (processes it started, by id; the namespaces; the test user;
+the temporary folder); the run is bounded by --timeout. Traffic stays inside the namespaces it
 makes.
 """
 
 import argparse
 import os
-import pty
 import re
-import select
 import shlex
 import shutil
 import signal
 import statistics
-import struct
-import subprocess
 import sys
-import tempfile
-import termios
-import fcntl
 import threading
 import time
 
 try:
-    import pyte
+    import pyte  # noqa: F401
 except ImportError:
     sys.exit("link_harness: pyte is missing: pip install pyte")
 
+from lab import MOSH_PORT, SERVE_PORT, Lab
+from lab import run as run_command
+from path_log import PathLog
+from pty_terminal import COLS, ROWS, Terminal
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-COLS, ROWS = 160, 48
-DA1_QUESTION = b"\x1b[c"
-DA1_ANSWER = b"\x1b[?62;22c"
-SYNC_END = b"\x1b[?2026l"
-# The link's two ends and their addresses (inside the namespaces this script makes).
-CLIENT_IP, SERVER_IP, PREFIX = "10.213.0.1", "10.213.0.2", "30"
-SSH_PORT, SERVE_PORT, MOSH_PORT = 2222, 2223, 60001
-RELAY_SSH, RELAY_SERVE = 12222, 12223
+# name: (tc rate, capacity in bytes a second, round trip added by the relay in ms; 0: no relay)
 LINKS = {
+    "2mbit": ("2mbit", 250_000, 0),
     "2mbit-20ms": ("2mbit", 250_000, 20),
     "2mbit-150ms": ("2mbit", 250_000, 150),
+    "256kbit": ("256kbit", 32_000, 0),
     "256kbit-300ms": ("256kbit", 32_000, 300),
 }
-MODES = ("ssh", "tmux", "mosh", "serve")
+CONFIGS = {
+    # The harness's first rows: its own sshd, always behind the relay, a stone every 0.5 s in
+    # the warm-up and one before each timed key.
+    "lab": {"links": ("2mbit-20ms", "2mbit-150ms", "256kbit-300ms"), "modes": ("ssh", "tmux", "mosh", "serve")},
+    # Issue 30's link as a user builds it: the stock sshd, no relay on the base row, a stone
+    # every 50 ms all through the row.
+    "stock": {
+        "links": ("2mbit", "2mbit-20ms", "2mbit-150ms", "256kbit-300ms"),
+        "modes": ("ssh", "screen", "tmux", "mosh", "serve", "kitty", "xterm", "tmux-passthrough", "tmux-attach", "screen-attach"),
+        # The rows run unless --modes names others (the -attach rows: see attach_command).
+        "default": ("ssh", "screen", "tmux", "mosh", "serve", "kitty", "xterm"),
+    },
+}
+# The stock configuration's busy water: a stone this often, all through the row.
+STOCK_STONES = 0.05
 # A key whose effect has not shown after this long counts as never shown.
 KEY_DEADLINE = 15.0
 
 
-def run(cmd, check=True, **kw):
-    """Runs a command to completion (bounded: 60 s)."""
-    return subprocess.run(cmd, check=check, timeout=60, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, **kw)
-
-
-class Lab:
-    """The namespaces, the shaped veth pair, sshd, relays; torn down by `close`."""
-
-    def __init__(self, tidepool, lifetime):
-        tag = str(os.getpid())
-        self.client_ns, self.server_ns = f"tpc{tag}", f"tps{tag}"
-        self.veth_client, self.veth_server = f"tpc{tag}"[:15], f"tps{tag}"[:15]
-        self.dir = tempfile.mkdtemp(prefix="link-harness-")
-        self.tidepool = tidepool
-        self.lifetime = lifetime
-        self.procs = []  # (Popen, description)
-        self.relays = []
-        self.made_namespaces = False
-
-    def ns(self, name, *cmd):
-        return ["ip", "netns", "exec", name, *cmd]
-
-    def setup(self):
-        for ns in (self.client_ns, self.server_ns):
-            run(["ip", "netns", "add", ns])
-        self.made_namespaces = True
-        run(["ip", "link", "add", self.veth_client, "type", "veth", "peer", "name", self.veth_server])
-        run(["ip", "link", "set", self.veth_client, "netns", self.client_ns])
-        run(["ip", "link", "set", self.veth_server, "netns", self.server_ns])
-        for ns, dev, ip in ((self.client_ns, self.veth_client, CLIENT_IP), (self.server_ns, self.veth_server, SERVER_IP)):
-            run(self.ns(ns, "ip", "addr", "add", f"{ip}/{PREFIX}", "dev", dev))
-            run(self.ns(ns, "ip", "link", "set", dev, "up"))
-            run(self.ns(ns, "ip", "link", "set", "lo", "up"))
-        # Keys made for this run: sshd's host key, the client's key, serve's host key.
-        for name in ("host_key", "client_key"):
-            run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f", f"{self.dir}/{name}"])
-        shutil.copy(f"{self.dir}/client_key.pub", f"{self.dir}/authorized_keys")
-        os.makedirs("/run/sshd", exist_ok=True)
-        with open(f"{self.dir}/sshd_config", "w") as f:
-            f.write(
-                f"""Port {SSH_PORT}
-ListenAddress {SERVER_IP}
-HostKey {self.dir}/host_key
-PidFile {self.dir}/sshd.pid
-AuthorizedKeysFile {self.dir}/authorized_keys
-PermitRootLogin prohibit-password
-PasswordAuthentication no
-KbdInteractiveAuthentication no
-UsePAM no
-StrictModes no
-AcceptEnv LANG LC_* COLORTERM
-PrintMotd no
-PrintLastLog no
-"""
-            )
-        run(["/usr/sbin/sshd", "-t", "-f", f"{self.dir}/sshd_config"])
-        self.start(self.ns(self.server_ns, "/usr/sbin/sshd", "-D", "-e", "-f", f"{self.dir}/sshd_config"), "sshd")
-        serve = [self.tidepool, "serve", "--listen", f"{SERVER_IP}:{SERVE_PORT}", "--host-key", f"{self.dir}/serve_key"]
-        self.start(self.ns(self.server_ns, *serve), "tidepool serve")
-        deadline = time.monotonic() + 20
-        for name, word in (("sshd", "Server listening"), ("tidepool_serve", "listening on")):
-            while word not in read_text(f"{self.dir}/{name}.log"):
-                if time.monotonic() > deadline:
-                    raise RuntimeError(f"{name} did not start: {read_text(f'{self.dir}/{name}.log')[-300:]}")
-                time.sleep(0.05)
-
-    def start(self, cmd, what, **kw):
-        # A new log for each start (relays are restarted for every link).
-        open(f"{self.dir}/{what.replace(' ', '_')}.log", "w").close()
-        proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=open(f"{self.dir}/{what.replace(' ', '_')}.log", "ab"), stderr=subprocess.STDOUT, **kw)
-        self.procs.append((proc, what))
-        return proc
-
-    def shape(self, rate, rtt_ms):
-        """Shapes both ends to `rate` and puts relays with `rtt_ms` of round trip in front."""
-        for ns, dev in ((self.client_ns, self.veth_client), (self.server_ns, self.veth_server)):
-            run(self.ns(ns, "tc", "qdisc", "replace", "dev", dev, "root", "tbf", "rate", rate, "burst", "32kbit", "latency", "400ms"))
-        for proc, _ in self.relays:
-            stop(proc)
-        self.relays = []
-        relay = [sys.executable, f"{HERE}/relay.py"]
-        for kind, port, target in (("tcp", RELAY_SSH, SSH_PORT), ("tcp", RELAY_SERVE, SERVE_PORT), ("udp", MOSH_PORT, MOSH_PORT)):
-            cmd = self.ns(self.client_ns, *relay, kind, "127.0.0.1", str(port), SERVER_IP, str(target), str(rtt_ms), str(self.lifetime))
-            self.relays.append((self.start(cmd, f"relay {kind} {port}"), f"relay_{kind}_{port}"))
-        # Each relay says when it listens (Python starts slowly on a loaded machine).
-        deadline = time.monotonic() + 20
-        for proc, name in self.relays:
-            while "listening" not in read_text(f"{self.dir}/{name}.log"):
-                if proc.poll() is not None or time.monotonic() > deadline:
-                    raise RuntimeError(f"the relay {name} did not start: {read_text(f'{self.dir}/{name}.log')[-300:]}")
-                time.sleep(0.05)
-
-    def ssh_command(self, port, remote=None, tty=True):
-        cmd = ["ssh", "-F", "/dev/null", "-i", f"{self.dir}/client_key", "-p", str(port)]
-        cmd += ["-o", "IdentitiesOnly=yes", "-o", f"UserKnownHostsFile={self.dir}/known_hosts", "-o", "StrictHostKeyChecking=no"]
-        cmd += ["-o", "LogLevel=ERROR", "-o", "SendEnv=COLORTERM"]
-        cmd += ["-t"] if tty else []
-        cmd += ["root@127.0.0.1"]
-        if remote:
-            cmd += ["--", remote]
-        return cmd
-
-    def close(self):
-        for proc, _ in reversed(self.procs):
-            stop(proc)
-        # Whatever still runs inside the namespaces was started there by this run (mosh-server
-        # detaches from its parent, tmux's server too): end it by id.
-        if self.made_namespaces:
-            for ns in (self.client_ns, self.server_ns):
-                pids = run(["ip", "netns", "pids", ns], check=False).stdout.split()
-                for pid in pids:
-                    try:
-                        os.kill(int(pid), signal.SIGTERM)
-                    except (ProcessLookupError, ValueError):
-                        pass
-            time.sleep(0.3)
-            for ns in (self.client_ns, self.server_ns):
-                for pid in run(["ip", "netns", "pids", ns], check=False).stdout.split():
-                    try:
-                        os.kill(int(pid), signal.SIGKILL)
-                    except (ProcessLookupError, ValueError):
-                        pass
-                run(["ip", "netns", "del", ns], check=False)
-        shutil.rmtree(self.dir, ignore_errors=True)
-
-
-def read_text(path):
-    try:
-        with open(path, errors="replace") as f:
-            return f.read()
-    except FileNotFoundError:
-        return ""
-
-
-def stop(proc):
-    if proc.poll() is None:
-        proc.terminate()
-        try:
-            proc.wait(timeout=3)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait(timeout=3)
-
-
-class Terminal:
-    """A pseudo-terminal driven as a user's terminal: it answers DA1 at once, keeps a pyte
-    screen, and records when each status line first appeared and when bytes arrived."""
-
-    def __init__(self, cmd, env, raw_path=None):
-        self.pid, self.fd = pty.fork()
-        if self.pid == 0:
-            try:
-                os.execvpe(cmd[0], cmd, env)
-            finally:
-                os._exit(127)
-        fcntl.ioctl(self.fd, termios.TIOCSWINSZ, struct.pack("HHHH", ROWS, COLS, 0, 0))
-        self.screen = pyte.Screen(COLS, ROWS)
-        self.stream = pyte.ByteStream(self.screen)
-        self.lock = threading.Lock()
-        # Held while the parser changes the screen, so a shot copies a whole parsed state.
-        self.screen_lock = threading.Lock()
-        # Every byte read, as read (--keep-logs), for ansi_view.py or a replay.
-        self.raw = open(raw_path, "wb") if raw_path else None
-        self.arrivals = []  # (time, bytes)
-        self.statuses = []  # (time, text)
-        self.changes = []  # times the screen changed
-        self.sync_ends = []  # times a synchronized frame ended
-        self.pending = []
-        self.done = False
-        self.tail = b""
-        self.reader = threading.Thread(target=self.read, daemon=True)
-        self.parser = threading.Thread(target=self.parse, daemon=True)
-        self.reader.start()
-        self.parser.start()
-
-    def read(self):
-        while not self.done:
-            ready, _, _ = select.select([self.fd], [], [], 0.1)
-            if not ready:
-                continue
-            try:
-                data = os.read(self.fd, 65536)
-            except OSError:
-                break
-            if not data:
-                break
-            now = time.monotonic()
-            if self.raw:
-                self.raw.write(data)
-            # Answer DA1 at once, as a terminal does once it has read the question.
-            window = self.tail + data
-            questions = window.count(DA1_QUESTION) - self.tail.count(DA1_QUESTION)
-            for _ in range(questions):
-                self.write(DA1_ANSWER)
-            ends = window.count(SYNC_END) - self.tail.count(SYNC_END)
-            self.tail = window[-8:]
-            with self.lock:
-                self.arrivals.append((now, len(data)))
-                self.sync_ends.extend([now] * ends)
-                self.pending.append((now, data))
-        self.done = True
-
-    def parse(self):
-        last_status = ""
-        while not self.done or self.pending:
-            with self.lock:
-                batch, self.pending = self.pending, []
-            if not batch:
-                time.sleep(0.002)
-                continue
-            for arrived, data in batch:
-                with self.screen_lock:
-                    self.stream.feed(data)
-                    dirty = bool(self.screen.dirty)
-                    self.screen.dirty.clear()
-                    status = self.status_text() if dirty else last_status
-                if dirty:
-                    with self.lock:
-                        self.changes.append(arrived)
-                        if status != last_status:
-                            self.statuses.append((arrived, status))
-                    last_status = status
-
-    def status_text(self):
-        # The player's status line is its last row (tmux runs with its own status off).
-        lines = self.screen.display
-        return lines[-1] + "\n" + lines[-2]
-
-    def copy_screen(self):
-        """The screen as the parser last left it (plain tuples, see screen_shots.py)."""
-        from screen_shots import copy_screen
-
-        with self.screen_lock:
-            return copy_screen(self.screen)
-
-    def write(self, data):
-        try:
-            os.write(self.fd, data)
-        except OSError:
-            pass
-
-    def shown_since(self, text, since):
-        with self.lock:
-            for t, s in self.statuses:
-                if t >= since and text in s:
-                    return t
-        return None
-
-    def close(self):
-        self.done = True
-        try:
-            os.kill(self.pid, signal.SIGTERM)
-        except ProcessLookupError:
-            pass
-        for _ in range(30):
-            if os.waitpid(self.pid, os.WNOHANG) != (0, 0):
-                break
-            time.sleep(0.1)
-        else:
-            try:
-                os.kill(self.pid, signal.SIGKILL)
-                os.waitpid(self.pid, 0)
-            except (ProcessLookupError, ChildProcessError):
-                pass
-        self.reader.join(timeout=1)
-        os.close(self.fd)
-        if self.raw:
-            self.raw.close()
-
-
-def client_command(lab, mode, play_args):
+def lab_command(lab, mode, play_args):
+    """The lab configuration's clients (its own sshd as root, the relay in front)."""
     tidepool = shlex.quote(lab.tidepool)
     play = f"{tidepool} play {play_args}"
     if mode == "ssh":
-        return lab.ns(lab.client_ns, *lab.ssh_command(RELAY_SSH, play))
+        return lab.ns(lab.client_ns, *lab.ssh_command(remote=play))
     if mode == "tmux":
         # A fresh tmux server on its own socket, its status line off, true colour passed on
         # (as the README's tmux paragraph asks); the pane runs the player.
@@ -340,9 +80,9 @@ def client_command(lab, mode, play_args):
             f"tmux -u -f /dev/null -L {socket} new-session -x {COLS} -y {ROWS} {shlex.quote(play)} \\; "
             "set status off \\; set -as terminal-features ',*:RGB'"
         )
-        return lab.ns(lab.client_ns, *lab.ssh_command(RELAY_SSH, inner))
+        return lab.ns(lab.client_ns, *lab.ssh_command(remote=inner))
     if mode == "mosh":
-        ssh = " ".join(shlex.quote(a) for a in lab.ssh_command(RELAY_SSH, tty=False)[:-1])
+        ssh = " ".join(shlex.quote(a) for a in lab.ssh_command(tty=False)[:-1])
         return lab.ns(
             lab.client_ns,
             "mosh",
@@ -354,8 +94,58 @@ def client_command(lab, mode, play_args):
             *shlex.split(play),
         )
     if mode == "serve":
-        return lab.ns(lab.client_ns, *lab.ssh_command(RELAY_SERVE))
+        return lab.ns(lab.client_ns, *lab.ssh_command(port=SERVE_PORT))
     raise ValueError(mode)
+
+
+def stock_command(lab, mode, play_args):
+    """The stock configuration's clients: the commands of issue 30, `tidepool` being the binary
+    measured (`ssh -tt host "..."` with the system's client config, the test user)."""
+    play = f"{shlex.quote(lab.tidepool)} play {play_args}".rstrip()
+    remote = {
+        "ssh": play,
+        "kitty": play,
+        "xterm": play,
+        "screen": f"screen -S x -c /dev/null env COLORTERM=truecolor {play}",
+        "tmux": (
+            f"tmux -f /dev/null -L x new-session -x {COLS} -y {ROWS} {shlex.quote(play)} \\; "
+            "set status off \\; set -as terminal-features ',*:RGB'"
+        ),
+    }
+    # The same tmux with its passthrough allowed (off by default since tmux 3.3).
+    remote["tmux-passthrough"] = remote["tmux"] + " \\; set -g allow-passthrough on"
+    if mode == "serve":
+        return lab.ns(lab.client_ns, *lab.ssh_command(port=SERVE_PORT, stock=True))
+    if mode == "mosh":
+        # `mosh host -- tidepool play` over the stock sshd (its ssh the system's client with the
+        # test user's key); mosh-server on the lab's UDP port, which the UDP relay forwards
+        # where a round trip is added.
+        *ssh, host = lab.ssh_command(stock=True, tty=False)
+        ssh_text = " ".join(shlex.quote(a) for a in ssh)
+        return lab.ns(lab.client_ns, "mosh", f"--ssh={ssh_text}", f"--port={MOSH_PORT}", "--predict=never", host, "--", *shlex.split(play))
+    if mode.endswith("-attach"):
+        attach = {"tmux-attach": "tmux -L x attach", "screen-attach": "screen -r x"}[mode]
+        return lab.ns(lab.client_ns, *lab.ssh_command(remote=attach, stock=True))
+    return lab.ns(lab.client_ns, *lab.ssh_command(remote=remote[mode], stock=True))
+
+
+def attach_first(lab, mode, play_args):
+    """The -attach rows: another SSH connection (still open, idle, as a second terminal of the
+    user's would be) starts the multiplexer detached with the player in it; the row's terminal
+    then attaches from its own connection. The player's SSH_CONNECTION names the first one."""
+    play = f"{shlex.quote(lab.tidepool)} play {play_args}".rstrip()
+    start = {
+        "tmux-attach": (
+            f"tmux -f /dev/null -L x new-session -d -x {COLS} -y {ROWS} {shlex.quote(play)} \\; "
+            "set status off \\; set -as terminal-features ',*:RGB'"
+        ),
+        "screen-attach": f"screen -dmS x -c /dev/null env COLORTERM=truecolor {play}",
+    }[mode]
+    return lab.start(lab.ns(lab.client_ns, *lab.ssh_command(remote=f"{start}; sleep 600", stock=True, tty=False)), "first connection")
+
+
+def run_text(cmd):
+    return run_command(cmd, check=False).stdout
 
 
 def percentile(values, p):
@@ -368,14 +158,21 @@ def percentile(values, p):
 SHOT_INTERVAL, SHOT_SECONDS, SHOT_PNG_AT = 0.2, 5.0, 3.0
 
 
-def take_shots(term):
+def take_shots(term, directory, name):
     """One stone, then copies of the screen every SHOT_INTERVAL s for SHOT_SECONDS s (painted
-    after the row, so the painting does not compete with the terminal's reader)."""
+    after the row, so the painting does not compete with the terminal's reader); a real
+    terminal's window is saved once, SHOT_PNG_AT s after the stone."""
     term.write(b" ")
     stone = time.monotonic()
     frames = []
     for i in range(int(SHOT_SECONDS / SHOT_INTERVAL) + 1):
         time.sleep(max(0.0, stone + i * SHOT_INTERVAL - time.monotonic()))
+        if hasattr(term, "screenshot"):
+            if abs(i * SHOT_INTERVAL - SHOT_PNG_AT) < 1e-6:
+                path = os.path.join(directory, f"{name}.png")
+                term.screenshot(path)
+                print(f"  shot: {path}", file=sys.stderr, flush=True)
+            continue
         frames.append(term.copy_screen())
     return frames
 
@@ -390,29 +187,88 @@ def save_shots(frames, directory, name):
     return png, gif
 
 
-def measure(lab, mode, capacity, play_args, presses, warm_up, shots=None, keep=None, name=""):
+class Stones(threading.Thread):
+    """Busy water for the stock rows: a stone every STOCK_STONES seconds until stopped."""
+
+    def __init__(self, term):
+        super().__init__(daemon=True)
+        self.term, self.done = term, False
+
+    def run(self):
+        start = time.monotonic()
+        i = 0
+        while not self.done:
+            self.term.write(b" ")
+            i += 1
+            time.sleep(max(0.0, start + i * STOCK_STONES - time.monotonic()))
+
+
+def redraw(lab, mode):
+    """Makes the multiplexer redraw its whole screen, as it does on attach, on a resize and (tmux)
+    after a client whose output backed up: a burst of a screenful the player did not send."""
+    user = ["runuser", "-u", lab.stock_user, "--"]
+    if mode.startswith("tmux"):
+        clients = run_text(lab.ns(lab.server_ns, *user, "tmux", "-L", "x", "list-clients", "-F", "#{client_name}")).split()
+        for client in clients[:4]:
+            run_text(lab.ns(lab.server_ns, *user, "tmux", "-L", "x", "refresh-client", "-t", client))
+    elif mode.startswith("screen"):
+        run_text(lab.ns(lab.server_ns, *user, "screen", "-S", "x", "-X", "redisplay"))
+
+
+def open_terminal(lab, config, mode, args, raw, display):
     env = dict(os.environ, TERM="xterm-256color", COLORTERM="truecolor", LANG="C.UTF-8", LC_ALL="C.UTF-8")
-    env.pop("TMUX", None)
-    env.pop("SSH_CONNECTION", None)
+    for var in ("TMUX", "STY", "SSH_CONNECTION", "SSH_TTY", "SSH_CLIENT"):
+        env.pop(var, None)
+    if config == "lab":
+        return Terminal(lab_command(lab, mode, args.play_args), env, raw)
+    cmd = stock_command(lab, mode, args.stock_play_args)
+    if mode in ("kitty", "xterm"):
+        from real_terminal import TappedTerminal
+
+        return TappedTerminal(mode, cmd, display, lab.dir, raw)
+    return Terminal(cmd, env, raw)
+
+
+def measure(lab, config, mode, capacity, args, display, name):
+    keep = args.keep_logs
     raw = os.path.join(keep, f"{name}.raw") if keep else None
-    term = Terminal(client_command(lab, mode, play_args), env, raw)
+    ports = (22, 2222, SERVE_PORT)
+    candidates = mode if args.candidates and mode.startswith(("tmux", "screen")) else None
+    path_log = PathLog(lab, os.path.join(keep or lab.dir, f"{name}.path.csv"), ports, candidates)
+    first = attach_first(lab, mode, args.stock_play_args) if mode.endswith("-attach") else None
+    # Another flow on the link (--cross-traffic): a bulk download over its own SSH connection.
+    bulk = None
+    if args.cross_traffic and config == "stock":
+        remote = "head -c 200000000 /dev/zero"
+        bulk = lab.start(lab.ns(lab.client_ns, *lab.ssh_command(remote=remote, stock=True, tty=False)), "bulk flow", quiet=True)
+    if first:
+        time.sleep(3)
+    term = open_terminal(lab, config, mode, args, raw, display)
+    stones = Stones(term) if config == "stock" else None
     shot_frames = None
     try:
         start = time.monotonic()
-        # Busy water: a stone every half second besides the rain and the breeze.
-        while time.monotonic() - start < warm_up:
-            term.write(b" ")
+        if stones:
+            stones.start()
+        # Busy water in the lab rows: a stone every half second besides the rain and the breeze.
+        redraws = sorted(args.redraw_at or [])
+        while time.monotonic() - start < args.warm_up:
+            if not stones:
+                term.write(b" ")
             time.sleep(0.5)
-        if shots:
-            shot_frames = take_shots(term)
+            while redraws and time.monotonic() - start >= redraws[0] and config == "stock":
+                redraws.pop(0)
+                redraw(lab, mode)
+        if args.shots:
+            shot_frames = take_shots(term, args.shots, name)
         measuring = time.monotonic()
-        with term.lock:
-            bytes_before = sum(n for _, n in term.arrivals)
         latencies, missed = [], 0
+        keys = []  # (pressed, shown or None), CLOCK_MONOTONIC: the clock the player's Instant reads
         size_up = True
-        for _ in range(presses):
-            term.write(b" ")
-            time.sleep(0.25)
+        for _ in range(args.presses):
+            if not stones:
+                term.write(b" ")
+                time.sleep(0.25)
             key, text = (b"+", "stone 4") if size_up else (b"-", "stone 3")
             at = time.monotonic()
             term.write(key)
@@ -423,14 +279,15 @@ def measure(lab, mode, capacity, play_args, presses, warm_up, shots=None, keep=N
                 if shown:
                     break
                 time.sleep(0.005)
+            keys.append((at, shown))
             if shown:
                 latencies.append(shown - at)
                 size_up = not size_up
             else:
                 missed += 1
-            next_press = at + 1.5
-            time.sleep(max(0.0, next_press - time.monotonic()))
-            term.write(b" ")
+            time.sleep(max(0.0, at + 1.5 - time.monotonic()))
+            if not stones:
+                term.write(b" ")
         end = time.monotonic()
         with term.lock:
             received = sum(n for t, n in term.arrivals if t >= measuring) if term.arrivals else 0
@@ -440,10 +297,17 @@ def measure(lab, mode, capacity, play_args, presses, warm_up, shots=None, keep=N
             # Bytes read but not yet parsed: the emulator's lag (it must keep up for the
             # timings to mean anything).
             unparsed = sum(len(d) for _, d in term.pending)
+        if keep:
+            with open(os.path.join(keep, f"{name}.keys.csv"), "w") as f:
+                f.write("pressed,shown,ms\n")
+                for at, shown in keys:
+                    f.write(f"{at:.4f},{shown or 0:.4f},{(shown - at) * 1e3 if shown else -1:.0f}\n")
         seconds = end - measuring
         gaps = [b - a for a, b in zip([measuring] + changes, changes + [end])]
         frames = len(syncs) if syncs else bursts(changes)
         said = re.search(r"(\d+) fps \u00b7 ([\d.]+ [kMG]?B/s)", status)
+        # The hint stands apart at the line's right end (after a run of spaces).
+        hint = re.search(r"\s{2,}(\S[^\n]*--bandwidth[^\n]*?)\s*$", status.split("\n")[0])
         return {
             "latencies": latencies,
             "missed": missed,
@@ -452,15 +316,27 @@ def measure(lab, mode, capacity, play_args, presses, warm_up, shots=None, keep=N
             "fps": frames / seconds,
             "fps_from": "sync" if syncs else "bursts",
             "stall": max(gaps) if gaps else seconds,
-            "player_says": f"{said.group(1)} fps, {said.group(2)}" if said else "-",
+            "player_says": (f"{said.group(1)} fps, {said.group(2)}" if said else "-") + (f"; {hint.group(1).strip()}" if hint else ""),
+            "status": status,
             "unparsed": unparsed,
         }
     finally:
+        if stones:
+            stones.done = True
+            stones.join(timeout=1)
         term.write(b"q")
         time.sleep(0.3)
         term.close()
+        print(f"  {name}: {path_log.stop()}", file=sys.stderr, flush=True)
+        for proc in (first, bulk):
+            if proc:
+                from lab import stop
+
+                stop(proc)
+        # A multiplexer's server outlives its client when the player did not quit: end it.
+        lab.stop_sessions()
         if shot_frames:
-            for path in save_shots(shot_frames, shots, name):
+            for path in save_shots(shot_frames, args.shots, name):
                 print(f"  shot: {path}", file=sys.stderr, flush=True)
 
 
@@ -474,7 +350,7 @@ def bursts(changes, gap=0.010):
     return count
 
 
-def row_text(link, mode, r):
+def row_text(config, link, mode, r):
     lat = r["latencies"]
     if lat:
         median, p90 = statistics.median(lat) * 1e3, percentile(lat, 0.9) * 1e3
@@ -486,50 +362,83 @@ def row_text(link, mode, r):
         missed += f" (the emulator lagged {r['unparsed'] / 1e3:.0f} kB)"
     used = r["bytes_per_s"] / r["capacity"] * 100
     return (
-        f"| {link:<14} | {mode:<6} | {latency.replace(' ms ', ' ms | ')}{missed} | "
+        f"| {config:<5} | {link:<14} | {mode:<6} | {latency.replace(' ms ', ' ms | ')}{missed} | "
         f"{r['bytes_per_s'] / 1e3:6.1f} kB/s of {r['capacity'] / 1e3:.0f} ({used:3.0f} %) | "
         f"{r['fps']:5.1f} ({r['fps_from']}) | {r['stall'] * 1e3:6.0f} ms | {r['player_says']} |"
     )
 
 
-def main():
+def parse_args():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--tidepool", default=os.path.join(HERE, "..", "..", "target", "release", "tidepool"), help="the binary to measure (default: this checkout's target/release/tidepool)")
-    parser.add_argument("--links", default=",".join(LINKS), help=f"links to run, of {', '.join(LINKS)}")
-    parser.add_argument("--modes", default=",".join(MODES), help=f"modes to run, of {', '.join(MODES)}")
+    parser.add_argument("--config", default="lab,stock", help="configurations to run, of lab, stock (default both)")
+    parser.add_argument("--links", help=f"links to run, of {', '.join(LINKS)} (default: each configuration's own)")
+    parser.add_argument("--modes", help="clients to run (default: each configuration's own: lab ssh,tmux,mosh,serve; stock ssh,screen,tmux,mosh,serve,kitty,xterm)")
     parser.add_argument("--presses", type=int, default=12, help="status-line keys timed per row (default 12)")
     parser.add_argument("--warm-up", type=float, default=6.0, help="seconds of busy water before timing (default 6)")
-    parser.add_argument("--play-args", default="--seed 5 --color truecolor", help="arguments for `tidepool play` (default: --seed 5 --color truecolor)")
+    parser.add_argument("--play-args", default="--seed 5 --color truecolor", help="arguments for `tidepool play` in the lab rows (default: --seed 5 --color truecolor)")
+    parser.add_argument("--stock-play-args", default="", help="arguments for `tidepool play` in the stock rows (default none: the issue's commands)")
     parser.add_argument("--timeout", type=float, default=1200.0, help="the whole run ends after this many seconds (default 1200)")
     parser.add_argument("--shots", metavar="DIR", help="after each row's warm-up: a stone, then the screen as a PNG 3 s later and a 5 s GIF, as DIR/MODE-LINK[-TAG].png/.gif (needs pillow)")
     parser.add_argument("--shot-tag", default="", help="appended to the shots' names (e.g. before, after)")
-    parser.add_argument("--keep-logs", metavar="DIR", help="keep every byte the terminal read (DIR/MODE-LINK[-TAG].raw) and the run's sshd, serve and relay logs (DIR/logs-TAG/)")
-    args = parser.parse_args()
+    parser.add_argument("--keep-logs", metavar="DIR", help="keep every byte the terminal read (DIR/MODE-LINK[-TAG].raw), what the player could see of its path (.path.csv) and the run's sshd, serve and relay logs (DIR/logs-TAG/)")
+    parser.add_argument("--names", help="the namespaces are NAMESc and NAMESs (default tp<pid>)")
+    parser.add_argument("--subnet", default="10.213.0", help="the veth pair's /24, three octets (default 10.213.0)")
+    parser.add_argument("--port-base", type=int, default=12200, help="the relays listen on the client namespace's loopback from this port (default 12200)")
+    parser.add_argument("--display", default=":79", help="the Xvfb display of the kitty and xterm rows (default :79)")
+    parser.add_argument("--redraw-at", type=float, action="append", help="stock tmux and screen rows: make the multiplexer redraw its whole screen this many seconds into the warm-up (tmux refresh-client, screen redisplay; repeatable)")
+    parser.add_argument("--cross-traffic", action="store_true", help="stock rows: another flow on the link, a bulk download over a second SSH connection all through the row")
+    parser.add_argument("--candidates", action="store_true", help="tmux and screen rows: also log what else a program inside could read (tmux's #{client_written}, sshd's /proc/PID/io and memory) in the .path.csv")
+    parser.add_argument("--congestion", help="TCP congestion control inside the two namespaces (default: the machine's, e.g. bbr; cubic is Linux's own default)")
+    parser.add_argument("--stock-user", default="tplink", help="the stock configuration's test user, made for the run if missing (default tplink)")
+    return parser.parse_args()
+
+
+def check(args):
+    """The rows to run, [(config, link, mode)], after checking the arguments and the tools."""
     if os.geteuid() != 0:
         sys.exit("link_harness: needs root (network namespaces, tc, sshd)")
-    for tool in ("ip", "tc", "ssh", "ssh-keygen", "mosh", "mosh-server", "tmux"):
+    configs = args.config.split(",")
+    for config in configs:
+        if config not in CONFIGS:
+            sys.exit(f"link_harness: unknown configuration {config!r}: one of {', '.join(CONFIGS)}")
+    rows = []
+    for link in LINKS:
+        for config in configs:
+            links = args.links.split(",") if args.links else CONFIGS[config]["links"]
+            modes = args.modes.split(",") if args.modes else CONFIGS[config].get("default", CONFIGS[config]["modes"])
+            for name in links:
+                if name not in LINKS:
+                    sys.exit(f"link_harness: unknown link {name!r}: one of {', '.join(LINKS)}")
+            for mode in modes:
+                if mode not in CONFIGS[config]["modes"]:
+                    if args.modes and not any(mode in CONFIGS[c]["modes"] for c in configs):
+                        sys.exit(f"link_harness: unknown client {mode!r} for {args.config}")
+                    continue
+                if link in links and not (config == "lab" and LINKS[link][2] == 0):
+                    rows.append((config, link, mode))
+    if not rows:
+        sys.exit("link_harness: no rows: the lab configuration needs a link with a round trip (e.g. 2mbit-20ms)")
+    tools = ["ip", "tc", "ssh", "ssh-keygen"]
+    tools += ["mosh", "mosh-server"] if any(m == "mosh" for _, _, m in rows) else []
+    tools += [m for _, _, m in rows if m in ("tmux", "screen", "kitty", "xterm")]
+    for tool in tools:
         if not shutil.which(tool):
-            sys.exit(f"link_harness: {tool} is missing: apt-get install -y openssh-server mosh tmux iproute2")
+            sys.exit(f"link_harness: {tool} is missing: apt-get install -y openssh-server mosh tmux screen iproute2 (kitty, xterm: with xvfb)")
     if not os.path.exists("/usr/sbin/sshd"):
         sys.exit("link_harness: /usr/sbin/sshd is missing: apt-get install -y openssh-server")
-    tidepool = os.path.abspath(args.tidepool)
-    if not os.access(tidepool, os.X_OK):
-        sys.exit(f"link_harness: no tidepool binary at {tidepool}: cargo build --release, or --tidepool PATH")
-    links = args.links.split(",")
-    modes = args.modes.split(",")
-    for name in links:
-        if name not in LINKS:
-            sys.exit(f"link_harness: unknown link {name!r}: one of {', '.join(LINKS)}")
-    for mode in modes:
-        if mode not in MODES:
-            sys.exit(f"link_harness: unknown mode {mode!r}: one of {', '.join(MODES)}")
-
-    def out_of_time(*_):
-        raise TimeoutError(f"the run took longer than --timeout {args.timeout:.0f} s")
-
-    for directory in (args.shots, args.keep_logs):
-        if directory:
-            os.makedirs(directory, exist_ok=True)
+    if not re.fullmatch(r"\d{1,3}\.\d{1,3}\.\d{1,3}", args.subnet):
+        sys.exit("link_harness: --subnet takes three octets, e.g. 10.213.0")
+    if args.names and not re.fullmatch(r"[a-z][a-z0-9]{0,12}", args.names):
+        sys.exit("link_harness: --names takes lower-case letters and digits (at most 13)")
+    if not re.fullmatch(r":[0-9]{1,4}", args.display):
+        sys.exit("link_harness: --display takes an X display such as :79")
+    if not 1024 <= args.port_base <= 65000:
+        sys.exit("link_harness: --port-base must be between 1024 and 65000")
+    if args.congestion and not re.fullmatch(r"[a-z0-9_]{1,16}", args.congestion):
+        sys.exit("link_harness: --congestion takes a congestion control's name, e.g. cubic")
+    if not re.fullmatch(r"[a-z][a-z0-9]{0,15}", args.stock_user):
+        sys.exit("link_harness: --stock-user takes a user name of lower-case letters and digits")
     if args.shots:
         try:
             import PIL  # noqa: F401
@@ -537,33 +446,56 @@ def main():
             sys.exit("link_harness: --shots needs pillow: pip install pillow")
     if args.shot_tag and not re.fullmatch(r"[A-Za-z0-9_.-]{1,40}", args.shot_tag):
         sys.exit("link_harness: --shot-tag takes letters, digits, '.', '_' and '-' (at most 40)")
+    return rows
+
+
+def main():
+    args = parse_args()
+    rows = check(args)
+    tidepool = os.path.abspath(args.tidepool)
+    if not os.access(tidepool, os.X_OK):
+        sys.exit(f"link_harness: no tidepool binary at {tidepool}: cargo build --release, or --tidepool PATH")
+    for directory in (args.shots, args.keep_logs):
+        if directory:
+            os.makedirs(directory, exist_ok=True)
     tag = f"-{args.shot_tag}" if args.shot_tag else ""
+
+    def out_of_time(*_):
+        raise TimeoutError(f"the run took longer than --timeout {args.timeout:.0f} s")
 
     signal.signal(signal.SIGALRM, out_of_time)
     signal.signal(signal.SIGTERM, out_of_time)
     signal.alarm(int(args.timeout))
-    lab = Lab(tidepool, args.timeout)
-    rows = []
+    lab = Lab(tidepool, args.timeout, names=args.names, subnet=args.subnet, port_base=args.port_base, stock_user=args.stock_user)
+    display = None
     try:
-        lab.setup()
+        from real_terminal import Display
+
+        display = Display(args.display)
+        configs = {c for c, _, _ in rows}
+        lab.setup(lab_sshd="lab" in configs, stock_sshd="stock" in configs, congestion=args.congestion)
         load_before = os.getloadavg()
-        print(f"tidepool: {tidepool}\nplay args: {args.play_args}; {args.presses} presses per row after {args.warm_up:.0f} s of busy water")
-        print("| link | client | key->effect median | p90 | reached the terminal | fps | longest stall | the player's status says |")
-        print("|---|---|---|---|---|---|---|---|")
-        for name in links:
-            rate, capacity, rtt = LINKS[name]
-            lab.shape(rate, rtt)
-            for mode in modes:
-                result = measure(lab, mode, capacity, args.play_args, args.presses, args.warm_up, args.shots, args.keep_logs, f"{mode}-{name}{tag}")
-                line = row_text(name, mode, result)
-                rows.append(line)
-                print(line, flush=True)
+        congestion = run_text(lab.ns(lab.server_ns, "sysctl", "-n", "net.ipv4.tcp_congestion_control")).strip()
+        print(f"TCP congestion control in the namespaces: {congestion}")
+        print(f"tidepool: {tidepool}\nlab play args: {args.play_args}; stock play args: {args.stock_play_args or '(none)'}; {args.presses} presses per row after {args.warm_up:.0f} s of busy water")
+        print("| config | link | client | key->effect median | p90 | reached the terminal | fps | longest stall | the player's status says |")
+        print("|---|---|---|---|---|---|---|---|---|")
+        shaped = None
+        for config, link, mode in rows:
+            rate, capacity, rtt = LINKS[link]
+            if shaped != link:
+                lab.shape(rate, rtt)
+                shaped = link
+            result = measure(lab, config, mode, capacity, args, display, f"{config}-{mode}-{link}{tag}")
+            print(row_text(config, link, mode, result), flush=True)
         load_after = os.getloadavg()
         print(f"load average before: {load_before[0]:.2f}, after: {load_after[0]:.2f} ({os.cpu_count()} cores)")
     finally:
         signal.alarm(0)
         if args.keep_logs:
-            shutil.copytree(lab.dir, os.path.join(args.keep_logs, f"logs{tag or '-run'}"), ignore=shutil.ignore_patterns("*key*", "authorized_keys", "known_hosts"), dirs_exist_ok=True)
+            shutil.copytree(lab.dir, os.path.join(args.keep_logs, f"logs{tag or '-run'}"), ignore=shutil.ignore_patterns("*key*", "authorized_keys", "known_hosts", "*.fifo"), dirs_exist_ok=True)
+        if display:
+            display.close()
         lab.close()
 
 

@@ -28,24 +28,9 @@ import subprocess
 import sys
 import time
 
-from harness import LINKS, RELAY_SSH, Lab, stop
-
-# The part of the 1600x1000 root window each terminal's window covers (no window manager: both
-# open at the top left).
-CROPS = {"kitty": "960x640+0+0", "xterm": "730x530+0+0"}
-TERMINALS = {
-    # The window sizes of scripts/real_terminals.sh (kitty 960x640 at 9x18 cells, xterm 120x40).
-    "kitty": lambda cmd, driver="softpipe": [
-        "env", "LIBGL_ALWAYS_SOFTWARE=1", f"GALLIUM_DRIVER={driver}",
-        "kitty", "-o", "initial_window_width=960", "-o", "initial_window_height=640", "-o", "remember_window_size=no",
-        *cmd,
-    ],
-    "xterm": lambda cmd, driver=None: [
-        "xterm", "-ti", "vt340", "-xrm", "XTerm*numColorRegisters: 256", "-xrm", "XTerm*maxGraphicSize: 2000x2000",
-        "-geometry", "120x40+0+0", "-e", *cmd,
-    ],
-}
-
+from harness import LINKS
+from lab import Lab, stop
+from real_terminal import CROPS, TERMINALS
 
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -60,6 +45,8 @@ def main():
     parser.add_argument("--logs", metavar="DIR", help="keep each terminal's own output as DIR/TERMINAL-over-LINK[-TAG].log, and both directions between it and ssh (util-linux script -B, advanced timing) as .raw and .timing")
     parser.add_argument("--display", default=":79", help="the Xvfb display to start (default :79)")
     parser.add_argument("--timeout", type=float, default=300.0, help="the whole run ends after this many seconds (default 300)")
+    parser.add_argument("--names", help="the namespaces are NAMESc and NAMESs (default tp<pid>)")
+    parser.add_argument("--subnet", default="10.213.0", help="the veth pair's /24, three octets (default 10.213.0)")
     args = parser.parse_args()
     if os.geteuid() != 0:
         sys.exit("terminals.py: needs root (network namespaces, tc, sshd)")
@@ -92,7 +79,7 @@ def main():
     signal.signal(signal.SIGALRM, out_of_time)
     signal.signal(signal.SIGTERM, out_of_time)
     signal.alarm(int(args.timeout))
-    lab = Lab(tidepool, args.timeout)
+    lab = Lab(tidepool, args.timeout, names=args.names, subnet=args.subnet)
     xvfb = None
     try:
         lab.setup()
@@ -104,7 +91,7 @@ def main():
         for var in ("TMUX", "SSH_CONNECTION", "SSH_TTY", "KITTY_WINDOW_ID", "TERM_PROGRAM"):
             env.pop(var, None)
         play = f"{shlex.quote(tidepool)} play {args.play_args}"
-        ssh = lab.ns(lab.client_ns, *lab.ssh_command(RELAY_SSH, play))
+        ssh = lab.ns(lab.client_ns, *lab.ssh_command(remote=play))
         for name in names:
             shot = os.path.join(args.out, f"{name}-over-{args.link}{tag}.png")
             log = open(os.path.join(args.logs or lab.dir, f"{name}-over-{args.link}{tag}.log"), "wb")

@@ -12,7 +12,7 @@
 //! - [`Parsed::NotAReply`]: the first bytes are input, not a reply.
 //!
 //! **Ambiguity.** Keys never produce APC, DCS or OSC strings, nor CSI sequences with a `?` or
-//! `>` marker or ending in `t` or `$y`; those are always replies. Two shapes overlap keys:
+//! `>` marker or ending in `t`, `n` or `$y`; those are always replies. Two shapes overlap keys:
 //! - A cursor position report `CSI row ; col R` is also how some terminals send F3 with
 //!   modifiers (`CSI 1 ; 5 R` is Ctrl-F3). It is taken as a reply only while one is outstanding
 //!   ([`Expecting::cursor_position`]); `CSI ? row ; col R` (DECXCPR) is always a reply. For
@@ -117,6 +117,9 @@ pub enum Reply {
         /// Pixels per point.
         scale: f64,
     },
+    /// A device status report `CSI Ps n` (the answer to `CSI 5 n`: 0 for "OK"): the link's
+    /// round trip inside tmux and screen, where the question is wrapped for their passthrough.
+    DeviceStatus(u32),
     /// Another CSI reply (`CSI ? ... u` keyboard flags, `CSI 8 ; rows ; cols t`...): its bytes
     /// between `CSI` and the final byte, and the final byte.
     OtherCsi(Vec<u8>, u8),
@@ -197,6 +200,8 @@ fn parse_csi(rest: &[u8], expecting: Expecting) -> Parsed {
             Reply::CursorPosition { row: p(0), col: p(1) }
         }
         (Some(b'?'), b"", b'u') => Reply::OtherCsi(rest[..i].to_vec(), last),
+        // No key ends in `n`.
+        (None, b"", b'n') if params.len() == 1 => Reply::DeviceStatus(p(0)),
         _ => return Parsed::NotAReply,
     };
     Parsed::Complete(reply, len)

@@ -458,7 +458,7 @@ impl Screen {
         let unasked = self.link.unasked(self.bytes_sent + (out.len() - start) as u64);
         if self.auto() && self.link.probe_due() && (out.len() > start || unasked) {
             // The question goes after the frame: its answer says the frame has arrived.
-            out.extend_from_slice(link::PROBE);
+            out.extend_from_slice(self.link.question());
             self.link.probed(now, self.bytes_sent + (out.len() - start) as u64);
         }
         let len = out.len() - start;
@@ -534,15 +534,6 @@ impl Screen {
     /// What sits between the program and the terminal, as the door said.
     pub fn link_path(&self) -> LinkPath {
         self.config.link_path
-    }
-
-    /// Inside a multiplexer over SSH: what sshd's socket holds for this connection now
-    /// (`queued` bytes, read by the door from the kernel's socket table every
-    /// `OUTER_INTERVAL`): the link's only signal there. Ignored on other paths.
-    pub fn outer_queue(&mut self, now: Instant, queued: u64) {
-        if self.auto() && self.link.outer_queue(now, self.bytes_sent, queued) == Change::Down {
-            self.bucket.drain();
-        }
     }
 
     /// What must be undone before [`Screen::RESTORE`] when the session ends: kitty's image

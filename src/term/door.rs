@@ -16,8 +16,7 @@ use super::writer::FrameWriter;
 use crate::error::{Error, Result};
 use crate::play::host::{Host, HostConfig};
 use crate::play::player::Player;
-use crate::play::screen::link::OUTER_INTERVAL;
-use crate::play::screen::{LinkPath, Screen, ScreenConfig};
+use crate::play::screen::{Screen, ScreenConfig};
 use crate::play::seat::{Flow, Seat};
 
 /// How long the door waits, when the person quits, for the answers to the screen's last
@@ -37,13 +36,6 @@ pub trait TerminalInput: Send {
 
     /// The terminal's size in cells (columns, rows), asked for on every turn of the loop.
     fn size(&mut self) -> std::io::Result<(u16, u16)>;
-
-    /// Inside a multiplexer over SSH, the bytes the SSH connection's socket holds now (the
-    /// link's one visible sign there), asked for every `OUTER_INTERVAL` (50 ms); `None` where it
-    /// cannot be seen (the default).
-    fn outer_queue(&mut self) -> Option<u64> {
-        None
-    }
 }
 
 /// A session on one terminal.
@@ -105,8 +97,6 @@ pub fn run_door(
     let mut owed = false;
     // A buffer kept back from a frame that had nothing to send.
     let mut unused: Option<Vec<u8>> = None;
-    let watches_outer = matches!(player.screen.link_path(), LinkPath::Multiplexer(_));
-    let mut next_outer = Instant::now();
     // The loop runs on a rayon worker: the parallel parts of a frame (simulation bands,
     // picture rows) then go to the worker's own queue instead of rayon's global injector,
     // which allocates a block every 63 jobs. Steady-state frames allocate nothing.
@@ -125,12 +115,6 @@ pub fn run_door(
             let now = Instant::now();
             player.feed(&bytes, now);
             player.screen.resize(input.size().map_err(read_error)?);
-            if watches_outer && now >= next_outer {
-                next_outer = now + OUTER_INTERVAL;
-                if let Some(queued) = input.outer_queue() {
-                    player.screen.outer_queue(now, queued);
-                }
-            }
             let turn = player.turn(now, host.status(), &mut requests);
             if turn.flow == Flow::Quit {
                 break;

@@ -31,7 +31,6 @@ use std::time::{Duration, Instant};
 use super::door::{PlayConfig, TerminalInput, run_door};
 use crate::error::{Error, Result};
 use crate::output::graphics::{GraphicsMode, kitty};
-use crate::play::screen::link::ssh_send_queue;
 use crate::play::screen::probe::{
     self, Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize,
 };
@@ -67,9 +66,7 @@ pub fn play(mut config: PlayConfig) -> Result<()> {
     let guard = TerminalGuard::raw().map_err(setup)?;
     config.screen.probe = asks.then(|| probe_options(winsize, true));
     config.screen.link_path = link_path();
-    let ssh_connection =
-        std::env::var("SSH_CONNECTION").ok().filter(|_| matches!(config.screen.link_path, LinkPath::Multiplexer(_)));
-    let mut input = Stdin { size: (winsize.cols, winsize.rows), ssh_connection };
+    let mut input = Stdin { size: (winsize.cols, winsize.rows) };
     let result = run_door(&mut input, TtyOut, config, &mut set_restore_prefix);
     drop(guard);
     set_restore_prefix(Vec::new());
@@ -154,22 +151,6 @@ fn link_path() -> LinkPath {
     }
     LinkPath::detect(|name| std::env::var(name).ok(), names.iter().map(String::as_str))
 }
-
-/// The kernel's table of TCP sockets (`/proc/net/tcp` and `tcp6`), at most [`MAX_SOCKET_TABLE`]
-/// bytes of each: where the SSH connection's send queue is read inside a multiplexer.
-fn socket_table() -> String {
-    use std::io::Read;
-    let mut text = String::new();
-    for path in ["/proc/net/tcp", "/proc/net/tcp6"] {
-        if let Ok(file) = File::open(path) {
-            let _ = file.take(MAX_SOCKET_TABLE).read_to_string(&mut text);
-        }
-    }
-    text
-}
-
-/// The most bytes read of each socket table (a busy machine's table is tens of kilobytes).
-const MAX_SOCKET_TABLE: u64 = 1 << 20;
 
 /// The window size of the terminal on standard output (TIOCGWINSZ, through crossterm).
 fn window_size() -> io::Result<WinSize> {
@@ -329,8 +310,6 @@ pub fn restore() {
 /// Standard input, read without blocking past the player's deadline.
 struct Stdin {
     size: (u16, u16),
-    /// `SSH_CONNECTION`, inside a multiplexer over SSH (where its socket's queue is watched).
-    ssh_connection: Option<String>,
 }
 
 impl TerminalInput for Stdin {
@@ -369,11 +348,6 @@ impl TerminalInput for Stdin {
             self.size = size;
         }
         Ok(self.size)
-    }
-
-    fn outer_queue(&mut self) -> Option<u64> {
-        let connection = self.ssh_connection.as_deref()?;
-        ssh_send_queue(&socket_table(), connection)
     }
 }
 

@@ -36,6 +36,7 @@ fn samples() -> Vec<(&'static [u8], Reply)> {
         ),
         (b"\x1b]1337;ReportCellSize=16;8\x07", Reply::Iterm2CellSize { width: 8.0, height: 16.0, scale: 1.0 }),
         (b"\x1b[?1u", Reply::OtherCsi(b"?1".to_vec(), b'u')),
+        (b"\x1b[0n", Reply::DeviceStatus(0)),
     ]
 }
 

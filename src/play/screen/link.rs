@@ -47,19 +47,35 @@
 //! on any link faster than that. Inside a multiplexer over SSH (tmux, screen, zellij) the
 //! multiplexer answers at once from its local pane and under mosh mosh-server does, so the
 //! round trip measures the local side, not the link ([`LinkPath`]): the rate is held at
-//! [`SAFE_RATE`] there and [`LinkControl::hint`] says how to set `--bandwidth`. One thing of
-//! the link stays visible inside a multiplexer on Linux: the bytes sshd's socket holds for the
-//! connection named by `SSH_CONNECTION` ([`ssh_send_queue`] reads `/proc/net/tcp*`); fed to
-//! [`LinkControl::outer_queue`] they lift the ceiling and the rate follows that queue instead.
+//! [`SAFE_RATE`] there and [`LinkControl::hint`] says how to set `--bandwidth`.
+//!
+//! **Inside tmux or screen over SSH the question is wrapped for the multiplexer's
+//! passthrough** ([`LinkPath::question`]): a device status report (`ESC[5n`, answered `ESC[0n`
+//! by every VT100-compatible terminal) inside `ESC P tmux; ... ESC \` (tmux, with
+//! `allow-passthrough on`) or `ESC P ... ESC \` (GNU screen, always). The multiplexer hands it
+//! to the outer terminal in order with the frames before it, and passes the terminal's answer
+//! back to the pane as input, so the round trip covers the whole path: the multiplexer, sshd's
+//! buffers (the client's 2 MB window), the socket and the link. Measured with tmux 3.3a and
+//! screen 4.9: DA1 wrapped the same way reaches the terminal too, but tmux keeps its answer;
+//! unwrapped, both multiplexers answer DA1 and DSR themselves. Until the first wrapped answer
+//! comes the rate stays under [`SAFE_RATE`]; when none comes (tmux without passthrough, the
+//! default) the controller goes silent after [`SILENCE`] and the status line names the
+//! passthrough option and `--bandwidth` ([`LinkControl::hint`]). Nothing short of the
+//! terminal's answer sees sshd's buffer: the queue of sshd's socket (`/proc/net/tcp`), which
+//! the player followed before, stands still at the socket's size while sshd holds megabytes
+//! behind it, and names another connection when the multiplexer was attached from elsewhere.
 //! Time comes in as an argument: the tests run on made-up clocks.
 
 use std::time::{Duration, Instant};
 
-mod socket;
-pub use socket::ssh_send_queue;
-
 /// The question: primary device attributes.
 pub const PROBE: &[u8] = b"\x1b[c";
+/// The question inside tmux over SSH: a device status report wrapped for tmux's passthrough
+/// (each ESC inside doubled). tmux drops it unless `allow-passthrough` is on.
+pub const TMUX_QUESTION: &[u8] = b"\x1bPtmux;\x1b\x1b[5n\x1b\\";
+/// The question inside GNU screen over SSH: a device status report in screen's passthrough
+/// (a DCS string, whose contents screen writes to the terminal as they are).
+pub const SCREEN_QUESTION: &[u8] = b"\x1bP\x1b[5n\x1b\\";
 /// The rate the player starts at, bytes per second: a whole 160x48 frame in under a second
 /// (coarse first, then exact), grown to a local terminal's speed within half a second, and not
 /// so far above a slow link's rate that the first second leaves a long queue behind.
@@ -120,11 +136,6 @@ pub const SILENCE: Duration = Duration::from_secs(3);
 pub const FOREIGN_WAIT: Duration = Duration::from_secs(1);
 /// How long an overdue question keeps its place for its late answer.
 pub const GIVE_UP: Duration = Duration::from_secs(10);
-/// How often the player reads the SSH socket's queue inside a multiplexer
-/// ([`LinkControl::outer_queue`]), and the shortest time between two changes it makes.
-pub const OUTER_INTERVAL: Duration = Duration::from_millis(50);
-/// The shortest time over which the link's take is measured from the socket's queue.
-pub const OUTER_DELIVERY_TIME: Duration = Duration::from_millis(200);
 /// Questions remembered at most (one link question at a time, overdue ones, foreign ones).
 const MAX_QUESTIONS: usize = 8;
 /// Round trips remembered for the base (the shortest of them).
@@ -150,7 +161,8 @@ pub enum LinkPath {
     #[default]
     Direct,
     /// A multiplexer (`tmux`, `screen`, `zellij`) over SSH: it answers DA1 itself from its
-    /// local pane, and its output goes into SSH's buffers unpaced, so the link cannot be
+    /// local pane, and its output goes into SSH's buffers unpaced. tmux and screen pass a
+    /// wrapped question on to the terminal ([`LinkPath::question`]); zellij's link cannot be
     /// measured in band.
     Multiplexer(&'static str),
     /// mosh: mosh-server is the terminal; it answers DA1 at once and sends the client only the
@@ -183,6 +195,29 @@ impl LinkPath {
             Some(name) if remote => LinkPath::Multiplexer(name),
             _ => LinkPath::Direct,
         }
+    }
+}
+
+impl LinkPath {
+    /// The link's question on this path: DA1, or inside tmux and screen a device status
+    /// report wrapped for their passthrough (answered by the terminal, not the multiplexer).
+    pub fn question(self) -> &'static [u8] {
+        match self {
+            LinkPath::Multiplexer("tmux") => TMUX_QUESTION,
+            LinkPath::Multiplexer("screen") => SCREEN_QUESTION,
+            _ => PROBE,
+        }
+    }
+
+    /// Whether the link's answers are device status reports (`ESC[0n`) rather than device
+    /// attributes: the wrapped question.
+    pub fn asks_status(self) -> bool {
+        self.question() != PROBE
+    }
+
+    /// Whether an answer to the link's question comes from the terminal at the far end.
+    fn answered_at_far_end(self) -> bool {
+        self == LinkPath::Direct || self.asks_status()
     }
 }
 
@@ -233,6 +268,17 @@ impl Questions {
         Some(oldest)
     }
 
+    /// Takes the oldest of the link's own questions out, the foreign ones keeping their places
+    /// (a device status answer is never the probe's).
+    fn pop_oldest_own(&mut self) -> Option<Question> {
+        let i = self.list[..self.len].iter().position(|q| q.is_some_and(|q| !q.foreign))?;
+        let own = self.list[i];
+        self.list.copy_within(i + 1..self.len, i);
+        self.len -= 1;
+        self.list[self.len] = None;
+        own
+    }
+
     /// Drops the questions `forget` says to, keeping the others in order.
     fn forget(&mut self, mut forget: impl FnMut(&Question) -> bool) {
         let mut kept = 0;
@@ -252,20 +298,6 @@ impl Questions {
 pub fn queue_marks(base: Duration) -> (Duration, Duration) {
     let high = base.clamp(QUEUE_HIGH_MIN, QUEUE_HIGH);
     (high / 3, high)
-}
-
-/// What the SSH socket's queue has shown ([`LinkControl::outer_queue`]).
-#[derive(Clone, Debug, Default)]
-struct Outer {
-    /// The last samples, in seconds of the rate, for the base (the shortest of them).
-    samples: [Duration; BASE_SAMPLES],
-    count: usize,
-    last_queue: Option<Duration>,
-    decided_at: Option<Instant>,
-    /// When the link's take was last measured: the time, the bytes sent, the bytes queued.
-    mark: Option<(Instant, u64, u64)>,
-    /// What the link took (bytes sent less the queue's growth, per second).
-    delivered: Option<f64>,
 }
 
 /// The controller: the rate in effect and the questions in flight.
@@ -308,8 +340,6 @@ pub struct LinkControl {
     acknowledged: u64,
     /// The bytes sent up to the last question asked.
     asked_up_to: u64,
-    /// The SSH socket's queue inside a multiplexer, once the player reads it.
-    outer: Option<Outer>,
     /// Every frame since the last question left most of its budget unspent.
     spare_since_question: bool,
     /// Answers to foreign questions seen, and answers nobody asked for.
@@ -353,7 +383,6 @@ impl LinkControl {
             fell: false,
             acknowledged: 0,
             asked_up_to: 0,
-            outer: None,
             spare_since_question: true,
             foreign_answers: 0,
             stray_answers: 0,
@@ -397,8 +426,8 @@ impl LinkControl {
         }
     }
 
-    /// The terminal answered at `now`: the oldest question is the one answered; a link
-    /// question's round trip adjusts the rate.
+    /// The terminal answered at `now` (device attributes): the oldest question is the one
+    /// answered; a link question's round trip adjusts the rate.
     pub fn answered(&mut self, now: Instant) -> Change {
         let Some(question) = self.questions.pop_oldest() else {
             // An answer nobody asked for (typed, or one given up on).
@@ -409,8 +438,31 @@ impl LinkControl {
             self.foreign_answers += 1;
             return Change::Hold;
         }
+        self.round_trip(question, now)
+    }
+
+    /// The terminal answered a device status report at `now` (the question wrapped for a
+    /// multiplexer's passthrough, [`LinkPath::question`]): the oldest of the link's own
+    /// questions is the one answered (the probe's are answered with device attributes).
+    pub fn status_answered(&mut self, now: Instant) -> Change {
+        match self.questions.pop_oldest_own() {
+            Some(question) => self.round_trip(question, now),
+            None => {
+                self.stray_answers += 1;
+                Change::Hold
+            }
+        }
+    }
+
+    /// The link's question `question` was answered at `now`.
+    fn round_trip(&mut self, question: Question, now: Instant) -> Change {
         let (sent, bytes, app_limited) = (question.asked, question.bytes, question.app_limited);
         let first = !self.answered;
+        if first && self.path.asks_status() {
+            // The terminal at the far end answers through the multiplexer: the path can be
+            // measured, and the rate may grow past the safe one.
+            self.ceiling = MAX_RATE;
+        }
         self.answered = true;
         self.silent = false;
         self.acknowledged = self.acknowledged.max(bytes);
@@ -443,7 +495,7 @@ impl LinkControl {
                 _ => took,
             });
         }
-        if self.path != LinkPath::Direct {
+        if !self.path.answered_at_far_end() {
             // The answers come from this side of the link (a multiplexer, mosh-server): they
             // pace the window, never the rate.
             return Change::Hold;
@@ -582,15 +634,17 @@ impl LinkControl {
 /// answers, the answers to wait for at the end.
 impl LinkControl {
     /// A few words for the status line when the link cannot be measured and the rate is a
-    /// guess ([`SAFE_RATE`]): how to set it.
+    /// guess ([`SAFE_RATE`]): how to set it. At most 67 characters: on a 160-column status
+    /// line they leave the rate and the stone size beside them.
     pub fn hint(&self) -> Option<&'static str> {
         match self.path {
-            LinkPath::Multiplexer(_) if self.outer.is_some() => None,
+            // The wrapped question is answered (or has not waited long yet).
+            LinkPath::Multiplexer(_) if self.path.asks_status() && !self.silent => None,
             LinkPath::Multiplexer("tmux") => {
-                Some("tmux over SSH: link not measured, set --bandwidth (250k = 2 Mbit/s)")
+                Some("tmux: set -g allow-passthrough on, or --bandwidth (250k = 2 Mbit/s)")
             }
             LinkPath::Multiplexer("screen") => {
-                Some("screen over SSH: link not measured, set --bandwidth (250k = 2 Mbit/s)")
+                Some("screen: terminal not answering, set --bandwidth (250k = 2 Mbit/s)")
             }
             LinkPath::Multiplexer(_) => {
                 Some("multiplexer over SSH: link not measured, set --bandwidth (250k = 2 Mbit/s)")
@@ -599,6 +653,17 @@ impl LinkControl {
             LinkPath::Direct if self.silent => Some("the terminal does not answer: set --bandwidth (250k = 2 Mbit/s)"),
             LinkPath::Direct => None,
         }
+    }
+
+    /// The link's question, to follow a frame ([`LinkPath::question`]).
+    pub fn question(&self) -> &'static [u8] {
+        self.path.question()
+    }
+
+    /// Whether the link's answers are device status reports ([`LinkControl::status_answered`])
+    /// rather than device attributes ([`LinkControl::answered`]).
+    pub fn asks_status(&self) -> bool {
+        self.path.asks_status()
     }
 
     /// The last round trip measured.
@@ -649,67 +714,9 @@ impl LinkControl {
     pub fn foreign_due(&self) -> bool {
         self.questions.iter().next().is_some_and(|q| q.foreign)
     }
-
-    /// What sshd's socket holds for this connection, measured at `now` (`queued` bytes:
-    /// [`ssh_send_queue`] on `/proc/net/tcp*`, read every [`OUTER_INTERVAL`] or so). Inside a
-    /// multiplexer over SSH the answers come from the multiplexer, so this is the link's only
-    /// signal: the first sample lifts the rate's ceiling and from then on the rate follows this
-    /// queue as it follows the round trip on a direct path. Bytes in the socket over the rate
-    /// are the time a byte written now waits to be acknowledged: its shortest recent value is
-    /// the link's own round trip, the excess the queue. Ignored on other paths.
-    /// `bytes_sent` counts every byte the player has written: what went in less what the
-    /// queue grew by is what the link took, where a fall drains to.
-    pub fn outer_queue(&mut self, now: Instant, bytes_sent: u64, queued: u64) -> Change {
-        if !matches!(self.path, LinkPath::Multiplexer(_)) {
-            return Change::Hold;
-        }
-        self.ceiling = MAX_RATE;
-        let outer = self.outer.get_or_insert(Outer::default());
-        match outer.mark {
-            Some((then, sent, held)) if now.saturating_duration_since(then) >= OUTER_DELIVERY_TIME => {
-                let taken = (bytes_sent.saturating_sub(sent) as f64 - (queued as f64 - held as f64)).max(0.0);
-                outer.delivered = Some(taken / now.saturating_duration_since(then).as_secs_f64());
-                outer.mark = Some((now, bytes_sent, queued));
-            }
-            Some(_) => {}
-            None => outer.mark = Some((now, bytes_sent, queued)),
-        }
-        let waited = Duration::from_secs_f64(queued as f64 / self.rate.max(MIN_RATE));
-        outer.samples[outer.count % BASE_SAMPLES] = waited;
-        outer.count += 1;
-        let base = outer.samples[..outer.count.min(BASE_SAMPLES)].iter().min().copied().unwrap_or(waited);
-        let queue = waited.saturating_sub(base);
-        let last = outer.last_queue.replace(queue);
-        // The lowest marks: the samples come right after a frame is written, so the base
-        // already holds a frame's time, and a queue seen here answers at once, not a round
-        // trip late.
-        let (low, high) = queue_marks(Duration::ZERO);
-        // One change per round trip (at least OUTER_INTERVAL): the queue answers a change
-        // that late.
-        let settle = base.max(OUTER_INTERVAL);
-        if outer.decided_at.is_some_and(|t| now < t + settle) {
-            return Change::Hold;
-        }
-        let standing = last.is_some_and(|last| last > high && queue >= last);
-        if queue > high && standing {
-            outer.decided_at = Some(now);
-            let target = match outer.delivered {
-                Some(delivered) => (delivered * DRAIN_SHARE).clamp(self.rate * 0.5, self.rate * DRAIN_SHARE),
-                None => self.rate * DECREASE,
-            };
-            self.rate = target.max(MIN_RATE);
-            self.fell = true;
-            Change::Down
-        } else if queue < low && self.rate < self.ceiling {
-            outer.decided_at = Some(now);
-            let growth = if self.fell { INCREASE_AFTER_LIMIT } else { INCREASE };
-            self.rate = (self.rate * growth).min(self.ceiling);
-            Change::Up
-        } else {
-            Change::Hold
-        }
-    }
 }
 
+#[cfg(test)]
+mod hidden_tests;
 #[cfg(test)]
 mod tests;

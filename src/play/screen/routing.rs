@@ -37,11 +37,24 @@ impl Screen {
                             probe.receive(Received::Reply(reply));
                         }
                         _ if self.probe_answers > 0 => self.probe_answers -= 1,
+                        // Inside tmux or screen the link's answers are device status reports:
+                        // a device attributes answer there is the multiplexer's to the probe.
+                        _ if self.link.asks_status() => {
+                            if self.link.foreign_due() {
+                                self.link.answered(now);
+                            }
+                        }
                         _ => {
                             if auto && self.link.answered(now) == Change::Down {
                                 self.bucket.drain();
                             }
                         }
+                    }
+                }
+                // The terminal's answer to the link's question wrapped for the multiplexer.
+                (Received::Reply(Reply::DeviceStatus(_)), _) if self.link.asks_status() => {
+                    if auto && self.link.status_answered(now) == Change::Down {
+                        self.bucket.drain();
                     }
                 }
                 (r @ Received::Input(_), Some(probe)) if probing => {

@@ -192,3 +192,29 @@ fn inside_tmux_its_own_answer_is_an_answer_and_the_hint_says_how_to_get_pictures
     screen.tick(t0 + probe::PROBE_BUDGET + LATE_ANSWERS, &mut inputs);
     assert_eq!(screen.take_notice(), None, "tmux answered: not a silent terminal");
 }
+
+#[test]
+fn inside_tmux_the_link_asks_the_terminal_through_passthrough_and_takes_only_its_answer() {
+    // tmux answers the probe's DA1 itself; the link's question, a device status report wrapped
+    // for tmux's passthrough, is answered by the terminal (`ESC[0n`).
+    for (name, question) in [("tmux", link::TMUX_QUESTION), ("screen", link::SCREEN_QUESTION)] {
+        let t0 = Instant::now();
+        let mut screen = Screen::new(
+            ScreenConfig { link_path: LinkPath::Multiplexer(name), ..config(Bandwidth::Auto, true) },
+            (40, 12),
+            t0,
+        );
+        screen.start(t0, &mut Vec::new());
+        let mut inputs = Vec::new();
+        screen.feed(b"\x1b[?1;2c", t0 + MS, &mut inputs);
+        assert!(!screen.probing(), "{name}: the multiplexer's own answer ends the probe");
+        let out = frame(&mut screen, t0 + 10 * MS, 10);
+        assert!(out.ends_with(question), "{name}: the wrapped question after the frame");
+        // A device attributes answer now is not the link's (the multiplexer's, or typed).
+        screen.feed(DA1, t0 + 30 * MS, &mut inputs);
+        assert_eq!(screen.link.last_rtt(), None, "{name}: DA1 is not the link's answer");
+        screen.feed(b"\x1b[0n", t0 + 90 * MS, &mut inputs);
+        assert_eq!(screen.link.last_rtt(), Some(80 * MS), "{name}: the terminal's answer, 90 - 10 ms");
+        assert!(inputs.is_empty(), "{name}: no answer became a key");
+    }
+}
