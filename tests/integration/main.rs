@@ -9,6 +9,7 @@ mod bytes_per_frame;
 mod cli;
 mod coherence;
 mod common;
+mod fake_terminals;
 mod goldens;
 mod graphics;
 mod hostile_input;

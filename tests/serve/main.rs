@@ -3,6 +3,10 @@
 
 mod bad_input;
 mod common;
+/// Fake graphics terminals (shared with the integration tests).
+#[allow(dead_code)]
+#[path = "../integration/common/fake_terminal.rs"]
+mod fake_terminal;
 mod groups;
 mod limits;
 mod load;

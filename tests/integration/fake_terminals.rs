@@ -1,0 +1,107 @@
+//! `tidepool play` in a pseudo-terminal against fake graphics terminals
+//! ([`crate::common::fake_terminal`]): each gets a picture in the protocol it speaks, or cells
+//! with a notice, never a blank screen.
+
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use crate::common::fake_terminal::{Edits, FakeTerminal, Profile};
+use crate::common::pty::{Player, temp_dir};
+use tidepool::graphics::kitty;
+
+/// Bound for a hang only: every scenario ends much sooner when the player works.
+const HANG: Duration = Duration::from_secs(20);
+const COLS: usize = 160;
+const ROWS: usize = 48;
+/// An SSH login's `SSH_CONNECTION`.
+const SSH: (&str, &str) = ("SSH_CONNECTION", "10.227.0.1 50000 10.227.0.2 22");
+
+/// What the terminal ended up showing.
+#[derive(Debug, PartialEq, Eq)]
+enum Shown {
+    /// A kitty picture, decoded by the independent decoder: its size.
+    Kitty(u32, u32),
+    /// Half-block cells, and the status line's text.
+    Cells(String),
+}
+
+/// Runs `tidepool play ARGS` in a pty of 160x48 cells against `profile`, over SSH when `ssh`,
+/// until the terminal shows a picture or cells with a notice; panics on a blank screen.
+fn play(profile: Profile, args: &[&str], ssh: bool) -> (Shown, Arc<Mutex<FakeTerminal>>) {
+    let fake = Arc::new(Mutex::new(FakeTerminal::new(profile.clone(), COLS, ROWS)));
+    let mut env = vec![("TERM", profile.term), ("COLORTERM", "")];
+    if ssh {
+        env.push(SSH);
+    }
+    let all: Vec<&str> = ["play", "--rain", "0.05"].iter().chain(args).copied().collect();
+    let name = format!("fake-{}", profile.name.replace(' ', "-"));
+    let mut p = Player::spawn_fake(&temp_dir(&name), &all, &env, Arc::clone(&fake));
+    let deadline = Instant::now() + HANG;
+    let mut cells_since: Option<Instant> = None;
+    let shown = loop {
+        {
+            let f = fake.lock().unwrap();
+            if f.kitty_shown(kitty::IMAGE_ID) {
+                // What the terminal holds now (the player deletes its image when it quits).
+                break Err(f.kitty_stream.clone());
+            }
+            if f.cells_drawn() {
+                // Cells, and the notice that says why (or, after a while, whatever it says).
+                let since = *cells_since.get_or_insert_with(Instant::now);
+                if f.status().contains("cells") || since.elapsed() > Duration::from_secs(5) {
+                    break Ok(Shown::Cells(f.status()));
+                }
+            }
+            if Instant::now() >= deadline {
+                let blank = format!(
+                    "{}: the screen stayed blank for {HANG:?}: {} bytes, status line {:?}",
+                    profile.name,
+                    f.raw.len(),
+                    f.status().trim_end()
+                );
+                drop(f);
+                panic!("{blank}");
+            }
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    p.send(b"q");
+    let _ = p.wait_exit(HANG);
+    let shown = shown.unwrap_or_else(|stream| {
+        let images = FakeTerminal::decode_kitty(&profile.name, &stream);
+        let image = images.iter().find(|i| i.id == kitty::IMAGE_ID).expect("the placed image decodes");
+        assert!(image.colours() > 16, "{}: the picture shows water, not a flat image", profile.name);
+        Shown::Kitty(image.width, image.height)
+    });
+    (shown, fake)
+}
+
+/// Panics with what `play` found when the screen stayed blank, instead of at once: the other
+/// runs still run, and the failure lists them all.
+fn play_or_blank(profile: Profile, args: &[&str], ssh: bool) -> Result<Shown, String> {
+    std::panic::catch_unwind(|| play(profile, args, ssh).0).map_err(|e| {
+        e.downcast_ref::<String>()
+            .cloned()
+            .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
+            .unwrap_or_default()
+    })
+}
+
+#[test]
+fn a_kitty_terminal_refusing_or_ignoring_frame_edits_over_ssh_gets_pictures() {
+    let mut outcomes = Vec::new();
+    for edits in [Edits::Refuse, Edits::Ignore] {
+        for args in [&["--graphics", "kitty"][..], &[][..]] {
+            for run in 0..3 {
+                let shown = play_or_blank(Profile::kitty_minimal(edits), args, true);
+                outcomes.push((edits, args, run, shown));
+            }
+        }
+    }
+    let failed: Vec<String> = outcomes
+        .iter()
+        .filter(|(_, _, _, shown)| !matches!(shown, Ok(Shown::Kitty(..))))
+        .map(|(edits, args, run, shown)| format!("{edits:?} {args:?} run {run}: {shown:?}"))
+        .collect();
+    assert!(failed.is_empty(), "{} of {} runs without a picture:\n{}", failed.len(), outcomes.len(), failed.join("\n"));
+}
