@@ -389,11 +389,12 @@ impl Screen {
             note: if self.auto() { self.link.hint() } else { None },
         };
         // On an auto link the unanswered bytes are capped too (see `link`: the first seconds).
-        let budget = if self.auto() {
-            self.bucket.budget().min(self.link.window_left(now, self.bytes_sent))
-        } else {
-            self.bucket.budget()
-        };
+        let window_left = if self.auto() { self.link.window_left(now, self.bytes_sent) } else { usize::MAX };
+        let budget = self.bucket.budget().min(window_left);
+        // The bucket as full as it gets and nothing big unanswered: a picture bigger than both
+        // may go now (and is owed), so a picture that never fits them still shows.
+        let overdraw =
+            self.bucket.budget() as f64 + 1.0 >= self.bucket.capacity() && window_left >= link::MIN_WINDOW as usize / 2;
         let options = RateOptions {
             approximate: rate.is_some_and(|r| r < APPROXIMATE_BELOW),
             ..RateOptions::from(self.config.encode)
@@ -439,10 +440,13 @@ impl Screen {
                 available: budget.saturating_sub(report.bytes),
                 rate,
                 frame_interval: Duration::from_secs(1) / self.config.fps.max(1),
+                overdraw,
             };
             let sent = p.add_to_frame(picture, &frame, left, now, &mut bytes);
             if sent > 0 {
-                self.bucket.spend(sent);
+                // Beyond the budget when overdrawn: the bucket is in debt until the rate has
+                // repaid it.
+                self.bucket.owe(sent);
                 self.shown.cursor = Cursor::Unknown;
             }
             spent += sent;

@@ -100,7 +100,7 @@ fn picture_stream_offers_decode_to_the_picture_at_its_rung() {
         let mut last = None;
         for n in 0..24u32 {
             let picture = pool(sw, sh, 10 + u64::from(n / 8));
-            let budget = Budget { available, rate, frame_interval: frame };
+            let budget = Budget::new(available, rate, frame);
             if let Some(offer) = stream.prepare(&picture, budget, t0 + frame * (4 * n)) {
                 wire.extend_from_slice(offer.bytes);
                 parts.push(offer.state.part);
@@ -113,7 +113,7 @@ fn picture_stream_offers_decode_to_the_picture_at_its_rung() {
             assert!(parts.iter().any(|p| matches!(p, Part::Tile(..))), "{name}: {parts:?}");
             // The picture holds still: the tiles go on until the terminal shows all of it.
             for n in 24..400u32 {
-                let budget = Budget { available, rate, frame_interval: frame };
+                let budget = Budget::new(available, rate, frame);
                 if let Some(offer) = stream.prepare(&picture, budget, t0 + frame * (4 * n)) {
                     wire.extend_from_slice(offer.bytes);
                     stream.commit();

@@ -501,7 +501,7 @@ impl FakeTerminal {
         let id: u32 = keys.get(&'i').and_then(|v| v.parse().ok()).unwrap_or(0);
         let quiet: u8 = keys.get(&'q').and_then(|v| v.parse().ok()).unwrap_or(0);
         let action = keys.get(&'a').cloned().unwrap_or_else(|| "t".into());
-        let mut reply = |message: &str, answers: &mut Vec<u8>, errors: &mut usize| {
+        let reply = |message: &str, answers: &mut Vec<u8>, errors: &mut usize| {
             let ok = message == "OK";
             if id > 0 && (quiet == 0 || (quiet == 1 && !ok)) {
                 answers.extend_from_slice(format!("\x1b_Gi={id};{message}\x1b\\").as_bytes());

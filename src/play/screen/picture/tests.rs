@@ -307,3 +307,46 @@ fn a_fixed_rate_below_the_crossover_starts_with_cells_and_says_why() {
         screen(config(Bandwidth::Fixed((at / 4.0) as u64), GraphicsRequest::Force(GraphicsMode::Kitty)), KITTY, t0);
     assert_eq!(forced.mode(), GraphicsMode::Kitty);
 }
+
+/// kitty's answers without frame edits (refused or not answered: the same to the probe).
+const KITTY_NO_EDITS: &[u8] = b"\x1b_Gi=31;OK\x1b\\\x1b[?62;22c";
+
+#[test]
+fn kitty_without_frame_edits_gets_whole_pictures_over_a_fast_link_answering_late() {
+    // A terminal 5 ms away over SSH: the first answers come back after the first frames, which
+    // carried the status line only. Every picture must still go (it went blank: the window
+    // stayed at the few bytes those frames took, and a whole picture never fit it).
+    for delay in [MS / 10, MS, 5 * MS, 30 * MS] {
+        for graphics in [GraphicsRequest::Auto, GraphicsRequest::Force(GraphicsMode::Kitty)] {
+            let t0 = Instant::now();
+            let mut s = screen(config(Bandwidth::Auto, graphics), KITTY_NO_EDITS, t0);
+            assert_eq!(s.mode(), GraphicsMode::Kitty);
+            let water = Water::new(s.picture_size(), 24);
+            let mut answers: VecDeque<Instant> = VecDeque::new();
+            let mut first = None;
+            let mut pictures = 0;
+            for n in 1..=30 * 3u32 {
+                let now = t0 + FRAME * n;
+                while answers.front().is_some_and(|t| *t <= now) {
+                    s.feed(b"\x1b[?62;22c", answers.pop_front().unwrap(), &mut Vec::new());
+                }
+                s.tick(now, &mut Vec::new());
+                if s.ready(now, false) && s.mode() == GraphicsMode::Kitty {
+                    let out = frame(&mut s, &water, n as usize, now);
+                    let whole = count(&out, b"a=T");
+                    assert_eq!(count(&out, b"a=f"), 0, "no frame edits where the terminal has none");
+                    if whole > 0 {
+                        first.get_or_insert(n);
+                    }
+                    pictures += whole;
+                    if out.ends_with(link::PROBE) {
+                        answers.push_back(now + delay);
+                    }
+                }
+            }
+            let first = first.unwrap_or_else(|| panic!("{delay:?} {graphics:?}: no picture in 3 s"));
+            assert!(first <= 15, "{delay:?} {graphics:?}: the first picture at frame {first}");
+            assert!(pictures >= 30, "{delay:?} {graphics:?}: {pictures} pictures in 3 s");
+        }
+    }
+}
