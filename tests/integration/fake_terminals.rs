@@ -105,3 +105,15 @@ fn a_kitty_terminal_refusing_or_ignoring_frame_edits_over_ssh_gets_pictures() {
         .collect();
     assert!(failed.is_empty(), "{} of {} runs without a picture:\n{}", failed.len(), outcomes.len(), failed.join("\n"));
 }
+
+#[test]
+fn a_forced_protocol_the_terminal_does_not_speak_draws_cells_and_says_why() {
+    use crate::common::fake_terminal::{Sgr, Tcap};
+    for (flag, says) in [("kitty", "kitty"), ("sixel", "sixel")] {
+        for ssh in [false, true] {
+            let (shown, _) = play(Profile::text(Tcap::Silent, Sgr::Silent), &["--graphics", flag], ssh);
+            let Shown::Cells(status) = &shown else { panic!("--graphics {flag}: {shown:?}") };
+            assert!(status.contains(says) && status.contains("cells"), "--graphics {flag} (ssh {ssh}): {status:?}");
+        }
+    }
+}

@@ -79,6 +79,12 @@ pub const TMUX_HINT: &str = "tmux hides pictures: `set -g allow-passthrough on` 
 /// What the status line says in tmux when the outer terminal speaks kitty graphics but has no
 /// Unicode placeholders, which images inside tmux need.
 pub const PLACEHOLDER_HINT: &str = "pictures inside tmux need kitty 0.28+ (Unicode placeholders)";
+/// What the status line says when `--graphics kitty` meets a terminal that answered the probe
+/// but not kitty's graphics query: its pictures would never show.
+pub const NO_KITTY: &str = "no answer to kitty's graphics query: half-block cells";
+/// What the status line says when `--graphics sixel` meets a terminal whose device attributes
+/// do not include sixel.
+pub const NO_SIXEL: &str = "the terminal does not say it draws sixel: half-block cells";
 /// A 1x1 black RGB pixel, base64.
 const ONE_PIXEL: &str = "AAAA";
 
@@ -491,9 +497,16 @@ pub fn should_probe(stdin_is_tty: bool, stdout_is_tty: bool) -> bool {
 /// The mode for `request` given what the probe found (`None`: no probe was made). `auto`
 /// prefers kitty (exact colours, scaled by the terminal, changed rectangles), then sixel, then
 /// iTerm2 (a whole PNG every frame), then cells. Inside tmux kitty needs passthrough and
-/// Unicode placeholders (the probe tests both), sixel is used only when tmux draws it itself, and iTerm2 is not used (its
-/// images are not placed through tmux). A forced mode is used as asked, wrapped for tmux when
-/// inside it.
+/// Unicode placeholders (the probe tests both), sixel is used only when tmux draws it itself,
+/// and iTerm2 is not used (its images are not placed through tmux).
+///
+/// A forced mode is used as asked (wrapped for tmux when inside it) unless the terminal's
+/// answers say its pictures would never show: a terminal that answered the probe but not
+/// kitty's query, or whose attributes lack sixel, or tmux without passthrough or placeholders,
+/// gets cells and the reason ([`NO_KITTY`], [`NO_SIXEL`], [`TMUX_HINT`], [`PLACEHOLDER_HINT`]),
+/// never a blank screen. Without answers (a silent terminal) it is used as asked. iTerm2 has
+/// no query other terminals answer (WezTerm, mintty and Konsole draw its images too), so a
+/// forced iTerm2 is always used as asked.
 pub fn choose(request: GraphicsRequest, support: Option<&GraphicsSupport>) -> GraphicsChoice {
     let cells = |hint| GraphicsChoice { mode: GraphicsMode::Cells, tmux_wrap: false, kitty_placeholders: false, hint };
     let Some(s) = support else {
@@ -506,9 +519,15 @@ pub fn choose(request: GraphicsRequest, support: Option<&GraphicsSupport>) -> Gr
     };
     let kitty = GraphicsChoice { mode: GraphicsMode::Kitty, tmux_wrap: s.tmux, kitty_placeholders: s.tmux, hint: None };
     match request {
-        GraphicsRequest::Force(GraphicsMode::Kitty) => {
-            GraphicsChoice { hint: (s.tmux && !s.tmux_passthrough).then_some(TMUX_HINT), ..kitty }
+        GraphicsRequest::Force(GraphicsMode::Kitty) if s.answered && s.tmux && !s.tmux_passthrough => {
+            cells(Some(TMUX_HINT))
         }
+        GraphicsRequest::Force(GraphicsMode::Kitty) if s.answered && !s.kitty => cells(Some(NO_KITTY)),
+        GraphicsRequest::Force(GraphicsMode::Kitty) if s.answered && s.tmux && !s.kitty_placeholders => {
+            cells(Some(PLACEHOLDER_HINT))
+        }
+        GraphicsRequest::Force(GraphicsMode::Kitty) => kitty,
+        GraphicsRequest::Force(GraphicsMode::Sixel) if s.answered && s.sixel.is_none() => cells(Some(NO_SIXEL)),
         GraphicsRequest::Force(GraphicsMode::Iterm2) => {
             GraphicsChoice { mode: GraphicsMode::Iterm2, tmux_wrap: s.tmux, kitty_placeholders: false, hint: None }
         }

@@ -84,18 +84,22 @@ impl Screen {
             }
             return;
         }
-        if first || (self.config.graphics == GraphicsRequest::Auto && self.choice.mode == GraphicsMode::Cells) {
+        // Late answers may upgrade `auto`'s cells, or show that a forced protocol's pictures
+        // never appear (then cells, and why).
+        let forced = self.config.graphics != GraphicsRequest::Auto;
+        if first || forced || self.choice.mode == GraphicsMode::Cells {
             self.choose(&support, first);
         }
     }
 
     /// Sets the protocol from what the terminal said (`first`: the first decision, before any
-    /// frame; later only an upgrade from cells to pixels). With `auto`, pixels are drawn only
-    /// where they show the truer moving picture at the link's rate (a fixed rate is known now;
-    /// a measured one starts with pixels and [`Screen::follow_link`] switches).
+    /// frame; later only a change of protocol: `auto`'s cells upgraded to pixels, a forced
+    /// protocol's pixels that would never show replaced by cells). With `auto`, pixels are drawn
+    /// only where they show the truer moving picture at the link's rate (a fixed rate is known
+    /// now; a measured one starts with pixels and [`Screen::follow_link`] switches).
     pub(super) fn choose(&mut self, support: &GraphicsSupport, first: bool) {
         let choice = probe::choose(self.config.graphics, Some(support));
-        if !first && choice.mode == GraphicsMode::Cells {
+        if !first && choice.mode == self.choice.mode {
             return;
         }
         self.support = support.clone();

@@ -192,3 +192,19 @@ fn inside_tmux_its_own_answer_is_an_answer_and_the_hint_says_how_to_get_pictures
     screen.tick(t0 + probe::PROBE_BUDGET + LATE_ANSWERS, &mut inputs);
     assert_eq!(screen.take_notice(), None, "tmux answered: not a silent terminal");
 }
+
+#[test]
+fn a_late_answer_without_kitty_turns_a_forced_kitty_into_cells() {
+    let t0 = Instant::now();
+    let mut config = config(Bandwidth::Unlimited, true);
+    config.graphics = GraphicsRequest::Force(GraphicsMode::Kitty);
+    let mut screen = Screen::new(config, (40, 12), t0);
+    screen.start(t0, &mut Vec::new());
+    let mut inputs = Vec::new();
+    screen.tick(t0 + probe::PROBE_BUDGET, &mut inputs);
+    assert_eq!(screen.mode(), GraphicsMode::Kitty, "no answer yet: as asked");
+    screen.feed(DA1, t0 + 700 * MS, &mut inputs);
+    assert_eq!(screen.mode(), GraphicsMode::Cells, "the answer came without kitty's");
+    assert_eq!(screen.take_notice().as_deref(), Some(probe::NO_KITTY));
+    assert!(!contains(&frame(&mut screen, t0 + 750 * MS, 10), b"\x1b_G"));
+}

@@ -228,9 +228,9 @@ fn tmux_without_passthrough_gets_cells_and_a_hint() {
     // tmux that draws sixel itself says so in its own DA1.
     let s = FakeTerminal::new(&[(1, b"\x1b[?1;2;4c")]).run(&options(true)).outcome.support;
     assert_eq!(choose(GraphicsRequest::Auto, Some(&s)).mode, GraphicsMode::Sixel);
-    // Forcing kitty wraps it and still shows the hint.
+    // Forcing kitty there would draw nothing: cells and the hint.
     let forced = choose(GraphicsRequest::Force(GraphicsMode::Kitty), Some(&run.outcome.support));
-    assert!(forced.tmux_wrap && forced.kitty_placeholders && forced.hint.is_some());
+    assert_eq!((forced.mode, forced.hint), (GraphicsMode::Cells, Some(TMUX_HINT)));
 }
 
 #[test]
@@ -415,4 +415,33 @@ mod through_the_screen {
         assert!(silent.take_notice().is_some_and(|n| n.contains("did not answer")));
         assert!(inputs.is_empty(), "{inputs:?}");
     }
+}
+
+#[test]
+fn a_forced_protocol_the_answers_rule_out_draws_cells_and_says_why() {
+    let kitty = GraphicsRequest::Force(GraphicsMode::Kitty);
+    let sixel = GraphicsRequest::Force(GraphicsMode::Sixel);
+    let answered = GraphicsSupport { answered: true, ..GraphicsSupport::default() };
+    let with_kitty = GraphicsSupport { kitty: true, ..answered.clone() };
+    assert_eq!(choose(kitty, Some(&with_kitty)).mode, GraphicsMode::Kitty);
+    assert_eq!(
+        choose(kitty, Some(&answered)),
+        GraphicsChoice { hint: Some(NO_KITTY), ..choose(GraphicsRequest::Auto, None) }
+    );
+    assert_eq!(choose(sixel, Some(&answered)).hint, Some(NO_SIXEL));
+    assert_eq!(choose(sixel, Some(&answered)).mode, GraphicsMode::Cells);
+    let with_sixel =
+        GraphicsSupport { sixel: Some(SixelSupport { registers: 256, max_w: None, max_h: None }), ..answered.clone() };
+    assert_eq!(choose(sixel, Some(&with_sixel)).mode, GraphicsMode::Sixel);
+    // Nothing answered: nothing is known, so the protocol is used as asked.
+    let silent = GraphicsSupport::default();
+    assert_eq!(choose(kitty, Some(&silent)).mode, GraphicsMode::Kitty);
+    assert_eq!(choose(sixel, Some(&silent)).mode, GraphicsMode::Sixel);
+    // iTerm2 has no query others answer: as asked.
+    assert_eq!(choose(GraphicsRequest::Force(GraphicsMode::Iterm2), Some(&answered)).mode, GraphicsMode::Iterm2);
+    // tmux passing kitty through without placeholders (kitty 0.26 outside).
+    let tmux = GraphicsSupport { tmux: true, tmux_passthrough: true, ..with_kitty };
+    assert_eq!(choose(kitty, Some(&tmux)).hint, Some(PLACEHOLDER_HINT));
+    let tmux = GraphicsSupport { kitty_placeholders: true, ..tmux };
+    assert_eq!(choose(kitty, Some(&tmux)).mode, GraphicsMode::Kitty);
 }
