@@ -512,3 +512,20 @@ fn a_sender_that_leaves_its_budget_unspent_is_not_taken_for_the_link() {
     let got = full.throughput(250_000.0, 3.0, 10.0);
     assert!(got > 0.8 * 250_000.0, "{got:.0} B/s");
 }
+
+#[test]
+fn a_first_question_after_a_few_status_line_bytes_does_not_set_the_rate() {
+    // The player's first frames carry the status line only (a picture waits for its probe and
+    // its budget): a few hundred bytes, far under the frame's budget. Their round trip over a
+    // 2 Mbit/s, 20 ms link said 5-16 kB/s (the first answer's bytes over its round trip), and
+    // that was taken for the link: `auto` left pixels for cells at "link 5.5 kB/s" (serve, real
+    // kitty) and 16 kB/s (a fake kitty in a pty).
+    let status_line_first = |t: f64| if t < 0.1 { 230.0 } else { f64::INFINITY };
+    let run = simulate(LinkPath::Direct, Link::far(250_000.0, ms(20)), 10.0, status_line_first);
+    let lowest = run.rates.iter().copied().fold(f64::INFINITY, f64::min);
+    assert!(lowest >= 100_000.0, "the rate fell to {lowest:.0} B/s on a 250 kB/s link");
+    let got = run.throughput(250_000.0, 2.0, 10.0);
+    assert!(got > 0.8 * 250_000.0, "the link is filled: {got:.0} B/s");
+    let p90 = run.queue_quantile(2.0, 0.9);
+    assert!(p90 <= 0.1 + 2.0 / FPS, "the queue's p90 after 2 s is {:.0} ms", p90 * 1e3);
+}
