@@ -448,7 +448,7 @@ impl LinkControl {
             // pace the window, never the rate.
             return Change::Hold;
         }
-        if first {
+        if first && !app_limited {
             // The first frame crossed the link within this round trip: the link carries at
             // least that much, and the rate may be far above it (a 400 kB/s start on a 32 kB/s
             // link). Starting from it drains what the first frames queued, so the next round
@@ -457,6 +457,10 @@ impl LinkControl {
             // A question after a few bytes says little of the link: never below the safe rate
             // then (measured on the real 256 kbit/s link: the player's first question followed
             // 4 kB, and 400 kB/s ran on for seconds of falls).
+            // A question after frames that left most of their budget unspent (the status line
+            // alone while the picture waits) says nothing of the link at all: the rate stays,
+            // and the window (sized from what that frame took) bounds the queue until answers
+            // to full frames measure the link (the rate fell to 16 kB/s on a 250 kB/s link).
             let shown = took.map_or(self.rate, |t| (t * DRAIN_SHARE).max(SAFE_RATE)).max(MIN_RATE);
             if shown < self.rate {
                 self.rate = shown.min(self.ceiling);
