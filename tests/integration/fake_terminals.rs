@@ -47,8 +47,11 @@ fn play(profile: Profile, args: &[&str], ssh: bool) -> (Shown, Arc<Mutex<FakeTer
             }
             if f.cells_drawn() {
                 // Cells, and the notice that says why (or, after a while, whatever it says).
+                // A terminal without graphics gets cells and nothing to say about them.
                 let since = *cells_since.get_or_insert_with(Instant::now);
-                if f.status().contains("cells") || since.elapsed() > Duration::from_secs(5) {
+                let text = profile.kitty.is_none() && !profile.da1.windows(2).any(|w| w == b";4");
+                let settle = Duration::from_millis(if text { 300 } else { 5000 });
+                if (f.status().contains("cells") && !text) || since.elapsed() > settle {
                     break Ok(Shown::Cells(f.status()));
                 }
             }
@@ -114,6 +117,46 @@ fn a_forced_protocol_the_terminal_does_not_speak_draws_cells_and_says_why() {
             let (shown, _) = play(Profile::text(Tcap::Silent, Sgr::Silent), &["--graphics", flag], ssh);
             let Shown::Cells(status) = &shown else { panic!("--graphics {flag}: {shown:?}") };
             assert!(status.contains(says) && status.contains("cells"), "--graphics {flag} (ssh {ssh}): {status:?}");
+        }
+    }
+}
+
+/// The colours a cell frame used after the probe: (24-bit codes, 256-colour codes).
+fn colour_codes(raw: &[u8]) -> (usize, usize) {
+    let count = |needle: &[u8]| raw.windows(needle.len()).filter(|w| *w == needle).count();
+    (count(b"8;2;"), count(b"8;5;"))
+}
+
+#[test]
+fn true_colour_is_found_by_asking_the_terminal_or_by_its_name() {
+    use crate::common::fake_terminal::{Sgr, Tcap};
+    let text = |tcap, sgr, term| Profile { term, ..Profile::text(tcap, sgr) };
+    let cases = [
+        (text(Tcap::Rgb, Sgr::Silent, "xterm-256color"), &[][..], true),
+        (text(Tcap::Silent, Sgr::TrueColor, "xterm-256color"), &[][..], true),
+        (text(Tcap::Missing, Sgr::TrueColor, "xterm-256color"), &[][..], true),
+        (text(Tcap::Missing, Sgr::Palette, "xterm-256color"), &[][..], false),
+        (text(Tcap::Silent, Sgr::Silent, "xterm-256color"), &[][..], false),
+        (text(Tcap::Silent, Sgr::Silent, "xterm-kitty"), &[][..], true),
+        (text(Tcap::Silent, Sgr::Silent, "foot"), &[][..], true),
+        (text(Tcap::Silent, Sgr::Silent, "wezterm"), &[][..], true),
+        // The manual override wins over the answers.
+        (text(Tcap::Rgb, Sgr::TrueColor, "xterm-256color"), &["--color", "256"][..], false),
+    ];
+    for (profile, args, truecolor) in cases {
+        for ssh in [true, false] {
+            let what = format!("{:?}/{:?} TERM={} {args:?} ssh {ssh}", profile.tcap, profile.sgr, profile.term);
+            let (shown, fake) = play(profile.clone(), args, ssh);
+            assert!(matches!(shown, Shown::Cells(_)), "{what}: {shown:?}");
+            let (rgb, palette) = colour_codes(&fake.lock().unwrap().raw);
+            if truecolor {
+                assert!(rgb > 100 && palette == 0, "{what}: 24-bit colours expected ({rgb} 24-bit, {palette} palette)");
+            } else {
+                assert!(palette > 100 && rgb == 0, "{what}: 256 colours expected ({rgb} 24-bit, {palette} palette)");
+            }
+            let raw = fake.lock().unwrap().raw.clone();
+            let hint = raw.windows(17).any(|w| w == b"--color truecolor");
+            assert_eq!(hint, !truecolor && args.is_empty(), "{what}: the hint to use --color truecolor");
         }
     }
 }
