@@ -114,7 +114,7 @@ fn probe_options(winsize: WinSize, file_medium: bool) -> ProbeOptions {
     let kitty_file = (file_medium && !env.ssh)
         .then(|| kitty::write_temp_file(&kitty::temp_dir(), PROBE_FILE_NUMBER, &[0, 0, 0]).ok())
         .flatten();
-    ProbeOptions { env, winsize, kitty_file }
+    ProbeOptions { env, winsize, kitty_file, colours: false }
 }
 
 /// Asks the terminal what it can show, waiting at most [`probe::PROBE_BUDGET`]; the terminal

@@ -5,7 +5,7 @@ mod bad_input;
 mod common;
 /// Fake graphics terminals (shared with the integration tests).
 #[allow(dead_code)]
-#[path = "../integration/common/fake_terminal.rs"]
+#[path = "../integration/common/fake_terminal/mod.rs"]
 mod fake_terminal;
 mod groups;
 mod limits;

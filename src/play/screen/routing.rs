@@ -76,6 +76,9 @@ impl Screen {
         };
         inputs.extend(probe.take_leftover());
         let support = probe.support();
+        if first || support.true_color {
+            self.settle_colours(support.true_color);
+        }
         if !probe.done() {
             self.asking = Asking::Late { probe, until: now + LATE_ANSWERS };
             if first {
@@ -120,6 +123,23 @@ impl Screen {
         }
         let late = if first { "" } else { " (the terminal answered late)" };
         self.draw_with(drawn, notice, late);
+    }
+
+    /// The colours from what the terminal said (`true_color`), when `--color` is `auto`: true
+    /// colour when it said so (a repaint, if frames went out before a late answer); otherwise
+    /// the environment's guess stays and, below true colour, the status line says how to get
+    /// it.
+    pub(super) fn settle_colours(&mut self, true_color: bool) {
+        if !self.config.color_auto || self.config.color == ColorMode::TrueColor {
+            return;
+        }
+        if true_color {
+            self.config.color = ColorMode::TrueColor;
+            self.shown = Shown::UNKNOWN;
+            self.colour_hint = false;
+        } else {
+            self.colour_hint = true;
+        }
     }
 
     /// `auto` between pixels and cells as the link's rate crosses the protocol's crossover

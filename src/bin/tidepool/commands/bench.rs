@@ -146,6 +146,7 @@ pub fn run(args: BenchArgs) -> Result<()> {
             fps: PLAYER_FPS as u32,
             bandwidth: Bandwidth::Unlimited,
             color: ColorMode::TrueColor,
+            color_auto: false,
             encode: EncodeOptions::default(),
             graphics: GraphicsRequest::Force(tidepool::graphics::GraphicsMode::Cells),
             probe: None,

@@ -315,7 +315,10 @@ impl russh::server::Handler for ClientHandler {
         let screen = ScreenConfig {
             fps: self.hub.fps,
             bandwidth: self.hub.limits.client_bandwidth,
+            // COLORTERM arrives only where the client sends it and this server accepts it
+            // (OpenSSH sends it only with SendEnv): the probe asks the terminal itself.
             color: ColorMode::detect(self.colorterm.as_deref(), self.term.as_deref()),
+            color_auto: true,
             encode: EncodeOptions { threshold: COLOR_THRESHOLD, sync: true },
             graphics: GraphicsRequest::Auto,
             // A remote terminal: no file medium; its TMUX is not ours to see.
@@ -323,6 +326,7 @@ impl russh::server::Handler for ClientHandler {
                 env: Environment { ssh: true, ..Environment::default() },
                 winsize,
                 kitty_file: None,
+                colours: false,
             }),
             // The far terminal answers for itself: whatever runs there, the round trip is real.
             link_path: tidepool::play::LinkPath::Direct,

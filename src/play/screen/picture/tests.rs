@@ -34,12 +34,14 @@ fn config(bandwidth: Bandwidth, graphics: GraphicsRequest) -> ScreenConfig {
         fps: 30,
         bandwidth,
         color: ColorMode::TrueColor,
+        color_auto: false,
         encode: EncodeOptions::default(),
         graphics,
         probe: Some(ProbeOptions {
             env: Environment { ssh: true, ..Environment::default() },
             winsize: WinSize { cols: 160, rows: 48, x_px: 1280, y_px: 768 },
             kitty_file: None,
+            colours: false,
         }),
         link_path: Default::default(),
     }

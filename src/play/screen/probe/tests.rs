@@ -64,6 +64,7 @@ fn options(tmux: bool) -> ProbeOptions {
         env: Environment { tmux, ..Environment::default() },
         winsize: WinSize { cols: 160, rows: 48, x_px: 0, y_px: 0 },
         kitty_file: None,
+        colours: true,
     }
 }
 
@@ -329,12 +330,14 @@ mod through_the_screen {
             fps: 30,
             bandwidth: Bandwidth::Unlimited,
             color: ColorMode::TrueColor,
+            color_auto: false,
             encode: EncodeOptions::default(),
             graphics: GraphicsRequest::Auto,
             probe: Some(ProbeOptions {
                 env: Environment { ssh: true, ..Environment::default() },
                 winsize: WinSize { cols: 40, rows: 12, x_px: 320, y_px: 192 },
                 kitty_file: None,
+                colours: false,
             }),
             link_path: Default::default(),
         };
@@ -444,4 +447,31 @@ fn a_forced_protocol_the_answers_rule_out_draws_cells_and_says_why() {
     assert_eq!(choose(kitty, Some(&tmux)).hint, Some(PLACEHOLDER_HINT));
     let tmux = GraphicsSupport { kitty_placeholders: true, ..tmux };
     assert_eq!(choose(kitty, Some(&tmux)).mode, GraphicsMode::Kitty);
+}
+
+#[test]
+fn true_colour_answers_are_read_and_a_palette_index_is_not_one() {
+    let with = |answer: &[u8]| FakeTerminal::new(&[(1, &[answer, XTERM_DA1].concat())]).run(&options(false));
+    for yes in [
+        &b"\x1bP1+r524742\x1b\\"[..],
+        b"\x1bP0+r524742\x1b\\\x1bP1+r5463=\x1b\\",
+        b"\x1bP1$r0;38:2::1:2:3m\x1b\\",
+        b"\x1bP1$r0;38:2:1:2:3m\x1b\\",
+        b"\x1bP1$r38;2;1;2;3m\x1b\\",
+    ] {
+        assert!(with(yes).outcome.support.true_color, "{:?}", String::from_utf8_lossy(yes));
+    }
+    for no in [
+        &b"\x1bP0+r524742\x1b\\\x1bP0+r5463\x1b\\"[..],
+        b"\x1bP1$r0;38:5:16m\x1b\\",
+        b"\x1bP1$r0;38:2::11:2:3m\x1b\\",
+        b"\x1bP0$r\x1b\\",
+        b"",
+    ] {
+        assert!(!with(no).outcome.support.true_color, "{:?}", String::from_utf8_lossy(no));
+    }
+    let has = |hay: &[u8], needle: &[u8]| hay.windows(needle.len()).any(|w| w == needle);
+    assert!(has(&queries(&options(false)), COLOUR_QUERIES));
+    let quiet = ProbeOptions { colours: false, ..options(false) };
+    assert!(!has(&queries(&quiet), b"\x1bP+q"), "no colour question unless asked for");
 }
