@@ -237,3 +237,31 @@ fn changed_cells_are_sent_alone_and_match_the_whole_picture() {
     assert_eq!(enc.encode(&third, w, h, &mut out), Update::Full);
     assert!(decode(&out, w, h) == dithered_rgb(&palette, &third, w, h));
 }
+
+#[test]
+fn every_colour_definition_is_followed_by_its_selection() {
+    // DEC's `#Pc;Pu;Px;Py;Pz` defines and selects; xterm (379, -ti vt340) only defines: the
+    // pixels that follow were drawn in the register it had selected before (a VT340 default:
+    // green lines along every block's first band). Each definition must be followed by `#Pc`.
+    let (w, h, rgb) = golden_pool();
+    let mut e = SixelEncoder::new(SixelPalette::for_registers(256), (0, 0), Some((8, 16)));
+    let mut out = Vec::new();
+    e.encode(&rgb, w, h, &mut out);
+    let text = String::from_utf8_lossy(&out);
+    let mut definitions = 0;
+    for (at, _) in text.match_indices(";2;") {
+        let before = &text[..at];
+        let hash = before.rfind('#').expect("a definition starts with #");
+        let register = &before[hash + 1..];
+        assert!(register.bytes().all(|b| b.is_ascii_digit()), "{register:?}");
+        let after = &text[at + 3..];
+        let end = after.find(|c: char| !(c.is_ascii_digit() || c == ';')).unwrap();
+        assert!(
+            after[end..].starts_with(&format!("#{register}")),
+            "#{register} is defined but not selected: {:?}",
+            &after[..end + 8]
+        );
+        definitions += 1;
+    }
+    assert!(definitions > 20, "{definitions} definitions");
+}
