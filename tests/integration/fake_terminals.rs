@@ -5,9 +5,8 @@
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use crate::common::fake_terminal::{Edits, FakeTerminal, Profile};
+use crate::common::fake_terminal::{Edits, FakeTerminal, Profile, Shown, Watch};
 use crate::common::pty::{Player, temp_dir};
-use tidepool::graphics::kitty;
 
 /// Bound for a hang only: every scenario ends much sooner when the player works.
 const HANG: Duration = Duration::from_secs(20);
@@ -15,15 +14,6 @@ const COLS: usize = 160;
 const ROWS: usize = 48;
 /// An SSH login's `SSH_CONNECTION`.
 const SSH: (&str, &str) = ("SSH_CONNECTION", "10.227.0.1 50000 10.227.0.2 22");
-
-/// What the terminal ended up showing.
-#[derive(Debug, PartialEq, Eq)]
-enum Shown {
-    /// A kitty picture, decoded by the independent decoder: its size.
-    Kitty(u32, u32),
-    /// Half-block cells, and the status line's text.
-    Cells(String),
-}
 
 /// Runs `tidepool play ARGS` in a pty of 160x48 cells against `profile`, over SSH when `ssh`,
 /// until the terminal shows a picture or cells with a notice; panics on a blank screen.
@@ -37,45 +27,26 @@ fn play(profile: Profile, args: &[&str], ssh: bool) -> (Shown, Arc<Mutex<FakeTer
     let name = format!("fake-{}", profile.name.replace(' ', "-"));
     let mut p = Player::spawn_fake(&temp_dir(&name), &all, &env, Arc::clone(&fake));
     let deadline = Instant::now() + HANG;
-    let mut cells_since: Option<Instant> = None;
+    let mut watch = Watch::new(fake.lock().unwrap().has_graphics());
+    let mut not_yet = String::from("blank");
     let shown = loop {
-        {
-            let f = fake.lock().unwrap();
-            if f.kitty_shown(kitty::IMAGE_ID) {
-                // What the terminal holds now (the player deletes its image when it quits).
-                break Err(f.kitty_stream.clone());
-            }
-            if f.cells_drawn() {
-                // Cells, and the notice that says why (or, after a while, whatever it says).
-                // A terminal without graphics gets cells and nothing to say about them.
-                let since = *cells_since.get_or_insert_with(Instant::now);
-                let text = profile.kitty.is_none() && !profile.da1.windows(2).any(|w| w == b";4");
-                let settle = Duration::from_millis(if text { 300 } else { 5000 });
-                if (f.status().contains("cells") && !text) || since.elapsed() > settle {
-                    break Ok(Shown::Cells(f.status()));
-                }
-            }
-            if Instant::now() >= deadline {
-                let blank = format!(
-                    "{}: the screen stayed blank for {HANG:?}: {} bytes, status line {:?}",
-                    profile.name,
-                    f.raw.len(),
-                    f.status().trim_end()
-                );
-                drop(f);
-                panic!("{blank}");
+        let f = fake.lock().unwrap();
+        let glance = watch.glance(&f);
+        let (bytes, status) = (f.raw.len(), f.status());
+        drop(f);
+        if let Some(glance) = glance {
+            match glance.check(profile.name) {
+                Ok(shown) => break shown,
+                Err(what) => not_yet = what,
             }
         }
-        std::thread::sleep(Duration::from_millis(20));
+        if Instant::now() >= deadline {
+            panic!("{}: {not_yet} for {HANG:?}: {bytes} bytes, status line {:?}", profile.name, status.trim_end());
+        }
+        std::thread::sleep(Duration::from_millis(if not_yet == "blank" { 20 } else { 200 }));
     };
     p.send(b"q");
     let _ = p.wait_exit(HANG);
-    let shown = shown.unwrap_or_else(|stream| {
-        let images = FakeTerminal::decode_kitty(profile.name, &stream);
-        let image = images.iter().find(|i| i.id == kitty::IMAGE_ID).expect("the placed image decodes");
-        assert!(image.colours() > 16, "{}: the picture shows water, not a flat image", profile.name);
-        Shown::Kitty(image.width, image.height)
-    });
     (shown, fake)
 }
 
@@ -121,16 +92,6 @@ fn a_forced_protocol_the_terminal_does_not_speak_draws_cells_and_says_why() {
     }
 }
 
-/// The colour codes the frames used (after the screen was taken; the probe sets a 24-bit
-/// colour of its own): (24-bit codes, 256-colour codes). In true colour the rate-controlled
-/// encoder still sends some cells approximately, in 256 colours (half the bytes).
-fn colour_codes(raw: &[u8]) -> (usize, usize) {
-    let entered = raw.windows(8).position(|w| w == b"\x1b[?1049h").expect("the screen was taken");
-    let frames = &raw[entered..];
-    let count = |needle: &[u8]| frames.windows(needle.len()).filter(|w| *w == needle).count();
-    (count(b"8;2;"), count(b"8;5;"))
-}
-
 #[test]
 fn true_colour_is_found_by_asking_the_terminal_or_by_its_name() {
     use crate::common::fake_terminal::{Sgr, Tcap};
@@ -152,7 +113,7 @@ fn true_colour_is_found_by_asking_the_terminal_or_by_its_name() {
             let what = format!("{:?}/{:?} TERM={} {args:?} ssh {ssh}", profile.tcap, profile.sgr, profile.term);
             let (shown, fake) = play(profile.clone(), args, ssh);
             assert!(matches!(shown, Shown::Cells(_)), "{what}: {shown:?}");
-            let (rgb, palette) = colour_codes(&fake.lock().unwrap().raw);
+            let (rgb, palette) = fake.lock().unwrap().colour_codes();
             if truecolor {
                 assert!(
                     rgb > 100 && rgb > palette,
@@ -166,4 +127,61 @@ fn true_colour_is_found_by_asking_the_terminal_or_by_its_name() {
             assert_eq!(hint, !truecolor && args.is_empty(), "{what}: the hint to use --color truecolor");
         }
     }
+}
+
+/// How many times each scenario runs (`TIDEPOOL_FAKE_RUNS`, default 3): a flaky outcome is a
+/// defect, so each runs more than once.
+fn runs() -> usize {
+    std::env::var("TIDEPOOL_FAKE_RUNS").ok().and_then(|v| v.parse().ok()).unwrap_or(3)
+}
+
+/// Whether `profile` says it draws 24-bit colour (by name, XTGETTCAP or DECRQSS).
+fn true_colour(profile: &Profile) -> bool {
+    use crate::common::fake_terminal::{Sgr, Tcap};
+    profile.tcap == Tcap::Rgb
+        || profile.sgr == Sgr::TrueColor
+        || tidepool::terminal::ColorMode::detect(None, Some(profile.term)) == tidepool::terminal::ColorMode::TrueColor
+}
+
+#[test]
+fn every_graphics_terminal_gets_pictures_in_the_protocol_it_speaks_locally_and_over_ssh() {
+    let scenarios: Vec<(Profile, &[&str], fn(&Shown) -> bool)> = vec![
+        (Profile::kitty_026(), &[], |s| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::kitty_026(), &["--graphics", "kitty"], |s| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::kitty_current(), &[], |s| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::ghostty(), &[], |s| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::ghostty(), &["--graphics", "kitty"], |s| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::wezterm(), &[], |s| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::wezterm(), &["--graphics", "sixel"], |s| matches!(s, Shown::Sixel)),
+        (Profile::wezterm(), &["--graphics", "iterm2"], |s| matches!(s, Shown::Iterm2(w, _) if *w >= 80)),
+        (Profile::konsole(), &[], |s| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::konsole(), &["--graphics", "kitty"], |s| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::konsole(), &["--graphics", "iterm2"], |s| matches!(s, Shown::Iterm2(w, _) if *w >= 80)),
+        (Profile::xterm_vt340(), &[], |s| matches!(s, Shown::Sixel)),
+        (Profile::xterm_vt340(), &["--graphics", "sixel"], |s| matches!(s, Shown::Sixel)),
+    ];
+    let mut failed = Vec::new();
+    let mut seen = 0;
+    for (profile, args, expected) in &scenarios {
+        for ssh in [false, true] {
+            for run in 0..runs() {
+                seen += 1;
+                let what = format!("{} {args:?} ssh {ssh} run {run}", profile.name);
+                match std::panic::catch_unwind(|| play(profile.clone(), args, ssh)) {
+                    Ok((shown, fake)) => {
+                        let (rgb, _) = fake.lock().unwrap().colour_codes();
+                        if !expected(&shown) {
+                            failed.push(format!("{what}: {shown:?}"));
+                        } else if true_colour(profile) != (rgb > 0) {
+                            failed.push(format!("{what}: true colour {} but {rgb} 24-bit codes", true_colour(profile)));
+                        }
+                    }
+                    Err(e) => {
+                        failed.push(format!("{what}: {}", e.downcast_ref::<String>().cloned().unwrap_or_default()))
+                    }
+                }
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{} of {seen} runs wrong:\n{}", failed.len(), failed.join("\n"));
 }

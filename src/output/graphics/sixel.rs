@@ -21,7 +21,10 @@
 //! **Bytes.** Raster attributes `"1;1;W;H` ask for square pixels, one per screen pixel; `P2=1`
 //! leaves pixels no colour covers as they are. The picture is cut into bands of six rows; in
 //! each band every colour used gets one pass (`#n`, then its sixels from its first to its last
-//! column, `$` back to the band's start), runs of four or more equal sixels are `!n`. Colours
+//! column, `$` back to the band's start), runs of four or more equal sixels are `!n`. A register
+//! is defined where an image first uses it and then selected again (`#n;2;r;g;b#n`): xterm's
+//! definition does not select, and without the second `#n` the band was drawn in the register
+//! selected before (a VT340 default: green). Colours
 //! and columns are collected per band in one pass over the band's pixels (each column's at most
 //! six registers and their bits, appended to each register's list), so the cost grows with the
 //! pixels, not with pixels x colours, and nothing of palette x width size is touched.
@@ -165,9 +168,10 @@ impl SixelPalette {
 /// When the colour registers are defined.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Registers {
-    /// Each image defines the registers it uses, where it first uses each (`#i;2;r;g;b`
-    /// selects as it defines): works in every terminal, and a small changed block defines only
-    /// its few colours instead of the whole palette (3.7 kB at 256 registers).
+    /// Each image defines the registers it uses, where it first uses each (`#i;2;r;g;b#i`:
+    /// defined, then selected, since xterm's definition does not select): works in every
+    /// terminal, and a small changed block defines only its few colours instead of the whole
+    /// palette (about 4 kB at 256 registers).
     PerImage,
     /// Each register is defined once, the first time any image uses it, and kept: only for a
     /// terminal whose images share their registers (xterm after `ESC [ ? 1070 l`, which the player
@@ -498,7 +502,11 @@ impl SixelEncoder {
             out.push(b'#');
             push_decimal(out, usize::from(c));
             if !self.defined[usize::from(c)] {
+                // Defined, then selected: xterm's `#Pc;2;...` only defines (DEC's selects
+                // too), and the band would be drawn in the register selected before.
                 out.extend_from_slice(&self.definitions[usize::from(c)]);
+                out.push(b'#');
+                push_decimal(out, usize::from(c));
                 self.defined[usize::from(c)] = true;
             }
             let cols = &mut self.columns[usize::from(c)];

@@ -123,7 +123,7 @@ fn runs_are_length_encoded() {
     let mut out = Vec::new();
     SixelEncoder::new(palette, (0, 0), None).encode(&[0; 100 * 6 * 3], 100, 6, &mut out);
     let text = String::from_utf8(out).unwrap();
-    assert!(text.ends_with("\"1;1;100;6#0;2;0;0;0!100~-\x1b\\"), "only the register used is defined: {text:?}");
+    assert!(text.ends_with("\"1;1;100;6#0;2;0;0;0#0!100~-\x1b\\"), "only the register used is defined: {text:?}");
     // A two-row stripe of white over black: passes overlap with `$`, empties are skipped.
     let mut rgb = vec![0u8; 10 * 6 * 3];
     rgb[..10 * 2 * 3].fill(255);
@@ -131,7 +131,7 @@ fn runs_are_length_encoded() {
     SixelEncoder::new(SixelPalette::for_registers(256), (0, 0), None).encode(&rgb, 10, 6, &mut out);
     let text = String::from_utf8(out).unwrap();
     // Black covers rows 2..6 (bits 0b111100 -> '?' + 60 = '{'), white rows 0..2 ('?' + 3 = 'B').
-    assert!(text.ends_with("#0;2;0;0;0!10{$#251;2;100;100;100!10B-\x1b\\"), "{text:?}");
+    assert!(text.ends_with("#0;2;0;0;0#0!10{$#251;2;100;100;100#251!10B-\x1b\\"), "{text:?}");
 }
 
 #[test]

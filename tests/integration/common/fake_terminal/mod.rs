@@ -28,9 +28,13 @@ use base64::Engine;
 use base64::engine::general_purpose::STANDARD as BASE64;
 use tidepool::terminal::TerminalModel;
 
+mod canvas;
 mod profiles;
+mod shown;
 
+pub use canvas::Canvas;
 pub use profiles::{Edits, Kitty, Placeholders, Profile, Sgr, Tcap};
+pub use shown::{Glance, Shown, Watch};
 
 /// kitty's chunked transmission in progress: the first chunk's keys, the payload so far.
 type Loading = (BTreeMap<char, String>, Vec<u8>);
@@ -46,6 +50,10 @@ pub struct FakeTerminal {
     pub placed: BTreeMap<u32, bool>,
     /// The sixel images received (each from `ESC P` to `ESC \`).
     pub sixels: Vec<Vec<u8>>,
+    /// The pixels the sixel images painted.
+    pub canvas: Canvas,
+    /// Sixel images icy_sixel could not decode.
+    pub broken_sixels: usize,
     /// The iTerm2 files received (their base64 payloads decoded).
     pub iterm2_files: Vec<Vec<u8>>,
     /// Everything received.
@@ -65,6 +73,8 @@ pub struct FakeTerminal {
 impl FakeTerminal {
     /// A terminal of `cols x rows` cells behaving as `profile`.
     pub fn new(profile: Profile, cols: usize, rows: usize) -> FakeTerminal {
+        let (w, h) = profile.cell_px.unwrap_or((8, 16));
+        let cell = (usize::from(w), usize::from(h));
         let mut screen = TerminalModel::new(cols, rows);
         // Raw mode: a line feed moves down only.
         screen.lf_returns = false;
@@ -74,6 +84,8 @@ impl FakeTerminal {
             kitty_stream: Vec::new(),
             placed: BTreeMap::new(),
             sixels: Vec::new(),
+            canvas: Canvas::new(cols, rows, cell),
+            broken_sixels: 0,
             iterm2_files: Vec::new(),
             raw: Vec::new(),
             da1_questions: 0,
@@ -88,24 +100,28 @@ impl FakeTerminal {
     /// Takes what the program wrote; returns the terminal's answers, in order.
     pub fn feed(&mut self, bytes: &[u8]) -> Vec<u8> {
         self.raw.extend_from_slice(bytes);
-        self.screen.feed(bytes);
         self.pending.extend_from_slice(bytes);
         let mut answers = Vec::new();
         let mut at = 0;
         let buf = std::mem::take(&mut self.pending);
+        // The screen sees each sequence as it is taken, so the cursor is where a picture that
+        // follows is drawn.
         while let Some(rel) = buf[at..].iter().position(|&b| b == 0x1b) {
             let start = at + rel;
             match sequence_len(&buf[start..]) {
                 Some(len) => {
+                    self.screen.feed(&buf[at..start + len]);
                     self.sequence(&buf[start..start + len], &mut answers);
                     at = start + len;
                 }
                 None => {
+                    self.screen.feed(&buf[at..start]);
                     self.pending = buf[start..].to_vec();
                     return answers;
                 }
             }
         }
+        self.screen.feed(&buf[at..]);
         answers
     }
 
@@ -207,6 +223,7 @@ impl FakeTerminal {
             answers.extend_from_slice(format!("\x1bP1$r{fg}m\x1b\\").as_bytes());
         } else if body.iter().take(16).any(|&b| b == b'q') && self.profile.da1.windows(2).any(|w| w == b";4") {
             self.sixels.push(whole.to_vec());
+            self.draw_sixel(whole);
         }
     }
 
@@ -398,10 +415,7 @@ pub struct DecodedImage {
 impl DecodedImage {
     /// How many distinct colours it has (a picture of water has hundreds; a flat image one).
     pub fn colours(&self) -> usize {
-        let mut seen: Vec<[u8; 3]> = self.rgb.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect();
-        seen.sort_unstable();
-        seen.dedup();
-        seen.len()
+        shown::distinct(&self.rgb)
     }
 }
 
