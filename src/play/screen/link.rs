@@ -448,7 +448,10 @@ impl LinkControl {
             // pace the window, never the rate.
             return Change::Hold;
         }
-        if first && !app_limited {
+        // Too few bytes before the first question (the set-up and a status line, sent before
+        // the bucket held anything) say nothing of the link either.
+        let informative = !app_limited && bytes >= FIRST_WINDOW / 4;
+        if first && informative {
             // The first frame crossed the link within this round trip: the link carries at
             // least that much, and the rate may be far above it (a 400 kB/s start on a 32 kB/s
             // link). Starting from it drains what the first frames queued, so the next round
@@ -458,9 +461,11 @@ impl LinkControl {
             // then (measured on the real 256 kbit/s link: the player's first question followed
             // 4 kB, and 400 kB/s ran on for seconds of falls).
             // A question after frames that left most of their budget unspent (the status line
-            // alone while the picture waits) says nothing of the link at all: the rate stays,
-            // and the window (sized from what that frame took) bounds the queue until answers
-            // to full frames measure the link (the rate fell to 16 kB/s on a 250 kB/s link).
+            // alone while the picture waits), or after a few hundred bytes, says nothing of the
+            // link at all: the rate stays, and the window (sized from what those bytes took)
+            // bounds the queue until answers to full frames measure the link (the rate fell to
+            // 16 kB/s on a 250 kB/s link, and on a local xterm whose first question followed
+            // 57 bytes).
             let shown = took.map_or(self.rate, |t| (t * DRAIN_SHARE).max(SAFE_RATE)).max(MIN_RATE);
             if shown < self.rate {
                 self.rate = shown.min(self.ceiling);
