@@ -106,6 +106,16 @@ impl Screen {
             return;
         }
         self.support = support.clone();
+        if choice.mode == GraphicsMode::Sixel && self.auto() && self.local_terminal() {
+            // A sixel terminal on this machine: its pty's blocking writes pace the pictures
+            // (the door drops frames while one is written). Measured in bytes, a sixel
+            // picture's cost is its pixels, not its bytes (xterm draws 2-5 MB/s of them); the
+            // link control settled at a few hundred kB/s and the stream drew its lowest rung,
+            // a coarse mosaic. Unlimited: whole pictures at full resolution, as fast as the
+            // terminal takes them.
+            self.config.bandwidth = Bandwidth::Unlimited;
+            self.bucket = ByteBucket::unlimited();
+        }
         let mut notice: Vec<String> = choice.hint.map(str::to_owned).into_iter().collect();
         self.auto_pixels = None;
         let mut drawn = choice.clone();
@@ -114,7 +124,7 @@ impl Screen {
                 Bandwidth::Fixed(rate) => Some(rate as f64),
                 Bandwidth::Auto | Bandwidth::Unlimited => None,
             };
-            let switch = picture::auto_switch(&choice, support, known);
+            let switch = picture::auto_switch(&choice, support, known, self.auto());
             if switch.mode() == GraphicsMode::Cells {
                 notice.push(picture::switch_notice(choice.mode, GraphicsMode::Cells, known));
                 drawn = probe::choose(GraphicsRequest::Force(GraphicsMode::Cells), None);
@@ -123,6 +133,12 @@ impl Screen {
         }
         let late = if first { "" } else { " (the terminal answered late)" };
         self.draw_with(drawn, notice, late);
+    }
+
+    /// Whether the terminal is on this machine: not over SSH (the probe's environment), and
+    /// nothing between (a multiplexer over SSH, mosh).
+    fn local_terminal(&self) -> bool {
+        self.config.probe.as_ref().is_some_and(|p| !p.env.ssh) && self.config.link_path == LinkPath::Direct
     }
 
     /// The colours from what the terminal said (`true_color`), when `--color` is `auto`: true

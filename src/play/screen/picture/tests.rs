@@ -352,3 +352,31 @@ fn kitty_without_frame_edits_gets_whole_pictures_over_a_fast_link_answering_late
         }
     }
 }
+
+#[test]
+fn a_local_sixel_terminal_gets_whole_pictures_at_full_resolution_and_over_a_link_auto_draws_cells() {
+    // xterm -ti vt340 on this machine: the pty paces the pictures, the link control does not
+    // (measured in bytes it settled at a few hundred kB/s and drew the lowest rung).
+    let t0 = Instant::now();
+    let mut local = config(Bandwidth::Auto, GraphicsRequest::Auto);
+    local.probe.as_mut().unwrap().env.ssh = false;
+    let mut s = screen(local, SIXEL, t0);
+    assert_eq!(s.mode(), GraphicsMode::Sixel);
+    assert_eq!(s.rate(), None, "no rate: the terminal's own pace");
+    let water = Water::new(s.picture_size(), 4);
+    for n in 1..=4u32 {
+        let out = frame(&mut s, &water, n as usize, t0 + FRAME * (2 * n));
+        assert!(!out.ends_with(link::PROBE), "no link questions");
+        let state = s.picture.as_ref().unwrap().state();
+        assert_eq!(state.size, (480, 281), "the top rung, every frame");
+    }
+    // Over SSH, sixel never beats cells on a measured link: cells from the start, and why.
+    let mut remote = screen(config(Bandwidth::Auto, GraphicsRequest::Auto), SIXEL, t0);
+    assert_eq!(remote.mode(), GraphicsMode::Cells);
+    let notice = remote.take_notice().unwrap();
+    assert!(notice.contains("sixel over a link: half-block cells are truer"), "{notice}");
+    // Asked for, sixel is drawn over the link too, at the link's rate.
+    let forced = screen(config(Bandwidth::Auto, GraphicsRequest::Force(GraphicsMode::Sixel)), SIXEL, t0);
+    assert_eq!(forced.mode(), GraphicsMode::Sixel);
+    assert!(forced.rate().is_some());
+}
