@@ -9,6 +9,7 @@
 use std::net::SocketAddr;
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
+use std::time::Instant;
 
 use russh::keys::ssh_key::HashAlg;
 use russh::server::{Auth, ChannelOpenHandle, Msg, PublicKeyOffer, Response, Session, VerifiedPublicKey};
@@ -51,7 +52,8 @@ pub struct ClientHandler {
     /// Whether the key's authorized_keys line allows a pty (`no-pty`, `restrict` take it away).
     pty_allowed: bool,
     terminal: Option<watch::Sender<TerminalState>>,
-    input: Option<mpsc::Sender<Vec<u8>>>,
+    /// The channel's bytes for the player task, with the moment each packet arrived.
+    input: Option<mpsc::Sender<(Instant, Vec<u8>)>>,
 }
 
 impl ClientHandler {
@@ -423,7 +425,7 @@ impl russh::server::Handler for ClientHandler {
             return Ok(());
         }
         if let Some(input) = &self.input
-            && input.try_send(data.to_vec()).is_err()
+            && input.try_send((Instant::now(), data.to_vec())).is_err()
         {
             self.hub.stats.input_dropped.fetch_add(1, Ordering::Relaxed);
         }
