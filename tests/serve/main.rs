@@ -7,6 +7,7 @@ mod common;
 #[allow(dead_code)]
 #[path = "../integration/common/fake_terminal/mod.rs"]
 mod fake_terminal;
+mod fake_terminals;
 mod groups;
 mod limits;
 mod load;

@@ -33,8 +33,8 @@ mod profiles;
 mod shown;
 
 pub use canvas::Canvas;
-pub use profiles::{Edits, Kitty, Placeholders, Profile, Sgr, Tcap};
-pub use shown::{Glance, Shown, Watch};
+pub use profiles::{Edits, Placeholders, Profile, Sgr, Tcap};
+pub use shown::{Shown, Watch};
 
 /// kitty's chunked transmission in progress: the first chunk's keys, the payload so far.
 type Loading = (BTreeMap<char, String>, Vec<u8>);
@@ -420,12 +420,6 @@ impl DecodedImage {
 }
 
 impl FakeTerminal {
-    /// The kitty images the terminal holds, read from the commands it accepted by the
-    /// independent decoder (needs `python3`: without it this fails, it does not skip).
-    pub fn kitty_images(&self) -> Vec<DecodedImage> {
-        FakeTerminal::decode_kitty(self.profile.name, &self.kitty_stream)
-    }
-
     /// Decodes a kitty command stream (as [`FakeTerminal::kitty_stream`] keeps it) with the
     /// independent decoder; `name` keeps parallel tests' files apart.
     pub fn decode_kitty(name: &str, stream: &[u8]) -> Vec<DecodedImage> {
