@@ -63,12 +63,21 @@ def run(cmd, check=True, **kw):
 
 
 class Lab:
-    """The namespaces, the shaped veth pair, sshd, relays; torn down by `close`."""
+    """The namespaces, the shaped veth pair, sshd, relays; torn down by `close`.
 
-    def __init__(self, tidepool, lifetime):
+    `prefix` names the namespaces (PREFIXc, PREFIXs; default tpc/tps and this process's id),
+    `subnet` their addresses (SUBNET.1 and SUBNET.2). `stock`: Debian's own sshd configuration
+    (/etc/ssh/sshd_config: port 22, `AcceptEnv LANG LC_*` only, PAM), read after four lines
+    that only say where this run's keys and pid file are, instead of the harness's own
+    (port 2222, `AcceptEnv COLORTERM`)."""
+
+    def __init__(self, tidepool, lifetime, prefix=None, subnet=None, stock=False):
         tag = str(os.getpid())
-        self.client_ns, self.server_ns = f"tpc{tag}", f"tps{tag}"
-        self.veth_client, self.veth_server = f"tpc{tag}"[:15], f"tps{tag}"[:15]
+        self.client_ns, self.server_ns = (f"{prefix}c", f"{prefix}s") if prefix else (f"tpc{tag}", f"tps{tag}")
+        self.veth_client, self.veth_server = self.client_ns[:15], self.server_ns[:15]
+        self.client_ip, self.server_ip = (f"{subnet}.1", f"{subnet}.2") if subnet else (CLIENT_IP, SERVER_IP)
+        self.stock = stock
+        self.ssh_port = 22 if stock else SSH_PORT
         self.dir = tempfile.mkdtemp(prefix="link-harness-")
         self.tidepool = tidepool
         self.lifetime = lifetime
@@ -86,7 +95,7 @@ class Lab:
         run(["ip", "link", "add", self.veth_client, "type", "veth", "peer", "name", self.veth_server])
         run(["ip", "link", "set", self.veth_client, "netns", self.client_ns])
         run(["ip", "link", "set", self.veth_server, "netns", self.server_ns])
-        for ns, dev, ip in ((self.client_ns, self.veth_client, CLIENT_IP), (self.server_ns, self.veth_server, SERVER_IP)):
+        for ns, dev, ip in ((self.client_ns, self.veth_client, self.client_ip), (self.server_ns, self.veth_server, self.server_ip)):
             run(self.ns(ns, "ip", "addr", "add", f"{ip}/{PREFIX}", "dev", dev))
             run(self.ns(ns, "ip", "link", "set", dev, "up"))
             run(self.ns(ns, "ip", "link", "set", "lo", "up"))
@@ -96,9 +105,16 @@ class Lab:
         shutil.copy(f"{self.dir}/client_key.pub", f"{self.dir}/authorized_keys")
         os.makedirs("/run/sshd", exist_ok=True)
         with open(f"{self.dir}/sshd_config", "w") as f:
-            f.write(
+            # sshd takes the first value it reads of each keyword: these four, then Debian's.
+            stock = f"""HostKey {self.dir}/host_key
+PidFile {self.dir}/sshd.pid
+AuthorizedKeysFile {self.dir}/authorized_keys
+StrictModes no
+Include /etc/ssh/sshd_config
+"""
+            f.write(stock if self.stock else
                 f"""Port {SSH_PORT}
-ListenAddress {SERVER_IP}
+ListenAddress {self.server_ip}
 HostKey {self.dir}/host_key
 PidFile {self.dir}/sshd.pid
 AuthorizedKeysFile {self.dir}/authorized_keys
@@ -114,7 +130,7 @@ PrintLastLog no
             )
         run(["/usr/sbin/sshd", "-t", "-f", f"{self.dir}/sshd_config"])
         self.start(self.ns(self.server_ns, "/usr/sbin/sshd", "-D", "-e", "-f", f"{self.dir}/sshd_config"), "sshd")
-        serve = [self.tidepool, "serve", "--listen", f"{SERVER_IP}:{SERVE_PORT}", "--host-key", f"{self.dir}/serve_key"]
+        serve = [self.tidepool, "serve", "--listen", f"{self.server_ip}:{SERVE_PORT}", "--host-key", f"{self.dir}/serve_key"]
         self.start(self.ns(self.server_ns, *serve), "tidepool serve")
         deadline = time.monotonic() + 20
         for name, word in (("sshd", "Server listening"), ("tidepool_serve", "listening on")):
@@ -131,15 +147,18 @@ PrintLastLog no
         return proc
 
     def shape(self, rate, rtt_ms):
-        """Shapes both ends to `rate` and puts relays with `rtt_ms` of round trip in front."""
+        """Shapes both ends to `rate` and puts relays with `rtt_ms` of round trip in front
+        (`rtt_ms` None: no relays, the plain shaped link)."""
         for ns, dev in ((self.client_ns, self.veth_client), (self.server_ns, self.veth_server)):
             run(self.ns(ns, "tc", "qdisc", "replace", "dev", dev, "root", "tbf", "rate", rate, "burst", "32kbit", "latency", "400ms"))
+        if rtt_ms is None:
+            return
         for proc, _ in self.relays:
             stop(proc)
         self.relays = []
         relay = [sys.executable, f"{HERE}/relay.py"]
         for kind, port, target in (("tcp", RELAY_SSH, SSH_PORT), ("tcp", RELAY_SERVE, SERVE_PORT), ("udp", MOSH_PORT, MOSH_PORT)):
-            cmd = self.ns(self.client_ns, *relay, kind, "127.0.0.1", str(port), SERVER_IP, str(target), str(rtt_ms), str(self.lifetime))
+            cmd = self.ns(self.client_ns, *relay, kind, "127.0.0.1", str(port), self.server_ip, str(target), str(rtt_ms), str(self.lifetime))
             self.relays.append((self.start(cmd, f"relay {kind} {port}"), f"relay_{kind}_{port}"))
         # Each relay says when it listens (Python starts slowly on a loaded machine).
         deadline = time.monotonic() + 20
@@ -149,12 +168,15 @@ PrintLastLog no
                     raise RuntimeError(f"the relay {name} did not start: {read_text(f'{self.dir}/{name}.log')[-300:]}")
                 time.sleep(0.05)
 
-    def ssh_command(self, port, remote=None, tty=True):
+    def ssh_command(self, port, remote=None, tty=True, host="127.0.0.1", send_env=True):
+        """The ssh client's command: to `host` (the relay on 127.0.0.1 by default), `-tt` for a
+        pty whatever its input; `send_env`: COLORTERM too (the harness's own sshd takes it;
+        OpenSSH sends nothing by default and Debian's sshd takes only LANG/LC_*)."""
         cmd = ["ssh", "-F", "/dev/null", "-i", f"{self.dir}/client_key", "-p", str(port)]
         cmd += ["-o", "IdentitiesOnly=yes", "-o", f"UserKnownHostsFile={self.dir}/known_hosts", "-o", "StrictHostKeyChecking=no"]
-        cmd += ["-o", "LogLevel=ERROR", "-o", "SendEnv=COLORTERM"]
-        cmd += ["-t"] if tty else []
-        cmd += ["root@127.0.0.1"]
+        cmd += ["-o", "LogLevel=ERROR"] + (["-o", "SendEnv=COLORTERM"] if send_env else [])
+        cmd += ["-tt"] if tty else []
+        cmd += [f"root@{host}"]
         if remote:
             cmd += ["--", remote]
         return cmd
