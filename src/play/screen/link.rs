@@ -490,7 +490,11 @@ impl LinkControl {
             // queue would take six to go.
             self.fall(now, if queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE });
             Change::Down
-        } else if queue < low && self.rate < self.ceiling {
+        } else if queue < low && self.rate < self.ceiling && !app_limited {
+            // Only a sender that used its budget learns that the link carries more: one that
+            // left it unspent (cells of calm water) would grow the rate without evidence, to
+            // "no limit" on a 250 kB/s link, and `auto` then switched to pixels that queued
+            // for seconds.
             let growth = if self.fell { INCREASE_AFTER_LIMIT } else { INCREASE };
             self.rate = (self.rate * growth).min(self.ceiling);
             self.decided_at = Some(now);
