@@ -591,13 +591,10 @@ fn changed_cells(
     let (x0, y0) = (left / cw * cw, top / ch * ch);
     let x1 = ((right + 1).div_ceil(cw) * cw).min(width);
     let y1 = ((bottom + 1).div_ceil(ch) * ch).min(height);
-    // Whole bands: a terminal may size an image by its bands; one that ends below the
-    // picture could reach the status line.
-    let h = (y1 - y0).div_ceil(6) * 6;
-    if y0 + h > height {
-        return Some((0, 0, width, height));
-    }
-    Some((x0, y0, x1 - x0, h))
+    // Whole cells, not whole bands (the last band may be partial): mlterm 3.9 sizes an image
+    // in whole cells and fills the rest of a row of cells it reaches into with its background,
+    // blanking the picture below a block a few rows taller than its cells.
+    Some((x0, y0, x1 - x0, y1 - y0))
 }
 
 /// The picture the terminal shows for `rgb` after dithering with `palette` (each pixel its

@@ -675,15 +675,16 @@ fn part_box(part: Part, size: (u32, u32)) -> (u32, u32, u32, u32) {
     }
 }
 
-/// The part of a sixel picture to send: the block of whole cells (and whole bands) around the
-/// changes, the whole picture when that block reaches its bottom; `None` when nothing changed.
+/// The part of a sixel picture to send: the block of whole cells around the changes (its last
+/// band may be partial: mlterm blanks the rest of a row of cells an image reaches into), the
+/// whole picture when that block is all of it; `None` when nothing changed.
 fn sixel_part(old: &[u8], new: &[u8], screen: (u32, u32), cell_px: (u16, u16)) -> Option<Part> {
     let (cw, ch) = (u32::from(cell_px.0.max(1)), u32::from(cell_px.1.max(1)));
     let (left, top, bw, bh) = scan::changed_box(old, new, screen.0, 1, 0..screen.1)?;
     let (x0, y0) = (left / cw * cw, top / ch * ch);
     let x1 = ((left + bw).div_ceil(cw) * cw).min(screen.0);
-    let h = ((top + bh).div_ceil(ch) * ch).min(screen.1).saturating_sub(y0).div_ceil(6) * 6;
-    if y0 + h > screen.1 || (x0, y0, x1 - x0, h) == (0, 0, screen.0, screen.1) {
+    let h = ((top + bh).div_ceil(ch) * ch).min(screen.1) - y0;
+    if (x0, y0, x1 - x0, h) == (0, 0, screen.0, screen.1) {
         return Some(Part::Whole);
     }
     Some(Part::Changed(x0, y0, x1 - x0, h))
