@@ -177,7 +177,9 @@ def main():
             local_serve = subprocess.Popen(
                 [tidepool, "serve", "--listen", f"127.0.0.1:{LOCAL_SERVE_PORT}", "--host-key", f"{lab.dir}/local_serve_key"],
                 stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=open(f"{lab.dir}/local_serve.log", "wb"))
-        xvfb = subprocess.Popen(["Xvfb", args.display, "-screen", "0", "1600x1000x24"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        # -noreset: Xvfb resets when its last client leaves, and a terminal opened during the
+        # reset cannot open the display (xterm, then kitty, failed so between two runs).
+        xvfb = subprocess.Popen(["Xvfb", args.display, "-noreset", "-screen", "0", "1600x1000x24"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         time.sleep(2)
         env = dict(os.environ, DISPLAY=args.display)
         for var in ("TMUX", "SSH_CONNECTION", "SSH_TTY", "SSH_CLIENT", "KITTY_WINDOW_ID", "TERM_PROGRAM", "COLORTERM"):
