@@ -151,7 +151,7 @@ pub struct ProbeOptions {
     /// over SSH). The caller writes it before and removes it after the probe if the terminal
     /// did not.
     pub kitty_file: Option<std::path::PathBuf>,
-    /// Ask whether the terminal draws 24-bit colour ([`COLOUR_QUERIES`]): set by the screen
+    /// Ask whether the terminal draws 24-bit colour (`COLOUR_QUERIES`): set by the screen
     /// when `--color auto` guessed 256 colours from the environment (a guess of 16 is a
     /// terminal too plain for the question's 24-bit SGR colour).
     pub colours: bool,
