@@ -243,7 +243,7 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
     for (n, shot) in shots.iter().enumerate() {
         let now = t0 + frame * (n as u32 + 1);
         bucket.refill(now);
-        let budget = Budget { available: bucket.budget(), rate, frame_interval: frame };
+        let budget = Budget::new(bucket.budget(), rate, frame);
         let started = Instant::now();
         let offer = stream.prepare(shot, budget, now).map(|o| o.bytes.to_vec());
         row.times.push(started.elapsed());

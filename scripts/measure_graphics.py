@@ -29,6 +29,8 @@ DA1_QUESTION = b"\x1b[c"
 DA1_ANSWER = b"\x1b[?62;4;22c"
 # xterm -ti vt340 -xrm 'XTerm*numColorRegisters: 256' -xrm 'XTerm*maxGraphicSize: 2000x2000'.
 SIXEL_ANSWERS = b"\x1b[?1;0;256S\x1b[?2;0;2000;2000S"
+# kitty's OK to the probe's graphics query (a forced protocol the answers rule out draws cells).
+KITTY_OK = b"\x1b_Gi=31;OK\x1b\\"
 # kitty's OK to the probe's frame-edit test (image id IMAGE_ID + 2).
 KITTY_EDIT_OK = b"\x1b_Gi=7627890;OK\x1b\\"
 SYNC_BEGIN = b"\x1b[?2026h"
@@ -80,7 +82,8 @@ def measure(mode, seconds):
         for _ in range(data.count(DA1_QUESTION)):
             answer = DA1_ANSWER
             if asked == 0:
-                answer = SIXEL_ANSWERS + (KITTY_EDIT_OK if mode == "kitty-edits" else b"") + DA1_ANSWER
+                kitty = KITTY_OK + (KITTY_EDIT_OK if mode == "kitty-edits" else b"")
+                answer = (kitty if graphics == "kitty" else b"") + SIXEL_ANSWERS + DA1_ANSWER
             os.write(master, answer)
             asked += 1
         if counting:

@@ -136,6 +136,7 @@ fn player_frames(scene: SceneSpec) -> usize {
             fps: 60,
             bandwidth: Bandwidth::Unlimited,
             color: ColorMode::TrueColor,
+            color_auto: false,
             encode: EncodeOptions { threshold: 0, sync: true },
             graphics: GraphicsRequest::Auto,
             probe: None,

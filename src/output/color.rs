@@ -1,10 +1,13 @@
 //! Terminal colours: what the terminal understands, and how a pixel becomes one of its colours.
 //!
-//! - Detection follows the usual signals: `COLORTERM=truecolor|24bit`, or a `TERM` ending in
-//!   `-direct`, means 24-bit colour; a `TERM` naming 256 colours (or any other modern `TERM`)
-//!   means the xterm 256-colour palette; `linux`, `vt100`/`vt220`, `ansi` and `dumb` mean 16.
-//!   SSH does not forward `COLORTERM` by default and tmux hides it unless told, so `--color`
-//!   always overrides the guess (see docs/GUIDE.md, "Truecolor over SSH and in tmux").
+//! - Detection follows the usual signals: `COLORTERM=truecolor|24bit`, a `TERM` ending in
+//!   `-direct`, or the `TERM` of a terminal that always draws 24-bit colour
+//!   ([`TRUE_COLOR_TERMS`]: kitty, Ghostty, WezTerm, foot, Alacritty, ...) means 24-bit colour;
+//!   a `TERM` naming 256 colours (or any other modern `TERM`) means the xterm 256-colour
+//!   palette; `linux`, `vt100`/`vt220`, `ansi` and `dumb` mean 16. SSH does not forward
+//!   `COLORTERM` (and Debian's sshd accepts only `LANG`/`LC_*`) while `TERM` does cross, so the
+//!   names matter there; the player then also asks the terminal (`play::screen::probe`), and
+//!   `--color` always overrides the guess.
 //! - The 256-colour palette is matched against the real xterm levels (0, 95, 135, 175, 215, 255
 //!   for the cube; 8..=238 step 10 for the grey ramp), with the midpoints as thresholds, not the
 //!   divide-by-43 shortcut, which picks the wrong level for a third of the values.
@@ -67,6 +70,23 @@ impl Color {
     }
 }
 
+/// `TERM` names of terminals that always draw 24-bit colour (each sets its own name and has
+/// no palette-only mode): kitty, Ghostty, WezTerm (with its terminfo installed), foot,
+/// Alacritty, Contour, Rio, iTerm2's own entry.
+pub const TRUE_COLOR_TERMS: &[&str] = &[
+    "xterm-kitty",
+    "xterm-ghostty",
+    "ghostty",
+    "wezterm",
+    "foot",
+    "foot-extra",
+    "alacritty",
+    "contour",
+    "contour-latest",
+    "rio",
+    "iterm2",
+];
+
 /// Bayer 4x4 thresholds, 0..16.
 const BAYER4: [[u8; 4]; 4] = [[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]];
 
@@ -88,7 +108,11 @@ impl ColorMode {
     pub fn detect(colorterm: Option<&str>, term: Option<&str>) -> ColorMode {
         let colorterm = colorterm.unwrap_or("").to_ascii_lowercase();
         let term = term.unwrap_or("").to_ascii_lowercase();
-        if colorterm == "truecolor" || colorterm == "24bit" || term.ends_with("-direct") {
+        if colorterm == "truecolor"
+            || colorterm == "24bit"
+            || term.ends_with("-direct")
+            || TRUE_COLOR_TERMS.contains(&term.as_str())
+        {
             return ColorMode::TrueColor;
         }
         let basic = ["linux", "vt100", "vt102", "vt220", "ansi", "dumb", "cons25", "xterm-color", "xterm-16color"];
@@ -160,7 +184,12 @@ mod tests {
         assert_eq!(ColorMode::detect(Some("24bit"), None), TrueColor);
         assert_eq!(ColorMode::detect(None, Some("xterm-direct")), TrueColor);
         assert_eq!(ColorMode::detect(None, Some("tmux-256color")), Palette256);
-        assert_eq!(ColorMode::detect(Some(""), Some("xterm-kitty")), Palette256);
+        // Terminals that always draw 24-bit colour, by their own TERM (over SSH COLORTERM is
+        // gone, TERM is not).
+        assert_eq!(ColorMode::detect(Some(""), Some("xterm-kitty")), TrueColor);
+        assert_eq!(ColorMode::detect(None, Some("xterm-ghostty")), TrueColor);
+        assert_eq!(ColorMode::detect(None, Some("foot")), TrueColor);
+        assert_eq!(ColorMode::detect(None, Some("xterm-256color")), Palette256);
         assert_eq!(ColorMode::detect(None, Some("linux")), Palette16);
         assert_eq!(ColorMode::detect(None, None), Palette16);
     }

@@ -167,6 +167,7 @@ impl Group {
             fps: key.fps,
             bandwidth,
             color: key.color,
+            color_auto: false,
             encode: key.encode,
             graphics: GraphicsRequest::Force(GraphicsMode::Cells),
             probe: None,

@@ -29,6 +29,7 @@
 //!     fps: 30,
 //!     bandwidth: Bandwidth::Unlimited,
 //!     color: Default::default(),
+//!     color_auto: false,
 //!     encode: Default::default(),
 //!     graphics: Default::default(),
 //!     probe: None,

@@ -65,6 +65,9 @@ pub struct ScreenConfig {
     pub bandwidth: Bandwidth,
     /// Terminal colours.
     pub color: ColorMode,
+    /// `color` is a guess from the environment (`--color auto`): the terminal's answers to the
+    /// probe raise it to true colour, and otherwise the status line says how to get it.
+    pub color_auto: bool,
     /// Encoder options (colour threshold, synchronized output).
     pub encode: EncodeOptions,
     /// How the picture is drawn (`--graphics`).
@@ -97,6 +100,13 @@ const APPROXIMATE_BELOW: f64 = 1_000_000.0;
 /// After the probe's deadline, how long its answers may still arrive and upgrade the picture
 /// (a far terminal answers a round trip later; a silent one is given up on after this).
 pub const LATE_ANSWERS: Duration = Duration::from_secs(5);
+
+/// What the status line says when `--color auto` stays below true colour: neither the
+/// environment (`COLORTERM`, which SSH does not carry, or a `TERM` known for it) nor the
+/// terminal's answers said it draws more, and the one flag that gives it.
+pub(crate) fn colour_hint(mode: ColorMode) -> String {
+    format!("{} colours (the terminal did not say more): try --color truecolor", mode.name())
+}
 
 /// The probe's progress.
 #[derive(Debug)]
@@ -134,6 +144,8 @@ pub struct Screen {
     /// The picture's layout changed since [`Screen::take_layout_change`] last said so.
     layout_changed: bool,
     notice: Option<String>,
+    /// The colours stayed below true colour under `--color auto`: say how to get it, once.
+    colour_hint: bool,
     pacer: FramePacer,
     bucket: ByteBucket,
     link: LinkControl,
@@ -185,6 +197,7 @@ impl Screen {
             mouse_pixels_pending: false,
             layout_changed: false,
             notice: None,
+            colour_hint: false,
             bucket,
             link,
             encoder: RateEncoder::new(),
@@ -199,10 +212,13 @@ impl Screen {
     /// asked (nothing otherwise). No frame is drawn until the answers are in or
     /// `PROBE_BUDGET` (500 ms) has passed.
     pub fn start(&mut self, now: Instant, out: &mut Vec<u8>) {
-        let Some(options) = self.config.probe.clone().filter(|_| matches!(self.asking, Asking::No)) else {
+        let Some(mut options) = self.config.probe.clone().filter(|_| matches!(self.asking, Asking::No)) else {
+            self.settle_colours(false);
             return;
         };
+        options.colours = self.config.color_auto && self.config.color == ColorMode::Palette256;
         if self.config.graphics == GraphicsRequest::Force(GraphicsMode::Cells) || self.entered {
+            self.settle_colours(false);
             return;
         }
         out.extend_from_slice(&probe::queries(&options));
@@ -307,7 +323,11 @@ impl Screen {
 
     /// Something to tell the person (which protocol draws, how to get pictures), once.
     pub fn take_notice(&mut self) -> Option<String> {
-        self.notice.take()
+        let colours = std::mem::take(&mut self.colour_hint).then(|| colour_hint(self.config.color));
+        match (self.notice.take(), colours) {
+            (Some(notice), Some(colours)) => Some(format!("{notice}; {colours}")),
+            (notice, colours) => notice.or(colours),
+        }
     }
 
     /// The picture `Screen::frame` takes, in pixels: the half-block picture (a pixel a
@@ -389,11 +409,12 @@ impl Screen {
             note: if self.auto() { self.link.hint() } else { None },
         };
         // On an auto link the unanswered bytes are capped too (see `link`: the first seconds).
-        let budget = if self.auto() {
-            self.bucket.budget().min(self.link.window_left(now, self.bytes_sent))
-        } else {
-            self.bucket.budget()
-        };
+        let window_left = if self.auto() { self.link.window_left(now, self.bytes_sent) } else { usize::MAX };
+        let budget = self.bucket.budget().min(window_left);
+        // The bucket as full as it gets and nothing big unanswered: a picture bigger than both
+        // may go now (and is owed), so a picture that never fits them still shows.
+        let overdraw =
+            self.bucket.budget() as f64 + 1.0 >= self.bucket.capacity() && window_left >= link::MIN_WINDOW as usize / 2;
         let options = RateOptions {
             approximate: rate.is_some_and(|r| r < APPROXIMATE_BELOW),
             ..RateOptions::from(self.config.encode)
@@ -439,10 +460,13 @@ impl Screen {
                 available: budget.saturating_sub(report.bytes),
                 rate,
                 frame_interval: Duration::from_secs(1) / self.config.fps.max(1),
+                overdraw,
             };
             let sent = p.add_to_frame(picture, &frame, left, now, &mut bytes);
             if sent > 0 {
-                self.bucket.spend(sent);
+                // Beyond the budget when overdrawn: the bucket is in debt until the rate has
+                // repaid it.
+                self.bucket.owe(sent);
                 self.shown.cursor = Cursor::Unknown;
             }
             spent += sent;

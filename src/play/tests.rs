@@ -18,6 +18,7 @@ fn session(t0: Instant, script: &[(u32, &[u8])], frames: u32) -> Vec<u8> {
         fps: 30,
         bandwidth: Bandwidth::Fixed(60_000),
         color: Default::default(),
+        color_auto: false,
         encode: Default::default(),
         graphics: GraphicsRequest::Auto,
         probe: None,

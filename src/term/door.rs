@@ -36,6 +36,15 @@ pub trait TerminalInput: Send {
 
     /// The terminal's size in cells (columns, rows), asked for on every turn of the loop.
     fn size(&mut self) -> std::io::Result<(u16, u16)>;
+
+    /// When the bytes the last [`TerminalInput::read`] appended arrived, if the input knows
+    /// (it reads on a thread of its own); `None`: when they were read. The answers to the
+    /// link's questions are timed by it: read after a long frame, they still measure the
+    /// round trip, not the loop.
+    fn arrived(&self) -> Option<Instant> {
+        None
+    }
+
 }
 
 /// A session on one terminal.
@@ -82,7 +91,7 @@ pub fn run_door(
         if !input.read(&mut bytes, wait).map_err(read_error)? {
             return Ok(());
         }
-        player.settle(&bytes, Instant::now());
+        player.settle(&bytes, input.arrived().unwrap_or_else(Instant::now));
     }
     player.screen.resize(input.size().map_err(read_error)?);
     restore_prefix(player.screen.restore_prefix());
@@ -113,7 +122,7 @@ pub fn run_door(
                 return Ok(());
             }
             let now = Instant::now();
-            player.feed(&bytes, now);
+            player.feed(&bytes, input.arrived().unwrap_or(now));
             player.screen.resize(input.size().map_err(read_error)?);
             let turn = player.turn(now, host.status(), &mut requests);
             if turn.flow == Flow::Quit {
@@ -186,7 +195,7 @@ pub fn run_door(
         if !input.read(&mut bytes, wait.min(MAX_WAIT)).map_err(read_error)? {
             break;
         }
-        player.feed(&bytes, Instant::now());
+        player.feed(&bytes, input.arrived().unwrap_or_else(Instant::now));
     }
     let finished = host.finish();
     played.and(finished)

@@ -3,6 +3,7 @@
 //! its restore on every way out ([`tty`]), and the writer thread that never queues frames
 //! ([`writer`]). Everything the session decides lives in [`crate::play`]; this is I/O only.
 
+mod arrivals;
 pub mod door;
 pub mod tty;
 pub mod writer;

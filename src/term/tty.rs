@@ -28,6 +28,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Mutex, MutexGuard, Once, OnceLock};
 use std::time::{Duration, Instant};
 
+use super::arrivals::Arrivals;
 use super::door::{PlayConfig, TerminalInput, run_door};
 use crate::error::{Error, Result};
 use crate::output::graphics::{GraphicsMode, kitty};
@@ -66,8 +67,11 @@ pub fn play(mut config: PlayConfig) -> Result<()> {
     let guard = TerminalGuard::raw().map_err(setup)?;
     config.screen.probe = asks.then(|| probe_options(winsize, true));
     config.screen.link_path = link_path();
-    let mut input = Stdin { size: (winsize.cols, winsize.rows) };
+    let arrivals = Arrivals::stdin().map_err(setup)?;
+    let mut input = Stdin { size: (winsize.cols, winsize.rows), arrivals, arrived: None };
     let result = run_door(&mut input, TtyOut, config, &mut set_restore_prefix);
+    // The reading thread stops before the terminal is given back.
+    drop(input);
     drop(guard);
     set_restore_prefix(Vec::new());
     remove_temp_files();
@@ -111,7 +115,7 @@ fn probe_options(winsize: WinSize, file_medium: bool) -> ProbeOptions {
     let kitty_file = (file_medium && !env.ssh)
         .then(|| kitty::write_temp_file(&kitty::temp_dir(), PROBE_FILE_NUMBER, &[0, 0, 0]).ok())
         .flatten();
-    ProbeOptions { env, winsize, kitty_file }
+    ProbeOptions { env, winsize, kitty_file, colours: false }
 }
 
 /// Asks the terminal what it can show, waiting at most [`probe::PROBE_BUDGET`]; the terminal
@@ -310,37 +314,26 @@ pub fn restore() {
 /// Standard input, read without blocking past the player's deadline.
 struct Stdin {
     size: (u16, u16),
+    /// The descriptor, read on a thread that times each chunk as it arrives.
+    arrivals: Arrivals,
+    /// When the chunk the last read appended arrived.
+    arrived: Option<Instant>,
 }
 
 impl TerminalInput for Stdin {
     fn read(&mut self, buf: &mut Vec<u8>, timeout: Duration) -> io::Result<bool> {
-        use rustix::event::{PollFd, PollFlags, Timespec, poll};
-        let stdin = io::stdin();
-        let mut fds = [PollFd::new(&stdin, PollFlags::IN)];
-        let timeout = Timespec::try_from(timeout).unwrap_or(Timespec { tv_sec: 0, tv_nsec: 50_000_000 });
-        match poll(&mut fds, Some(&timeout)) {
-            Ok(0) => return Ok(true),
-            Ok(_) => {}
-            Err(rustix::io::Errno::INTR) => return Ok(true),
-            Err(e) => return Err(e.into()),
-        }
-        if fds[0].revents().intersects(PollFlags::HUP | PollFlags::ERR | PollFlags::NVAL)
-            && !fds[0].revents().contains(PollFlags::IN)
-        {
-            return Ok(false);
-        }
-        // Read the descriptor itself: std's buffered `Stdin` could keep bytes that `poll` then
-        // no longer sees.
-        let mut chunk = [0u8; 4096];
-        match rustix::io::read(stdin.as_fd(), &mut chunk) {
-            Ok(0) => Ok(false),
-            Ok(n) => {
-                buf.extend_from_slice(&chunk[..n]);
+        match self.arrivals.next(buf, timeout) {
+            Ok(at) => {
+                self.arrived = at;
                 Ok(true)
             }
-            Err(rustix::io::Errno::INTR | rustix::io::Errno::AGAIN) => Ok(true),
-            Err(e) => Err(e.into()),
+            Err(e) if e.kind() == io::ErrorKind::UnexpectedEof => Ok(false),
+            Err(e) => Err(e),
         }
+    }
+
+    fn arrived(&self) -> Option<Instant> {
+        self.arrived
     }
 
     fn size(&mut self) -> io::Result<(u16, u16)> {

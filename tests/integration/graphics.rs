@@ -69,8 +69,9 @@ fn assert_image_deleted_on_restore(p: &Player) {
 
 #[test]
 fn forced_kitty_frames_decode_into_the_scenes_picture() {
-    // The terminal answers DA1 only (no kitty): a forced mode is used as asked.
-    let mut p = spawn("gfx-kitty", &["--graphics", "kitty"], Some(DA1_ANSWER));
+    // A kitty terminal answering the probe (forcing kitty where the terminal answered without
+    // it draws cells instead: `fake_terminals.rs`).
+    let mut p = spawn("gfx-kitty", &["--graphics", "kitty"], Some(KITTY_ANSWERS));
     let start = p.wait_for(APC_G, 0, WAIT);
     p.wait_for(SYNC_END, start, WAIT);
     p.send(b"p");
@@ -151,7 +152,7 @@ fn a_silent_terminal_gets_cells_and_its_late_answers_never_become_keys() {
 
 #[test]
 fn sigterm_deletes_the_kitty_image() {
-    let mut p = spawn("gfx-sigterm", &["--graphics", "kitty"], Some(DA1_ANSWER));
+    let mut p = spawn("gfx-sigterm", &["--graphics", "kitty"], Some(KITTY_ANSWERS));
     let start = p.wait_for(APC_G, 0, WAIT);
     p.wait_for(SYNC_END, start, WAIT);
     p.signal("TERM");
@@ -208,7 +209,7 @@ fn render_into_a_pipe_asks_nothing_and_writes_half_blocks() {
 
 #[test]
 fn a_resize_resends_the_picture_for_the_new_cell_area() {
-    let mut p = spawn("gfx-resize", &["--graphics", "kitty"], Some(DA1_ANSWER));
+    let mut p = spawn("gfx-resize", &["--graphics", "kitty"], Some(KITTY_ANSWERS));
     let start = p.wait_for(b"c=100,r=11,", 0, WAIT);
     p.master.resize(portable_pty::PtySize { rows: 10, cols: 80, pixel_width: 0, pixel_height: 0 }).unwrap();
     (p.cols, p.rows) = (80, 10);

@@ -4,7 +4,6 @@
 //! a misreading of the protocol shared by the encoder and that decoder cannot pass. Needs
 //! `python3` (CI has it): without it the test fails, it does not skip.
 
-use std::process::Command;
 use std::time::{Duration, Instant};
 
 use tidepool::graphics::kitty::{IMAGE_ID, KittyEncoder, KittyOptions};
@@ -12,39 +11,13 @@ use tidepool::graphics::{Budget, GraphicsMode, Part, PictureStream, Protocol, pu
 use tidepool::graphics::{SCALED_CAP, layout};
 use tiny_skia::Pixmap;
 
-const DECODER: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/scripts/kitty_decode.py");
+use crate::common::fake_terminal::FakeTerminal;
 
-/// Decodes `stream` with the Python decoder: image id -> (width, height, RGB).
+/// Decodes `stream` with the Python decoder (`scripts/kitty_decode.py`, run as the fake
+/// terminals run it): image id -> (width, height, RGB).
 fn decode(name: &str, stream: &[u8]) -> Vec<(u32, u32, u32, Vec<u8>)> {
-    let dir = std::env::temp_dir().join(format!("tidepool-kitty-independent-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let input = dir.join("stream.bin");
-    std::fs::write(&input, stream).unwrap();
-    let out = Command::new("python3")
-        .arg(DECODER)
-        .arg(&input)
-        .arg(&dir)
-        .output()
-        .unwrap_or_else(|e| panic!("this test needs python3 to run the independent decoder ({DECODER}): {e}"));
-    assert!(
-        out.status.success(),
-        "the independent decoder refused the stream: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let images = String::from_utf8(out.stdout)
-        .unwrap()
-        .lines()
-        .map(|line| {
-            let v: Vec<u32> = line.split(' ').map(|x| x.parse().unwrap()).collect();
-            let ppm = std::fs::read(dir.join(format!("image-{}.ppm", v[0]))).unwrap();
-            let header = format!("P6\n{} {}\n255\n", v[1], v[2]);
-            assert!(ppm.starts_with(header.as_bytes()));
-            (v[0], v[1], v[2], ppm[header.len()..].to_vec())
-        })
-        .collect();
-    let _ = std::fs::remove_dir_all(&dir);
-    images
+    let name = format!("kitty-independent-{name}");
+    FakeTerminal::decode_kitty(&name, stream).into_iter().map(|i| (i.id, i.width, i.height, i.rgb)).collect()
 }
 
 fn pool(w: u32, h: u32, steps: u64) -> Pixmap {
@@ -100,7 +73,7 @@ fn picture_stream_offers_decode_to_the_picture_at_its_rung() {
         let mut last = None;
         for n in 0..24u32 {
             let picture = pool(sw, sh, 10 + u64::from(n / 8));
-            let budget = Budget { available, rate, frame_interval: frame };
+            let budget = Budget::new(available, rate, frame);
             if let Some(offer) = stream.prepare(&picture, budget, t0 + frame * (4 * n)) {
                 wire.extend_from_slice(offer.bytes);
                 parts.push(offer.state.part);
@@ -113,7 +86,7 @@ fn picture_stream_offers_decode_to_the_picture_at_its_rung() {
             assert!(parts.iter().any(|p| matches!(p, Part::Tile(..))), "{name}: {parts:?}");
             // The picture holds still: the tiles go on until the terminal shows all of it.
             for n in 24..400u32 {
-                let budget = Budget { available, rate, frame_interval: frame };
+                let budget = Budget::new(available, rate, frame);
                 if let Some(offer) = stream.prepare(&picture, budget, t0 + frame * (4 * n)) {
                     wire.extend_from_slice(offer.bytes);
                     stream.commit();

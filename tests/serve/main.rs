@@ -3,6 +3,11 @@
 
 mod bad_input;
 mod common;
+/// Fake graphics terminals (shared with the integration tests).
+#[allow(dead_code)]
+#[path = "../integration/common/fake_terminal/mod.rs"]
+mod fake_terminal;
+mod fake_terminals;
 mod groups;
 mod limits;
 mod load;

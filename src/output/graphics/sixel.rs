@@ -21,7 +21,10 @@
 //! **Bytes.** Raster attributes `"1;1;W;H` ask for square pixels, one per screen pixel; `P2=1`
 //! leaves pixels no colour covers as they are. The picture is cut into bands of six rows; in
 //! each band every colour used gets one pass (`#n`, then its sixels from its first to its last
-//! column, `$` back to the band's start), runs of four or more equal sixels are `!n`. Colours
+//! column, `$` back to the band's start), runs of four or more equal sixels are `!n`. A register
+//! is defined where an image first uses it and then selected again (`#n;2;r;g;b#n`): xterm's
+//! definition does not select, and without the second `#n` the band was drawn in the register
+//! selected before (a VT340 default: green). Colours
 //! and columns are collected per band in one pass over the band's pixels (each column's at most
 //! six registers and their bits, appended to each register's list), so the cost grows with the
 //! pixels, not with pixels x colours, and nothing of palette x width size is touched.
@@ -165,9 +168,10 @@ impl SixelPalette {
 /// When the colour registers are defined.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Registers {
-    /// Each image defines the registers it uses, where it first uses each (`#i;2;r;g;b`
-    /// selects as it defines): works in every terminal, and a small changed block defines only
-    /// its few colours instead of the whole palette (3.7 kB at 256 registers).
+    /// Each image defines the registers it uses, where it first uses each (`#i;2;r;g;b#i`:
+    /// defined, then selected, since xterm's definition does not select): works in every
+    /// terminal, and a small changed block defines only its few colours instead of the whole
+    /// palette (about 4 kB at 256 registers).
     PerImage,
     /// Each register is defined once, the first time any image uses it, and kept: only for a
     /// terminal whose images share their registers (xterm after `ESC [ ? 1070 l`, which the player
@@ -498,7 +502,11 @@ impl SixelEncoder {
             out.push(b'#');
             push_decimal(out, usize::from(c));
             if !self.defined[usize::from(c)] {
+                // Defined, then selected: xterm's `#Pc;2;...` only defines (DEC's selects
+                // too), and the band would be drawn in the register selected before.
                 out.extend_from_slice(&self.definitions[usize::from(c)]);
+                out.push(b'#');
+                push_decimal(out, usize::from(c));
                 self.defined[usize::from(c)] = true;
             }
             let cols = &mut self.columns[usize::from(c)];
@@ -583,13 +591,10 @@ fn changed_cells(
     let (x0, y0) = (left / cw * cw, top / ch * ch);
     let x1 = ((right + 1).div_ceil(cw) * cw).min(width);
     let y1 = ((bottom + 1).div_ceil(ch) * ch).min(height);
-    // Whole bands: a terminal may size an image by its bands; one that ends below the
-    // picture could reach the status line.
-    let h = (y1 - y0).div_ceil(6) * 6;
-    if y0 + h > height {
-        return Some((0, 0, width, height));
-    }
-    Some((x0, y0, x1 - x0, h))
+    // Whole cells, not whole bands (the last band may be partial): mlterm 3.9 sizes an image
+    // in whole cells and fills the rest of a row of cells it reaches into with its background,
+    // blanking the picture below a block a few rows taller than its cells.
+    Some((x0, y0, x1 - x0, y1 - y0))
 }
 
 /// The picture the terminal shows for `rgb` after dithering with `palette` (each pixel its

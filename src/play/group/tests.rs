@@ -19,6 +19,7 @@ fn player(t0: Instant) -> Player {
         fps: 30,
         bandwidth: Bandwidth::Unlimited,
         color: ColorMode::TrueColor,
+        color_auto: false,
         encode: EncodeOptions::default(),
         graphics: GraphicsRequest::Force(GraphicsMode::Cells),
         probe: None,

@@ -500,7 +500,10 @@ impl LinkControl {
             // pace the window, never the rate.
             return Change::Hold;
         }
-        if first {
+        // Too few bytes before the first question (the set-up and a status line, sent before
+        // the bucket held anything) say nothing of the link either.
+        let informative = !app_limited && bytes >= FIRST_WINDOW / 4;
+        if first && informative {
             // The first frame crossed the link within this round trip: the link carries at
             // least that much, and the rate may be far above it (a 400 kB/s start on a 32 kB/s
             // link). Starting from it drains what the first frames queued, so the next round
@@ -509,6 +512,12 @@ impl LinkControl {
             // A question after a few bytes says little of the link: never below the safe rate
             // then (measured on the real 256 kbit/s link: the player's first question followed
             // 4 kB, and 400 kB/s ran on for seconds of falls).
+            // A question after frames that left most of their budget unspent (the status line
+            // alone while the picture waits), or after a few hundred bytes, says nothing of the
+            // link at all: the rate stays, and the window (sized from what those bytes took)
+            // bounds the queue until answers to full frames measure the link (the rate fell to
+            // 16 kB/s on a 250 kB/s link, and on a local xterm whose first question followed
+            // 57 bytes).
             let shown = took.map_or(self.rate, |t| (t * DRAIN_SHARE).max(SAFE_RATE)).max(MIN_RATE);
             if shown < self.rate {
                 self.rate = shown.min(self.ceiling);
@@ -533,7 +542,11 @@ impl LinkControl {
             // queue would take six to go.
             self.fall(now, if queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE });
             Change::Down
-        } else if queue < low && self.rate < self.ceiling {
+        } else if queue < low && self.rate < self.ceiling && !app_limited {
+            // Only a sender that used its budget learns that the link carries more: one that
+            // left it unspent (cells of calm water) would grow the rate without evidence, to
+            // "no limit" on a 250 kB/s link, and `auto` then switched to pixels that queued
+            // for seconds.
             let growth = if self.fell { INCREASE_AFTER_LIMIT } else { INCREASE };
             self.rate = (self.rate * growth).min(self.ceiling);
             self.decided_at = Some(now);

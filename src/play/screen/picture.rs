@@ -183,18 +183,29 @@ pub fn switch_notice(pixels: GraphicsMode, to: GraphicsMode, rate: Option<f64>) 
         write_human_rate(&mut at, c as u64);
     }
     match to {
+        GraphicsMode::Cells if at.is_empty() => format!("{} over a link: half-block cells are truer", pixels.name()),
         GraphicsMode::Cells => format!("link {link}: half-block cells (truer than {} below {at})", pixels.name()),
         _ => format!("link {link}: pixels again"),
     }
 }
 
 /// `auto`'s switch between `choice`'s pixels and cells at the link's rate (`known`: a fixed
-/// `--bandwidth`). A kitty that reads the pictures from temporary files is on this machine and
+/// `--bandwidth`; `measured`: the rate will be measured, no `--bandwidth` was given). A kitty that reads the pictures from temporary files is on this machine and
 /// its pictures do not cross the link: it keeps them whatever the rate is measured at (see
 /// [`AutoSwitch::local`]).
-pub fn auto_switch(choice: &GraphicsChoice, support: &GraphicsSupport, known: Option<f64>) -> AutoSwitch {
+///
+/// A protocol that never beats cells over a link (sixel: no crossover) starts in cells when
+/// the link will be measured: its pictures would only show for the seconds before the switch.
+pub fn auto_switch(
+    choice: &GraphicsChoice,
+    support: &GraphicsSupport,
+    known: Option<f64>,
+    measured: bool,
+) -> AutoSwitch {
     if choice.mode == GraphicsMode::Kitty && support.kitty_temp_file && !choice.tmux_wrap {
         AutoSwitch::local(choice.mode)
+    } else if crossover(choice.mode).is_none() && measured {
+        AutoSwitch::new(choice.mode, Some(0.0))
     } else {
         AutoSwitch::new(choice.mode, known)
     }

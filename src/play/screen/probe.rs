@@ -19,6 +19,12 @@
 //! - `CSI 16 t` (cell size) and `CSI 14 t` (text area size), for when TIOCGWINSZ has no pixels;
 //! - DECRQM for SGR-pixels mouse (`?1016`) and synchronized output (`?2026`);
 //! - iTerm2's `OSC 1337 ; ReportCellSize`, which only iTerm2 answers;
+//! - true colour, two ways, since over SSH `COLORTERM` is gone (OpenSSH does not send it and
+//!   Debian's sshd accepts only `LANG`/`LC_*`) and `tidepool serve` never sees it:
+//!   XTGETTCAP (`DCS + q` for `RGB`, then `Tc`: the terminal's terminfo says it takes 24-bit
+//!   colours; xterm, kitty, foot answer from their own terminfo), and a 24-bit SGR colour set
+//!   and read back with DECRQSS (`DCS $ q m`): a terminal that keeps 24-bit colours reports
+//!   them as set, one that maps them to its palette reports an index (then reset);
 //! - DA1 (`CSI c`): sixel when its attributes include 4.
 //!
 //! **tmux** answers DA1 itself and swallows what it does not understand, so inside tmux (the
@@ -79,6 +85,12 @@ pub const TMUX_HINT: &str = "tmux hides pictures: `set -g allow-passthrough on` 
 /// What the status line says in tmux when the outer terminal speaks kitty graphics but has no
 /// Unicode placeholders, which images inside tmux need.
 pub const PLACEHOLDER_HINT: &str = "pictures inside tmux need kitty 0.28+ (Unicode placeholders)";
+/// What the status line says when `--graphics kitty` meets a terminal that answered the probe
+/// but not kitty's graphics query: its pictures would never show.
+pub const NO_KITTY: &str = "no answer to kitty's graphics query: half-block cells";
+/// What the status line says when `--graphics sixel` meets a terminal whose device attributes
+/// do not include sixel.
+pub const NO_SIXEL: &str = "the terminal does not say it draws sixel: half-block cells";
 /// A 1x1 black RGB pixel, base64.
 const ONE_PIXEL: &str = "AAAA";
 
@@ -139,6 +151,10 @@ pub struct ProbeOptions {
     /// over SSH). The caller writes it before and removes it after the probe if the terminal
     /// did not.
     pub kitty_file: Option<std::path::PathBuf>,
+    /// Ask whether the terminal draws 24-bit colour (`COLOUR_QUERIES`): set by the screen
+    /// when `--color auto` guessed 256 colours from the environment (a guess of 16 is a
+    /// terminal too plain for the question's 24-bit SGR colour).
+    pub colours: bool,
 }
 
 /// Sixel support.
@@ -186,6 +202,9 @@ pub struct GraphicsSupport {
     pub tmux: bool,
     /// tmux passes sequences through to the outer terminal.
     pub tmux_passthrough: bool,
+    /// The terminal says it draws 24-bit colour (XTGETTCAP `RGB` or `Tc`, or a 24-bit SGR
+    /// colour read back as set).
+    pub true_color: bool,
 }
 
 impl GraphicsSupport {
@@ -218,7 +237,8 @@ pub fn queries(options: &ProbeOptions) -> Vec<u8> {
     let mut out = Vec::new();
     if options.env.tmux {
         // tmux answers these itself, at once.
-        for q in [SIXEL, b"\x1b[?2026$p", DA1] {
+        let colours: &[u8] = if options.colours { COLOUR_QUERIES } else { b"" };
+        for q in [SIXEL, b"\x1b[?2026$p", colours, DA1] {
             out.extend_from_slice(q);
         }
         // These reach the outer terminal only through passthrough; each sequence on its own.
@@ -228,11 +248,37 @@ pub fn queries(options: &ProbeOptions) -> Vec<u8> {
             tmux::push_wrapped(&mut out, q);
         }
     } else {
-        for q in [&kitty_queries[..], SIXEL, CELLS, MODES, ITERM2, DA1] {
+        let colours: &[u8] = if options.colours { COLOUR_QUERIES } else { b"" };
+        for q in [&kitty_queries[..], SIXEL, CELLS, MODES, ITERM2, colours, DA1] {
             out.extend_from_slice(q);
         }
     }
     out
+}
+
+/// The true-colour questions: XTGETTCAP for `RGB` and for `Tc` (one name a request: xterm
+/// stops a list at its first unknown name), then a 24-bit foreground set, read back with
+/// DECRQSS and reset.
+pub const COLOUR_QUERIES: &[u8] = b"\x1bP+q524742\x1b\\\x1bP+q5463\x1b\\\x1b[38;2;1;2;3m\x1bP$qm\x1b\\\x1b[m";
+
+/// Whether a DCS reply says the terminal draws 24-bit colour: XTGETTCAP found `RGB` or `Tc`
+/// (`1+r524742...`, `1+r5463...`), or DECRQSS read the probe's colour 1, 2, 3 back as a 24-bit
+/// one (`1$r...38:2::1:2:3m`, `38:2:1:2:3` or `38;2;1;2;3`).
+fn says_true_color(body: &[u8]) -> bool {
+    if let Some(found) = body.strip_prefix(b"1+r") {
+        return found.starts_with(b"524742") || found.starts_with(b"5463");
+    }
+    let Some(sgr) = body.strip_prefix(b"1$r").and_then(|b| b.strip_suffix(b"m")) else {
+        return false;
+    };
+    let text = String::from_utf8_lossy(sgr);
+    ["38:2::1:2:3", "38:2:1:2:3", "38;2;1;2;3"].iter().any(|form| {
+        text.match_indices(form).any(|(at, f)| {
+            let before = text[..at].chars().last();
+            let after = text[at + f.len()..].chars().next();
+            before.is_none_or(|c| c == ';') && after.is_none_or(|c| c == ';')
+        })
+    })
 }
 
 fn file_query(path: &Path) -> String {
@@ -385,6 +431,7 @@ impl Probe {
                 }
                 Reply::ModeReport { mode: 1016, state: 1..=3, private: true } => support.sgr_pixels_mouse = !env.tmux,
                 Reply::ModeReport { mode: 2026, state: 1..=3, private: true } => support.sync_output = true,
+                Reply::Dcs(body) if says_true_color(body) => support.true_color = true,
                 _ => {}
             }
         }
@@ -420,10 +467,12 @@ impl Probe {
             .or_else(|| iterm2_cell.and_then(fits));
         if !answered {
             // Nothing that arrived can be trusted to be complete.
+            // Except a colour the terminal said it draws: that answer is complete in itself.
             support = GraphicsSupport {
                 garbled: self.garbled,
                 tmux: env.tmux,
                 cell_px: support.cell_px,
+                true_color: support.true_color && !self.garbled,
                 ..Default::default()
             };
         }
@@ -491,9 +540,16 @@ pub fn should_probe(stdin_is_tty: bool, stdout_is_tty: bool) -> bool {
 /// The mode for `request` given what the probe found (`None`: no probe was made). `auto`
 /// prefers kitty (exact colours, scaled by the terminal, changed rectangles), then sixel, then
 /// iTerm2 (a whole PNG every frame), then cells. Inside tmux kitty needs passthrough and
-/// Unicode placeholders (the probe tests both), sixel is used only when tmux draws it itself, and iTerm2 is not used (its
-/// images are not placed through tmux). A forced mode is used as asked, wrapped for tmux when
-/// inside it.
+/// Unicode placeholders (the probe tests both), sixel is used only when tmux draws it itself,
+/// and iTerm2 is not used (its images are not placed through tmux).
+///
+/// A forced mode is used as asked (wrapped for tmux when inside it) unless the terminal's
+/// answers say its pictures would never show: a terminal that answered the probe but not
+/// kitty's query, or whose attributes lack sixel, or tmux without passthrough or placeholders,
+/// gets cells and the reason ([`NO_KITTY`], [`NO_SIXEL`], [`TMUX_HINT`], [`PLACEHOLDER_HINT`]),
+/// never a blank screen. Without answers (a silent terminal) it is used as asked. iTerm2 has
+/// no query other terminals answer (WezTerm, mintty and Konsole draw its images too), so a
+/// forced iTerm2 is always used as asked.
 pub fn choose(request: GraphicsRequest, support: Option<&GraphicsSupport>) -> GraphicsChoice {
     let cells = |hint| GraphicsChoice { mode: GraphicsMode::Cells, tmux_wrap: false, kitty_placeholders: false, hint };
     let Some(s) = support else {
@@ -506,9 +562,15 @@ pub fn choose(request: GraphicsRequest, support: Option<&GraphicsSupport>) -> Gr
     };
     let kitty = GraphicsChoice { mode: GraphicsMode::Kitty, tmux_wrap: s.tmux, kitty_placeholders: s.tmux, hint: None };
     match request {
-        GraphicsRequest::Force(GraphicsMode::Kitty) => {
-            GraphicsChoice { hint: (s.tmux && !s.tmux_passthrough).then_some(TMUX_HINT), ..kitty }
+        GraphicsRequest::Force(GraphicsMode::Kitty) if s.answered && s.tmux && !s.tmux_passthrough => {
+            cells(Some(TMUX_HINT))
         }
+        GraphicsRequest::Force(GraphicsMode::Kitty) if s.answered && !s.kitty => cells(Some(NO_KITTY)),
+        GraphicsRequest::Force(GraphicsMode::Kitty) if s.answered && s.tmux && !s.kitty_placeholders => {
+            cells(Some(PLACEHOLDER_HINT))
+        }
+        GraphicsRequest::Force(GraphicsMode::Kitty) => kitty,
+        GraphicsRequest::Force(GraphicsMode::Sixel) if s.answered && s.sixel.is_none() => cells(Some(NO_SIXEL)),
         GraphicsRequest::Force(GraphicsMode::Iterm2) => {
             GraphicsChoice { mode: GraphicsMode::Iterm2, tmux_wrap: s.tmux, kitty_placeholders: false, hint: None }
         }

@@ -89,6 +89,9 @@ impl Screen {
         };
         inputs.extend(probe.take_leftover());
         let support = probe.support();
+        if first || support.true_color {
+            self.settle_colours(support.true_color);
+        }
         if !probe.done() {
             self.asking = Asking::Late { probe, until: now + LATE_ANSWERS };
             if first {
@@ -97,21 +100,35 @@ impl Screen {
             }
             return;
         }
-        if first || (self.config.graphics == GraphicsRequest::Auto && self.choice.mode == GraphicsMode::Cells) {
+        // Late answers may upgrade `auto`'s cells, or show that a forced protocol's pictures
+        // never appear (then cells, and why).
+        let forced = self.config.graphics != GraphicsRequest::Auto;
+        if first || forced || self.choice.mode == GraphicsMode::Cells {
             self.choose(&support, first);
         }
     }
 
     /// Sets the protocol from what the terminal said (`first`: the first decision, before any
-    /// frame; later only an upgrade from cells to pixels). With `auto`, pixels are drawn only
-    /// where they show the truer moving picture at the link's rate (a fixed rate is known now;
-    /// a measured one starts with pixels and [`Screen::follow_link`] switches).
+    /// frame; later only a change of protocol: `auto`'s cells upgraded to pixels, a forced
+    /// protocol's pixels that would never show replaced by cells). With `auto`, pixels are drawn
+    /// only where they show the truer moving picture at the link's rate (a fixed rate is known
+    /// now; a measured one starts with pixels and [`Screen::follow_link`] switches).
     pub(super) fn choose(&mut self, support: &GraphicsSupport, first: bool) {
         let choice = probe::choose(self.config.graphics, Some(support));
-        if !first && choice.mode == GraphicsMode::Cells {
+        if !first && choice.mode == self.choice.mode {
             return;
         }
         self.support = support.clone();
+        if choice.mode == GraphicsMode::Sixel && self.auto() && self.local_terminal() {
+            // A sixel terminal on this machine: its pty's blocking writes pace the pictures
+            // (the door drops frames while one is written). Measured in bytes, a sixel
+            // picture's cost is its pixels, not its bytes (xterm draws 2-5 MB/s of them); the
+            // link control settled at a few hundred kB/s and the stream drew its lowest rung,
+            // a coarse mosaic. Unlimited: whole pictures at full resolution, as fast as the
+            // terminal takes them.
+            self.config.bandwidth = Bandwidth::Unlimited;
+            self.bucket = ByteBucket::unlimited();
+        }
         let mut notice: Vec<String> = choice.hint.map(str::to_owned).into_iter().collect();
         self.auto_pixels = None;
         let mut drawn = choice.clone();
@@ -120,7 +137,7 @@ impl Screen {
                 Bandwidth::Fixed(rate) => Some(rate as f64),
                 Bandwidth::Auto | Bandwidth::Unlimited => None,
             };
-            let switch = picture::auto_switch(&choice, support, known);
+            let switch = picture::auto_switch(&choice, support, known, self.auto());
             if switch.mode() == GraphicsMode::Cells {
                 notice.push(picture::switch_notice(choice.mode, GraphicsMode::Cells, known));
                 drawn = probe::choose(GraphicsRequest::Force(GraphicsMode::Cells), None);
@@ -129,6 +146,29 @@ impl Screen {
         }
         let late = if first { "" } else { " (the terminal answered late)" };
         self.draw_with(drawn, notice, late);
+    }
+
+    /// Whether the terminal is on this machine: not over SSH (the probe's environment), and
+    /// nothing between (a multiplexer over SSH, mosh).
+    fn local_terminal(&self) -> bool {
+        self.config.probe.as_ref().is_some_and(|p| !p.env.ssh) && self.config.link_path == LinkPath::Direct
+    }
+
+    /// The colours from what the terminal said (`true_color`), when `--color` is `auto`: true
+    /// colour when it said so (a repaint, if frames went out before a late answer); otherwise
+    /// the environment's guess stays and, below true colour, the status line says how to get
+    /// it.
+    pub(super) fn settle_colours(&mut self, true_color: bool) {
+        if !self.config.color_auto || self.config.color == ColorMode::TrueColor {
+            return;
+        }
+        if true_color {
+            self.config.color = ColorMode::TrueColor;
+            self.shown = Shown::UNKNOWN;
+            self.colour_hint = false;
+        } else {
+            self.colour_hint = true;
+        }
     }
 
     /// `auto` between pixels and cells as the link's rate crosses the protocol's crossover

@@ -12,12 +12,14 @@ fn config(bandwidth: Bandwidth, probe: bool) -> ScreenConfig {
         fps: 30,
         bandwidth,
         color: ColorMode::TrueColor,
+        color_auto: false,
         encode: EncodeOptions::default(),
         graphics: GraphicsRequest::Auto,
         probe: probe.then(|| ProbeOptions {
             env: Environment { ssh: true, ..Environment::default() },
             winsize: WinSize { cols: 40, rows: 12, x_px: 320, y_px: 192 },
             kitty_file: None,
+            colours: false,
         }),
         link_path: LinkPath::Direct,
     }
@@ -217,4 +219,71 @@ fn inside_tmux_the_link_asks_the_terminal_through_passthrough_and_takes_only_its
         assert_eq!(screen.link.last_rtt(), Some(80 * MS), "{name}: the terminal's answer, 90 - 10 ms");
         assert!(inputs.is_empty(), "{name}: no answer became a key");
     }
+}
+
+#[test]
+fn a_late_answer_without_kitty_turns_a_forced_kitty_into_cells() {
+    let t0 = Instant::now();
+    let mut config = config(Bandwidth::Unlimited, true);
+    config.graphics = GraphicsRequest::Force(GraphicsMode::Kitty);
+    let mut screen = Screen::new(config, (40, 12), t0);
+    screen.start(t0, &mut Vec::new());
+    let mut inputs = Vec::new();
+    screen.tick(t0 + probe::PROBE_BUDGET, &mut inputs);
+    assert_eq!(screen.mode(), GraphicsMode::Kitty, "no answer yet: as asked");
+    screen.feed(DA1, t0 + 700 * MS, &mut inputs);
+    assert_eq!(screen.mode(), GraphicsMode::Cells, "the answer came without kitty's");
+    assert_eq!(screen.take_notice().as_deref(), Some(probe::NO_KITTY));
+    assert!(!contains(&frame(&mut screen, t0 + 750 * MS, 10), b"\x1b_G"));
+}
+
+/// A screen with `--color auto` guessed `guess` from the environment, asking the terminal.
+fn colour_screen(guess: ColorMode, t0: Instant) -> Screen {
+    let mut config = config(Bandwidth::Unlimited, true);
+    (config.color, config.color_auto) = (guess, true);
+    let mut screen = Screen::new(config, (40, 12), t0);
+    let mut asked = Vec::new();
+    screen.start(t0, &mut asked);
+    assert!(contains(&asked, probe::COLOUR_QUERIES), "the colour questions go with the probe");
+    screen
+}
+
+#[test]
+fn true_colour_comes_from_the_terminals_answers_and_the_hint_only_when_none_said_so() {
+    let t0 = Instant::now();
+    let answers: [(&[u8], bool); 6] = [
+        (b"\x1bP1+r524742\x1b\\", true),
+        (b"\x1bP0+r524742\x1b\\\x1bP1+r5463=\x1b\\", true),
+        (b"\x1bP1$r0;38:2::1:2:3m\x1b\\", true),
+        (b"\x1bP1$r38;2;1;2;3m\x1b\\", true),
+        (b"\x1bP0+r524742\x1b\\\x1bP0+r5463\x1b\\\x1bP1$r0;38:5:16m\x1b\\", false),
+        (b"", false),
+    ];
+    for (answer, true_color) in answers {
+        let mut screen = colour_screen(ColorMode::Palette256, t0);
+        let mut inputs = Vec::new();
+        screen.feed(&[answer, DA1].concat(), t0 + 5 * MS, &mut inputs);
+        assert!(inputs.is_empty(), "{answer:?}: no answer became a key");
+        let want = if true_color { ColorMode::TrueColor } else { ColorMode::Palette256 };
+        assert_eq!(screen.config.color, want, "{:?}", String::from_utf8_lossy(answer));
+        let notice = screen.take_notice().unwrap_or_default();
+        assert_eq!(notice.contains("try --color truecolor"), !true_color, "{notice:?}");
+        let out = frame(&mut screen, t0 + 10 * MS, 10);
+        assert_eq!(contains(&out, b"8;2;"), true_color);
+    }
+    // A colour asked for is kept, whatever the terminal says.
+    let mut config = config(Bandwidth::Unlimited, true);
+    config.color = ColorMode::Palette256;
+    let mut screen = Screen::new(config, (40, 12), t0);
+    screen.start(t0, &mut Vec::new());
+    screen.feed(&[b"\x1bP1+r524742\x1b\\", DA1].concat(), t0 + 5 * MS, &mut Vec::new());
+    assert_eq!(screen.config.color, ColorMode::Palette256);
+    assert!(!screen.take_notice().unwrap_or_default().contains("--color"), "asked for: no hint");
+    // A late answer still upgrades, with a repaint.
+    let mut screen = colour_screen(ColorMode::Palette256, t0);
+    screen.tick(t0 + probe::PROBE_BUDGET, &mut Vec::new());
+    let _ = frame(&mut screen, t0 + probe::PROBE_BUDGET, 10);
+    screen.feed(&[b"\x1bP1+r524742\x1b\\", DA1].concat(), t0 + 900 * MS, &mut Vec::new());
+    assert_eq!(screen.config.color, ColorMode::TrueColor);
+    assert!(contains(&frame(&mut screen, t0 + 950 * MS, 10), b"8;2;"));
 }

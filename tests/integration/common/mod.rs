@@ -1,5 +1,6 @@
 //! Helpers shared by the integration tests: running the binary and the golden-image harness.
 
+pub mod fake_terminal;
 pub mod golden;
 pub mod pty;
 

@@ -55,6 +55,50 @@ impl Player {
         env: &[(&str, &str)],
         answer: impl Fn(usize) -> Option<Vec<u8>> + Send + 'static,
     ) -> Player {
+        let mut asked = 0;
+        // The last two bytes of the previous read: a question may straddle two reads (and
+        // two bytes cannot hold a whole one, so none is counted twice).
+        let mut tail: Vec<u8> = Vec::new();
+        Player::spawn_responding(dir, cols, rows, args, env, move |chunk| {
+            tail.extend_from_slice(chunk);
+            let questions = tail.windows(3).filter(|w| *w == DA1_QUESTION).count();
+            tail.drain(..tail.len().saturating_sub(2));
+            let mut out = Vec::new();
+            for _ in 0..questions {
+                if let Some(bytes) = answer(asked) {
+                    out.extend_from_slice(&bytes);
+                }
+                asked += 1;
+            }
+            out
+        })
+    }
+
+    /// [`Player::spawn`] with a fake terminal ([`super::fake_terminal`]) answering everything
+    /// the player asks, as that terminal would; the fake also keeps the pictures it took.
+    pub fn spawn_fake(
+        dir: &Path,
+        args: &[&str],
+        env: &[(&str, &str)],
+        fake: Arc<Mutex<super::fake_terminal::FakeTerminal>>,
+    ) -> Player {
+        let (cols, rows) = {
+            let f = fake.lock().unwrap();
+            (f.screen.cols() as u16, f.screen.rows() as u16)
+        };
+        Player::spawn_responding(dir, cols, rows, args, env, move |chunk| fake.lock().unwrap().feed(chunk))
+    }
+
+    /// [`Player::spawn`] with `respond` given every chunk the player writes, returning the
+    /// terminal's answers (written back at once).
+    pub fn spawn_responding(
+        dir: &Path,
+        cols: u16,
+        rows: u16,
+        args: &[&str],
+        env: &[(&str, &str)],
+        mut respond: impl FnMut(&[u8]) -> Vec<u8> + Send + 'static,
+    ) -> Player {
         let pty = native_pty_system();
         let pair = pty.openpty(PtySize { rows, cols, pixel_width: 0, pixel_height: 0 }).unwrap();
         let mut cmd = CommandBuilder::new(env!("CARGO_BIN_EXE_tidepool"));
@@ -81,24 +125,16 @@ impl Player {
         let drained = Arc::new(AtomicBool::new(false));
         let done = Arc::clone(&drained);
         std::thread::spawn(move || {
-            let mut asked = 0;
             let mut buf = [0u8; 65536];
             while let Ok(n) = reader.read(&mut buf) {
                 if n == 0 {
                     break;
                 }
-                let mut out = sink.lock().unwrap();
-                // A question may straddle two reads: look from just before this chunk.
-                let from = out.len().saturating_sub(2);
-                out.extend_from_slice(&buf[..n]);
-                let questions = out[from..].windows(3).filter(|w| *w == DA1_QUESTION).count();
-                drop(out);
-                for _ in 0..questions {
-                    if let Some(bytes) = answer(asked) {
-                        let mut w = answers.lock().unwrap();
-                        let _ = w.write_all(&bytes).and_then(|()| w.flush());
-                    }
-                    asked += 1;
+                sink.lock().unwrap().extend_from_slice(&buf[..n]);
+                let bytes = respond(&buf[..n]);
+                if !bytes.is_empty() {
+                    let mut w = answers.lock().unwrap();
+                    let _ = w.write_all(&bytes).and_then(|()| w.flush());
                 }
             }
             done.store(true, Ordering::SeqCst);

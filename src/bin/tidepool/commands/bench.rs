@@ -164,6 +164,7 @@ fn player_rows(
             fps: PLAYER_FPS as u32,
             bandwidth: Bandwidth::Unlimited,
             color: ColorMode::TrueColor,
+            color_auto: false,
             encode: EncodeOptions::default(),
             graphics: GraphicsRequest::Force(tidepool::graphics::GraphicsMode::Cells),
             probe: None,

@@ -23,16 +23,6 @@ pub fn default_threshold(ssh_connection: Option<&str>) -> u8 {
     if ssh_connection.is_some_and(|v| !v.trim().is_empty()) { SSH_COLOR_THRESHOLD } else { 0 }
 }
 
-/// What to tell a user whose terminal was guessed to have fewer than 16 million colours.
-///
-/// SSH does not forward `COLORTERM` and tmux hides it, so most terminals that could show true
-/// colour are guessed as 256-colour ones there, and the water loses its shades. Saying so in
-/// the status line's first seconds tells the user the one flag that fixes it.
-pub fn color_hint(choice: ColorChoice, mode: ColorMode) -> Option<String> {
-    (choice == ColorChoice::Auto && mode != ColorMode::TrueColor)
-        .then(|| format!("{} colours (no COLORTERM): try --color truecolor", mode.name()))
-}
-
 /// Runs the player.
 pub fn run(command: PlayCommand) -> Result<()> {
     if !std::io::stdout().is_terminal() {
@@ -72,6 +62,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
         fps: command.fps,
         bandwidth: command.max_bps.map_or(command.bandwidth, Bandwidth::Fixed),
         color,
+        color_auto: command.color == ColorChoice::Auto,
         encode: EncodeOptions { threshold, sync: !command.no_sync },
         graphics: command.graphics.into(),
         // The door asks the terminal itself when both ends are terminals, and finds what sits
@@ -79,7 +70,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
         probe: None,
         link_path: tidepool::play::LinkPath::Direct,
     };
-    let config = PlayConfig { host, screen, greeting: color_hint(command.color, color), quit: Arc::clone(&quit) };
+    let config = PlayConfig { host, screen, greeting: None, quit: Arc::clone(&quit) };
     let _stop_on_signal = crate::signals::StopOnSignal::new(quit);
     tidepool::tty::play(config).map_err(|e| match e {
         tidepool::Error::TooLarge { what, width, height } => {
@@ -92,14 +83,6 @@ pub fn run(command: PlayCommand) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn a_guessed_palette_says_how_to_get_true_colour() {
-        assert!(color_hint(ColorChoice::Auto, ColorMode::Palette256).unwrap().contains("--color truecolor"));
-        assert!(color_hint(ColorChoice::Auto, ColorMode::Palette16).unwrap().starts_with("16 colours"));
-        assert_eq!(color_hint(ColorChoice::Auto, ColorMode::TrueColor), None);
-        assert_eq!(color_hint(ColorChoice::Palette256, ColorMode::Palette256), None, "asked for: no hint");
-    }
 
     #[test]
     fn threshold_is_exact_locally_and_3_over_ssh() {

@@ -9,6 +9,7 @@
 use std::net::SocketAddr;
 use std::sync::Arc;
 use std::sync::atomic::Ordering;
+use std::time::Instant;
 
 use russh::keys::ssh_key::HashAlg;
 use russh::server::{Auth, ChannelOpenHandle, Msg, PublicKeyOffer, Response, Session, VerifiedPublicKey};
@@ -51,7 +52,8 @@ pub struct ClientHandler {
     /// Whether the key's authorized_keys line allows a pty (`no-pty`, `restrict` take it away).
     pty_allowed: bool,
     terminal: Option<watch::Sender<TerminalState>>,
-    input: Option<mpsc::Sender<Vec<u8>>>,
+    /// The channel's bytes for the player task, with the moment each packet arrived.
+    input: Option<mpsc::Sender<(Instant, Vec<u8>)>>,
 }
 
 impl ClientHandler {
@@ -315,7 +317,10 @@ impl russh::server::Handler for ClientHandler {
         let screen = ScreenConfig {
             fps: self.hub.fps,
             bandwidth: self.hub.limits.client_bandwidth,
+            // COLORTERM arrives only where the client sends it and this server accepts it
+            // (OpenSSH sends it only with SendEnv): the probe asks the terminal itself.
             color: ColorMode::detect(self.colorterm.as_deref(), self.term.as_deref()),
+            color_auto: true,
             encode: EncodeOptions { threshold: COLOR_THRESHOLD, sync: true },
             graphics: GraphicsRequest::Auto,
             // A remote terminal: no file medium; its TMUX is not ours to see.
@@ -323,6 +328,7 @@ impl russh::server::Handler for ClientHandler {
                 env: Environment { ssh: true, ..Environment::default() },
                 winsize,
                 kitty_file: None,
+                colours: false,
             }),
             // The far terminal answers for itself: whatever runs there, the round trip is real.
             link_path: tidepool::play::LinkPath::Direct,
@@ -419,7 +425,7 @@ impl russh::server::Handler for ClientHandler {
             return Ok(());
         }
         if let Some(input) = &self.input
-            && input.try_send(data.to_vec()).is_err()
+            && input.try_send((Instant::now(), data.to_vec())).is_err()
         {
             self.hub.stats.input_dropped.fetch_add(1, Ordering::Relaxed);
         }

@@ -44,7 +44,10 @@ pub(crate) struct ViewerCtx {
     pub peer: SocketAddr,
     pub write: ChannelWriteHalf<Msg>,
     pub terminal: watch::Receiver<TerminalState>,
-    pub input: mpsc::Receiver<Vec<u8>>,
+    /// The channel's packets and when each arrived: the link's answers are timed by their
+    /// arrival, not by when this task got to them (after a frame's encoding or a write that
+    /// waited for the client's window).
+    pub input: mpsc::Receiver<(Instant, Vec<u8>)>,
     pub screen: ScreenConfig,
     pub kill: CancellationToken,
     pub slot: PlayerSlot,
@@ -101,8 +104,8 @@ pub(crate) async fn run(ctx: ViewerCtx) {
                 }
                 _ = tokio::time::sleep(RESIZE_RETRY), if resize.is_some() => {}
                 bytes = input.recv() => {
-                    let Some(bytes) = bytes else { break 'game Leave::Cut };
-                    if player.feed(&bytes, Instant::now()) {
+                    let Some((arrived, bytes)) = bytes else { break 'game Leave::Cut };
+                    if player.feed(&bytes, arrived) {
                         last_input = Instant::now();
                     }
                 }

@@ -123,7 +123,7 @@ fn runs_are_length_encoded() {
     let mut out = Vec::new();
     SixelEncoder::new(palette, (0, 0), None).encode(&[0; 100 * 6 * 3], 100, 6, &mut out);
     let text = String::from_utf8(out).unwrap();
-    assert!(text.ends_with("\"1;1;100;6#0;2;0;0;0!100~-\x1b\\"), "only the register used is defined: {text:?}");
+    assert!(text.ends_with("\"1;1;100;6#0;2;0;0;0#0!100~-\x1b\\"), "only the register used is defined: {text:?}");
     // A two-row stripe of white over black: passes overlap with `$`, empties are skipped.
     let mut rgb = vec![0u8; 10 * 6 * 3];
     rgb[..10 * 2 * 3].fill(255);
@@ -131,7 +131,7 @@ fn runs_are_length_encoded() {
     SixelEncoder::new(SixelPalette::for_registers(256), (0, 0), None).encode(&rgb, 10, 6, &mut out);
     let text = String::from_utf8(out).unwrap();
     // Black covers rows 2..6 (bits 0b111100 -> '?' + 60 = '{'), white rows 0..2 ('?' + 3 = 'B').
-    assert!(text.ends_with("#0;2;0;0;0!10{$#251;2;100;100;100!10B-\x1b\\"), "{text:?}");
+    assert!(text.ends_with("#0;2;0;0;0#0!10{$#251;2;100;100;100#251!10B-\x1b\\"), "{text:?}");
 }
 
 #[test]
@@ -213,13 +213,13 @@ fn changed_cells_are_sent_alone_and_match_the_whole_picture() {
     enc.encode(&first, w, h, &mut whole);
     let mut part = Vec::new();
     // Pixels 100..103 x 40..45 lie in cell column 12, cell row 2: the block 96..104 x 32..48,
-    // made 18 rows tall (whole sixel bands).
-    assert_eq!(enc.encode(&second, w, h, &mut part), Update::Rect(96, 32, 8, 18));
+    // whole cells (16 rows: its last band partial).
+    assert_eq!(enc.encode(&second, w, h, &mut part), Update::Rect(96, 32, 8, 16));
     assert!(part.starts_with(b"\x1b[4;14H"), "placed at the block's cell (origin + (12, 2))");
-    let patch = decode(&part, 8, 18);
+    let patch = decode(&part, 8, 16);
     // The patch pasted on the first picture gives the second.
     let mut shown = decode(&whole, w, h);
-    for y in 0..18 {
+    for y in 0..16 {
         let to = ((32 + y) * w as usize + 96) * 3;
         shown[to..to + 24].copy_from_slice(&patch[y * 24..(y + 1) * 24]);
     }
@@ -229,11 +229,73 @@ fn changed_cells_are_sent_alone_and_match_the_whole_picture() {
     assert_eq!(enc.encode(&second, w, h, &mut again), Update::Unchanged, "nothing changed since");
     assert!(again.is_empty());
 
-    // A change in the last cell row, whose block cannot grow to whole bands inside the
-    // picture (352 + 12 > 360), sends the whole picture instead.
+    // A change in the last cell row, cut short by the picture's bottom (352..360): that row alone.
     let mut third = second.clone();
     third[(358 * w as usize + 5) * 3] ^= 0xff;
     let mut out = Vec::new();
-    assert_eq!(enc.encode(&third, w, h, &mut out), Update::Full);
-    assert!(decode(&out, w, h) == dithered_rgb(&palette, &third, w, h));
+    assert_eq!(enc.encode(&third, w, h, &mut out), Update::Rect(0, 352, 8, 8));
+    let patch = decode(&out, 8, 8);
+    let want = dithered_rgb(&palette, &third, w, h);
+    for y in 0..8 {
+        let from = ((352 + y) * w as usize) * 3;
+        assert!(patch[y * 24..(y + 1) * 24] == want[from..from + 24]);
+    }
+}
+
+#[test]
+fn a_changed_block_ends_at_a_cell_boundary_not_below_it() {
+    // mlterm 3.9 sizes a sixel image in whole cells and fills the rest of the last row of cells
+    // it reaches into with its background: a block of one 22-pixel row of cells made 24 rows
+    // tall (whole bands) blanked 20 rows of the picture below it (white holes under every
+    // block, seen under Xvfb). A block must end where its cells end.
+    let (w, h, first) = golden_pool();
+    let palette = SixelPalette::for_registers(256);
+    let mut second = first.clone();
+    second[(30 * w as usize + 15) * 3] ^= 0xff; // cell (1, 1) of 10x22-pixel cells
+    let mut enc = SixelEncoder::new(palette, (0, 0), Some((10, 22)));
+    enc.encode(&first, w, h, &mut Vec::new());
+    let mut part = Vec::new();
+    assert_eq!(enc.encode(&second, w, h, &mut part), Update::Rect(10, 22, 10, 22));
+    let start = part.windows(2).position(|w| w == b"\x1bP").unwrap();
+    let image = icy_sixel::SixelImage::decode(&part[start..]).unwrap();
+    let painted = image.pixels.chunks_exact(4).enumerate().filter(|(_, p)| p[3] == 255);
+    let lowest = painted.map(|(i, _)| i / image.width).max().unwrap();
+    assert_eq!((image.width, lowest), (10, 21), "painted down to the cell's last row, no further");
+    assert!(header_height(&part[start..]) == 22, "the raster attributes say 22 rows");
+}
+
+/// The height `"Pan;Pad;Ph;Pv` gives in a sixel image.
+fn header_height(image: &[u8]) -> u32 {
+    let at = image.iter().position(|&b| b == b'"').expect("raster attributes");
+    let end = image[at..].iter().position(|&b| b == b'#').unwrap() + at;
+    let fields: Vec<&str> = std::str::from_utf8(&image[at + 1..end]).unwrap().split(';').collect();
+    fields[3].parse().unwrap()
+}
+
+#[test]
+fn every_colour_definition_is_followed_by_its_selection() {
+    // DEC's `#Pc;Pu;Px;Py;Pz` defines and selects; xterm (379, -ti vt340) only defines: the
+    // pixels that follow were drawn in the register it had selected before (a VT340 default:
+    // green lines along every block's first band). Each definition must be followed by `#Pc`.
+    let (w, h, rgb) = golden_pool();
+    let mut e = SixelEncoder::new(SixelPalette::for_registers(256), (0, 0), Some((8, 16)));
+    let mut out = Vec::new();
+    e.encode(&rgb, w, h, &mut out);
+    let text = String::from_utf8_lossy(&out);
+    let mut definitions = 0;
+    for (at, _) in text.match_indices(";2;") {
+        let before = &text[..at];
+        let hash = before.rfind('#').expect("a definition starts with #");
+        let register = &before[hash + 1..];
+        assert!(register.bytes().all(|b| b.is_ascii_digit()), "{register:?}");
+        let after = &text[at + 3..];
+        let end = after.find(|c: char| !(c.is_ascii_digit() || c == ';')).unwrap();
+        assert!(
+            after[end..].starts_with(&format!("#{register}")),
+            "#{register} is defined but not selected: {:?}",
+            &after[..end + 8]
+        );
+        definitions += 1;
+    }
+    assert!(definitions > 20, "{definitions} definitions");
 }

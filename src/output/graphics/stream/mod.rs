@@ -135,12 +135,22 @@ pub struct Budget {
     pub rate: Option<f64>,
     /// The caller's frame interval (pictures come at most once a frame).
     pub frame_interval: Duration,
+    /// The caller may take one picture beyond `available` now (its bucket is as full as it
+    /// gets and nothing big waits on the link) and owe the excess. A protocol that cannot send
+    /// part of a picture (iTerm2, kitty without frame edits) sends its smallest whole picture
+    /// then when even that is more than the bucket ever holds: fewer pictures, never none.
+    pub overdraw: bool,
 }
 
 impl Budget {
     /// No limit, frames every `frame_interval`.
     pub fn unlimited(frame_interval: Duration) -> Budget {
-        Budget { available: usize::MAX, rate: None, frame_interval }
+        Budget { available: usize::MAX, rate: None, frame_interval, overdraw: false }
+    }
+
+    /// `available` bytes now at `rate`, frames every `frame_interval`, no overdraw.
+    pub fn new(available: usize, rate: Option<f64>, frame_interval: Duration) -> Budget {
+        Budget { available, rate, frame_interval, overdraw: false }
     }
 }
 
@@ -342,7 +352,19 @@ impl PictureStream {
         let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
         let interval = Duration::from_secs_f64(1.0 / most).max(budget.frame_interval) - budget.frame_interval / 2;
         // The bucket does not hold what this rung costs yet: no picture is encoded for nothing.
-        if limited && self.predict(self.rung).is_some_and(|c| c > room as f64 && c <= allowance as f64) {
+        if limited
+            && !budget.overdraw
+            && self.predict(self.rung).is_some_and(|c| c > room as f64 && c <= allowance as f64)
+        {
+            return None;
+        }
+        // Nor the bottom rung of a protocol without tiles, and the caller cannot overdraw.
+        let bottom = self.rungs.len() - 1;
+        if self.rung == bottom
+            && !self.protocol.edits()
+            && !budget.overdraw
+            && self.predict(bottom).is_some_and(|c| c > budget.available as f64)
+        {
             return None;
         }
         let mut rung = self.rung;
@@ -353,7 +375,7 @@ impl PictureStream {
                 return None;
             };
             self.learn(rung, part);
-            if self.bytes.len() <= room {
+            if self.bytes.len() <= room || (budget.overdraw && self.bytes.len() <= allowance) {
                 return self.offer(rung, part, limited, now + interval);
             }
             if self.bytes.len() <= allowance {
@@ -365,9 +387,10 @@ impl PictureStream {
                 continue;
             }
             // The bottom rung of a protocol without tiles: fewer than 10 pictures a second,
-            // each up to what the bucket holds at most.
-            if !self.protocol.edits() && limited {
-                if self.bytes.len() > budget.available {
+            // each when the bucket holds it, or (bigger than the bucket ever holds) when the
+            // caller can overdraw.
+            if !self.protocol.edits() {
+                if self.bytes.len() > budget.available && !budget.overdraw {
                     return None;
                 }
                 return self.offer(rung, part, limited, now + interval);
@@ -652,15 +675,16 @@ fn part_box(part: Part, size: (u32, u32)) -> (u32, u32, u32, u32) {
     }
 }
 
-/// The part of a sixel picture to send: the block of whole cells (and whole bands) around the
-/// changes, the whole picture when that block reaches its bottom; `None` when nothing changed.
+/// The part of a sixel picture to send: the block of whole cells around the changes (its last
+/// band may be partial: mlterm blanks the rest of a row of cells an image reaches into), the
+/// whole picture when that block is all of it; `None` when nothing changed.
 fn sixel_part(old: &[u8], new: &[u8], screen: (u32, u32), cell_px: (u16, u16)) -> Option<Part> {
     let (cw, ch) = (u32::from(cell_px.0.max(1)), u32::from(cell_px.1.max(1)));
     let (left, top, bw, bh) = scan::changed_box(old, new, screen.0, 1, 0..screen.1)?;
     let (x0, y0) = (left / cw * cw, top / ch * ch);
     let x1 = ((left + bw).div_ceil(cw) * cw).min(screen.0);
-    let h = ((top + bh).div_ceil(ch) * ch).min(screen.1).saturating_sub(y0).div_ceil(6) * 6;
-    if y0 + h > screen.1 || (x0, y0, x1 - x0, h) == (0, 0, screen.0, screen.1) {
+    let h = ((top + bh).div_ceil(ch) * ch).min(screen.1) - y0;
+    if (x0, y0, x1 - x0, h) == (0, 0, screen.0, screen.1) {
         return Some(Part::Whole);
     }
     Some(Part::Changed(x0, y0, x1 - x0, h))

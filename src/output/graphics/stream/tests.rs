@@ -48,7 +48,7 @@ fn play(stream: &mut PictureStream, rate: f64, frames: u32) -> (u32, usize, isiz
     for n in 1..=frames {
         let now = t0 + FRAME * n;
         bucket.refill(now);
-        let budget = Budget { available: bucket.budget(), rate: Some(rate), frame_interval: FRAME };
+        let budget = Budget::new(bucket.budget(), Some(rate), FRAME);
         let picture = moving(n);
         if let Some(offer) = stream.prepare(&picture, budget, now) {
             let len = offer.bytes.len();
@@ -120,7 +120,7 @@ fn kitty_offers_decode_to_the_picture_on_the_wire_and_edits_apply_to_it() {
                 *px = tiny_skia::ColorU8::from_rgba(255, 0, 0, 255).premultiply();
             }
         }
-        let budget = Budget { available: usize::MAX, rate, frame_interval: FRAME };
+        let budget = Budget::new(usize::MAX, rate, FRAME);
         let offer = stream.prepare(&picture, budget, t0 + FRAME * (10 * n)).expect("an offer");
         let part = offer.state.part;
         wire.extend_from_slice(offer.bytes);
@@ -135,4 +135,53 @@ fn kitty_offers_decode_to_the_picture_on_the_wire_and_edits_apply_to_it() {
             assert!(matches!(part, Part::Changed(..)), "{part:?}");
         }
     }
+}
+
+#[test]
+fn a_picture_bigger_than_the_bucket_ever_holds_goes_when_the_caller_can_overdraw() {
+    // kitty without frame edits: no tiles. Its smallest whole picture is more than 500 bytes.
+    let layout = layout(GraphicsMode::Kitty, (160, 48), Some((8, 16)), None, SCALED_CAP);
+    let protocol = Protocol::Kitty(KittyOptions { origin: layout.origin, ..KittyOptions::new(layout.cells) });
+    let mut stream = PictureStream::new(protocol, layout);
+    let picture = moving(0);
+    let t0 = Instant::now();
+    let tight = Budget::new(500, Some(5_000.0), FRAME);
+    for n in 0..10u32 {
+        assert!(stream.prepare(&picture, tight, t0 + FRAME * n).is_none(), "nothing fits 500 bytes");
+    }
+    let offer = stream.prepare(&picture, Budget { overdraw: true, ..tight }, t0 + FRAME * 10);
+    let offer = offer.expect("the smallest whole picture goes when the caller can overdraw");
+    assert!(offer.bytes.len() > 500 && offer.state.part == Part::Whole);
+}
+
+#[test]
+fn sixel_tiles_and_blocks_end_where_their_cells_end() {
+    // mlterm 3.9 fills the rest of a row of cells a sixel image reaches into with its
+    // background: tiles of whole bands (24 rows on 22-pixel cells) left white holes across the
+    // picture over a shaped link. Every part starts at a cell and ends at one or at the bottom.
+    let cell = (10u16, 22u16);
+    let l = layout(GraphicsMode::Sixel, (140, 45), Some(cell), Some((4096, 4096)), SCALED_CAP);
+    let protocol =
+        Protocol::Sixel { palette: SixelPalette::for_registers(256), registers: Registers::PerImage, tmux: false };
+    let mut stream = PictureStream::new(protocol, l);
+    let (pw, ph) = l.picture;
+    let t0 = Instant::now();
+    let mut bucket = ByteBucket::new(30_000.0);
+    let mut parts = 0;
+    for n in 1..=90u32 {
+        let now = t0 + FRAME * n;
+        bucket.refill(now);
+        let budget = Budget::new(bucket.budget(), Some(30_000.0), FRAME);
+        let Some(offer) = stream.prepare(&moving(n), budget, now) else { continue };
+        bucket.spend(offer.bytes.len());
+        if let Part::Changed(x, y, w, h) | Part::Tile(x, y, w, h) = offer.state.part {
+            parts += 1;
+            let (cw, ch) = (u32::from(cell.0), u32::from(cell.1));
+            assert!(x % cw == 0 && y % ch == 0, "({x}, {y}) is not a cell's corner");
+            assert!((y + h) % ch == 0 || y + h == ph, "{w}x{h} at ({x}, {y}) ends inside a row of cells");
+            assert!(x + w <= pw && y + h <= ph);
+        }
+        stream.commit();
+    }
+    assert!(parts > 0, "30 kB/s sends tiles of the 1400x966 picture");
 }

@@ -8,8 +8,10 @@
 //! the picture is refreshed in turn. Of the first tile that changed, only the box around its
 //! changes is sent; when that is still too big for the bytes available, its width is halved
 //! until it fits. Sixel tiles start at a cell (a sixel image is drawn from the cursor's cell)
-//! and are whole six-row bands tall (a band may reach two or four rows into the next row of
-//! cells, repainting them with the same picture).
+//! and end at one (or at the picture's bottom): their last band may be partial. A tile that
+//! reached a few rows into the next row of cells (whole bands) left the rest of that row
+//! blank in mlterm 3.9, which sizes an image in whole cells and fills them with its
+//! background.
 
 use super::{Part, PictureStream, Protocol, scan};
 
@@ -44,10 +46,9 @@ impl PictureStream {
         for k in 0..count {
             let index = (self.next_tile + k) % count;
             let (x, y) = ((index as u32 % cols) * tw, (index as u32 / cols) * th);
-            let mut bh = th.min(h - y);
-            if sixel {
-                bh = bh.div_ceil(6).saturating_mul(6).min(h - y);
-            }
+            // Whole rows of cells for sixel too, not whole bands: mlterm 3.9 blanks the rest of
+            // a row of cells an image reaches into (white holes under every tile).
+            let bh = th.min(h - y);
             let cell = (x, y, tw.min(w - x), bh);
             let shown = &self.shown.as_ref()?.1;
             let Some((left, _, bw, _)) = scan::changed_in(shown, &self.candidate, stride, bpp, cell) else { continue };

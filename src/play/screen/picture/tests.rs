@@ -34,12 +34,14 @@ fn config(bandwidth: Bandwidth, graphics: GraphicsRequest) -> ScreenConfig {
         fps: 30,
         bandwidth,
         color: ColorMode::TrueColor,
+        color_auto: false,
         encode: EncodeOptions::default(),
         graphics,
         probe: Some(ProbeOptions {
             env: Environment { ssh: true, ..Environment::default() },
             winsize: WinSize { cols: 160, rows: 48, x_px: 1280, y_px: 768 },
             kitty_file: None,
+            colours: false,
         }),
         link_path: Default::default(),
     }
@@ -306,4 +308,75 @@ fn a_fixed_rate_below_the_crossover_starts_with_cells_and_says_why() {
     let forced =
         screen(config(Bandwidth::Fixed((at / 4.0) as u64), GraphicsRequest::Force(GraphicsMode::Kitty)), KITTY, t0);
     assert_eq!(forced.mode(), GraphicsMode::Kitty);
+}
+
+/// kitty's answers without frame edits (refused or not answered: the same to the probe).
+const KITTY_NO_EDITS: &[u8] = b"\x1b_Gi=31;OK\x1b\\\x1b[?62;22c";
+
+#[test]
+fn kitty_without_frame_edits_gets_whole_pictures_over_a_fast_link_answering_late() {
+    // A terminal 5 ms away over SSH: the first answers come back after the first frames, which
+    // carried the status line only. Every picture must still go (it went blank: the window
+    // stayed at the few bytes those frames took, and a whole picture never fit it).
+    for delay in [MS / 10, MS, 5 * MS, 30 * MS] {
+        for graphics in [GraphicsRequest::Auto, GraphicsRequest::Force(GraphicsMode::Kitty)] {
+            let t0 = Instant::now();
+            let mut s = screen(config(Bandwidth::Auto, graphics), KITTY_NO_EDITS, t0);
+            assert_eq!(s.mode(), GraphicsMode::Kitty);
+            let water = Water::new(s.picture_size(), 24);
+            let mut answers: VecDeque<Instant> = VecDeque::new();
+            let mut first = None;
+            let mut pictures = 0;
+            for n in 1..=30 * 3u32 {
+                let now = t0 + FRAME * n;
+                while answers.front().is_some_and(|t| *t <= now) {
+                    s.feed(b"\x1b[?62;22c", answers.pop_front().unwrap(), &mut Vec::new());
+                }
+                s.tick(now, &mut Vec::new());
+                if s.ready(now, false) && s.mode() == GraphicsMode::Kitty {
+                    let out = frame(&mut s, &water, n as usize, now);
+                    let whole = count(&out, b"a=T");
+                    assert_eq!(count(&out, b"a=f"), 0, "no frame edits where the terminal has none");
+                    if whole > 0 {
+                        first.get_or_insert(n);
+                    }
+                    pictures += whole;
+                    if out.ends_with(link::PROBE) {
+                        answers.push_back(now + delay);
+                    }
+                }
+            }
+            let first = first.unwrap_or_else(|| panic!("{delay:?} {graphics:?}: no picture in 3 s"));
+            assert!(first <= 15, "{delay:?} {graphics:?}: the first picture at frame {first}");
+            assert!(pictures >= 30, "{delay:?} {graphics:?}: {pictures} pictures in 3 s");
+        }
+    }
+}
+
+#[test]
+fn a_local_sixel_terminal_gets_whole_pictures_at_full_resolution_and_over_a_link_auto_draws_cells() {
+    // xterm -ti vt340 on this machine: the pty paces the pictures, the link control does not
+    // (measured in bytes it settled at a few hundred kB/s and drew the lowest rung).
+    let t0 = Instant::now();
+    let mut local = config(Bandwidth::Auto, GraphicsRequest::Auto);
+    local.probe.as_mut().unwrap().env.ssh = false;
+    let mut s = screen(local, SIXEL, t0);
+    assert_eq!(s.mode(), GraphicsMode::Sixel);
+    assert_eq!(s.rate(), None, "no rate: the terminal's own pace");
+    let water = Water::new(s.picture_size(), 4);
+    for n in 1..=4u32 {
+        let out = frame(&mut s, &water, n as usize, t0 + FRAME * (2 * n));
+        assert!(!out.ends_with(link::PROBE), "no link questions");
+        let state = s.picture.as_ref().unwrap().state();
+        assert_eq!(state.size, (480, 281), "the top rung, every frame");
+    }
+    // Over SSH, sixel never beats cells on a measured link: cells from the start, and why.
+    let mut remote = screen(config(Bandwidth::Auto, GraphicsRequest::Auto), SIXEL, t0);
+    assert_eq!(remote.mode(), GraphicsMode::Cells);
+    let notice = remote.take_notice().unwrap();
+    assert!(notice.contains("sixel over a link: half-block cells are truer"), "{notice}");
+    // Asked for, sixel is drawn over the link too, at the link's rate.
+    let forced = screen(config(Bandwidth::Auto, GraphicsRequest::Force(GraphicsMode::Sixel)), SIXEL, t0);
+    assert_eq!(forced.mode(), GraphicsMode::Sixel);
+    assert!(forced.rate().is_some());
 }

@@ -64,6 +64,7 @@ fn options(tmux: bool) -> ProbeOptions {
         env: Environment { tmux, ..Environment::default() },
         winsize: WinSize { cols: 160, rows: 48, x_px: 0, y_px: 0 },
         kitty_file: None,
+        colours: true,
     }
 }
 
@@ -228,9 +229,9 @@ fn tmux_without_passthrough_gets_cells_and_a_hint() {
     // tmux that draws sixel itself says so in its own DA1.
     let s = FakeTerminal::new(&[(1, b"\x1b[?1;2;4c")]).run(&options(true)).outcome.support;
     assert_eq!(choose(GraphicsRequest::Auto, Some(&s)).mode, GraphicsMode::Sixel);
-    // Forcing kitty wraps it and still shows the hint.
+    // Forcing kitty there would draw nothing: cells and the hint.
     let forced = choose(GraphicsRequest::Force(GraphicsMode::Kitty), Some(&run.outcome.support));
-    assert!(forced.tmux_wrap && forced.kitty_placeholders && forced.hint.is_some());
+    assert_eq!((forced.mode, forced.hint), (GraphicsMode::Cells, Some(TMUX_HINT)));
 }
 
 #[test]
@@ -329,12 +330,14 @@ mod through_the_screen {
             fps: 30,
             bandwidth: Bandwidth::Unlimited,
             color: ColorMode::TrueColor,
+            color_auto: false,
             encode: EncodeOptions::default(),
             graphics: GraphicsRequest::Auto,
             probe: Some(ProbeOptions {
                 env: Environment { ssh: true, ..Environment::default() },
                 winsize: WinSize { cols: 40, rows: 12, x_px: 320, y_px: 192 },
                 kitty_file: None,
+                colours: false,
             }),
             link_path: Default::default(),
         };
@@ -414,4 +417,60 @@ mod through_the_screen {
         assert!(silent.take_notice().is_some_and(|n| n.contains("did not answer")));
         assert!(inputs.is_empty(), "{inputs:?}");
     }
+}
+
+#[test]
+fn a_forced_protocol_the_answers_rule_out_draws_cells_and_says_why() {
+    let kitty = GraphicsRequest::Force(GraphicsMode::Kitty);
+    let sixel = GraphicsRequest::Force(GraphicsMode::Sixel);
+    let answered = GraphicsSupport { answered: true, ..GraphicsSupport::default() };
+    let with_kitty = GraphicsSupport { kitty: true, ..answered.clone() };
+    assert_eq!(choose(kitty, Some(&with_kitty)).mode, GraphicsMode::Kitty);
+    assert_eq!(
+        choose(kitty, Some(&answered)),
+        GraphicsChoice { hint: Some(NO_KITTY), ..choose(GraphicsRequest::Auto, None) }
+    );
+    assert_eq!(choose(sixel, Some(&answered)).hint, Some(NO_SIXEL));
+    assert_eq!(choose(sixel, Some(&answered)).mode, GraphicsMode::Cells);
+    let with_sixel =
+        GraphicsSupport { sixel: Some(SixelSupport { registers: 256, max_w: None, max_h: None }), ..answered.clone() };
+    assert_eq!(choose(sixel, Some(&with_sixel)).mode, GraphicsMode::Sixel);
+    // Nothing answered: nothing is known, so the protocol is used as asked.
+    let silent = GraphicsSupport::default();
+    assert_eq!(choose(kitty, Some(&silent)).mode, GraphicsMode::Kitty);
+    assert_eq!(choose(sixel, Some(&silent)).mode, GraphicsMode::Sixel);
+    // iTerm2 has no query others answer: as asked.
+    assert_eq!(choose(GraphicsRequest::Force(GraphicsMode::Iterm2), Some(&answered)).mode, GraphicsMode::Iterm2);
+    // tmux passing kitty through without placeholders (kitty 0.26 outside).
+    let tmux = GraphicsSupport { tmux: true, tmux_passthrough: true, ..with_kitty };
+    assert_eq!(choose(kitty, Some(&tmux)).hint, Some(PLACEHOLDER_HINT));
+    let tmux = GraphicsSupport { kitty_placeholders: true, ..tmux };
+    assert_eq!(choose(kitty, Some(&tmux)).mode, GraphicsMode::Kitty);
+}
+
+#[test]
+fn true_colour_answers_are_read_and_a_palette_index_is_not_one() {
+    let with = |answer: &[u8]| FakeTerminal::new(&[(1, &[answer, XTERM_DA1].concat())]).run(&options(false));
+    for yes in [
+        &b"\x1bP1+r524742\x1b\\"[..],
+        b"\x1bP0+r524742\x1b\\\x1bP1+r5463=\x1b\\",
+        b"\x1bP1$r0;38:2::1:2:3m\x1b\\",
+        b"\x1bP1$r0;38:2:1:2:3m\x1b\\",
+        b"\x1bP1$r38;2;1;2;3m\x1b\\",
+    ] {
+        assert!(with(yes).outcome.support.true_color, "{:?}", String::from_utf8_lossy(yes));
+    }
+    for no in [
+        &b"\x1bP0+r524742\x1b\\\x1bP0+r5463\x1b\\"[..],
+        b"\x1bP1$r0;38:5:16m\x1b\\",
+        b"\x1bP1$r0;38:2::11:2:3m\x1b\\",
+        b"\x1bP0$r\x1b\\",
+        b"",
+    ] {
+        assert!(!with(no).outcome.support.true_color, "{:?}", String::from_utf8_lossy(no));
+    }
+    let has = |hay: &[u8], needle: &[u8]| hay.windows(needle.len()).any(|w| w == needle);
+    assert!(has(&queries(&options(false)), COLOUR_QUERIES));
+    let quiet = ProbeOptions { colours: false, ..options(false) };
+    assert!(!has(&queries(&quiet), b"\x1bP+q"), "no colour question unless asked for");
 }

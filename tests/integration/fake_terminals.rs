@@ -1,0 +1,202 @@
+//! `tidepool play` in a pseudo-terminal against fake graphics terminals
+//! ([`crate::common::fake_terminal`]): each gets a picture in the protocol it speaks, or cells
+//! with a notice, never a blank screen.
+
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+
+use crate::common::fake_terminal::{Edits, FakeTerminal, Profile, Shown, Watch};
+use crate::common::pty::{Player, temp_dir};
+
+/// Bound for a hang only: every scenario ends much sooner when the player works.
+const HANG: Duration = Duration::from_secs(20);
+const COLS: usize = 160;
+const ROWS: usize = 48;
+/// An SSH login's `SSH_CONNECTION`.
+const SSH: (&str, &str) = ("SSH_CONNECTION", "10.227.0.1 50000 10.227.0.2 22");
+
+/// Runs `tidepool play ARGS` in a pty of 160x48 cells against `profile`, over SSH when `ssh`,
+/// until the terminal shows a picture or cells with a notice; panics on a blank screen.
+fn play(profile: Profile, args: &[&str], ssh: bool) -> (Shown, Arc<Mutex<FakeTerminal>>) {
+    let fake = Arc::new(Mutex::new(FakeTerminal::new(profile.clone(), COLS, ROWS)));
+    let mut env = vec![("TERM", profile.term), ("COLORTERM", "")];
+    if ssh {
+        env.push(SSH);
+    }
+    let all: Vec<&str> = ["play", "--rain", "0.05"].iter().chain(args).copied().collect();
+    let name = format!("fake-{}", profile.name.replace(' ', "-"));
+    let mut p = Player::spawn_fake(&temp_dir(&name), &all, &env, Arc::clone(&fake));
+    let deadline = Instant::now() + HANG;
+    let mut watch = Watch::new(fake.lock().unwrap().has_graphics());
+    let mut not_yet = String::from("blank");
+    let shown = loop {
+        let f = fake.lock().unwrap();
+        let glance = watch.glance(&f);
+        let (bytes, status) = (f.raw.len(), f.status());
+        drop(f);
+        if let Some(glance) = glance {
+            match glance.check(profile.name) {
+                Ok(shown) => break shown,
+                Err(what) => not_yet = what,
+            }
+        }
+        if Instant::now() >= deadline {
+            panic!("{}: {not_yet} for {HANG:?}: {bytes} bytes, status line {:?}", profile.name, status.trim_end());
+        }
+        std::thread::sleep(Duration::from_millis(if not_yet == "blank" { 20 } else { 200 }));
+    };
+    let took = deadline - HANG;
+    let (rgb, palette) = fake.lock().unwrap().colour_codes();
+    // The table in docs/terminals/right-pictures.md (`--nocapture`).
+    println!(
+        "pty | {} | {args:?} | ssh {ssh} | {shown:?} | {} | {:.1} s",
+        profile.name,
+        if rgb > palette { "24-bit" } else { "256" },
+        took.elapsed().as_secs_f64()
+    );
+    p.send(b"q");
+    let _ = p.wait_exit(HANG);
+    (shown, fake)
+}
+
+/// Panics with what `play` found when the screen stayed blank, instead of at once: the other
+/// runs still run, and the failure lists them all.
+fn play_or_blank(profile: Profile, args: &[&str], ssh: bool) -> Result<Shown, String> {
+    std::panic::catch_unwind(|| play(profile, args, ssh).0).map_err(|e| {
+        e.downcast_ref::<String>()
+            .cloned()
+            .or_else(|| e.downcast_ref::<&str>().map(|s| s.to_string()))
+            .unwrap_or_default()
+    })
+}
+
+#[test]
+fn a_kitty_terminal_refusing_or_ignoring_frame_edits_over_ssh_gets_pictures() {
+    let mut outcomes = Vec::new();
+    for edits in [Edits::Refuse, Edits::Ignore] {
+        for args in [&["--graphics", "kitty"][..], &[][..]] {
+            for run in 0..3 {
+                let shown = play_or_blank(Profile::kitty_minimal(edits), args, true);
+                outcomes.push((edits, args, run, shown));
+            }
+        }
+    }
+    let failed: Vec<String> = outcomes
+        .iter()
+        .filter(|(_, _, _, shown)| !matches!(shown, Ok(Shown::Kitty(..))))
+        .map(|(edits, args, run, shown)| format!("{edits:?} {args:?} run {run}: {shown:?}"))
+        .collect();
+    assert!(failed.is_empty(), "{} of {} runs without a picture:\n{}", failed.len(), outcomes.len(), failed.join("\n"));
+}
+
+#[test]
+fn a_forced_protocol_the_terminal_does_not_speak_draws_cells_and_says_why() {
+    use crate::common::fake_terminal::{Sgr, Tcap};
+    for (flag, says) in [("kitty", "kitty"), ("sixel", "sixel")] {
+        for ssh in [false, true] {
+            let (shown, _) = play(Profile::text(Tcap::Silent, Sgr::Silent), &["--graphics", flag], ssh);
+            let Shown::Cells(status) = &shown else { panic!("--graphics {flag}: {shown:?}") };
+            assert!(status.contains(says) && status.contains("cells"), "--graphics {flag} (ssh {ssh}): {status:?}");
+        }
+    }
+}
+
+#[test]
+fn true_colour_is_found_by_asking_the_terminal_or_by_its_name() {
+    use crate::common::fake_terminal::{Sgr, Tcap};
+    let text = |tcap, sgr, term| Profile { term, ..Profile::text(tcap, sgr) };
+    let cases = [
+        (text(Tcap::Rgb, Sgr::Silent, "xterm-256color"), &[][..], true),
+        (text(Tcap::Silent, Sgr::TrueColor, "xterm-256color"), &[][..], true),
+        (text(Tcap::Missing, Sgr::TrueColor, "xterm-256color"), &[][..], true),
+        (text(Tcap::Missing, Sgr::Palette, "xterm-256color"), &[][..], false),
+        (text(Tcap::Silent, Sgr::Silent, "xterm-256color"), &[][..], false),
+        (text(Tcap::Silent, Sgr::Silent, "xterm-kitty"), &[][..], true),
+        (text(Tcap::Silent, Sgr::Silent, "foot"), &[][..], true),
+        (text(Tcap::Silent, Sgr::Silent, "wezterm"), &[][..], true),
+        // The manual override wins over the answers.
+        (text(Tcap::Rgb, Sgr::TrueColor, "xterm-256color"), &["--color", "256"][..], false),
+    ];
+    for (profile, args, truecolor) in cases {
+        for ssh in [true, false] {
+            let what = format!("{:?}/{:?} TERM={} {args:?} ssh {ssh}", profile.tcap, profile.sgr, profile.term);
+            let (shown, fake) = play(profile.clone(), args, ssh);
+            assert!(matches!(shown, Shown::Cells(_)), "{what}: {shown:?}");
+            let (rgb, palette) = fake.lock().unwrap().colour_codes();
+            if truecolor {
+                assert!(
+                    rgb > 100 && rgb > palette,
+                    "{what}: 24-bit colours expected ({rgb} 24-bit, {palette} palette)"
+                );
+            } else {
+                assert!(palette > 100 && rgb == 0, "{what}: 256 colours expected ({rgb} 24-bit, {palette} palette)");
+            }
+            let raw = fake.lock().unwrap().raw.clone();
+            let hint = raw.windows(17).any(|w| w == b"--color truecolor");
+            assert_eq!(hint, !truecolor && args.is_empty(), "{what}: the hint to use --color truecolor");
+        }
+    }
+}
+
+/// How many times each scenario runs (`TIDEPOOL_FAKE_RUNS`, default 3): a flaky outcome is a
+/// defect, so each runs more than once.
+fn runs() -> usize {
+    std::env::var("TIDEPOOL_FAKE_RUNS").ok().and_then(|v| v.parse().ok()).unwrap_or(3)
+}
+
+/// Whether `profile` says it draws 24-bit colour (by name, XTGETTCAP or DECRQSS).
+fn true_colour(profile: &Profile) -> bool {
+    use crate::common::fake_terminal::{Sgr, Tcap};
+    profile.tcap == Tcap::Rgb
+        || profile.sgr == Sgr::TrueColor
+        || tidepool::terminal::ColorMode::detect(None, Some(profile.term)) == tidepool::terminal::ColorMode::TrueColor
+}
+
+#[test]
+fn every_graphics_terminal_gets_pictures_in_the_protocol_it_speaks_locally_and_over_ssh() {
+    // Each terminal, the flags, and what it must show (locally, or over SSH when the flag is set).
+    type Scenario = (Profile, &'static [&'static str], fn(&Shown, bool) -> bool);
+    let scenarios: Vec<Scenario> = vec![
+        (Profile::kitty_026(), &[], |s, _| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::kitty_026(), &["--graphics", "kitty"], |s, _| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::kitty_current(), &[], |s, _| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::ghostty(), &[], |s, _| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::ghostty(), &["--graphics", "kitty"], |s, _| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::wezterm(), &[], |s, _| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::wezterm(), &["--graphics", "sixel"], |s, _| matches!(s, Shown::Sixel)),
+        (Profile::wezterm(), &["--graphics", "iterm2"], |s, _| matches!(s, Shown::Iterm2(w, _) if *w >= 80)),
+        (Profile::konsole(), &[], |s, _| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::konsole(), &["--graphics", "kitty"], |s, _| matches!(s, Shown::Kitty(w, _) if *w >= 80)),
+        (Profile::konsole(), &["--graphics", "iterm2"], |s, _| matches!(s, Shown::Iterm2(w, _) if *w >= 80)),
+        // Over SSH auto draws cells (sixel never beat them over a link) and says so.
+        (Profile::xterm_vt340(), &[], |s, ssh| match ssh {
+            false => matches!(s, Shown::Sixel),
+            true => matches!(s, Shown::Cells(status) if status.contains("sixel over a link")),
+        }),
+        (Profile::xterm_vt340(), &["--graphics", "sixel"], |s, _| matches!(s, Shown::Sixel)),
+    ];
+    let mut failed = Vec::new();
+    let mut seen = 0;
+    for (profile, args, expected) in &scenarios {
+        for ssh in [false, true] {
+            for run in 0..runs() {
+                seen += 1;
+                let what = format!("{} {args:?} ssh {ssh} run {run}", profile.name);
+                match std::panic::catch_unwind(|| play(profile.clone(), args, ssh)) {
+                    Ok((shown, fake)) => {
+                        let (rgb, _) = fake.lock().unwrap().colour_codes();
+                        if !expected(&shown, ssh) {
+                            failed.push(format!("{what}: {shown:?}"));
+                        } else if true_colour(profile) != (rgb > 0) {
+                            failed.push(format!("{what}: true colour {} but {rgb} 24-bit codes", true_colour(profile)));
+                        }
+                    }
+                    Err(e) => {
+                        failed.push(format!("{what}: {}", e.downcast_ref::<String>().cloned().unwrap_or_default()))
+                    }
+                }
+            }
+        }
+    }
+    assert!(failed.is_empty(), "{} of {seen} runs wrong:\n{}", failed.len(), failed.join("\n"));
+}
