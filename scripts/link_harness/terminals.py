@@ -4,21 +4,23 @@
 For each terminal, door and place it opens the terminal (140x45 cells under Xvfb) on:
 - `play`, `local`: `tidepool play ARGS` in the terminal itself;
 - `serve`, `local`: `ssh` to a `tidepool serve` on this machine's loopback;
-- `play`, `link`: `ssh -tt root@FAR tidepool play ARGS`, the ssh client in the client network
-  namespace, so everything crosses the shaped link;
-- `serve`, `link`: `ssh -tt` to `tidepool serve` in the far namespace.
+- `play`, `link`: `ssh -tt USER@FAR tidepool play ARGS`, the ssh client in the client network
+  namespace, so everything crosses the shaped link (`ssh -t root@...` in the harness lab);
+- `serve`, `link`: `ssh -tt` to `tidepool serve` in the far namespace (`-t` in the harness lab).
 A `space` stone is dropped at 5 s (xdotool, through XTEST: xterm ignores synthetic key events);
 the terminal's window is saved at each of --shots seconds (2, 6, 12, 30) as
 OUT/TERMINAL-DOOR-PLACE[-TAG]-Ns.png; through util-linux `script -B -m advanced` both directions
 between the terminal and its client are kept with their times, and the summary says when the
 probe was answered and when the first picture (kitty `a=T`, a sixel image) arrived after it.
 
-The link (`--lab stock`, the default): two namespaces (--ns-prefix: PREFIXc, PREFIXs) joined by
-a veth pair (--subnet: SUBNET.1, SUBNET.2), both ends `tc qdisc replace dev X root tbf rate 2mbit
-burst 32kbit latency 400ms`, no relay, and Debian's own sshd on port 22 in the far namespace with
-its own configuration (`AcceptEnv LANG LC_*`: COLORTERM never arrives; four lines before it say
-where this run's keys are). `--lab harness` is harness.py's lab instead (its sshd on 2222 taking
-COLORTERM, the relays adding the link's round trip).
+The link is lab.py's: two namespaces (--ns-prefix: PREFIXc, PREFIXs) joined by a veth pair
+(--subnet: SUBNET.1, SUBNET.2), both ends `tc qdisc replace dev X root tbf rate 2mbit burst 32kbit
+latency 400ms`. `--lab stock` (the default) is lab.py's stock configuration: no relay, Debian's
+own sshd started plainly on port 22 of the far namespace (/etc/ssh/sshd_config as shipped:
+`AcceptEnv LANG LC_*`, COLORTERM never arrives), the test user (--stock-user, made for the run
+unless it exists) and the system's ssh client configuration. `--lab harness` is lab.py's lab
+configuration instead (root, its sshd on 2222 taking COLORTERM, the relays adding the link's
+round trip).
 
     sudo python3 scripts/link_harness/terminals.py --out docs/terminals/right-pictures
     sudo python3 scripts/link_harness/terminals.py --terminals kitty --doors serve --places link
@@ -41,7 +43,8 @@ import subprocess
 import sys
 import time
 
-from harness import LINKS, SERVE_PORT, Lab, stop
+from harness import LINKS
+from lab import SERVE_PORT, STOCK_USER, Lab, stop
 
 # Each terminal at 140x45 cells, at the top left of the screen (no window manager).
 TERMINALS = {
@@ -60,6 +63,14 @@ DOORS = ("play", "serve")
 PLACES = ("local", "link")
 # A loopback port of this run's range for the local `tidepool serve`.
 LOCAL_SERVE_PORT = 27223
+
+
+def local_ssh(lab, port):
+    """OpenSSH's client for the `tidepool serve` on this machine's loopback: no config, this
+    run's key, root, `-tt`."""
+    cmd = ["ssh", "-F", "/dev/null", "-i", f"{lab.dir}/client_key", "-p", str(port)]
+    cmd += ["-o", "IdentitiesOnly=yes", "-o", f"UserKnownHostsFile={lab.dir}/known_hosts", "-o", "StrictHostKeyChecking=no"]
+    return cmd + ["-o", "LogLevel=ERROR", "-tt", "root@127.0.0.1"]
 
 
 def window_box(env, pid):
@@ -110,9 +121,10 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--tidepool", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "target", "release", "tidepool"))
     parser.add_argument("--link", default="2mbit-20ms", help=f"the link's rate, of {', '.join(LINKS)} (default 2mbit-20ms; the stock lab adds no round trip)")
-    parser.add_argument("--lab", default="stock", choices=("stock", "harness"), help="stock: Debian's sshd on port 22, no relay (default); harness: harness.py's sshd and relays")
+    parser.add_argument("--lab", default="stock", choices=("stock", "harness"), help="stock: Debian's sshd on port 22, the test user, no relay (default); harness: lab.py's own sshd as root, and relays")
+    parser.add_argument("--stock-user", default=STOCK_USER, help=f"the stock lab's test user, made for the run if missing (default {STOCK_USER})")
     parser.add_argument("--ns-prefix", default="p27", help="the namespaces' names: PREFIXc, PREFIXs (default p27)")
-    parser.add_argument("--subnet", default="10.227.0", help="the veth pair's /30: SUBNET.1, SUBNET.2 (default 10.227.0)")
+    parser.add_argument("--subnet", default="10.227.0", help="the veth pair's /24: SUBNET.1, SUBNET.2 (default 10.227.0)")
     parser.add_argument("--terminals", default="kitty,xterm,mlterm", help="of kitty, xterm, mlterm (default all)")
     parser.add_argument("--doors", default="play,serve", help="of play, serve (default both)")
     parser.add_argument("--places", default="local,link", help="of local, link (default both)")
@@ -144,6 +156,8 @@ def main():
         sys.exit("terminals.py: --tag takes letters, digits, '.', '_' and '-' (at most 40)")
     if not re.fullmatch(r":[0-9]{1,4}", args.display):
         sys.exit("terminals.py: --display takes an X display such as :271")
+    if not re.fullmatch(r"[a-z][a-z0-9]{0,15}", args.stock_user):
+        sys.exit("terminals.py: --stock-user takes a user name of lower-case letters and digits (at most 16)")
     if not re.fullmatch(r"[a-z0-9]{1,8}", args.ns_prefix) or not re.fullmatch(r"10\.[0-9]{1,3}\.[0-9]{1,3}", args.subnet):
         sys.exit("terminals.py: --ns-prefix takes up to 8 letters or digits, --subnet three octets such as 10.227.0")
     for tool in ("Xvfb", "import", "convert", "xdotool", "script", "ssh", *lists["terminal"]):
@@ -162,14 +176,15 @@ def main():
     signal.signal(signal.SIGTERM, out_of_time)
     signal.alarm(int(args.timeout))
     stock = args.lab == "stock"
-    lab = Lab(tidepool, args.timeout, prefix=args.ns_prefix, subnet=args.subnet, stock=stock)
+    lab = Lab(tidepool, args.timeout, names=args.ns_prefix, subnet=args.subnet, stock_user=args.stock_user)
     xvfb = local_serve = None
     summary = []
     try:
         if "link" in lists["place"]:
-            lab.setup()
+            lab.setup(lab_sshd=not stock, stock_sshd=stock)
             rate, _, rtt = LINKS[args.link]
-            lab.shape(rate, None if stock else rtt)
+            # The stock lab goes straight to the shaped veth (no relay, no added round trip).
+            lab.shape(rate, 0 if stock else rtt)
         else:
             for name in ("client_key",):
                 subprocess.run(["ssh-keygen", "-q", "-t", "ed25519", "-N", "", "-f", f"{lab.dir}/{name}"], check=True, timeout=30)
@@ -185,18 +200,17 @@ def main():
         for var in ("TMUX", "SSH_CONNECTION", "SSH_TTY", "SSH_CLIENT", "KITTY_WINDOW_ID", "TERM_PROGRAM", "COLORTERM"):
             env.pop(var, None)
         play = f"{shlex.quote(tidepool)} play {args.play_args}"
-        far = lab.server_ip if stock else "127.0.0.1"
         for name in lists["terminal"]:
             for door in lists["door"]:
                 for place in lists["place"]:
                     if place == "local" and door == "play":
                         client = ["sh", "-c", play]
                     elif place == "local":
-                        client = lab.ssh_command(LOCAL_SERVE_PORT, host="127.0.0.1", send_env=False)
+                        client = local_ssh(lab, LOCAL_SERVE_PORT)
                     elif door == "play":
-                        client = lab.ns(lab.client_ns, *lab.ssh_command(lab.ssh_port, play, host=far, send_env=not stock))
+                        client = lab.ns(lab.client_ns, *lab.ssh_command(remote=play, stock=stock))
                     else:
-                        client = lab.ns(lab.client_ns, *lab.ssh_command(SERVE_PORT, host=far, send_env=not stock))
+                        client = lab.ns(lab.client_ns, *lab.ssh_command(port=SERVE_PORT, stock=stock))
                     base = os.path.join(args.out, f"{name}-{door}-{place}{tag}")
                     # Both directions (-B) with their times: the probe's answers and the pictures.
                     recorded = ["script", "-q", "-f", "-m", "advanced", "-T", f"{base}.timing", "-B", f"{base}.raw", "-c", shlex.join(client)]
@@ -226,8 +240,11 @@ def main():
                             f"{'never' if picture is None else f'{picture:.2f} s after it'}")
                     summary.append(line)
                     print(line, flush=True)
-                    # The remote player ends with its ssh session; give sshd a moment to reap it.
+                    # The remote player ends with its ssh session; give sshd a moment to reap it,
+                    # then end by id whatever of the row still runs in the far namespace.
                     time.sleep(1)
+                    if place == "link":
+                        lab.stop_sessions()
         load = os.getloadavg()
         print(f"load average: {load[0]:.2f} {load[1]:.2f} {load[2]:.2f} ({os.cpu_count()} cores)")
         with open(os.path.join(args.out, f"summary{tag}.txt"), "w") as f:
