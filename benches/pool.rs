@@ -1,4 +1,5 @@
-//! Benchmarks of the ripple pool: `sim/ripple_step`, `render/pool`, `output/png`.
+//! Benchmarks of the ripple pool: `sim/ripple_step`, `render/pool`, `render/pool_player`,
+//! `output/png`.
 //!
 //! `sim/ripple_step` runs a plain transliteration of the papers' scalar loop next to tidepool's
 //! step in the same run, and prints the speed-ups at the end, so every run shows how much
@@ -7,7 +8,7 @@
 //! Run: `cargo bench --bench pool` (add `-- sim/` to run one group).
 
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
-use tidepool::{Damping, Event, PoolLook, PoolScene, PoolSettings, RipplePool, Scene, Stone};
+use tidepool::{BreezeStyle, Damping, Event, PoolLook, PoolScene, PoolSettings, RipplePool, Scene, Stone};
 use tiny_skia::Pixmap;
 
 /// The papers' loop, transliterated: index arithmetic, an i32 sum, shifts, store, swap.
@@ -129,6 +130,63 @@ fn render_pool(c: &mut Criterion) {
     group.finish();
 }
 
+/// The player's pool as the pixel modes draw it: 480x282 pixels (160x48 cells of 8x16 pixels
+/// less the status row, within the player's scene cap) with the player's defaults (`play`'s
+/// `PoolDefaults::PLAYER`: a grid of two cells a pixel, 30 steps a second, gusts at level 1, rain
+/// 0.01; the default look: caustics, shading) and a few stones' rings on it.
+fn player_pool() -> PoolScene {
+    let settings = PoolSettings {
+        rain_rate: 0.01,
+        breeze: 1.0,
+        breeze_style: BreezeStyle::Gusts,
+        grid: 2,
+        steps_per_second: 30,
+        seed: 1,
+        ..PoolSettings::default()
+    };
+    let mut scene = PoolScene::new(480, 282, settings).expect("the player's pool");
+    for k in 0..6u32 {
+        scene.drop_stone(Stone::clamped((k * 7919 % 480) as i32, (k * 104729 % 282) as i32, 4, 128));
+        Scene::advance(&mut scene, 20);
+    }
+    scene
+}
+
+/// The picture of the player's pool (issue 29's "the pool's frame at 480x282"): `render` is the
+/// picture alone, `frame` one step (1/30 s at 30 steps a second) and the picture, with a stone
+/// a second as a player drops them; each on rayon's pool (all cores) and on one thread (what
+/// the frame costs in CPU time).
+fn render_player_pool(c: &mut Criterion) {
+    let mut group = c.benchmark_group("render/pool_player");
+    group.sample_size(30);
+    group.throughput(Throughput::Elements(480 * 282));
+    let one = thread_pool(1);
+    let mut out = Pixmap::new(480, 282).unwrap();
+    // Each iteration runs on the given pool (`install` costs microseconds, the frame milliseconds).
+    for (suffix, pool) in [("", None), ("_1thread", Some(&one))] {
+        let run = |f: &mut (dyn FnMut() + Send)| match pool {
+            Some(p) => p.install(f),
+            None => f(),
+        };
+        let mut scene = player_pool();
+        group.bench_function(format!("render{suffix}/480x282"), |b| b.iter(|| run(&mut || scene.render(&mut out))));
+        let mut k = 0u32;
+        group.bench_function(format!("frame{suffix}/480x282"), |b| {
+            b.iter(|| {
+                run(&mut || {
+                    k = k.wrapping_add(1);
+                    if k.is_multiple_of(30) {
+                        scene.drop_stone(Stone::clamped((k * 7919 % 480) as i32, (k * 104729 % 282) as i32, 3, 128));
+                    }
+                    Scene::advance(&mut scene, 1);
+                    scene.render(&mut out)
+                })
+            })
+        });
+    }
+    group.finish();
+}
+
 fn output_png(c: &mut Criterion) {
     let mut group = c.benchmark_group("output/png");
     group.sample_size(10);
@@ -169,7 +227,7 @@ fn print_speedups() {
     }
 }
 
-criterion_group!(benches, ripple_step, render_pool, output_png);
+criterion_group!(benches, ripple_step, render_pool, render_player_pool, output_png);
 
 fn main() {
     benches();
