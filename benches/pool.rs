@@ -5,8 +5,14 @@
 //! step in the same run, and prints the speed-ups at the end, so every run shows how much
 //! faster the real step is on this machine.
 //!
-//! Run: `cargo bench --bench pool` (add `-- sim/` to run one group).
+//! `render/pool_player` is issue 29's renderer figure: the player's pool at 480x282 in wall
+//! time; `cpu/pool_player` the same frame in the process's CPU time (all threads), which the
+//! load of other processes does not inflate.
+//!
+//! Run: `cargo bench --bench pool` (add `-- sim/` to run one group, `-- pool_player` for the
+//! player's frame).
 
+use criterion::measurement::{Measurement, ValueFormatter, WallTime};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
 use tidepool::{BreezeStyle, Damping, Event, PoolLook, PoolScene, PoolSettings, RipplePool, Scene, Stone};
 use tiny_skia::Pixmap;
@@ -187,6 +193,68 @@ fn render_player_pool(c: &mut Criterion) {
     group.finish();
 }
 
+/// The process's CPU time (every thread, user and system: `CLOCK_PROCESS_CPUTIME_ID`) as a
+/// criterion measurement: what a frame costs a user's `top`, rayon's idle workers included,
+/// and unlike the wall clock not inflated when other processes share the cores.
+struct ProcessCpu(WallTime);
+
+impl ProcessCpu {
+    fn now() -> std::time::Duration {
+        let t = rustix::time::clock_gettime(rustix::time::ClockId::ProcessCPUTime);
+        std::time::Duration::new(t.tv_sec as u64, t.tv_nsec as u32)
+    }
+}
+
+impl Measurement for ProcessCpu {
+    type Intermediate = std::time::Duration;
+    type Value = std::time::Duration;
+
+    fn start(&self) -> Self::Intermediate {
+        ProcessCpu::now()
+    }
+
+    fn end(&self, start: Self::Intermediate) -> Self::Value {
+        ProcessCpu::now().saturating_sub(start)
+    }
+
+    fn add(&self, a: &Self::Value, b: &Self::Value) -> Self::Value {
+        *a + *b
+    }
+
+    fn zero(&self) -> Self::Value {
+        std::time::Duration::ZERO
+    }
+
+    fn to_f64(&self, value: &Self::Value) -> f64 {
+        value.as_nanos() as f64
+    }
+
+    fn formatter(&self) -> &dyn ValueFormatter {
+        self.0.formatter()
+    }
+}
+
+/// `render/pool_player`'s frame in CPU time ([`ProcessCpu`]) on rayon's pool.
+fn cpu_player_pool(c: &mut Criterion<ProcessCpu>) {
+    let mut group = c.benchmark_group("cpu/pool_player");
+    group.sample_size(30);
+    let mut out = Pixmap::new(480, 282).unwrap();
+    let mut scene = player_pool();
+    group.bench_function("render/480x282", |b| b.iter(|| scene.render(&mut out)));
+    let mut k = 0u32;
+    group.bench_function("frame/480x282", |b| {
+        b.iter(|| {
+            k = k.wrapping_add(1);
+            if k.is_multiple_of(30) {
+                scene.drop_stone(Stone::clamped((k * 7919 % 480) as i32, (k * 104729 % 282) as i32, 3, 128));
+            }
+            Scene::advance(&mut scene, 1);
+            scene.render(&mut out)
+        })
+    });
+    group.finish();
+}
+
 fn output_png(c: &mut Criterion) {
     let mut group = c.benchmark_group("output/png");
     group.sample_size(10);
@@ -228,9 +296,15 @@ fn print_speedups() {
 }
 
 criterion_group!(benches, ripple_step, render_pool, render_player_pool, output_png);
+criterion_group! {
+    name = cpu;
+    config = Criterion::default().with_measurement(ProcessCpu(WallTime));
+    targets = cpu_player_pool
+}
 
 fn main() {
     benches();
+    cpu();
     Criterion::default().configure_from_args().final_summary();
     print_speedups();
 }
