@@ -7,7 +7,6 @@ use super::{Action, Controls, Event, Scene, SceneKind};
 use crate::error::{Error, Result};
 use crate::render::background;
 use crate::render::pool::{Fields, PoolLook, PoolRenderer};
-use crate::render::supersample::{Downsample, downsample};
 use crate::sim::breeze::gusts::{GustShape, Gusts};
 use crate::sim::breeze::{Breeze, BreezeStyle};
 use crate::sim::rain::Rain;
@@ -174,8 +173,6 @@ pub struct PoolScene {
     size: (u32, u32),
     grid: u32,
     steps_per_second: u32,
-    /// The picture at the simulation's resolution, when the grid is finer than the picture.
-    fine: Option<Pixmap>,
     /// The pool's heights with the gusts' ripples added ([`GUST_UNITS`] a unit), all of them
     /// (`field`) and [`GUST_REFRACTION`] of them (`refraction`); `composer` makes them.
     field: Vec<i16>,
@@ -215,7 +212,6 @@ impl PoolScene {
         let steps_per_second = check_steps_per_second(u64::from(settings.steps_per_second)).ok()?;
         let (cols, rows) = (width.checked_mul(grid)?, height.checked_mul(grid)?);
         let fitted = background::cover(&settings.floor, cols, rows)?;
-        let fine = if grid > 1 { Some(Pixmap::new(cols, rows)?) } else { None };
         Some(PoolScene {
             pool: RipplePool::new(cols as usize, rows as usize, settings.damping),
             rain: Rain::new(settings.rain_rate, settings.seed),
@@ -226,7 +222,6 @@ impl PoolScene {
             size: (width, height),
             grid,
             steps_per_second,
-            fine,
             field: Vec::new(),
             refraction: Vec::new(),
             composer: Composer::default(),
@@ -343,13 +338,7 @@ impl PoolScene {
             true => Fields { refraction: &self.refraction, light: &self.field },
             false => Fields { refraction: self.pool.heights(), light: self.pool.heights() },
         };
-        match &mut self.fine {
-            None => self.renderer.render_fields(fields, out),
-            Some(fine) => {
-                self.renderer.render_fields(fields, fine);
-                downsample(fine, self.grid, Downsample::Box, out);
-            }
-        }
+        self.renderer.render_fields(fields, out);
     }
 
     /// Starts over at a new size: still water, the floor refitted, the rain continuing.
@@ -363,17 +352,9 @@ impl PoolScene {
         let Some(fitted) = background::cover(&self.floor, cols, rows) else {
             return false;
         };
-        let fine = match g {
-            1 => None,
-            _ => match Pixmap::new(cols, rows) {
-                Some(p) => Some(p),
-                None => return false,
-            },
-        };
         let damping = self.pool.damping();
         self.pool = RipplePool::new(cols as usize, rows as usize, damping);
         self.renderer = PoolRenderer::on_grid(fitted, self.renderer.look(), g, self.units());
-        self.fine = fine;
         self.size = (width, height);
         if let Wind::Gusts(gusts) = &mut self.wind {
             gusts.clear();

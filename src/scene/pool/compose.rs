@@ -10,7 +10,7 @@
 //! whatever the split and the set.
 
 use super::{GUST_REFRACTION, GUST_UNITS};
-use crate::sim::breeze::gusts::GustField;
+use crate::sim::breeze::gusts::{GUST_LANES, GustField};
 use crate::simd::{Simd, Tier};
 
 /// Pools with fewer cells are composed on one thread.
@@ -44,7 +44,8 @@ impl Composer {
         let tasks = n.div_ceil(chunk);
         self.rows.resize_with(tasks, Vec::new);
         let run = |(task, ((light, refraction), row)): BandTask<'_>| {
-            row.resize(cols, 0.0);
+            // Room for the packets' padding past the last column (see `GustField::add_row`).
+            row.resize(cols + GUST_LANES, 0.0);
             let band = Band { sources, first_row: task * rows_per_task };
             match simd.tier() {
                 // SAFETY: a `Simd` of this tier exists only when run-time detection found the

@@ -85,6 +85,9 @@ const WAVE_SPEED: f32 = std::f32::consts::FRAC_1_SQRT_2;
 const SEED_SALT: u64 = 0x0067_7573_7473; // "gusts"
 /// The most packets alive at once (a bound on work per picture, whatever the pool's size).
 pub const MAX_PACKETS: usize = 64;
+/// The gusts' columns are added this many at a time ([`GustField::add_row`]): a vector of
+/// AVX-512, two of AVX2.
+pub const GUST_LANES: usize = 16;
 
 /// One packet: where it was born, where it goes, its wave and its strength.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -236,7 +239,7 @@ impl Gusts {
         real.clear();
         imaginary.clear();
         // Room for every packet at its widest at once: no steady-state frame allocates.
-        let most = self.packets.len() * (width + height);
+        let most = self.packets.len() * (width + GUST_LANES + height);
         real.reserve(most.saturating_sub(real.len()));
         imaginary.reserve(most.saturating_sub(imaginary.len()));
         let life = self.shape.life_steps.max(1) as f32;
@@ -270,6 +273,10 @@ impl Gusts {
                 real.push(re);
                 imaginary.push(im);
             }
+            // Zeros up to a whole number of vectors (see `GustField::add_row`).
+            let padded = columns + xs.len().next_multiple_of(GUST_LANES);
+            real.resize(padded, 0.0);
+            imaginary.resize(padded, 0.0);
             let rows = real.len();
             let (pc, ps) = (amplitude * libm::cosf(p.phase), amplitude * libm::sinf(p.phase));
             for y in ys.clone() {
@@ -313,9 +320,14 @@ pub struct GustField<'a> {
 }
 
 impl GustField<'_> {
-    /// Adds the gusts' heights in row `y` to `row` (the pool's width): every packet that
-    /// covers the row in the order they were born, so each cell sums the same terms in the
-    /// same order whichever rows are drawn together and on whichever thread.
+    /// Adds the gusts' heights in row `y` to `row` (the pool's width, or more: see below):
+    /// every packet that covers the row in the order they were born, so each cell sums the
+    /// same terms in the same order whichever rows are drawn together and on whichever thread.
+    ///
+    /// Each packet's columns are added [`GUST_LANES`] at a time, its column factors padded
+    /// with zeros to a whole number of them; a `row` at least [`GUST_LANES`] longer than the
+    /// pool takes the padding too and needs no scalar remainder. Adding a zero leaves every
+    /// cell as it is: a sum that starts at +0 never becomes -0, and +0 + ±0 is +0.
     #[inline(always)]
     pub fn add_row(&self, y: usize, row: &mut [f32]) {
         for p in self.patches {
@@ -324,10 +336,11 @@ impl GustField<'_> {
             }
             let at = p.row_factors + (y - p.rows.start);
             let (yr, yi) = (self.real[at], self.imaginary[at]);
-            let n = p.columns.len();
+            let end = (p.columns.start + p.columns.len().next_multiple_of(GUST_LANES)).min(row.len());
+            let out = &mut row[p.columns.start..end];
+            let n = out.len();
             let xr = &self.real[p.column_factors..p.column_factors + n];
             let xi = &self.imaginary[p.column_factors..p.column_factors + n];
-            let out = &mut row[p.columns.clone()];
             for i in 0..n {
                 out[i] += xr[i] * yr - xi[i] * yi;
             }
