@@ -328,14 +328,6 @@ impl PoolRenderer {
         u32::from_ne_bytes(self.texels[4 * i..4 * i + 4].try_into().expect("four bytes"))
     }
 
-    /// Texels `i` and `i + 1` as packed words, in one load.
-    #[inline(always)]
-    fn texel_pair(&self, i: usize) -> (u32, u32) {
-        let pair = u64::from_ne_bytes(self.texels[4 * i..4 * i + 8].try_into().expect("eight bytes"));
-        let (low, high) = (pair as u32, (pair >> 32) as u32);
-        if cfg!(target_endian = "little") { (low, high) } else { (high, low) }
-    }
-
     /// The background at an 8.8 fixed-point position inside the picture, bilinearly filtered.
     #[inline(always)]
     fn sample(&self, sx: i32, sy: i32) -> u32 {

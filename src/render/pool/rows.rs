@@ -25,10 +25,10 @@ struct SpanScratch {
     delta: [i32; SPAN],
     across: [i32; SPAN],
     along: [i32; SPAN],
-    p00: [u32; SPAN],
-    p01: [u32; SPAN],
-    p10: [u32; SPAN],
-    p11: [u32; SPAN],
+    /// The texel at the position and its right neighbour, and the two below them, each pair
+    /// as it lies in memory (see [`split`]).
+    top: [u64; SPAN],
+    bottom: [u64; SPAN],
     gain: [u8; SPAN],
 }
 
@@ -42,10 +42,8 @@ impl Default for SpanScratch {
             delta: [0; SPAN],
             across: [0; SPAN],
             along: [0; SPAN],
-            p00: [0; SPAN],
-            p01: [0; SPAN],
-            p10: [0; SPAN],
-            p11: [0; SPAN],
+            top: [0; SPAN],
+            bottom: [0; SPAN],
             gain: [caustics::UNIT_GAIN; SPAN],
         }
     }
@@ -146,12 +144,12 @@ impl PoolRenderer {
         let (u1, d1) = (&up[2..n + 2], &down[2..n + 2]);
         let [up2, up, mid, down, down2] = rows.light.map(|r| &r[x0 - 2..x0 + n + 2]);
         let q = self.refraction_q8;
-        let SpanScratch { index, fx, fy, light_index, delta, across, along, p00, p01, p10, p11, gain } = scratch;
+        let SpanScratch { index, fx, fy, light_index, delta, across, along, top, bottom, gain } = scratch;
         // Every slice exactly `n` long, so the loops below carry no bounds checks.
         let (index, fx, fy) = (&mut index[..n], &mut fx[..n], &mut fy[..n]);
         let (light_index, delta, across, along) =
             (&mut light_index[..n], &mut delta[..n], &mut across[..n], &mut along[..n]);
-        let (p00, p01, p10, p11, gain) = (&mut p00[..n], &mut p01[..n], &mut p10[..n], &mut p11[..n], &mut gain[..n]);
+        let (top, bottom, gain) = (&mut top[..n], &mut bottom[..n], &mut gain[..n]);
         let (lm2, lm1, lp1, lp2) = (&mid[..n], &mid[1..n + 1], &mid[3..n + 3], &mid[4..n + 4]);
         let (lu2, lu1, ld1, ld2) = (&up2[2..n + 2], &up[2..n + 2], &down[2..n + 2], &down2[2..n + 2]);
         let (lw, lshift) = (self.light.width as i32, self.light.shift);
@@ -164,7 +162,8 @@ impl PoolRenderer {
             let sx = ((x << 8) + xoff * q).clamp(0, (w - 1) << 8);
             let sy = (((y as i32) << 8) + yoff * q).clamp(0, (h - 1) << 8);
             let (tx, ty) = (sx >> 8, sy >> 8);
-            index[i] = (ty * w + tx) as u32;
+            // The texel's byte offset.
+            index[i] = ((ty * w + tx) * 4) as u32;
             fx[i] = (sx & 255) as u32;
             fy[i] = (sy & 255) as u32;
             let lx = (tx - shift_x).clamp(0, w - 1) >> lshift;
@@ -193,40 +192,46 @@ impl PoolRenderer {
                 }
             }
         }
-        if self.look.caustics.is_some() {
-            // In range by construction; the `min` lets the compiler see it too.
-            let last = self.light.gains.len() - 1;
-            for i in 0..n {
-                gain[i] = self.light.gains[(light_index[i] as usize).min(last)];
+        // The fetches, in one loop: the texels (a pair in one load) and the floor's light.
+        // Offsets are in range by construction; the `min`s let the compiler see it too.
+        let stride = 4 * w as usize;
+        let texels = &self.texels[..];
+        let last = texels.len() - stride - 8;
+        let gains = &self.light.gains[..];
+        let light = self.look.caustics.is_some() && !gains.is_empty();
+        let last_gain = gains.len().saturating_sub(1);
+        for i in 0..n {
+            let at = (index[i] as usize).min(last);
+            top[i] = u64::from_ne_bytes(texels[at..at + 8].try_into().expect("eight bytes"));
+            bottom[i] = u64::from_ne_bytes(texels[at + stride..at + stride + 8].try_into().expect("eight bytes"));
+            if light {
+                gain[i] = gains[(light_index[i] as usize).min(last_gain)];
             }
-        } else {
+        }
+        if !light {
             gain.fill(caustics::UNIT_GAIN);
         }
-        let stride = w as usize;
-        // Indices are in range by construction; the `min` lets the compiler see it too.
-        let last = self.texels.len() / 4 - stride - 2;
         if self.refraction_q8 & 255 == 0 {
-            // A whole-number factor moves by whole pixels: no filtering, one fetch.
-            for i in 0..n {
-                p00[i] = self.texel((index[i] as usize).min(last));
-            }
-            for (((out, &p), &g), &d) in out.iter_mut().zip(&*p00).zip(&*gain).zip(&*delta) {
-                *out = light_pixel_always(p, g, d);
+            // A whole-number factor moves by whole pixels: no filtering.
+            for (((out, &t), &g), &d) in out.iter_mut().zip(&*top).zip(&*gain).zip(&*delta) {
+                *out = light_pixel_always(split(t).0, g, d);
             }
             return;
         }
-        for i in 0..n {
-            let at = (index[i] as usize).min(last);
-            (p00[i], p01[i]) = self.texel_pair(at);
-            (p10[i], p11[i]) = self.texel_pair(at + stride);
-        }
-        let texels = p00.iter().zip(&*p01).zip(p10.iter().zip(&*p11));
         let weights = fx.iter().zip(&*fy).zip(gain.iter().zip(&*delta));
-        for (out, (((&a, &b), (&c, &d)), ((&fx, &fy), (&g, &l)))) in out.iter_mut().zip(texels.zip(weights)) {
+        for (out, ((&t, &b), ((&fx, &fy), (&g, &l)))) in out.iter_mut().zip(top.iter().zip(&*bottom).zip(weights)) {
+            let ((a, b), (c, d)) = (split(t), split(b));
             let colour = lerp_packed(lerp_packed(a, b, fx), lerp_packed(c, d, fx), fy);
             *out = light_pixel_always(colour, g, l);
         }
     }
+}
+
+/// Two neighbouring texels read as one word from memory: (the left, the right) packed words.
+#[inline(always)]
+fn split(pair: u64) -> (u32, u32) {
+    let (low, high) = (pair as u32, (pair >> 32) as u32);
+    if cfg!(target_endian = "little") { (low, high) } else { (high, low) }
 }
 
 /// Grid 1: the fine row is the picture's row.
