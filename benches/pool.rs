@@ -158,6 +158,17 @@ fn player_pool() -> PoolScene {
     scene
 }
 
+/// Frame `k` (counted up first) of the player's pool: a stone every 30 frames (a second), one
+/// step, the picture.
+fn player_frame(scene: &mut PoolScene, out: &mut Pixmap, k: &mut u32) {
+    *k = k.wrapping_add(1);
+    if k.is_multiple_of(30) {
+        scene.drop_stone(Stone::clamped((*k * 7919 % 480) as i32, (*k * 104729 % 282) as i32, 3, 128));
+    }
+    Scene::advance(scene, 1);
+    scene.render(out)
+}
+
 /// The picture of the player's pool (issue 29's "the pool's frame at 480x282"): `render` is the
 /// picture alone, `frame` one step (1/30 s at 30 steps a second) and the picture, with a stone
 /// a second as a player drops them; each on rayon's pool (all cores) and on one thread (what
@@ -178,16 +189,7 @@ fn render_player_pool(c: &mut Criterion) {
         group.bench_function(format!("render{suffix}/480x282"), |b| b.iter(|| run(&mut || scene.render(&mut out))));
         let mut k = 0u32;
         group.bench_function(format!("frame{suffix}/480x282"), |b| {
-            b.iter(|| {
-                run(&mut || {
-                    k = k.wrapping_add(1);
-                    if k.is_multiple_of(30) {
-                        scene.drop_stone(Stone::clamped((k * 7919 % 480) as i32, (k * 104729 % 282) as i32, 3, 128));
-                    }
-                    Scene::advance(&mut scene, 1);
-                    scene.render(&mut out)
-                })
-            })
+            b.iter(|| run(&mut || player_frame(&mut scene, &mut out, &mut k)))
         });
     }
     group.finish();
@@ -242,16 +244,7 @@ fn cpu_player_pool(c: &mut Criterion<ProcessCpu>) {
     let mut scene = player_pool();
     group.bench_function("render/480x282", |b| b.iter(|| scene.render(&mut out)));
     let mut k = 0u32;
-    group.bench_function("frame/480x282", |b| {
-        b.iter(|| {
-            k = k.wrapping_add(1);
-            if k.is_multiple_of(30) {
-                scene.drop_stone(Stone::clamped((k * 7919 % 480) as i32, (k * 104729 % 282) as i32, 3, 128));
-            }
-            Scene::advance(&mut scene, 1);
-            scene.render(&mut out)
-        })
-    });
+    group.bench_function("frame/480x282", |b| b.iter(|| player_frame(&mut scene, &mut out, &mut k)));
     group.finish();
 }
 
