@@ -238,8 +238,11 @@ impl Gusts {
         patches.clear();
         real.clear();
         imaginary.clear();
-        // Room for every packet at its widest at once: no steady-state frame allocates.
-        let most = self.packets.len() * (width + GUST_LANES + height);
+        // Room for the most packets there can be, each at its widest, from the first frame: no
+        // later frame allocates when more packets are alive than before (reserved, the pages
+        // untouched until used).
+        patches.reserve(MAX_PACKETS);
+        let most = MAX_PACKETS * (width + GUST_LANES + height);
         real.reserve(most.saturating_sub(real.len()));
         imaginary.reserve(most.saturating_sub(imaginary.len()));
         let life = self.shape.life_steps.max(1) as f32;
