@@ -1,13 +1,20 @@
-//! Benchmarks of the ripple pool: `sim/ripple_step`, `render/pool`, `output/png`.
+//! Benchmarks of the ripple pool: `sim/ripple_step`, `render/pool`, `render/pool_player`,
+//! `output/png`.
 //!
 //! `sim/ripple_step` runs a plain transliteration of the papers' scalar loop next to tidepool's
 //! step in the same run, and prints the speed-ups at the end, so every run shows how much
 //! faster the real step is on this machine.
 //!
-//! Run: `cargo bench --bench pool` (add `-- sim/` to run one group).
+//! `render/pool_player` is issue 29's renderer figure: the player's pool at 480x282 in wall
+//! time; `cpu/pool_player` the same frame in the process's CPU time (all threads), which the
+//! load of other processes does not inflate.
+//!
+//! Run: `cargo bench --bench pool` (add `-- sim/` to run one group, `-- pool_player` for the
+//! player's frame).
 
+use criterion::measurement::{Measurement, ValueFormatter, WallTime};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
-use tidepool::{Damping, Event, PoolLook, PoolScene, PoolSettings, RipplePool, Scene, Stone};
+use tidepool::{BreezeStyle, Damping, Event, PoolLook, PoolScene, PoolSettings, RipplePool, Scene, Stone};
 use tiny_skia::Pixmap;
 
 /// The papers' loop, transliterated: index arithmetic, an i32 sum, shifts, store, swap.
@@ -129,6 +136,118 @@ fn render_pool(c: &mut Criterion) {
     group.finish();
 }
 
+/// The player's pool as the pixel modes draw it: 480x282 pixels (160x48 cells of 8x16 pixels
+/// less the status row, within the player's scene cap) with the player's defaults (`play`'s
+/// `PoolDefaults::PLAYER`: a grid of two cells a pixel, 30 steps a second, gusts at level 1, rain
+/// 0.01; the default look: caustics, shading) and a few stones' rings on it.
+fn player_pool() -> PoolScene {
+    let settings = PoolSettings {
+        rain_rate: 0.01,
+        breeze: 1.0,
+        breeze_style: BreezeStyle::Gusts,
+        grid: 2,
+        steps_per_second: 30,
+        seed: 1,
+        ..PoolSettings::default()
+    };
+    let mut scene = PoolScene::new(480, 282, settings).expect("the player's pool");
+    for k in 0..6u32 {
+        scene.drop_stone(Stone::clamped((k * 7919 % 480) as i32, (k * 104729 % 282) as i32, 4, 128));
+        Scene::advance(&mut scene, 20);
+    }
+    scene
+}
+
+/// Frame `k` (counted up first) of the player's pool: a stone every 30 frames (a second), one
+/// step, the picture.
+fn player_frame(scene: &mut PoolScene, out: &mut Pixmap, k: &mut u32) {
+    *k = k.wrapping_add(1);
+    if k.is_multiple_of(30) {
+        scene.drop_stone(Stone::clamped((*k * 7919 % 480) as i32, (*k * 104729 % 282) as i32, 3, 128));
+    }
+    Scene::advance(scene, 1);
+    scene.render(out)
+}
+
+/// The picture of the player's pool (issue 29's "the pool's frame at 480x282"): `render` is the
+/// picture alone, `frame` one step (1/30 s at 30 steps a second) and the picture, with a stone
+/// a second as a player drops them; each on rayon's pool (all cores) and on one thread (what
+/// the frame costs in CPU time).
+fn render_player_pool(c: &mut Criterion) {
+    let mut group = c.benchmark_group("render/pool_player");
+    group.sample_size(30);
+    group.throughput(Throughput::Elements(480 * 282));
+    let one = thread_pool(1);
+    let mut out = Pixmap::new(480, 282).unwrap();
+    // Each iteration runs on the given pool (`install` costs microseconds, the frame milliseconds).
+    for (suffix, pool) in [("", None), ("_1thread", Some(&one))] {
+        let run = |f: &mut (dyn FnMut() + Send)| match pool {
+            Some(p) => p.install(f),
+            None => f(),
+        };
+        let mut scene = player_pool();
+        group.bench_function(format!("render{suffix}/480x282"), |b| b.iter(|| run(&mut || scene.render(&mut out))));
+        let mut k = 0u32;
+        group.bench_function(format!("frame{suffix}/480x282"), |b| {
+            b.iter(|| run(&mut || player_frame(&mut scene, &mut out, &mut k)))
+        });
+    }
+    group.finish();
+}
+
+/// The process's CPU time (every thread, user and system: `CLOCK_PROCESS_CPUTIME_ID`) as a
+/// criterion measurement: what a frame costs a user's `top`, rayon's idle workers included,
+/// and unlike the wall clock not inflated when other processes share the cores.
+struct ProcessCpu(WallTime);
+
+impl ProcessCpu {
+    fn now() -> std::time::Duration {
+        let t = rustix::time::clock_gettime(rustix::time::ClockId::ProcessCPUTime);
+        std::time::Duration::new(t.tv_sec as u64, t.tv_nsec as u32)
+    }
+}
+
+impl Measurement for ProcessCpu {
+    type Intermediate = std::time::Duration;
+    type Value = std::time::Duration;
+
+    fn start(&self) -> Self::Intermediate {
+        ProcessCpu::now()
+    }
+
+    fn end(&self, start: Self::Intermediate) -> Self::Value {
+        ProcessCpu::now().saturating_sub(start)
+    }
+
+    fn add(&self, a: &Self::Value, b: &Self::Value) -> Self::Value {
+        *a + *b
+    }
+
+    fn zero(&self) -> Self::Value {
+        std::time::Duration::ZERO
+    }
+
+    fn to_f64(&self, value: &Self::Value) -> f64 {
+        value.as_nanos() as f64
+    }
+
+    fn formatter(&self) -> &dyn ValueFormatter {
+        self.0.formatter()
+    }
+}
+
+/// `render/pool_player`'s frame in CPU time ([`ProcessCpu`]) on rayon's pool.
+fn cpu_player_pool(c: &mut Criterion<ProcessCpu>) {
+    let mut group = c.benchmark_group("cpu/pool_player");
+    group.sample_size(30);
+    let mut out = Pixmap::new(480, 282).unwrap();
+    let mut scene = player_pool();
+    group.bench_function("render/480x282", |b| b.iter(|| scene.render(&mut out)));
+    let mut k = 0u32;
+    group.bench_function("frame/480x282", |b| b.iter(|| player_frame(&mut scene, &mut out, &mut k)));
+    group.finish();
+}
+
 fn output_png(c: &mut Criterion) {
     let mut group = c.benchmark_group("output/png");
     group.sample_size(10);
@@ -169,10 +288,16 @@ fn print_speedups() {
     }
 }
 
-criterion_group!(benches, ripple_step, render_pool, output_png);
+criterion_group!(benches, ripple_step, render_pool, render_player_pool, output_png);
+criterion_group! {
+    name = cpu;
+    config = Criterion::default().with_measurement(ProcessCpu(WallTime));
+    targets = cpu_player_pool
+}
 
 fn main() {
     benches();
+    cpu();
     Criterion::default().configure_from_args().final_summary();
     print_speedups();
 }

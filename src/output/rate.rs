@@ -67,6 +67,13 @@ use crate::output::oklab::JND;
 
 /// A budget that never runs out: every change is sent exactly.
 pub const UNLIMITED: usize = usize::MAX;
+
+/// What `budget` leaves once `spent` bytes are taken from it: [`UNLIMITED`] stays unlimited
+/// (a plain subtraction would turn it into a huge but finite budget, which the picture stream
+/// reads as a link with a rate: lossy JPEG for iTerm2 under `--bandwidth unlimited`).
+pub(crate) fn budget_after(budget: usize, spent: usize) -> usize {
+    if budget == UNLIMITED { UNLIMITED } else { budget.saturating_sub(spent) }
+}
 /// The error of a text cell whose glyph or colours are wrong (or of any cell the encoder
 /// cannot measure, such as one in the terminal's default colours): more than a picture cell
 /// can have (the OKLab distance between two sRGB colours is at most about 1, and a cell has

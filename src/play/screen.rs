@@ -42,7 +42,7 @@ use crate::output::frame::Frame;
 use crate::output::graphics::GraphicsMode;
 use crate::output::graphics::stream::Budget;
 use crate::output::graphics::stream::crossover::AutoSwitch;
-use crate::output::rate::{RateEncoder, RateOptions, Report, Target};
+use crate::output::rate::{RateEncoder, RateOptions, Report, Target, budget_after};
 use crate::play::clock::{FramePacer, Meter};
 
 /// How many bytes a second a screen may send.
@@ -457,7 +457,7 @@ impl Screen {
             };
             // What the cells left of this frame's budget: the picture is never owed.
             let left = Budget {
-                available: budget.saturating_sub(report.bytes),
+                available: budget_after(budget, report.bytes),
                 rate,
                 frame_interval: Duration::from_secs(1) / self.config.fps.max(1),
                 overdraw,

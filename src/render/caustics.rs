@@ -18,6 +18,10 @@
 use crate::error::ValueError;
 use crate::simd::{Simd, Tier};
 
+mod grid;
+
+use grid::Coarse;
+
 /// Amplitude units per pixel of surface height: a weight-64 stone makes a dent one pixel deep.
 pub const AMPLITUDE_PER_PIXEL: f32 = 64.0;
 /// Water's refractive index.
@@ -171,116 +175,6 @@ impl LightMap {
         }
     }
 }
-
-impl LightMap {
-    /// The light of a pool of `grid x grid` cells a pixel, `width x height` cells, whose
-    /// heights hold `look.1` units per amplitude unit: computed on the heights averaged over
-    /// each pixel's cells (so the caustics have the shapes, the smoothing and the depth in
-    /// pixels they have on a pool of one cell a pixel), then spread back over the cells
-    /// bilinearly. The result has one entry a cell. Grid 1 is
-    /// [`LightMap::compute_in_units`].
-    pub fn compute_on_grid(
-        &mut self,
-        heights: &[i16],
-        (width, height): (usize, usize),
-        grid: usize,
-        look: (CausticsLook, f32),
-        simd: Simd,
-    ) {
-        if grid <= 1 {
-            self.compute_in_units(heights, width, height, look, simd);
-            return;
-        }
-        let (cols, rows) = (width / grid, height / grid);
-        let coarse = self.coarse.get_or_insert_with(Box::default);
-        let Coarse { means, light, columns, line, sums } = &mut **coarse;
-        // The means with a margin of PAD pixels around them, continued by odd reflection
-        // (h(-d) = 2·h(0) - h(d)): a slope runs on past the edge instead of folding back, so
-        // the edge draws no false caustic line (repeating the edge value would bend every
-        // slope that reaches it).
-        let (padded_cols, padded_rows) = (cols + 2 * PAD, rows + 2 * PAD);
-        means.clear();
-        means.resize(padded_cols * padded_rows, 0);
-        // Each pixel's mean, rounded to the nearest unit: floor((2·sum + area) / (2·area)).
-        let area = (grid * grid) as i32;
-        sums.clear();
-        sums.resize(cols, 0);
-        for cy in 0..rows {
-            sums.fill(0);
-            for y in cy * grid..(cy + 1) * grid {
-                let row = &heights[y * width..y * width + cols * grid];
-                for (sum, cell) in sums.iter_mut().zip(row.chunks_exact(grid)) {
-                    *sum += cell.iter().map(|&v| i32::from(v)).sum::<i32>();
-                }
-            }
-            let out = &mut means[(cy + PAD) * padded_cols + PAD..(cy + PAD) * padded_cols + PAD + cols];
-            for (mean, &sum) in out.iter_mut().zip(sums.iter()) {
-                *mean = (2 * sum + area).div_euclid(2 * area) as i16;
-            }
-        }
-        let reflect =
-            |edge: i16, mirrored: i16| (2 * i32::from(edge) - i32::from(mirrored)).clamp(-32768, 32767) as i16;
-        for y in PAD..PAD + rows {
-            let row = &mut means[y * padded_cols..(y + 1) * padded_cols];
-            for d in 1..=PAD {
-                let (left, right) = (PAD, PAD + cols - 1);
-                row[left - d] = reflect(row[left], row[(left + d).min(right)]);
-                row[right + d] = reflect(row[right], row[right.saturating_sub(d).max(left)]);
-            }
-        }
-        for d in 1..=PAD {
-            let (top, bottom) = (PAD, PAD + rows - 1);
-            for x in 0..padded_cols {
-                let at = |means: &[i16], y: usize| means[y * padded_cols + x];
-                means[(top - d) * padded_cols + x] = reflect(at(means, top), at(means, (top + d).min(bottom)));
-                means[(bottom + d) * padded_cols + x] =
-                    reflect(at(means, bottom), at(means, bottom.saturating_sub(d).max(top)));
-            }
-        }
-        light.compute_in_units(means, padded_cols, padded_rows, look, simd);
-        // Each cell's light from the four nearest pixels' (cell centres at (x + 1/2) / grid),
-        // in 1/256 steps: the rows blended first, then the columns.
-        self.shift = 0;
-        (self.width, self.height) = (width, height);
-        self.gains.resize(width * height, UNIT_GAIN);
-        let tap = |n: usize, size: usize| -> (usize, usize, u32) {
-            let at = (((2 * n + 1) * 128 / grid) as i64 - 128).clamp(0, 256 * (size as i64 - 1)) as usize;
-            let lo = at >> 8;
-            (lo + PAD, (lo + 1).min(size - 1) + PAD, (at & 255) as u32)
-        };
-        columns.clear();
-        columns.extend((0..width).map(|x| tap(x, cols)));
-        line.resize(padded_cols, 0);
-        for y in 0..height {
-            let (y0, y1, wy) = tap(y, rows);
-            for (x, v) in line.iter_mut().enumerate() {
-                *v = u32::from(light.gain(x, y0)) * (256 - wy) + u32::from(light.gain(x, y1)) * wy;
-            }
-            let out = &mut self.gains[y * width..(y + 1) * width];
-            for (gain, &(x0, x1, wx)) in out.iter_mut().zip(columns.iter()) {
-                *gain = ((line[x0] * (256 - wx) + line[x1] * wx + (1 << 15)) >> 16) as u8;
-            }
-        }
-    }
-}
-
-/// What [`LightMap::compute_on_grid`] keeps between frames: the heights averaged per pixel
-/// (with a margin), their light, and the interpolation's taps and row.
-#[derive(Clone, Debug, Default)]
-struct Coarse {
-    means: Vec<i16>,
-    light: LightMap,
-    /// Per cell column: the two light columns it lies between and the weight of the second.
-    columns: Vec<(usize, usize, u32)>,
-    /// One row of light blended between two light rows, in 1/256.
-    line: Vec<u32>,
-    /// One row of pixels' sums of heights.
-    sums: Vec<i32>,
-}
-
-/// The margin of the light computed for a pool finer than its picture, in pixels: the
-/// smoothing and the curvature together reach three pixels out.
-const PAD: usize = 3;
 
 /// The pool's heights and how the light map samples them.
 struct Field<'a> {

@@ -17,13 +17,15 @@
 use tiny_skia::Pixmap;
 
 mod look;
+mod rows;
 
 pub use look::{PoolLook, Refraction, Sun};
 
 use super::caustics::{self, AMPLITUDE_PER_PIXEL, WATER_INDEX};
 #[cfg(test)]
 use crate::sim::ripple::RipplePool;
-use crate::simd::{Simd, Tier};
+use crate::simd::Simd;
+use rows::RowScratch;
 
 /// Brightness change per unit of the two-cell slope stencil along the sun, in colour steps.
 const SHADE_PER_SLOPE: f32 = 1.77;
@@ -42,9 +44,10 @@ const STENCIL_SPAN: f32 = 6.0;
 #[derive(Clone, Debug)]
 pub struct PoolRenderer {
     background: Pixmap,
-    /// The background's pixels as packed RGBA words, for two-channels-at-a-time filtering,
-    /// followed by a copy of the last row and one more texel.
-    texels: Vec<u32>,
+    /// The background's RGBA pixels ([`PoolRenderer::texel`] reads one as a packed word, for
+    /// two-channels-at-a-time filtering), followed by a copy of the last row and one more
+    /// pixel.
+    texels: Vec<u8>,
     look: PoolLook,
     refraction_q8: i32,
     /// The caustics' light on the floor, rebuilt every frame.
@@ -58,6 +61,8 @@ pub struct PoolRenderer {
     grid: u32,
     /// Height units per amplitude unit of the pool.
     units: f32,
+    /// Each parallel task's scratch rows, kept between frames.
+    scratch: Vec<RowScratch>,
 }
 
 /// The sun's light, prepared once per renderer.
@@ -97,46 +102,9 @@ struct Rows<'a> {
     light: [&'a [i16]; 5],
 }
 
-/// Pixels per staged span (see [`PoolRenderer::render_span`]).
-const SPAN: usize = 64;
-
-/// The per-pixel values a span passes between its stages; kept for a whole band of rows.
-struct SpanScratch {
-    index: [u32; SPAN],
-    fx: [u32; SPAN],
-    fy: [u32; SPAN],
-    light_index: [u32; SPAN],
-    delta: [i32; SPAN],
-    across: [i32; SPAN],
-    along: [i32; SPAN],
-    p00: [u32; SPAN],
-    p01: [u32; SPAN],
-    p10: [u32; SPAN],
-    p11: [u32; SPAN],
-    gain: [u8; SPAN],
-}
-
-impl Default for SpanScratch {
-    fn default() -> Self {
-        SpanScratch {
-            index: [0; SPAN],
-            fx: [0; SPAN],
-            fy: [0; SPAN],
-            light_index: [0; SPAN],
-            delta: [0; SPAN],
-            across: [0; SPAN],
-            along: [0; SPAN],
-            p00: [0; SPAN],
-            p01: [0; SPAN],
-            p10: [0; SPAN],
-            p11: [0; SPAN],
-            gain: [caustics::UNIT_GAIN; SPAN],
-        }
-    }
-}
-/// Pictures smaller than this are drawn on one thread.
+/// Pictures of fewer cells are drawn on one thread.
 const PARALLEL_MIN_PIXELS: usize = 1 << 16;
-/// Pixels per parallel task: big enough to amortise scheduling, small enough to balance.
+/// Cells per parallel task: big enough to amortise scheduling, small enough to balance.
 const PIXELS_PER_TASK: usize = 1 << 15;
 
 impl PoolRenderer {
@@ -161,10 +129,9 @@ impl PoolRenderer {
         // One extra row and texel past the end, so the filter's right and lower neighbours can be
         // fetched without a check at the last column and row (their weight is 0 there).
         let (w, h) = (background.width() as usize, background.height() as usize);
-        let mut texels: Vec<u32> =
-            background.data().chunks_exact(4).map(|p| u32::from_ne_bytes([p[0], p[1], p[2], p[3]])).collect();
-        texels.extend_from_within((h - 1) * w..h * w);
-        texels.push(texels[texels.len() - 1]);
+        let mut texels = background.data().to_vec();
+        texels.extend_from_within((h - 1) * w * 4..h * w * 4);
+        texels.extend_from_within(texels.len() - 4..);
         let sun = look.sun.direction();
         let horizontal = (sun[0] * sun[0] + sun[1] * sun[1]).sqrt().max(1e-6);
         // Sunlight enters the water at (90° - elevation) from the vertical and is bent
@@ -209,6 +176,7 @@ impl PoolRenderer {
             simd: Simd::detect(),
             grid,
             units,
+            scratch: Vec::new(),
         }
     }
 
@@ -230,185 +198,43 @@ impl PoolRenderer {
         self.render_fields(Fields { refraction: pool.heights(), light: pool.heights() }, out);
     }
 
-    /// Draws the water into `out`, which has the background's size: the floor displaced by
-    /// one set of heights and lit (caustics, shading, glints) by another, each a pool of the
-    /// background's size row by row (for a pool's own picture both are its heights; the scene
-    /// adds the gusts' swells to them). Large pictures are drawn in row bands on all cores;
-    /// every pixel is computed the same way whatever the split.
+    /// Draws the water into `out`, which has the picture's size (the background's over the
+    /// grid): the floor displaced by one set of heights and lit (caustics, shading, glints) by
+    /// another, each a pool of the background's size row by row (for a pool's own picture both
+    /// are its heights; the scene adds the gusts' swells to them), each picture pixel the mean
+    /// of its `grid x grid` cells' ([`crate::render::supersample`]'s box filter). Large
+    /// pictures are drawn in row bands on all cores; every pixel is computed the same way
+    /// whatever the split.
     ///
     /// # Panics
     /// When the sizes differ (a programming error, not a user error).
     pub fn render_fields(&mut self, fields: Fields<'_>, out: &mut Pixmap) {
         let (w, h) = (self.background.width() as usize, self.background.height() as usize);
+        let grid = self.grid as usize;
         assert_eq!(fields.refraction.len(), w * h, "heights and background sizes differ");
         assert_eq!(fields.light.len(), w * h, "heights and background sizes differ");
-        assert_eq!((out.width() as usize, out.height() as usize), (w, h), "output size differs");
+        assert_eq!((out.width() as usize * grid, out.height() as usize * grid), (w, h), "output size differs");
         if let Some(look) = self.look.caustics {
-            self.light.compute_on_grid(fields.light, (w, h), self.grid as usize, (look, self.units), self.simd);
+            self.light.compute_on_grid(fields.light, (w, h), grid, (look, self.units), self.simd);
         }
+        let picture_rows = h / grid;
+        let rows_per_task =
+            if w * h < PARALLEL_MIN_PIXELS { picture_rows } else { (PIXELS_PER_TASK / (w * grid)).max(1) };
+        let tasks = picture_rows.div_ceil(rows_per_task.max(1));
+        let mut scratch = std::mem::take(&mut self.scratch);
+        scratch.resize_with(tasks, RowScratch::default);
         let this = &*self;
-        let bytes = out.data_mut();
-        if w * h < PARALLEL_MIN_PIXELS {
-            this.render_rows(fields, 0, bytes);
-        } else {
+        let chunk = rows_per_task.max(1) * (w / grid) * 4;
+        let run = |(task, (rows, scratch)): (usize, (&mut [u8], &mut RowScratch))| {
+            this.render_rows(fields, task * rows_per_task, rows, scratch)
+        };
+        if tasks > 1 {
             use rayon::prelude::*;
-            let rows_per_task = (PIXELS_PER_TASK / w).max(1);
-            bytes
-                .par_chunks_mut(rows_per_task * w * 4)
-                .enumerate()
-                .for_each(|(task, rows)| this.render_rows(fields, task * rows_per_task, rows));
-        }
-    }
-
-    /// Draws the rows starting at `first_row` into `out` (whole rows of RGBA bytes), with the
-    /// widest instruction set this CPU has (see [`crate::simd`]).
-    fn render_rows(&self, fields: Fields<'_>, first_row: usize, out: &mut [u8]) {
-        match self.simd.tier() {
-            // SAFETY: a `Simd` of this tier exists only when run-time detection found the
-            // feature (see `crate::simd`).
-            #[cfg(target_arch = "x86_64")]
-            Tier::Avx512 => unsafe { self.render_rows_avx512(fields, first_row, out) },
-            #[cfg(target_arch = "x86_64")]
-            Tier::Avx2 => unsafe { self.render_rows_avx2(fields, first_row, out) },
-            _ => self.render_rows_with(fields, first_row, out),
-        }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn render_rows_avx2(&self, fields: Fields<'_>, first_row: usize, out: &mut [u8]) {
-        self.render_rows_with(fields, first_row, out)
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw")]
-    fn render_rows_avx512(&self, fields: Fields<'_>, first_row: usize, out: &mut [u8]) {
-        self.render_rows_with(fields, first_row, out)
-    }
-
-    #[inline(always)]
-    fn render_rows_with<'a>(&self, fields: Fields<'a>, first_row: usize, out: &mut [u8]) {
-        let (w, h) = (self.background.width() as usize, self.background.height() as usize);
-        let mut scratch = SpanScratch::default();
-        for (i, out_row) in out.chunks_exact_mut(w * 4).enumerate() {
-            let y = first_row + i;
-            // Rows y-2..=y+2 of both fields, the picture's edge rows repeated beyond it.
-            let around = |heights: &'a [i16]| {
-                [-2isize, -1, 0, 1, 2].map(|dy| {
-                    let r = (y as isize + dy).clamp(0, h as isize - 1) as usize;
-                    &heights[r * w..(r + 1) * w]
-                })
-            };
-            let rows = Rows { refraction: around(fields.refraction), light: around(fields.light) };
-            let pixels: &mut [[u8; 4]] = out_row.as_chunks_mut::<4>().0;
-            // Columns two or more away from the edges need no clamping: they go through the
-            // staged span renderer in chunks; the edge columns one pixel at a time.
-            let inner = 2..w.saturating_sub(2).max(2);
-            for x in (0..w).filter(|x| !inner.contains(x)) {
-                let near = [x.saturating_sub(2), x.saturating_sub(1), (x + 1).min(w - 1), (x + 2).min(w - 1)];
-                pixels[x] = self.pixel(&rows, x, y, near).to_ne_bytes();
-            }
-            let mut start = inner.start;
-            while start < inner.end {
-                let end = (start + SPAN).min(inner.end);
-                self.render_span(&rows, y, start, &mut pixels[start..end], &mut scratch);
-                start = end;
-            }
-        }
-    }
-
-    /// Interior pixels `x0..x0 + out.len()` of row `y` (all at least two columns from the
-    /// edges), in stages: positions and light in one loop, the texture fetches in a second,
-    /// filtering and lighting in a third. The first and last are free of branches and
-    /// clamped indexing, so the compiler vectorizes them; only the fetches stay scalar.
-    /// Computes exactly what [`PoolRenderer::pixel`] does.
-    #[inline(always)]
-    fn render_span(&self, rows: &Rows<'_>, y: usize, x0: usize, out: &mut [[u8; 4]], scratch: &mut SpanScratch) {
-        let (w, h) = (self.background.width() as i32, self.background.height() as i32);
-        let n = out.len();
-        let [_, up, mid, down, _] = rows.refraction.map(|r| &r[x0 - 2..x0 + n + 2]);
-        let (m1, p1) = (&mid[1..n + 1], &mid[3..n + 3]);
-        let (u1, d1) = (&up[2..n + 2], &down[2..n + 2]);
-        let [up2, up, mid, down, down2] = rows.light.map(|r| &r[x0 - 2..x0 + n + 2]);
-        let q = self.refraction_q8;
-        let SpanScratch { index, fx, fy, light_index, delta, across, along, p00, p01, p10, p11, gain } = scratch;
-        // Every slice exactly `n` long, so the loops below carry no bounds checks.
-        let (index, fx, fy) = (&mut index[..n], &mut fx[..n], &mut fy[..n]);
-        let (light_index, delta, across, along) =
-            (&mut light_index[..n], &mut delta[..n], &mut across[..n], &mut along[..n]);
-        let (p00, p01, p10, p11, gain) = (&mut p00[..n], &mut p01[..n], &mut p10[..n], &mut p11[..n], &mut gain[..n]);
-        let (lm2, lm1, lp1, lp2) = (&mid[..n], &mid[1..n + 1], &mid[3..n + 3], &mid[4..n + 4]);
-        let (lu2, lu1, ld1, ld2) = (&up2[2..n + 2], &up[2..n + 2], &down[2..n + 2], &down2[2..n + 2]);
-        let (lw, lshift) = (self.light.width as i32, self.light.shift);
-        let (shift_x, shift_y) = self.light_shift;
-        let lighting = self.lighting;
-        for i in 0..n {
-            let x = (x0 + i) as i32;
-            let xoff = i32::from(m1[i]) - i32::from(p1[i]);
-            let yoff = i32::from(u1[i]) - i32::from(d1[i]);
-            let sx = ((x << 8) + xoff * q).clamp(0, (w - 1) << 8);
-            let sy = (((y as i32) << 8) + yoff * q).clamp(0, (h - 1) << 8);
-            let (tx, ty) = (sx >> 8, sy >> 8);
-            index[i] = (ty * w + tx) as u32;
-            fx[i] = (sx & 255) as u32;
-            fy[i] = (sy & 255) as u32;
-            let lx = (tx - shift_x).clamp(0, w - 1) >> lshift;
-            let ly = (ty - shift_y).clamp(0, h - 1) >> lshift;
-            light_index[i] = (ly * lw + lx) as u32;
-            across[i] = i32::from(lm2[i]) + i32::from(lm1[i]) - i32::from(lp1[i]) - i32::from(lp2[i]);
-            along[i] = i32::from(lu2[i]) + i32::from(lu1[i]) - i32::from(ld1[i]) - i32::from(ld2[i]);
-            delta[i] = ((across[i] * lighting.shade_x_q8 + along[i] * lighting.shade_y_q8) >> 8)
-                .clamp(-SHADE_LIMIT, SHADE_LIMIT);
-        }
-        if !self.look.shading {
-            delta.fill(0);
+            out.data_mut().par_chunks_mut(chunk).zip(scratch.par_iter_mut()).enumerate().for_each(run);
         } else {
-            // The pre-test in a loop that vectorizes; the exact glint (rare) out of line.
-            let mut candidates = [false; SPAN];
-            let mut any = false;
-            for i in 0..n {
-                candidates[i] = self.may_glint(across[i], along[i]);
-                any |= candidates[i];
-            }
-            if any {
-                for i in 0..n {
-                    if candidates[i] {
-                        delta[i] += self.glint_exact(across[i], along[i]);
-                    }
-                }
-            }
+            out.data_mut().chunks_mut(chunk).zip(scratch.iter_mut()).enumerate().for_each(run);
         }
-        if self.look.caustics.is_some() {
-            for i in 0..n {
-                gain[i] = self.light.gains[light_index[i] as usize];
-            }
-        } else {
-            gain.fill(caustics::UNIT_GAIN);
-        }
-        let stride = w as usize;
-        // Indices are in range by construction; the `min` lets the compiler see it too.
-        let last = self.texels.len() - stride - 2;
-        if self.refraction_q8 & 255 == 0 {
-            // A whole-number factor moves by whole pixels: no filtering, one fetch.
-            for i in 0..n {
-                p00[i] = self.texels[(index[i] as usize).min(last)];
-            }
-            for (i, out) in out.iter_mut().enumerate() {
-                *out = light_pixel_always(p00[i], gain[i], delta[i]).to_ne_bytes();
-            }
-            return;
-        }
-        for i in 0..n {
-            let at = (index[i] as usize).min(last);
-            (p00[i], p01[i]) = (self.texels[at], self.texels[at + 1]);
-            (p10[i], p11[i]) = (self.texels[at + stride], self.texels[at + stride + 1]);
-        }
-        for (i, out) in out.iter_mut().enumerate() {
-            let top = lerp_packed(p00[i], p01[i], fx[i]);
-            let bottom = lerp_packed(p10[i], p11[i], fx[i]);
-            let colour = lerp_packed(top, bottom, fy[i]);
-            *out = light_pixel_always(colour, gain[i], delta[i]).to_ne_bytes();
-        }
+        self.scratch = scratch;
     }
 
     /// One output pixel: `rows` are the height rows y-2..=y+2, `near` the columns x-2, x-1,
@@ -496,13 +322,19 @@ impl PoolRenderer {
         (t2 * t2 * GLINT_LEVELS) as i32
     }
 
+    /// Texel `i` (row-major, the extra row and pixel included) as a packed word.
+    #[inline(always)]
+    fn texel(&self, i: usize) -> u32 {
+        u32::from_ne_bytes(self.texels[4 * i..4 * i + 4].try_into().expect("four bytes"))
+    }
+
     /// The background at an 8.8 fixed-point position inside the picture, bilinearly filtered.
     #[inline(always)]
     fn sample(&self, sx: i32, sy: i32) -> u32 {
         let (w, h) = (self.background.width() as usize, self.background.height() as usize);
         let (x0, y0) = ((sx >> 8) as usize, (sy >> 8) as usize);
         let (fx, fy) = ((sx & 255) as u32, (sy & 255) as u32);
-        let at = |x: usize, y: usize| self.texels[y * w + x];
+        let at = |x: usize, y: usize| self.texel(y * w + x);
         if fx == 0 && fy == 0 {
             return at(x0, y0);
         }

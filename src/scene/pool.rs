@@ -7,12 +7,12 @@ use super::{Action, Controls, Event, Scene, SceneKind};
 use crate::error::{Error, Result};
 use crate::render::background;
 use crate::render::pool::{Fields, PoolLook, PoolRenderer};
-use crate::render::supersample::{Downsample, downsample};
 use crate::sim::breeze::gusts::{GustShape, Gusts};
 use crate::sim::breeze::{Breeze, BreezeStyle};
 use crate::sim::rain::Rain;
 use crate::sim::ripple::{Damping, RipplePool, Stone};
 use crate::simd::Simd;
+use compose::{Composer, Sources};
 
 /// Everything about a pool except its size.
 #[derive(Clone, Debug, PartialEq)]
@@ -96,24 +96,6 @@ pub const GUST_UNITS: u32 = 4;
 /// on the codec benchmark's pool), while the light a swell focuses drifts smoothly.
 pub const GUST_REFRACTION: f32 = 0.3;
 
-/// `heights` plus `ripples` in `light`, and plus `share` of them in `refraction`, in
-/// [`GUST_UNITS`] a unit, each rounded to the nearest unit (floor(v + 1/2) by truncating a
-/// positive number: a conversion the compiler vectorizes; `round` is a call).
-fn fill_units((light, refraction): (&mut Vec<i16>, &mut Vec<i16>), heights: &[i16], ripples: &[f32], share: f32) {
-    let n = heights.len().min(ripples.len());
-    light.resize(n, 0);
-    refraction.resize(n, 0);
-    let (lowest, highest, units) = (f32::from(i16::MIN), f32::from(i16::MAX), GUST_UNITS as f32);
-    let unit = |v: f32| ((v * units).clamp(lowest, highest) - lowest + 0.5) as i32 as f32 + lowest;
-    let (heights, ripples) = (&heights[..n], &ripples[..n]);
-    let (light, refraction) = (&mut light[..n], &mut refraction[..n]);
-    for i in 0..n {
-        let h = f32::from(heights[i]);
-        light[i] = unit(h + ripples[i]).min(highest) as i16;
-        refraction[i] = unit(h + share * ripples[i]).min(highest) as i16;
-    }
-}
-
 /// The units of the pictures of a pool whose breeze is `style`.
 fn units_for(style: BreezeStyle) -> u32 {
     match style {
@@ -191,12 +173,12 @@ pub struct PoolScene {
     size: (u32, u32),
     grid: u32,
     steps_per_second: u32,
-    /// The picture at the simulation's resolution, when the grid is finer than the picture.
-    fine: Option<Pixmap>,
-    /// The pool's heights with the gusts' ripples added (amplitude units), and those alone.
+    /// The pool's heights with the gusts' ripples added ([`GUST_UNITS`] a unit), all of them
+    /// (`field`) and [`GUST_REFRACTION`] of them (`refraction`); `composer` makes them.
     field: Vec<i16>,
     refraction: Vec<i16>,
-    gust_heights: Vec<f32>,
+    composer: Composer,
+    simd: Simd,
     /// The rate `r` switches the rain back on to.
     rain_when_on: f64,
     /// The level `b` switches the breeze back on to.
@@ -230,7 +212,6 @@ impl PoolScene {
         let steps_per_second = check_steps_per_second(u64::from(settings.steps_per_second)).ok()?;
         let (cols, rows) = (width.checked_mul(grid)?, height.checked_mul(grid)?);
         let fitted = background::cover(&settings.floor, cols, rows)?;
-        let fine = if grid > 1 { Some(Pixmap::new(cols, rows)?) } else { None };
         Some(PoolScene {
             pool: RipplePool::new(cols as usize, rows as usize, settings.damping),
             rain: Rain::new(settings.rain_rate, settings.seed),
@@ -241,10 +222,10 @@ impl PoolScene {
             size: (width, height),
             grid,
             steps_per_second,
-            fine,
             field: Vec::new(),
             refraction: Vec::new(),
-            gust_heights: Vec::new(),
+            composer: Composer::default(),
+            simd: Simd::detect(),
             rain_when_on: if settings.rain_rate > 0.0 { settings.rain_rate } else { DEFAULT_TOGGLE_RAIN },
             breeze_when_on: if settings.breeze > 0.0 { settings.breeze } else { crate::sim::breeze::DEFAULT_LEVEL },
         })
@@ -275,6 +256,7 @@ impl PoolScene {
     pub fn set_simd(&mut self, simd: Simd) {
         self.pool.set_simd(simd);
         self.renderer.set_simd(simd);
+        self.simd = simd;
     }
 
     /// Drops a stone now; its centre and radius are in pixels (on a finer grid it covers the
@@ -345,11 +327,8 @@ impl PoolScene {
     fn compose(&mut self) -> bool {
         let Wind::Gusts(gusts) = &mut self.wind else { return false };
         let (cols, rows) = (self.pool.width(), self.pool.height());
-        self.gust_heights.clear();
-        self.gust_heights.resize(cols * rows, 0.0);
-        gusts.add_to(&mut self.gust_heights, cols, rows);
-        let fields = (&mut self.field, &mut self.refraction);
-        fill_units(fields, self.pool.heights(), &self.gust_heights, GUST_REFRACTION);
+        let sources = Sources { gusts: gusts.field(cols, rows), heights: self.pool.heights(), cols };
+        self.composer.compose(sources, (&mut self.field, &mut self.refraction), self.simd);
         true
     }
 
@@ -359,13 +338,7 @@ impl PoolScene {
             true => Fields { refraction: &self.refraction, light: &self.field },
             false => Fields { refraction: self.pool.heights(), light: self.pool.heights() },
         };
-        match &mut self.fine {
-            None => self.renderer.render_fields(fields, out),
-            Some(fine) => {
-                self.renderer.render_fields(fields, fine);
-                downsample(fine, self.grid, Downsample::Box, out);
-            }
-        }
+        self.renderer.render_fields(fields, out);
     }
 
     /// Starts over at a new size: still water, the floor refitted, the rain continuing.
@@ -379,17 +352,9 @@ impl PoolScene {
         let Some(fitted) = background::cover(&self.floor, cols, rows) else {
             return false;
         };
-        let fine = match g {
-            1 => None,
-            _ => match Pixmap::new(cols, rows) {
-                Some(p) => Some(p),
-                None => return false,
-            },
-        };
         let damping = self.pool.damping();
         self.pool = RipplePool::new(cols as usize, rows as usize, damping);
         self.renderer = PoolRenderer::on_grid(fitted, self.renderer.look(), g, self.units());
-        self.fine = fine;
         self.size = (width, height);
         if let Wind::Gusts(gusts) = &mut self.wind {
             gusts.clear();
@@ -566,5 +531,6 @@ impl Controls for PoolScene {
     }
 }
 
+mod compose;
 #[cfg(test)]
 mod tests;

@@ -39,6 +39,15 @@ fn the_default_pool() {
 }
 
 #[test]
+fn the_players_pool_in_pixels() {
+    // What kitty, sixel and iTerm2 show at 160x48 cells: 480x282 pixels of the player's pool
+    // (two cells a pixel, gusts, rain), three stones' rings on it.
+    let script = stones(&[(120, 80, 4, 128), (330, 200, 4, 128), (240, 141, 3, 160)]);
+    let p = picture(&SceneSpec::Pool(crate::pool_bits::player(1)), 480, 282, &script, 90);
+    golden::check_png("pool_player", &rgba(&p), Tolerance::default());
+}
+
+#[test]
 fn a_small_pool_as_half_block_text() {
     let script = stones(&[(20, 14, 4, 128), (44, 26, 3, 128)]);
     let p = picture(&SceneSpec::Pool(PoolSettings::default()), 64, 40, &script, 30);

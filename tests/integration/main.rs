@@ -19,6 +19,7 @@ mod lake;
 mod ocean;
 mod player;
 mod pool;
+mod pool_bits;
 mod replay;
 mod slow_link;
 mod soak;

@@ -21,6 +21,7 @@ use crate::output::graphics::kitty::{self, KittyOptions, Medium};
 use crate::output::graphics::sixel::{Registers, SixelPalette};
 use crate::output::graphics::stream::crossover::{AutoSwitch, crossover};
 use crate::output::graphics::stream::{Budget, PictureStream, Protocol};
+use crate::output::rate::budget_after;
 use crate::output::units::write_human_rate;
 
 /// The largest picture a scene renders at in a pixel mode, in pixels. The pool's simulation
@@ -138,7 +139,7 @@ impl Picture {
         }
         // The synchronized-output markers a frame without cells needs come out of the budget.
         let markers = if frame.sync && !bytes.ends_with(SYNC_END) { SYNC_BEGIN.len() + SYNC_END.len() } else { 0 };
-        let budget = Budget { available: budget.available.saturating_sub(markers), ..budget };
+        let budget = Budget { available: budget_after(budget.available, markers), ..budget };
         let Some(offer) = self.stream.prepare(pixmap, budget, now) else { return 0 };
         let before = bytes.len();
         splice_picture(bytes, offer.bytes, frame.sync);

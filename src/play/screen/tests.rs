@@ -287,3 +287,24 @@ fn true_colour_comes_from_the_terminals_answers_and_the_hint_only_when_none_said
     assert_eq!(screen.config.color, ColorMode::TrueColor);
     assert!(contains(&frame(&mut screen, t0 + 950 * MS, 10), b"8;2;"));
 }
+
+#[test]
+fn unlimited_bandwidth_sends_iterm2_pictures_exactly_as_png_after_the_cells_bytes() {
+    // The cells' bytes (the status line) and the synchronized-output markers come out of an
+    // unlimited budget: it must stay unlimited, or the stream plans for a link and sends JPEG.
+    let t0 = Instant::now();
+    let config =
+        ScreenConfig { graphics: GraphicsRequest::Force(GraphicsMode::Iterm2), ..config(Bandwidth::Unlimited, false) };
+    let mut screen = Screen::new(config, (40, 12), t0);
+    assert_eq!(screen.mode(), GraphicsMode::Iterm2);
+    let mut sent = Vec::new();
+    screen.start(t0, &mut sent);
+    for k in 0..3u32 {
+        sent.extend(frame(&mut screen, t0 + k * 100 * MS, 10 + 40 * k as u8));
+    }
+    let files: Vec<&[u8]> = sent.split(|&b| b == b':').skip(1).filter(|p| p.len() > 8).collect();
+    assert!(contains(&sent, b"1337;File=") && !files.is_empty(), "iTerm2 pictures were sent");
+    let png = files.iter().filter(|p| p.starts_with(b"iVBOR")).count();
+    let jpeg = files.iter().filter(|p| p.starts_with(b"/9j/")).count();
+    assert!(png > 0 && jpeg == 0, "{png} PNG and {jpeg} JPEG payloads under --bandwidth unlimited");
+}

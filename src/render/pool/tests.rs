@@ -212,7 +212,7 @@ fn parallel_rows_equal_single_thread_rows() {
     renderer.render(&pool, &mut parallel);
     let mut single = Pixmap::new(w, h).unwrap();
     let fields = Fields { refraction: pool.heights(), light: pool.heights() };
-    renderer.render_rows(fields, 0, single.data_mut());
+    renderer.render_rows(fields, 0, single.data_mut(), &mut RowScratch::default());
     assert_eq!(parallel.data(), single.data());
 }
 

@@ -85,6 +85,9 @@ const WAVE_SPEED: f32 = std::f32::consts::FRAC_1_SQRT_2;
 const SEED_SALT: u64 = 0x0067_7573_7473; // "gusts"
 /// The most packets alive at once (a bound on work per picture, whatever the pool's size).
 pub const MAX_PACKETS: usize = 64;
+/// The gusts' columns are added this many at a time ([`GustField::add_row`]): a vector of
+/// AVX-512, two of AVX2.
+pub const GUST_LANES: usize = 16;
 
 /// One packet: where it was born, where it goes, its wave and its strength.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -115,9 +118,8 @@ pub struct Gusts {
     step: i64,
     /// Whether the first packets were drawn (the gusts start as if the breeze had always blown).
     primed: bool,
-    /// Per-packet scratch: the column and row factors (real, imaginary).
-    columns: Vec<(f32, f32)>,
-    rows: Vec<(f32, f32)>,
+    /// The live packets' factors for the picture being drawn.
+    factors: GustFactors,
 }
 
 impl Gusts {
@@ -131,8 +133,7 @@ impl Gusts {
             packets: Vec::with_capacity(MAX_PACKETS),
             step: 0,
             primed: false,
-            columns: Vec::new(),
-            rows: Vec::new(),
+            factors: GustFactors::default(),
         }
     }
 
@@ -223,12 +224,29 @@ impl Gusts {
     /// simulated, and ripples cut off at the wall would draw a false crease along it.
     pub fn add_to(&mut self, field: &mut [f32], width: usize, height: usize) {
         assert_eq!(field.len(), width * height, "the field is the pool's size");
-        // Room for the widest packet at once: no steady-state frame allocates.
-        self.columns.reserve(width.saturating_sub(self.columns.len()));
-        self.rows.reserve(height.saturating_sub(self.rows.len()));
+        let gusts = self.field(width, height);
+        for (y, row) in field.chunks_exact_mut(width.max(1)).enumerate() {
+            gusts.add_row(y, row);
+        }
+    }
+
+    /// The gusts' heights now on a `width x height` pool, ready to be added row by row
+    /// ([`GustField::add_row`], from any thread): each live packet's column and row factors
+    /// are computed once here.
+    pub fn field(&mut self, width: usize, height: usize) -> GustField<'_> {
+        let GustFactors { patches, real, imaginary } = &mut self.factors;
+        patches.clear();
+        real.clear();
+        imaginary.clear();
+        // Room for the most packets there can be, each at its widest, from the first frame: no
+        // later frame allocates when more packets are alive than before (reserved, the pages
+        // untouched until used).
+        patches.reserve(MAX_PACKETS);
+        let most = MAX_PACKETS * (width + GUST_LANES + height);
+        real.reserve(most.saturating_sub(real.len()));
+        imaginary.reserve(most.saturating_sub(imaginary.len()));
         let life = self.shape.life_steps.max(1) as f32;
-        for k in 0..self.packets.len() {
-            let p = self.packets[k];
+        for p in &self.packets {
             let age = (self.step - p.born) as f32;
             let window = libm::sinf(std::f32::consts::PI * age / life);
             let amplitude = p.amplitude * window * window;
@@ -244,27 +262,90 @@ impl Gusts {
             if xs.is_empty() || ys.is_empty() || amplitude == 0.0 {
                 continue;
             }
-            // cos(k·d·(p - c) + φ)·exp(-|p - c|²/2σ²) = Re(X(x)·Y(y)), with the amplitude and
-            // the phase in the row factor.
+            // cos(k·d·(p - c) + φ)·env(p - c) = Re(X(x)·Y(y)), with the amplitude and the phase
+            // in the row factor.
             let factor = |offset: f32, along: f32| {
                 let u = (offset / p.radius) * (offset / p.radius);
                 let envelope = if u < 1.0 { (1.0 - u) * (1.0 - u) } else { 0.0 };
                 let angle = p.wavenumber * along * offset;
                 (envelope * libm::cosf(angle), envelope * libm::sinf(angle))
             };
-            self.columns.clear();
-            self.columns.extend(xs.clone().map(|x| factor(x as f32 - centre.0, p.direction.0)));
+            let columns = real.len();
+            for x in xs.clone() {
+                let (re, im) = factor(x as f32 - centre.0, p.direction.0);
+                real.push(re);
+                imaginary.push(im);
+            }
+            // Zeros up to a whole number of vectors (see `GustField::add_row`).
+            let padded = columns + xs.len().next_multiple_of(GUST_LANES);
+            real.resize(padded, 0.0);
+            imaginary.resize(padded, 0.0);
+            let rows = real.len();
             let (pc, ps) = (amplitude * libm::cosf(p.phase), amplitude * libm::sinf(p.phase));
-            self.rows.clear();
-            self.rows.extend(ys.clone().map(|y| {
+            for y in ys.clone() {
                 let (c, s) = factor(y as f32 - centre.1, p.direction.1);
-                (c * pc - s * ps, c * ps + s * pc)
-            }));
-            for (&(yr, yi), y) in self.rows.iter().zip(ys) {
-                let row = &mut field[y * width + xs.start..y * width + xs.end];
-                for (v, &(xr, xi)) in row.iter_mut().zip(&self.columns) {
-                    *v += xr * yr - xi * yi;
-                }
+                real.push(c * pc - s * ps);
+                imaginary.push(c * ps + s * pc);
+            }
+            patches.push(Patch { columns: xs, rows: ys, column_factors: columns, row_factors: rows });
+        }
+        GustField { patches, real, imaginary }
+    }
+}
+
+/// Where one live packet draws: the cells it covers and where its factors are.
+#[derive(Clone, Debug, Default)]
+struct Patch {
+    columns: std::ops::Range<usize>,
+    rows: std::ops::Range<usize>,
+    /// Where its column factors (one a column) and its row factors (one a row) start in
+    /// [`GustFactors`]'s lists.
+    column_factors: usize,
+    row_factors: usize,
+}
+
+/// The live packets' factors for one picture, kept between frames for their allocations.
+#[derive(Clone, Debug, Default)]
+struct GustFactors {
+    patches: Vec<Patch>,
+    /// The factors' real and imaginary parts, the packets' columns and rows one after another.
+    real: Vec<f32>,
+    imaginary: Vec<f32>,
+}
+
+/// The gusts' heights at one step, ready to be added to a field row by row (see
+/// [`Gusts::field`]).
+#[derive(Clone, Copy, Debug)]
+pub struct GustField<'a> {
+    patches: &'a [Patch],
+    real: &'a [f32],
+    imaginary: &'a [f32],
+}
+
+impl GustField<'_> {
+    /// Adds the gusts' heights in row `y` to `row` (the pool's width, or more: see below):
+    /// every packet that covers the row in the order they were born, so each cell sums the
+    /// same terms in the same order whichever rows are drawn together and on whichever thread.
+    ///
+    /// Each packet's columns are added [`GUST_LANES`] at a time, its column factors padded
+    /// with zeros to a whole number of them; a `row` at least [`GUST_LANES`] longer than the
+    /// pool takes the padding too and needs no scalar remainder. Adding a zero leaves every
+    /// cell as it is: a sum that starts at +0 never becomes -0, and +0 + ±0 is +0.
+    #[inline(always)]
+    pub fn add_row(&self, y: usize, row: &mut [f32]) {
+        for p in self.patches {
+            if !p.rows.contains(&y) {
+                continue;
+            }
+            let at = p.row_factors + (y - p.rows.start);
+            let (yr, yi) = (self.real[at], self.imaginary[at]);
+            let end = (p.columns.start + p.columns.len().next_multiple_of(GUST_LANES)).min(row.len());
+            let out = &mut row[p.columns.start..end];
+            let n = out.len();
+            let xr = &self.real[p.column_factors..p.column_factors + n];
+            let xi = &self.imaginary[p.column_factors..p.column_factors + n];
+            for i in 0..n {
+                out[i] += xr[i] * yr - xi[i] * yi;
             }
         }
     }
