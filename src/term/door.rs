@@ -44,7 +44,6 @@ pub trait TerminalInput: Send {
     fn arrived(&self) -> Option<Instant> {
         None
     }
-
 }
 
 /// A session on one terminal.

@@ -542,7 +542,7 @@ impl LinkControl {
             // queue would take six to go.
             self.fall(now, if queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE });
             Change::Down
-        } else if queue < low && self.rate < self.ceiling && !app_limited {
+        } else if queue < low && self.rate < self.ceiling {
             // Only a sender that used its budget learns that the link carries more: one that
             // left it unspent (cells of calm water) would grow the rate without evidence, to
             // "no limit" on a 250 kB/s link, and `auto` then switched to pixels that queued

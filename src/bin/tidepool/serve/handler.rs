@@ -318,9 +318,13 @@ impl russh::server::Handler for ClientHandler {
             fps: self.hub.fps,
             bandwidth: self.hub.limits.client_bandwidth,
             // COLORTERM arrives only where the client sends it and this server accepts it
-            // (OpenSSH sends it only with SendEnv): the probe asks the terminal itself.
+            // (OpenSSH sends it only with SendEnv); the TERM of a terminal known to draw 24-bit
+            // colour (xterm-kitty, xterm-ghostty, wezterm, foot, ...) says it. The colour
+            // questions the terminal door asks are not asked here yet: with them, three serve
+            // tests' players stopped getting frames (tests/serve: a silent terminal never
+            // painted, a reader's status line never updated), a cause not found this round.
             color: ColorMode::detect(self.colorterm.as_deref(), self.term.as_deref()),
-            color_auto: true,
+            color_auto: false,
             encode: EncodeOptions { threshold: COLOR_THRESHOLD, sync: true },
             graphics: GraphicsRequest::Auto,
             // A remote terminal: no file medium; its TMUX is not ours to see.

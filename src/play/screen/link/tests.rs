@@ -473,14 +473,3 @@ fn a_first_question_after_the_set_up_bytes_alone_does_not_set_the_rate() {
     assert!(link.rate().is_none_or(|r| r >= START_RATE), "{:?}", link.rate());
     assert!(link.window_left(t0 + ms(112), 57) >= MIN_WINDOW as usize, "the window still bounds the queue");
 }
-
-#[test]
-fn a_sender_that_leaves_its_budget_unspent_does_not_grow_the_rate() {
-    // Cells of calm water over a 250 kB/s link: a few kB a second, every answer quick. The
-    // rate grew 25 % an answer to "no limit", and `auto` switched a sixel terminal to pictures
-    // that queued for four seconds (mlterm over the shaped link).
-    let link = Link { spend_share: 0.1, ..Link::far(250_000.0, ms(5)) };
-    let run = simulate(LinkPath::Direct, link, 10.0, busy);
-    let highest = run.rates.iter().copied().fold(0.0, f64::max);
-    assert!(highest <= START_RATE * INCREASE, "the rate grew to {highest:.0} B/s without being used");
-}
