@@ -71,6 +71,7 @@ pub const UNLIMITED: usize = usize::MAX;
 /// What `budget` leaves once `spent` bytes are taken from it: [`UNLIMITED`] stays unlimited
 /// (a plain subtraction would turn it into a huge but finite budget, which the picture stream
 /// reads as a link with a rate: lossy JPEG for iTerm2 under `--bandwidth unlimited`).
+#[cfg(feature = "player")]
 pub(crate) fn budget_after(budget: usize, spent: usize) -> usize {
     if budget == UNLIMITED { UNLIMITED } else { budget.saturating_sub(spent) }
 }

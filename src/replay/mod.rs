@@ -23,8 +23,10 @@
 //! (its recorder), so a replay on disk is always complete; a file without its `end` line is
 //! reported as truncated.
 
+#[cfg(feature = "player")]
 mod recorder;
 
+#[cfg(feature = "player")]
 pub(crate) use recorder::Recorder;
 
 use std::path::{Path, PathBuf};

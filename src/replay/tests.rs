@@ -137,6 +137,7 @@ impl Storage for Memory {
 }
 
 #[test]
+#[cfg(feature = "player")]
 fn recorder_saves_once_when_finished() {
     let storage = std::sync::Arc::new(Memory::default());
     let mut rec = Recorder::new(Path::new("s.jsonl"), &header(), storage.clone());
@@ -152,6 +153,7 @@ fn recorder_saves_once_when_finished() {
 }
 
 #[test]
+#[cfg(feature = "player")]
 fn a_dropped_recorder_still_saves() {
     let storage = std::sync::Arc::new(Memory::default());
     let mut rec = Recorder::new(Path::new("s.jsonl"), &header(), storage.clone());

@@ -47,6 +47,7 @@
 //! the bucket holds it. Without a rate every picture goes at the source's own size (no
 //! interpolated pixels), in the packing that costs least CPU.
 
+#[cfg(feature = "player")]
 pub mod crossover;
 pub mod ladder;
 mod tiles;
