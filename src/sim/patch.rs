@@ -340,7 +340,8 @@ impl Lattice {
             })
             .collect();
         self.ifft2_transposed(&mut buf);
-        (buf.iter().map(|c| c.re).collect(), buf.iter().map(|c| c.im).collect())
+        // Element by element, so in parallel with the same bits.
+        (buf.par_iter().map(|c| c.re).collect(), buf.par_iter().map(|c| c.im).collect())
     }
 
     /// The displacement's gradient per unit λ, each times -1: g_ab = Σ a·(k_a·k_b/k)·cos θ.
@@ -462,15 +463,17 @@ impl PatchSea {
         let (lag, b) = self.lagrangian(time);
         let (n, cell) = (self.size, (self.extent_m / self.size as f64) as f32);
         let lambda = self.params.choppiness as f32;
-        let h_l: Vec<f32> = (0..n * n).map(|i| lag.h[i] + 0.5 * lambda * b[i].norm_sqr()).collect();
+        // Element by element below, so in parallel with the same bits on any number of cores.
+        let h_l: Vec<f32> = (0..n * n).into_par_iter().map(|i| lag.h[i] + 0.5 * lambda * b[i].norm_sqr()).collect();
         let displacement: Vec<[f32; 3]> =
-            (0..n * n).map(|i| [lambda * lag.dx[i], lambda * lag.dy[i], h_l[i]]).collect();
+            (0..n * n).into_par_iter().map(|i| [lambda * lag.dx[i], lambda * lag.dy[i], h_l[i]]).collect();
         // The fields read together, side by side: the displacement in lattice units (the Euler
         // iterations read it four times a texel), and the slopes and gradient at the end.
         let to_cell = lambda / cell;
-        let carried: Vec<[f32; 2]> = (0..n * n).map(|i| [lag.dx[i] * to_cell, lag.dy[i] * to_cell]).collect();
+        let carried: Vec<[f32; 2]> =
+            (0..n * n).into_par_iter().map(|i| [lag.dx[i] * to_cell, lag.dy[i] * to_cell]).collect();
         let gradients: Vec<[f32; 5]> =
-            (0..n * n).map(|i| [lag.hx[i], lag.hy[i], lag.gxx[i], lag.gyy[i], lag.gxy[i]]).collect();
+            (0..n * n).into_par_iter().map(|i| [lag.hx[i], lag.hy[i], lag.gxx[i], lag.gyy[i], lag.gxy[i]]).collect();
         let mut height = vec![0.0f32; n * n];
         let mut normal = vec![[0.0f32; 3]; n * n];
         let mut foam = vec![0.0f32; n * n];
