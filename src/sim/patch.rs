@@ -295,22 +295,15 @@ impl Lattice {
             .collect()
     }
 
-    /// The inverse 2-D FFT, in place, of a spectrum laid out transposed (`buf[kx·n + ky]`, see
-    /// [`Lattice::transposed`]): along ky on rows, one transpose, along kx on rows, which
-    /// leaves the field in row-major order (one transpose fewer than from the natural layout).
-    /// Rows in parallel: the same result on any number of cores.
+    /// The inverse 2-D FFT, in place, of a spectrum laid out transposed (`buf[kx·n + ky]`:
+    /// buffer row c is the lattice's column c): along ky on rows, one transpose, along kx on
+    /// rows, which leaves the field in row-major order (one transpose fewer than from the
+    /// natural layout). Rows in parallel: the same result on any number of cores.
     fn ifft2_transposed(&self, buf: &mut [Complex32]) {
         let n = self.n;
         buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
         transpose_square(buf, n);
         buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
-    }
-
-    /// The lattice index (row-major, row = ky) of position `j` of a transposed spectrum.
-    #[inline(always)]
-    fn transposed(&self, j: usize) -> usize {
-        let n = self.n;
-        (j % n) * n + j / n
     }
 
     /// Two real fields from one complex transform. `coefficients(i, w)` gives, for the
@@ -336,19 +329,23 @@ impl Lattice {
         coefficients: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
     ) -> Vec<Complex32> {
         let n = self.n;
-        let mut buf: Vec<Complex32> = (0..n * n)
-            .into_par_iter()
-            .map(|j| {
-                let i = self.transposed(j);
-                let (r, c) = (i / n, i % n);
-                let mirror = ((n - r) % n) * n + (n - c) % n;
+        // Filled in the lattice's order, row by row (no index needs a division, and the reads
+        // run along rows: walking columns missed the cache at every point), then transposed
+        // in blocks into the layout the transform wants.
+        let mut buf = vec![Complex32::new(0.0, 0.0); n * n];
+        buf.par_chunks_mut(n).enumerate().for_each(|(r, row)| {
+            let r_mirror = if r == 0 { 0 } else { n - r };
+            for (c, out) in row.iter_mut().enumerate() {
+                let i = r * n + c;
+                let mirror = r_mirror * n + if c == 0 { 0 } else { n - c };
                 let (f, g) = coefficients(i, waves[i]);
                 let (fm, gm) = coefficients(mirror, waves[mirror]);
                 let sf = (f + fm.conj()) * 0.5;
                 let sg = (g + gm.conj()) * 0.5;
-                sf + Complex32::new(0.0, 1.0) * sg
-            })
-            .collect();
+                *out = sf + Complex32::new(0.0, 1.0) * sg;
+            }
+        });
+        transpose_square(&mut buf, n);
         self.ifft2_transposed(&mut buf);
         buf
     }
@@ -429,13 +426,16 @@ impl PatchSea {
         let gxx_gyy = l.real_fields_packed(&waves, |i, w| (w * (kx[i] * kx[i] / k[i]), w * (ky[i] * ky[i] / k[i])));
         // B = Σ a·√k·e^(iθ): the waves themselves, a complex field.
         let n = self.size;
-        let mut b: Vec<Complex32> = (0..n * n)
-            .into_par_iter()
-            .map(|j| {
-                let i = l.transposed(j);
-                if l.amp[i].norm_sqr() == 0.0 { Complex32::new(0.0, 0.0) } else { waves[i] * unit(i).2.sqrt() }
-            })
-            .collect();
+        let mut b = vec![Complex32::new(0.0, 0.0); n * n];
+        b.par_chunks_mut(n).enumerate().for_each(|(r, row)| {
+            for (c, out) in row.iter_mut().enumerate() {
+                let i = r * n + c;
+                if l.amp[i].norm_sqr() != 0.0 {
+                    *out = waves[i] * unit(i).2.sqrt();
+                }
+            }
+        });
+        transpose_square(&mut b, n);
         l.ifft2_transposed(&mut b);
         (Lagrangian { h_dx, dy_hx, hy_gxy, gxx_gyy }, b)
     }
