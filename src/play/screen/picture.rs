@@ -28,7 +28,7 @@ use crate::output::units::write_human_rate;
 /// grid is its picture, and its breeze costs about 33 ns a cell a step (`tidepool render pool
 /// --breeze 1 --stats`): at the full 1280x752 of a 160x48 window, 60 steps a second would need
 /// two cores. Within this size the pool (simulation, picture, encoding) stays near half a core
-/// (`scripts/measure_graphics.py`); kitty and iTerm2 scale the picture up to the cell area
+/// (`scripts/pixel_cpu.py`); kitty and iTerm2 scale the picture up to the cell area
 /// themselves, the sixel stream repeats its pixels.
 pub const SCENE_CAP: (u32, u32) = (480, 300);
 
