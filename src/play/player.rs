@@ -62,10 +62,9 @@ impl Player {
     }
 
     /// While the screen is asking the terminal what it draws (before a door can size its
-    /// scene): takes the terminal's bytes and looks at the clock; keys typed meanwhile wait for
-    /// the first [`Player::turn`].
-    pub fn settle(&mut self, bytes: &[u8], now: Instant) {
-        self.screen.feed(bytes, now, &mut self.inputs);
+    /// scene): looks at the clock (the probe's deadline); keys typed meanwhile wait for the
+    /// first [`Player::turn`].
+    pub fn settle(&mut self, now: Instant) {
         self.screen.tick(now, &mut self.inputs);
     }
 

@@ -40,8 +40,8 @@ use crate::output::cursor::Cursor;
 use crate::output::diff::{EncodeOptions, Shown};
 use crate::output::frame::Frame;
 use crate::output::graphics::GraphicsMode;
-use crate::output::graphics::stream::Budget;
 use crate::output::graphics::stream::crossover::AutoSwitch;
+use crate::output::graphics::stream::{Budget, FileWrite};
 use crate::output::rate::{RateEncoder, RateOptions, Report, Target, budget_after};
 use crate::play::clock::{FramePacer, Meter};
 
@@ -106,6 +106,12 @@ pub const LATE_ANSWERS: Duration = Duration::from_secs(5);
 /// terminal's answers said it draws more, and the one flag that gives it.
 pub(crate) fn colour_hint(mode: ColorMode) -> String {
     format!("{} colours (the terminal did not say more): try --color truecolor", mode.name())
+}
+
+/// Where the door writes kitty's temporary files: beside the probe's file, which the door
+/// wrote there to ask the terminal whether it reads them (`None`: no file medium).
+fn files_dir(config: &ScreenConfig) -> Option<std::path::PathBuf> {
+    config.probe.as_ref()?.kitty_file.as_ref()?.parent().map(|d| d.to_path_buf())
 }
 
 /// The probe's progress.
@@ -180,7 +186,7 @@ impl Screen {
             Bandwidth::Unlimited => ByteBucket::unlimited(),
         };
         Screen {
-            picture: Picture::new(&choice, &support, term),
+            picture: Picture::new(&choice, &support, term, files_dir(&config)),
             pacer: FramePacer::new(config.fps, now),
             meter: Meter::new(now),
             config,
@@ -503,6 +509,23 @@ impl Screen {
             self.bucket.budget().min(self.link.window_left(now, self.bytes_sent))
         } else {
             self.bucket.budget()
+        }
+    }
+
+    /// Moves the temporary files the frames handed out so far name (kitty's file medium) to
+    /// `out`: the door writes them before it sends those frames' bytes.
+    pub fn take_files(&mut self, out: &mut Vec<FileWrite>) {
+        if let Some(p) = &mut self.picture {
+            p.take_files(out);
+        }
+    }
+
+    /// The door could not write a temporary file: pixels go directly from now on (the next
+    /// picture whole).
+    pub fn handle_file_error(&mut self) {
+        self.config.probe.iter_mut().for_each(|p| p.kitty_file = None);
+        if let Some(p) = &mut self.picture {
+            p.files_failed();
         }
     }
 

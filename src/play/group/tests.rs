@@ -57,7 +57,7 @@ fn play_with(frames: u32, keys: &[(u32, &[u8])], stones: bool) -> (Vec<Member>, 
         })
         .collect();
     let pool = PoolSettings { rain_rate: 0.0, breeze: 0.0, seed: 5, ..PoolSettings::default() };
-    let config = HostConfig { scenes: vec![SceneSpec::Pool(pool)], seed: 5, record: None, storage: None };
+    let config = HostConfig { scenes: vec![SceneSpec::Pool(pool)], seed: 5, record: None, screenshots: false };
     let size = members[0].player.screen.picture_size();
     let mut host = Host::new(config, size, t0).unwrap();
     let mut picture = Pixmap::new(size.0, size.1).unwrap();

@@ -133,7 +133,7 @@ impl GameOptions {
     /// The host of the first scene (so a bad scene setting fails before the server starts).
     /// Nothing is recorded and no file is saved on a player's behalf.
     pub fn host(&self) -> tidepool::Result<Host> {
-        let config = HostConfig { scenes: self.scenes.clone(), seed: self.seed, record: None, storage: None };
+        let config = HostConfig { scenes: self.scenes.clone(), seed: self.seed, record: None, screenshots: false };
         Host::new(config, self.size, Instant::now())
     }
 }

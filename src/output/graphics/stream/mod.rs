@@ -6,8 +6,11 @@
 //! or JPEG) and the picture rate — so that a picture never costs more than the bytes the caller
 //! has now.
 //!
-//! Pure and clock-injected: no terminal, no clock. Time comes in as an argument. (The one
-//! side effect: kitty's temporary files, when the terminal is on this machine.)
+//! Pure and clock-injected: no terminal, no clock, no file. Time comes in as an argument.
+//! kitty's temporary files (a terminal on this machine reads the pixels from them) are data
+//! too: a committed offer's file is handed out by [`PictureStream::take_files`] and the door
+//! writes it before the offer's bytes; a file it cannot write is reported back
+//! ([`PictureStream::files_failed`]) and the stream sends pixels directly from then on.
 //!
 //! # The contract (how the Screen calls it)
 //!
@@ -190,6 +193,16 @@ pub enum Part {
     Tile(u32, u32, u32, u32),
 }
 
+/// A file the door writes before it sends the bytes that name it (kitty's temporary-file
+/// medium: the terminal reads the pixels from it and deletes it).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FileWrite {
+    /// Where the file goes (a new file: an existing one of that name is not followed).
+    pub path: PathBuf,
+    /// Its bytes.
+    pub bytes: Vec<u8>,
+}
+
 /// What is pending until [`PictureStream::commit`].
 #[derive(Clone, Copy, Debug)]
 struct Pending {
@@ -230,10 +243,12 @@ pub struct PictureStream {
     sixel: Option<Box<SixelEncoder>>,
     /// kitty's placeholder text must be (re)printed after the next whole image.
     placeholders_due: bool,
-    /// kitty's temporary files: how many were written, and the one the pending offer names
-    /// (removed when the offer is not committed: no terminal will read it).
+    /// kitty's temporary files: how many were named, the one the pending offer names (dropped
+    /// when the offer is not committed: it is never written), and the committed ones the door
+    /// has not taken yet.
     files: u64,
-    pending_file: Option<PathBuf>,
+    pending_file: Option<FileWrite>,
+    committed_files: Vec<FileWrite>,
 }
 
 impl PictureStream {
@@ -275,6 +290,7 @@ impl PictureStream {
             placeholders_due: true,
             files: 0,
             pending_file: None,
+            committed_files: Vec::new(),
         };
         stream.build_ladder(layout.picture);
         stream
@@ -445,7 +461,7 @@ impl PictureStream {
     /// The offer was written: the terminal shows it from now on.
     pub fn commit(&mut self) {
         let Some(Pending { rung, part }) = self.pending.take() else { return };
-        self.pending_file = None;
+        self.committed_files.extend(self.pending_file.take());
         let sixel = matches!(self.protocol, Protocol::Sixel { .. });
         let (stride, bpp) = self.stride(rung);
         match (part, &mut self.shown) {
@@ -468,12 +484,25 @@ impl PictureStream {
         self.rung = rung;
     }
 
-    /// An offer not committed: its temporary file is removed (no terminal will read it).
+    /// An offer not committed: its temporary file is never written.
     fn forget_pending(&mut self) {
         self.pending = None;
-        if let Some(path) = self.pending_file.take() {
-            let _ = std::fs::remove_file(path);
+        self.pending_file = None;
+    }
+
+    /// Moves the files the committed offers name to `out`: the door writes them before it
+    /// sends those offers' bytes.
+    pub fn take_files(&mut self, out: &mut Vec<FileWrite>) {
+        out.append(&mut self.committed_files);
+    }
+
+    /// The door could not write a file (a full or read-only `/dev/shm`): pixels go directly
+    /// from now on, and the next picture is sent whole (the terminal did not get the last one).
+    pub fn files_failed(&mut self) {
+        if let Protocol::Kitty(options) = &mut self.protocol {
+            options.medium = Medium::Direct;
         }
+        self.invalidate();
     }
 
     /// Bytes a row of the shown picture at `rung` takes, and bytes a pixel.
@@ -622,32 +651,19 @@ impl PictureStream {
                 } else {
                     kitty::edit_keys(&mut keys, o.image_id, (x, y, w, h));
                 }
-                let through_file = match (&o.medium, packing) {
+                match (&o.medium, packing) {
                     (Medium::TempFile(dir), None) => {
                         self.files += 1;
-                        match kitty::write_temp_file(dir, self.files, pixels) {
-                            Ok(path) => {
-                                kitty::push_temp_file_command(&mut self.bytes, &keys, &path, o.tmux);
-                                self.pending_file = Some(path);
-                                true
-                            }
-                            Err(_) => false,
-                        }
+                        let path = kitty::temp_file_path(dir, self.files);
+                        kitty::push_temp_file_command(&mut self.bytes, &keys, &path, o.tmux);
+                        self.pending_file = Some(FileWrite { path, bytes: pixels.to_vec() });
                     }
-                    _ => false,
-                };
-                if !through_file {
-                    if matches!(o.medium, Medium::TempFile(_)) {
-                        // The file could not be written (a full or read-only /dev/shm): direct
-                        // from now on, and this picture directly too.
-                        if let Protocol::Kitty(options) = &mut self.protocol {
-                            options.medium = Medium::Direct;
-                        }
+                    _ => {
+                        let packing = packing.unwrap_or(Packing::Zlib(1));
+                        pack(packing, pixels, w, h, &mut self.packed);
+                        let more: &[u8] = if whole { b"" } else { b"a=f," };
+                        kitty::push_chunks(&mut self.bytes, &keys, more, packing, &self.packed, o.tmux);
                     }
-                    let packing = packing.unwrap_or(Packing::Zlib(1));
-                    pack(packing, pixels, w, h, &mut self.packed);
-                    let more: &[u8] = if whole { b"" } else { b"a=f," };
-                    kitty::push_chunks(&mut self.bytes, &keys, more, packing, &self.packed, o.tmux);
                 }
                 if whole && o.placeholders && self.placeholders_due {
                     kitty::push_placeholders(&mut self.bytes, o.image_id, o.origin.0, o.origin.1, o.cells.0, o.cells.1);
@@ -659,12 +675,6 @@ impl PictureStream {
             }
             Protocol::Sixel { .. } => unreachable!("sixel is encoded by its encoder"),
         }
-    }
-}
-
-impl Drop for PictureStream {
-    fn drop(&mut self) {
-        self.forget_pending();
     }
 }
 

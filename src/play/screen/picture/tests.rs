@@ -105,7 +105,7 @@ fn count(hay: &[u8], needle: &[u8]) -> usize {
 
 #[test]
 fn cells_mode_has_no_picture() {
-    assert!(Picture::new(&choice(GraphicsMode::Cells), &GraphicsSupport::default(), (80, 24)).is_none());
+    assert!(Picture::new(&choice(GraphicsMode::Cells), &GraphicsSupport::default(), (80, 24), None).is_none());
 }
 
 #[test]

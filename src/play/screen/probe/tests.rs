@@ -1,7 +1,9 @@
 use std::cell::{Cell, RefCell};
+use std::time::Instant;
 
 use super::*;
 use crate::output::graphics::kitty_decode;
+use crate::term::probe::run_probe;
 
 const MS: Duration = Duration::from_millis(1);
 
