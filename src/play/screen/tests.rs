@@ -1,7 +1,10 @@
+use tiny_skia::Pixmap;
+
 use super::*;
 use crate::play::fit::Fit;
 use crate::play::host::SceneStatus;
 use crate::play::screen::probe::{Environment, WinSize};
+use crate::play::seat::SeatView;
 
 const MS: Duration = Duration::from_millis(1);
 const KITTY_OK: &[u8] = b"\x1b_Gi=31;OK\x1b\\";
