@@ -160,6 +160,7 @@ impl Host {
             status: SceneStatus::default(),
         };
         host.describe_scene();
+        host.refresh_status();
         Ok(host)
     }
 
@@ -193,9 +194,14 @@ impl Host {
                 self.clock.set_paused(!self.clock.paused(), now);
                 self.status.paused = self.clock.paused();
             }
-            Request::NextScene => return self.next_scene(now),
+            Request::NextScene => {
+                let message = self.next_scene(now);
+                self.refresh_status();
+                return message;
+            }
             Request::Screenshot => return self.screenshot(),
         }
+        self.refresh_status();
         None
     }
 
@@ -204,6 +210,7 @@ impl Host {
     pub fn resize(&mut self, width: u32, height: u32) {
         if (width, height) != self.scene.size() {
             self.apply_event(Event::Resize([width, height]));
+            self.refresh_status();
         }
     }
 
@@ -215,6 +222,7 @@ impl Host {
         if let Some(r) = &mut self.recorder {
             r.advance(self.step);
         }
+        self.refresh_status();
         due
     }
 
@@ -226,14 +234,20 @@ impl Host {
     /// Draws the scene into `out`, which has the scene's size.
     pub fn render(&mut self, out: &mut Pixmap) {
         self.scene.render(out);
+        self.refresh_status();
     }
 
-    /// What the status line and the help say now (the scene's summary is refreshed in place:
-    /// no allocation once its text has grown).
-    pub fn status(&mut self) -> &SceneStatus {
+    /// What the status line and the help say now (kept current by every change the host
+    /// makes to the scene).
+    pub fn status(&self) -> &SceneStatus {
+        &self.status
+    }
+
+    /// The scene's summary, refreshed in place (no allocation once its text has grown) after
+    /// anything that may change it: the scene changes only through the host's own methods.
+    fn refresh_status(&mut self) {
         self.status.detail.clear();
         self.scene.status(&mut self.status.detail);
-        &self.status
     }
 
     /// What the door must do for the host (a screenshot to save), oldest first.
@@ -248,6 +262,7 @@ impl Host {
             Ok(name) => {
                 let message = format!("saved {name}");
                 self.apply_event(Event::Screenshot(name));
+                self.refresh_status();
                 message
             }
             Err(e) => format!("screenshot failed: {e}"),

@@ -77,7 +77,7 @@ pub use fit::Fit;
 pub use group::{GroupFeed, GroupKey, Groups, Membership, Source};
 pub use host::{Effect, Host, HostConfig, Recording, SceneStatus};
 pub use input::Input;
-pub use player::{Player, Turn};
+pub use player::Player;
 pub use request::Request;
 pub use screen::probe::{Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
 pub use screen::{Bandwidth, LinkPath, Screen, ScreenConfig};

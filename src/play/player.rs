@@ -1,7 +1,7 @@
-//! A player: one person at one terminal, a [`Seat`] and a [`Screen`] driven together. Every door
-//! does the same with them on each turn (the terminal's bytes to the screen, its deadlines, a
-//! new layout, its notices, the person's inputs to the seat, the seat's requests out, a frame
-//! with the seat's overlay); this is that turn once, so a door is its I/O and nothing else.
+//! A player: one person at one terminal, a [`Seat`] and a [`Screen`] together. The turn every
+//! door takes with them (the terminal's bytes to the screen, its deadlines, a new layout, its
+//! notices, the person's inputs to the seat, the seat's requests out, a frame with the seat's
+//! overlay) is [`super::driver::Driver`]'s, built on the steps here.
 
 use std::io;
 use std::time::Instant;
@@ -16,7 +16,7 @@ use super::seat::{Flow, Seat};
 
 /// What a turn found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Turn {
+pub(crate) struct Turn {
     /// Whether the person stays.
     pub flow: Flow,
     /// The picture's layout changed (a resize, the probe's answer): the door makes the scene
@@ -55,7 +55,7 @@ impl Player {
 
     /// Takes the terminal's bytes; says whether the person did something (the terminal's own
     /// answers are no sign of life: an idle timeout must not count them).
-    pub fn feed(&mut self, bytes: &[u8], now: Instant) -> bool {
+    pub(crate) fn feed(&mut self, bytes: &[u8], now: Instant) -> bool {
         let before = self.inputs.len();
         self.screen.feed(bytes, now, &mut self.inputs);
         self.inputs.len() > before
@@ -64,13 +64,13 @@ impl Player {
     /// While the screen is asking the terminal what it draws (before a door can size its
     /// scene): looks at the clock (the probe's deadline); keys typed meanwhile wait for the
     /// first [`Player::turn`].
-    pub fn settle(&mut self, now: Instant) {
+    pub(crate) fn settle(&mut self, now: Instant) {
         self.screen.tick(now, &mut self.inputs);
     }
 
     /// One turn at `now`: the screen's deadlines, its layout and notices, and the person's
     /// inputs as requests for the host (appended to `requests`). `status` is the scene's.
-    pub fn turn(&mut self, now: Instant, status: &SceneStatus, requests: &mut Vec<Request>) -> Turn {
+    pub(crate) fn turn(&mut self, now: Instant, status: &SceneStatus, requests: &mut Vec<Request>) -> Turn {
         self.screen.tick(now, &mut self.inputs);
         let layout_changed = self.screen.take_layout_change();
         if !self.screen.probing()
@@ -96,12 +96,12 @@ impl Player {
     }
 
     /// The scene (of `scene` pixels) fits the screen's new layout.
-    pub fn refit(&mut self, scene: (u32, u32)) {
+    pub(crate) fn refit(&mut self, scene: (u32, u32)) {
         self.seat.set_fit(self.screen.fit(scene));
     }
 
     /// A message from the host for this person (a screenshot's name).
-    pub fn say(&mut self, message: String, now: Instant) {
+    pub(crate) fn say(&mut self, message: String, now: Instant) {
         self.seat.say(message, now);
     }
 

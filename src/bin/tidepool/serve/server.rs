@@ -140,7 +140,7 @@ impl GameOptions {
 
 /// Binds and starts serving. Errors only for the bind (e.g. port in use) and the first scene.
 pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
-    let mut host = opts.game.host().map_err(StartError::Scene)?;
+    let host = opts.game.host().map_err(StartError::Scene)?;
     let listener = TcpListener::bind(opts.listen).await.map_err(StartError::Bind)?;
     let local_addr = listener.local_addr().map_err(StartError::Bind)?;
     let config = Arc::new(russh_config(opts.host_key, opts.allow.is_some(), &opts.limits, opts.compression));
