@@ -25,7 +25,7 @@ use crate::scene::{Action, Event, Playable, SceneKind, SceneSpec};
 /// `space` does not change the rain.
 const STONE_SEED_MIX: u64 = 0x5354_4f4e_4553_0001;
 /// Screenshot names tried before giving up on a free one.
-pub const SCREENSHOT_NAMES: usize = 1000;
+const SCREENSHOT_NAMES: usize = 1000;
 
 /// What the host runs.
 #[derive(Clone)]
@@ -55,7 +55,7 @@ impl std::fmt::Debug for HostConfig {
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum Effect {
     /// Save the scene's picture, a PNG, as `BASE.png` (or, when that is taken, the first free
-    /// `BASE-N.png` for N up to [`SCREENSHOT_NAMES`]), then tell the host
+    /// `BASE-N.png` for N up to 1000: [`Effect::names`]), then tell the host
     /// ([`Host::handle_saved`]).
     Screenshot {
         /// The name without its extension (`tidepool-pool-000120`).
