@@ -79,7 +79,7 @@ pub use host::{Effect, Host, HostConfig, Recording, SceneStatus};
 pub use input::Input;
 pub use player::Player;
 pub use request::Request;
-pub use screen::probe::{Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
+pub use screen::probe::{EnvHints, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
 pub use screen::{Bandwidth, LinkPath, Screen, ScreenConfig};
 pub use seat::{Flow, Seat};
 pub use session::{Session, SessionEvent};

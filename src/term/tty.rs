@@ -33,7 +33,7 @@ use super::door::{PlayConfig, TerminalInput, run_door};
 use crate::error::{Error, Result};
 use crate::output::graphics::{GraphicsMode, kitty};
 use crate::play::screen::probe::{
-    self, Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize,
+    self, EnvHints, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize,
 };
 use crate::play::screen::{LinkPath, Screen};
 
@@ -111,7 +111,7 @@ pub fn probe_for_picture(request: GraphicsRequest) -> (GraphicsChoice, GraphicsS
 /// The probe's starting point for this process's terminal: its environment and window size,
 /// and (when `file_medium` and not over SSH) a temporary file for the kitty file-medium query.
 fn probe_options(winsize: WinSize, file_medium: bool) -> ProbeOptions {
-    let env = Environment::from_lookup(|name| std::env::var(name).ok());
+    let env = EnvHints::from_lookup(|name| std::env::var(name).ok());
     let kitty_file = (file_medium && !env.ssh)
         .then(|| kitty::write_temp_file(&kitty::temp_dir(), PROBE_FILE_NUMBER, &[0, 0, 0]).ok())
         .flatten();

@@ -93,9 +93,11 @@ pub const NO_SIXEL: &str = "the terminal does not say it draws sixel: half-block
 /// A 1x1 black RGB pixel, base64.
 const ONE_PIXEL: &str = "AAAA";
 
-/// The environment variables the probe looks at.
+/// What the process's environment variables say about the terminal (the door reads them):
+/// hints the probe uses where no answer comes. (Named apart from the renderer's
+/// `Environment`, the sky and light a scene is lit by.)
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Environment {
+pub struct EnvHints {
     /// Inside tmux (`TMUX` is set).
     pub tmux: bool,
     /// Over SSH (`SSH_CONNECTION` or `SSH_TTY` is set): no temporary-file query.
@@ -104,11 +106,11 @@ pub struct Environment {
     pub term_program: Option<String>,
 }
 
-impl Environment {
+impl EnvHints {
     /// Reads the variables through `var` (`std::env::var` in the player, a table in tests).
-    pub fn from_lookup(var: impl Fn(&str) -> Option<String>) -> Environment {
+    pub fn from_lookup(var: impl Fn(&str) -> Option<String>) -> EnvHints {
         let set = |name: &str| var(name).is_some_and(|v| !v.is_empty());
-        Environment {
+        EnvHints {
             tmux: set("TMUX"),
             ssh: set("SSH_CONNECTION") || set("SSH_TTY"),
             term_program: var("TERM_PROGRAM").filter(|v| !v.is_empty()),
@@ -142,7 +144,7 @@ impl WinSize {
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ProbeOptions {
     /// The environment hints.
-    pub env: Environment,
+    pub env: EnvHints,
     /// The window size.
     pub winsize: WinSize,
     /// A temporary file holding one RGB pixel (3 bytes) whose name carries

@@ -3,7 +3,7 @@ use tiny_skia::Pixmap;
 use super::*;
 use crate::play::fit::Fit;
 use crate::play::host::SceneStatus;
-use crate::play::screen::probe::{Environment, WinSize};
+use crate::play::screen::probe::{EnvHints, WinSize};
 use crate::play::seat::SeatView;
 
 const MS: Duration = Duration::from_millis(1);
@@ -19,7 +19,7 @@ fn config(bandwidth: Bandwidth, probe: bool) -> ScreenConfig {
         encode: EncodeOptions::default(),
         graphics: GraphicsRequest::Auto,
         probe: probe.then(|| ProbeOptions {
-            env: Environment { ssh: true, ..Environment::default() },
+            env: EnvHints { ssh: true, ..EnvHints::default() },
             winsize: WinSize { cols: 40, rows: 12, x_px: 320, y_px: 192 },
             kitty_file: None,
             colours: false,

@@ -11,7 +11,7 @@ use crate::output::graphics::stream::Part;
 use crate::output::graphics::stream::ladder::resample;
 use crate::output::graphics::test_pictures::golden_pool;
 use crate::play::host::SceneStatus;
-use crate::play::screen::probe::{Environment, GraphicsRequest, ProbeOptions, WinSize};
+use crate::play::screen::probe::{EnvHints, GraphicsRequest, ProbeOptions, WinSize};
 use crate::play::screen::{Bandwidth, Screen, ScreenConfig, link};
 use crate::play::seat::SeatView;
 
@@ -38,7 +38,7 @@ fn config(bandwidth: Bandwidth, graphics: GraphicsRequest) -> ScreenConfig {
         encode: EncodeOptions::default(),
         graphics,
         probe: Some(ProbeOptions {
-            env: Environment { ssh: true, ..Environment::default() },
+            env: EnvHints { ssh: true, ..EnvHints::default() },
             winsize: WinSize { cols: 160, rows: 48, x_px: 1280, y_px: 768 },
             kitty_file: None,
             colours: false,
