@@ -190,17 +190,11 @@ impl Driver {
     /// Appends the frame for `now` to `out.bytes` (`picture` of the screen's picture size,
     /// `status` the scene's) and the files to write before it to `out.files`; returns the
     /// bytes appended (0: nothing changed).
-    pub fn transmit(
-        &mut self,
-        now: Instant,
-        picture: &Pixmap,
-        status: &SceneStatus,
-        out: &mut Transmit,
-    ) -> std::io::Result<usize> {
+    pub fn transmit(&mut self, now: Instant, picture: &Pixmap, status: &SceneStatus, out: &mut Transmit) -> usize {
         self.sent();
-        let len = self.player.frame(now, picture, status, &mut out.bytes)?;
+        let len = self.player.frame(now, picture, status, &mut out.bytes);
         self.player.screen.take_files(&mut out.files);
-        Ok(len)
+        len
     }
 
     /// A frame went out by another way (a group's bytes): nothing is owed.

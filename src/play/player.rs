@@ -3,7 +3,6 @@
 //! notices, the person's inputs to the seat, the seat's requests out, a frame with the seat's
 //! overlay) is [`super::driver::Driver`]'s, built on the steps here.
 
-use std::io;
 use std::time::Instant;
 
 use tiny_skia::Pixmap;
@@ -107,13 +106,7 @@ impl Player {
 
     /// Appends the frame for now: `picture` (of the screen's picture size) with the seat's
     /// overlay and `status`'s status line. Returns the bytes appended.
-    pub fn frame(
-        &mut self,
-        now: Instant,
-        picture: &Pixmap,
-        status: &SceneStatus,
-        out: &mut Vec<u8>,
-    ) -> io::Result<usize> {
+    pub fn frame(&mut self, now: Instant, picture: &Pixmap, status: &SceneStatus, out: &mut Vec<u8>) -> usize {
         let view = self.seat.view(now, status);
         self.screen.frame(now, picture, status, &view, out)
     }

@@ -203,7 +203,7 @@ impl Session {
         if self.driver.player().screen.drawable() {
             host.render(picture);
         }
-        let len = self.driver.transmit(now, picture, host.status(), out).map_err(Error::Output)?;
+        let len = self.driver.transmit(now, picture, host.status(), out);
         Ok(len > 0)
     }
 

@@ -75,7 +75,7 @@ fn play_with(frames: u32, keys: &[(u32, &[u8])], stones: bool) -> (Vec<Member>, 
         host.advance(now);
         host.render(&mut picture);
         let status = host.status().clone();
-        group.frame(now, &picture, &status).unwrap();
+        group.frame(now, &picture, &status);
         encoded.push(group.number);
         let feed = group.feed();
         for (i, m) in members.iter_mut().enumerate() {
@@ -87,8 +87,7 @@ fn play_with(frames: u32, keys: &[(u32, &[u8])], stones: bool) -> (Vec<Member>, 
             m.player.turn(now, &status, &mut requests);
             assert_eq!(m.membership.key(&m.player.screen), Some(key));
             let mut out = Vec::new();
-            let (len, source) =
-                m.membership.frame(&mut m.player, now, &picture, &status, Some(&feed), &mut out).unwrap();
+            let (len, source) = m.membership.frame(&mut m.player, now, &picture, &status, Some(&feed), &mut out);
             assert_eq!(len, out.len());
             m.vt.feed(&out);
             m.frames.push((out, source));

@@ -1,7 +1,6 @@
 //! A frame's bytes: the cells (composed here, or a group's), the picture in real pixels, the
 //! link's question, within the byte bucket and the link's window of unanswered bytes.
 
-use std::io;
 use std::time::{Duration, Instant};
 
 use tiny_skia::Pixmap;
@@ -31,8 +30,7 @@ struct Plan {
 impl Screen {
     /// Appends the frame for now to `out`: `picture` (of [`Screen::picture_size`]), the seat's
     /// overlay, the status line. Returns the bytes appended (0 when nothing changed). Nothing
-    /// in it fails today (a kitty temporary file that cannot be written falls back to direct
-    /// transmission); the `Result` is the doors' contract.
+    /// in it can fail: it writes to memory (kitty's temporary files are data the door writes).
     pub(crate) fn frame(
         &mut self,
         now: Instant,
@@ -40,7 +38,7 @@ impl Screen {
         status: &SceneStatus,
         seat: &SeatView<'_>,
         out: &mut Vec<u8>,
-    ) -> io::Result<usize> {
+    ) -> usize {
         self.frame_from(now, picture, status, seat, Cells::Own { figures: None }, out)
     }
 
@@ -54,7 +52,7 @@ impl Screen {
         seat: &SeatView<'_>,
         cells: Cells<'_>,
         out: &mut Vec<u8>,
-    ) -> io::Result<usize> {
+    ) -> usize {
         let start = out.len();
         if !self.entered {
             out.extend_from_slice(Self::ENTER);
@@ -93,7 +91,7 @@ impl Screen {
         self.bytes_sent += len as u64;
         self.meter.frame(now, len);
         self.pacer.sent(now);
-        Ok(len)
+        len
     }
 
     /// What the frame at `now` may spend (the bucket refilled already).

@@ -38,7 +38,7 @@ fn frame(screen: &mut Screen, now: Instant, shade: u8) -> Vec<u8> {
     let mut picture = Pixmap::new(w, h).unwrap();
     picture.fill(tiny_skia::Color::from_rgba8(shade, 90, 160, 255));
     let mut out = Vec::new();
-    screen.frame(now, &picture, &status(), &SeatView { stone: 3, ..SeatView::default() }, &mut out).unwrap();
+    screen.frame(now, &picture, &status(), &SeatView { stone: 3, ..SeatView::default() }, &mut out);
     out
 }
 

@@ -241,10 +241,7 @@ impl Viewer {
         self.out.clear();
         let feed = self.viewing.group.and_then(|key| shared.groups.get(&key));
         let player = self.driver.player_mut();
-        let Ok((len, source)) = self.membership.frame(player, now, &picture, &shared.status, feed, &mut self.out)
-        else {
-            return false;
-        };
+        let (len, source) = self.membership.frame(player, now, &picture, &shared.status, feed, &mut self.out);
         if len == 0 {
             return false;
         }

@@ -95,7 +95,7 @@ fn frame(screen: &mut Screen, water: &Water, n: usize, now: Instant) -> Vec<u8> 
     let mut out = Vec::new();
     let picture = &water.frames[n % water.frames.len()];
     assert_eq!((picture.width(), picture.height()), screen.picture_size());
-    screen.frame(now, picture, &status(), &SeatView { stone: 3, ..SeatView::default() }, &mut out).unwrap();
+    screen.frame(now, picture, &status(), &SeatView { stone: 3, ..SeatView::default() }, &mut out);
     out
 }
 
