@@ -7,9 +7,9 @@
 //! - [`Seat`]: one person: aim, stone size, drag, help, messages, and the [`Fit`] between their
 //!   terminal and the scene. [`Seat::handle`] turns an [`Input`] into requests.
 //! - [`Screen`]: one terminal: the graphics probe, the link control and byte budget, the
-//!   rate-controlled cell encoder and the picture encoders. [`Screen::feed`] takes the
-//!   terminal's bytes (replies stay in the screen, inputs come out); `Screen::frame` appends a
-//!   frame's bytes.
+//!   rate-controlled cell encoder and the picture encoders. It takes the terminal's bytes
+//!   (replies stay in the screen, inputs come out) and appends a frame's bytes; its methods
+//!   are the crate's, the doors reach it through a [`Driver`].
 //!
 //! - [`Groups`]: screens alike enough to share frames, encoded once per group; a player's [`Membership`]
 //!   takes the group's bytes while its terminal shows the group's model.
@@ -24,7 +24,7 @@
 //!
 //! Two doors drive them: [`crate::tty::run`] (and [`crate::tty::play`], for this process's own
 //! terminal) runs a [`Session`] on one terminal; `tidepool serve` runs one host on a thread and
-//! a [`Driver`] per SSH channel. A key's route is straight: bytes -> [`Screen::feed`] ->
+//! a [`Driver`] per SSH channel. A key's route is straight: bytes -> [`Driver::handle_bytes`] ->
 //! [`Input`] -> [`Seat::handle`] -> [`Request`] -> [`Host::apply`] -> the scene.
 //!
 //! ```

@@ -166,7 +166,7 @@ impl Screen {
     /// (buttons and drags only, mode 1002, not every motion; SGR coordinates, mode 1006),
     /// screen cleared.
     pub const ENTER: &'static [u8] = b"\x1b[?1049h\x1b[?25l\x1b[?1000h\x1b[?1002h\x1b[?1006h\x1b[0m\x1b[2J";
-    /// Sent when the session ends (after [`Screen::restore_prefix`]): abort any cut sequence,
+    /// Sent when the session ends (after the restore prefix, see [`Screen::farewell`]): abort any cut sequence,
     /// end synchronized output, reset colours, mouse off, cursor on, back to the normal screen.
     pub const RESTORE: &'static [u8] = b"\x18\x1b[?2026l\x1b[0m\x1b[?1006l\x1b[?1002l\x1b[?1000l\x1b[?25h\x1b[?1049l";
 
@@ -213,7 +213,7 @@ impl Screen {
     /// Starts the session: appends the probe's questions to `out` when the terminal is to be
     /// asked (nothing otherwise). No frame is drawn until the answers are in or
     /// `PROBE_BUDGET` (500 ms) has passed.
-    pub fn start(&mut self, now: Instant, out: &mut Vec<u8>) {
+    pub(crate) fn start(&mut self, now: Instant, out: &mut Vec<u8>) {
         let Some(mut options) = self.config.probe.clone().filter(|_| matches!(self.asking, Asking::No)) else {
             self.settle_colours(false);
             return;
@@ -232,14 +232,14 @@ impl Screen {
     }
 
     /// Whether the probe's first answers are still awaited (no frame is drawn meanwhile).
-    pub fn probing(&self) -> bool {
+    pub(crate) fn probing(&self) -> bool {
         matches!(self.asking, Asking::First { .. })
     }
 
     /// Takes bytes the terminal sent at `now`: replies are used here, the person's inputs are
     /// appended to `inputs` (keys typed during the probe come once it is over; a run of drags
     /// is merged into its last position).
-    pub fn feed(&mut self, bytes: &[u8], now: Instant, inputs: &mut Vec<Input>) {
+    pub(crate) fn feed(&mut self, bytes: &[u8], now: Instant, inputs: &mut Vec<Input>) {
         if let Asking::First { probe, .. } = &mut self.asking {
             probe.count_bytes(bytes.len());
         }
@@ -249,7 +249,7 @@ impl Screen {
 
     /// Looks at the clock: a lone Escape that waited long enough, the probe's deadline, the
     /// link's lost questions.
-    pub fn tick(&mut self, now: Instant, inputs: &mut Vec<Input>) {
+    pub(crate) fn tick(&mut self, now: Instant, inputs: &mut Vec<Input>) {
         self.parser.flush_stale(now, &mut self.received);
         self.route(now, inputs);
         match &self.asking {
@@ -276,7 +276,7 @@ impl Screen {
 
     /// When [`Screen::tick`] must next look at the clock (a lone Escape's wait, the probe's
     /// deadline), if at all.
-    pub fn next_tick(&self) -> Option<Instant> {
+    pub(crate) fn next_tick(&self) -> Option<Instant> {
         let asking = match &self.asking {
             Asking::First { deadline, .. } => Some(*deadline),
             Asking::Late { until, .. } => Some(*until),
@@ -289,12 +289,12 @@ impl Screen {
     }
 
     /// When the next frame is due (frames are drawn at most `fps` a second).
-    pub fn next_frame(&self) -> Instant {
+    pub(crate) fn next_frame(&self) -> Instant {
         self.pacer.next_due()
     }
 
     /// The terminal is now `term` cells: the next frame repaints everything.
-    pub fn resize(&mut self, term: (u16, u16)) {
+    pub(crate) fn resize(&mut self, term: (u16, u16)) {
         if term == self.term {
             return;
         }
@@ -307,24 +307,24 @@ impl Screen {
     }
 
     /// The terminal's size in cells.
-    pub fn term(&self) -> (u16, u16) {
+    pub(crate) fn term(&self) -> (u16, u16) {
         self.term
     }
 
     /// Whether the terminal is big enough for the picture and the status line (a smaller one
     /// shows a notice, and the scene need not be drawn).
-    pub fn drawable(&self) -> bool {
+    pub(crate) fn drawable(&self) -> bool {
         big_enough(self.term)
     }
 
     /// Whether the picture's size or place changed (a resize, the probe's answer) since this
     /// was last asked: the door then makes a new fit (and the local player resizes its scene).
-    pub fn take_layout_change(&mut self) -> bool {
+    pub(crate) fn take_layout_change(&mut self) -> bool {
         std::mem::take(&mut self.layout_changed)
     }
 
     /// Something to tell the person (which protocol draws, how to get pictures), once.
-    pub fn take_notice(&mut self) -> Option<String> {
+    pub(crate) fn take_notice(&mut self) -> Option<String> {
         let colours = std::mem::take(&mut self.colour_hint).then(|| colour_hint(self.config.color));
         match (self.notice.take(), colours) {
             (Some(notice), Some(colours)) => Some(format!("{notice}; {colours}")),
@@ -343,7 +343,7 @@ impl Screen {
     }
 
     /// How a scene of `scene` pixels sits in this terminal's picture.
-    pub fn fit(&self, scene: (u32, u32)) -> Fit {
+    pub(crate) fn fit(&self, scene: (u32, u32)) -> Fit {
         let grid = match &self.picture {
             _ if !big_enough(self.term) => CellGrid::HalfBlocks { cols: 0, rows: 0 },
             Some(p) => CellGrid::Pixels { layout: *p.layout(), mouse_pixels: self.mouse_pixels },
@@ -354,18 +354,18 @@ impl Screen {
 
     /// Whether a frame should be drawn now: the probe is not holding the screen, and the frame
     /// is due or `urgent` (a key's frame goes out at once).
-    pub fn ready(&self, now: Instant, urgent: bool) -> bool {
+    pub(crate) fn ready(&self, now: Instant, urgent: bool) -> bool {
         !self.probing() && (urgent || self.pacer.ready(now))
     }
 
     /// A due frame was not drawn (the door's writer was still busy): the cadence moves on.
-    pub fn skip(&mut self, now: Instant) {
+    pub(crate) fn skip(&mut self, now: Instant) {
         self.pacer.sent(now);
     }
 
     /// Moves the temporary files the frames handed out so far name (kitty's file medium) to
     /// `out`: the door writes them before it sends those frames' bytes.
-    pub fn take_files(&mut self, out: &mut Vec<FileWrite>) {
+    pub(crate) fn take_files(&mut self, out: &mut Vec<FileWrite>) {
         if let Some(p) = &mut self.picture {
             p.take_files(out);
         }
@@ -373,7 +373,7 @@ impl Screen {
 
     /// The door could not write a temporary file: pixels go directly from now on (the next
     /// picture whole).
-    pub fn handle_file_error(&mut self) {
+    pub(crate) fn handle_file_error(&mut self) {
         self.config.probe.iter_mut().for_each(|p| p.kitty_file = None);
         if let Some(p) = &mut self.picture {
             p.files_failed();
@@ -425,35 +425,30 @@ impl Screen {
 
     /// Whether link questions are still unanswered (a door that is closing waits a little for
     /// their answers, so they do not reach the shell as typed text).
-    pub fn awaiting_answers(&self) -> bool {
+    pub(crate) fn awaiting_answers(&self) -> bool {
         self.link.awaiting() > 0 || matches!(self.asking, Asking::Late { .. })
-    }
-
-    /// What sits between the program and the terminal, as the door said.
-    pub fn link_path(&self) -> LinkPath {
-        self.config.link_path
     }
 
     /// What must be undone before [`Screen::RESTORE`] when the session ends: kitty's image
     /// deleted, pixel mouse reports off. A door writes it on every way out (a signal too).
-    pub fn restore_prefix(&self) -> Vec<u8> {
+    pub(crate) fn restore_prefix(&self) -> Vec<u8> {
         picture::restore_bytes(&self.choice, self.mouse_pixels)
     }
 
-    /// The bytes that hand the terminal back: [`Screen::restore_prefix`], then
-    /// [`Screen::RESTORE`].
+    /// The bytes that hand the terminal back: what the picture needs undone (kitty's image
+    /// deleted, pixel mouse reports off), then [`Screen::RESTORE`].
     pub fn farewell(&self, out: &mut Vec<u8>) {
         out.extend_from_slice(&self.restore_prefix());
         out.extend_from_slice(Self::RESTORE);
     }
 
     /// Frames and bytes a second over the last whole second.
-    pub fn figures(&self) -> (u32, u64) {
+    pub(crate) fn figures(&self) -> (u32, u64) {
         (self.meter.fps, self.meter.bytes_per_second)
     }
 
     /// The protocol drawing the picture.
-    pub fn mode(&self) -> GraphicsMode {
+    pub(crate) fn mode(&self) -> GraphicsMode {
         self.choice.mode
     }
 }
