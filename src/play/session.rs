@@ -53,6 +53,8 @@ pub struct Session {
     events: VecDeque<SessionEvent>,
     /// The status line while there is no host yet.
     waiting: SceneStatus,
+    /// When the session started.
+    started: Instant,
 }
 
 impl Session {
@@ -80,6 +82,7 @@ impl Session {
             questions,
             events: VecDeque::new(),
             waiting: SceneStatus::default(),
+            started: now,
         }
     }
 
@@ -172,6 +175,10 @@ impl Session {
     /// (a lone Escape, the probe, the link), the next frame, a key's frame waiting for the
     /// writer, the host's next step.
     pub fn poll_timeout(&self) -> Option<Instant> {
+        if !self.questions.is_empty() {
+            // The probe's questions go at once.
+            return Some(self.started);
+        }
         let screen = self.driver.poll_timeout();
         let host = self.host.as_ref().and_then(Host::next_due);
         match (screen, host) {
