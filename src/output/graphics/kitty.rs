@@ -352,7 +352,9 @@ pub fn changed_rect(old: &[u8], new: &[u8], width: u32, height: u32) -> Option<(
 }
 
 mod files;
-pub use files::{temp_dir, write_new_file, write_temp_file};
+#[cfg(feature = "player")]
+pub use files::write_new_file;
+pub use files::{temp_dir, write_temp_file};
 
 #[cfg(test)]
 mod tests;
