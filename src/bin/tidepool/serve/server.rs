@@ -133,14 +133,14 @@ impl GameOptions {
     /// The host of the first scene (so a bad scene setting fails before the server starts).
     /// Nothing is recorded and no file is saved on a player's behalf.
     pub fn host(&self) -> tidepool::Result<Host> {
-        let config = HostConfig { scenes: self.scenes.clone(), seed: self.seed, record: None, storage: None };
+        let config = HostConfig { scenes: self.scenes.clone(), seed: self.seed, record: None, screenshots: false };
         Host::new(config, self.size, Instant::now())
     }
 }
 
 /// Binds and starts serving. Errors only for the bind (e.g. port in use) and the first scene.
 pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
-    let mut host = opts.game.host().map_err(StartError::Scene)?;
+    let host = opts.game.host().map_err(StartError::Scene)?;
     let listener = TcpListener::bind(opts.listen).await.map_err(StartError::Bind)?;
     let local_addr = listener.local_addr().map_err(StartError::Bind)?;
     let config = Arc::new(russh_config(opts.host_key, opts.allow.is_some(), &opts.limits, opts.compression));
