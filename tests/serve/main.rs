@@ -2,6 +2,9 @@
 //! real OpenSSH client where it is installed).
 
 mod bad_input;
+/// One pool across machines over NATS (needs nats-server: scripts/bus_tests.sh).
+#[cfg(feature = "bus")]
+mod bus;
 mod common;
 /// Fake graphics terminals (shared with the integration tests).
 #[allow(dead_code)]

@@ -65,13 +65,15 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     let stats = hub.stats.clone();
     let now = Instant::now();
     let screen = Screen::new(screen, terminal.borrow().size, now);
-    let mut player =
-        Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into())).without_screenshots();
+    let mut player = Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into()));
+    if !hub.screenshots {
+        player = player.without_screenshots();
+    }
     let mut membership = Membership::new();
     let mut viewing = Viewing { fit: *player.seat.fit(), group: None };
     hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
     let mut frames = hub.frames.clone();
-    let mut gate = RequestGate::new(&hub.limits);
+    let mut gate = RequestGate::new(&hub.limits, id);
     let mut resizes = hub.limits.resizes_bucket();
     // A new terminal size waiting for the resize rate.
     let mut resize: Option<(u16, u16)> = None;
