@@ -26,8 +26,44 @@ use super::sequencer::{Sequencer, SequencerLimits, TICK_PERIOD};
 pub const SNAPSHOT_PERIOD: Duration = Duration::from_secs(5);
 /// The lease's key.
 const LEASE_KEY: &str = "sequencer";
+/// Log entries read back for the last good tick.
+const LOOK_BACK: u64 = 64;
 /// Refusals printed a second at most (a flood is counted, not printed).
 const REFUSALS_PRINTED_PER_SECOND: u32 = 5;
+
+/// The refusals' log: the first few of each second in full, the rest counted and summed up
+/// with the last reason (a flood must not flood the log).
+#[derive(Default)]
+struct Refusals {
+    second: Option<Instant>,
+    printed: u32,
+    unprinted: u64,
+    last: String,
+}
+
+impl Refusals {
+    fn note(&mut self, why: String, total: u64, now: Instant) {
+        if self.second.is_none_or(|s| now.duration_since(s) >= Duration::from_secs(1)) {
+            self.summarize(now);
+            (self.second, self.printed) = (Some(now), 0);
+        }
+        if self.printed < REFUSALS_PRINTED_PER_SECOND {
+            self.printed += 1;
+            eprintln!("bus: refused a request ({total} refused so far): {why}");
+        } else {
+            self.unprinted += 1;
+            self.last = why;
+        }
+    }
+
+    fn summarize(&mut self, now: Instant) {
+        let due = self.second.is_some_and(|s| now.duration_since(s) >= Duration::from_secs(1));
+        if due && self.unprinted > 0 {
+            eprintln!("bus: refused {} more requests in a second; the last: {}", self.unprinted, self.last);
+            self.unprinted = 0;
+        }
+    }
+}
 
 /// An edge's part in the sequencer's role.
 pub struct Leader {
@@ -94,13 +130,28 @@ impl Leader {
         }
     }
 
-    /// The last tick in the log and its sequence (none in a new pool).
+    /// The log's last sequence, and its last good tick (none in a new pool): the last entries
+    /// may be another writer's garbage, so up to [`LOOK_BACK`] entries are read back.
     async fn last_tick(&self) -> Result<(u64, Option<Tick>), String> {
-        match self.pool.stream.get_last_raw_message_by_subject(&self.pool.names.log).await {
-            Ok(message) => Ok((message.sequence, protocol::read_tick(&message.payload, self.size).ok())),
-            Err(e) if e.to_string().contains("no message") || e.to_string().contains("not found") => Ok((0, None)),
-            Err(e) => Err(e.to_string()),
+        let last = match self.pool.stream.get_last_raw_message_by_subject(&self.pool.names.log).await {
+            Ok(message) => message,
+            Err(e) if e.to_string().contains("no message") || e.to_string().contains("not found") => {
+                return Ok((0, None));
+            }
+            Err(e) => return Err(e.to_string()),
+        };
+        let end = last.sequence;
+        if let Ok(tick) = protocol::read_tick(&last.payload, self.size) {
+            return Ok((end, Some(tick)));
         }
+        for seq in (end.saturating_sub(LOOK_BACK)..end).rev().filter(|&s| s > 0) {
+            if let Ok(message) = self.pool.stream.get_raw_message(seq).await {
+                if let Ok(tick) = protocol::read_tick(&message.payload, self.size) {
+                    return Ok((end, Some(tick)));
+                }
+            }
+        }
+        Ok((end, None))
     }
 
     /// Sequences while the lease holds.
@@ -126,24 +177,19 @@ impl Leader {
         let mut ticks = tokio::time::interval(TICK_PERIOD);
         let mut refresh = tokio::time::interval(lease::REFRESH);
         let mut snapshot = tokio::time::interval(SNAPSHOT_PERIOD);
-        let (mut printed, mut second) = (0u32, Instant::now());
+        let mut refusals = Refusals::default();
         loop {
             tokio::select! {
                 _ = stop.cancelled() => return Ended::Stopped,
                 Some(m) = submits.next() => {
                     let now = Instant::now();
                     if let Err(why) = seq.submit(&m.payload, now) {
-                        if now.duration_since(second) >= Duration::from_secs(1) {
-                            (printed, second) = (0, now);
-                        }
-                        printed += 1;
-                        if printed <= REFUSALS_PRINTED_PER_SECOND {
-                            eprintln!("bus: refused a request ({} refused so far): {why}", seq.counts().refused);
-                        }
+                        refusals.note(why.0, seq.counts().refused, now);
                     }
                 }
                 Some(m) = presence.next() => { let _ = seq.presence(&m.payload, Instant::now()); }
                 _ = ticks.tick() => {
+                    refusals.summarize(Instant::now());
                     let tick = seq.tick(Instant::now());
                     match self.publish(&tick, last_seq).await {
                         Ok(s) => last_seq = s,

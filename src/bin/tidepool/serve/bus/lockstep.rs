@@ -109,9 +109,11 @@ impl Lockstep {
         if self.pending.len() + tick.events.len() > MAX_PENDING {
             return Err(Missed::Bad(Refusal("more events waiting than an edge keeps".into())));
         }
-        // A tick's step is never behind the last one's; if one were, its events apply at once.
-        let stamp = tick.step.max(self.step);
-        self.frontier = self.frontier.max(tick.step);
+        // A tick's step is never behind the last one's; if one were (a sequencer that could
+        // not read the log's end), its events apply at the frontier: a step every edge agrees
+        // on, as it follows from the log alone.
+        let stamp = tick.step.max(self.frontier);
+        self.frontier = stamp;
         self.paused = tick.paused;
         self.players = tick.players;
         self.pending.extend(tick.events.into_iter().map(|e| (stamp, e)));
