@@ -207,10 +207,8 @@ fn bus_options(args: &ServeCommand, limits: &Limits) -> Result<Option<bus::BusOp
         }
         None => default_edge_name(),
     };
-    if let Some(dir) = &flags.bus_shots {
-        if !dir.is_dir() {
-            return Err(Error::arg("--bus-shots", format!("{} is not a folder; make it first", dir.display())));
-        }
+    if let Some(dir) = flags.bus_shots.as_ref().filter(|d| !d.is_dir()) {
+        return Err(Error::arg("--bus-shots", format!("{} is not a folder; make it first", dir.display())));
     }
     Ok(Some(bus::BusOptions {
         url: url.clone(),

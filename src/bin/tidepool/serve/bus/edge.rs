@@ -150,7 +150,7 @@ fn take_incoming(pool: &mut Lockstep, bus: &mut EdgeLinks, now: Instant) {
             Incoming::Entry { seq, bytes } => match pool.receive(seq, &bytes, now) {
                 Ok(()) => {
                     if bus.trace {
-                        trace_applied(&bytes, &bus.edge);
+                        trace_applied(&bytes, &bus.edge, pool.step());
                     }
                 }
                 Err(Missed::Gap { expected, got }) => {
@@ -183,10 +183,10 @@ fn take_incoming(pool: &mut Lockstep, bus: &mut EdgeLinks, now: Instant) {
 
 /// The trace's line for every event of another edge in a tick just taken (the ring shows at
 /// its step, within a frame and the lead of this moment).
-fn trace_applied(bytes: &[u8], me: &str) {
+fn trace_applied(bytes: &[u8], me: &str, step: u64) {
     if let Ok(tick) = serde_json::from_slice::<protocol::Tick>(bytes) {
         for e in tick.events.iter().filter(|e| e.edge != me) {
-            eprintln!("bus-trace taken {} {} step {} {}", e.edge, e.n, tick.step, unix_us());
+            eprintln!("bus-trace taken {} {} at {step} for {} {} {}", e.edge, e.n, tick.step, unix_us(), bytes.len());
         }
     }
 }

@@ -145,10 +145,10 @@ impl Leader {
             return Ok((end, Some(tick)));
         }
         for seq in (end.saturating_sub(LOOK_BACK)..end).rev().filter(|&s| s > 0) {
-            if let Ok(message) = self.pool.stream.get_raw_message(seq).await {
-                if let Ok(tick) = protocol::read_tick(&message.payload, self.size) {
-                    return Ok((end, Some(tick)));
-                }
+            if let Ok(message) = self.pool.stream.get_raw_message(seq).await
+                && let Ok(tick) = protocol::read_tick(&message.payload, self.size)
+            {
+                return Ok((end, Some(tick)));
             }
         }
         Ok((end, None))
@@ -199,10 +199,11 @@ impl Leader {
                         }
                         // The bus is away: this tick's events are lost (never acknowledged);
                         // the next tick carries on, after the log's end as it then stands.
-                        Err(None) => match self.last_tick().await {
-                            Ok((s, _)) => last_seq = s,
-                            Err(_) => {}
-                        },
+                        Err(None) => {
+                            if let Ok((s, _)) = self.last_tick().await {
+                                last_seq = s;
+                            }
+                        }
                     }
                 }
                 _ = refresh.tick() => {
