@@ -22,7 +22,18 @@ use crate::common::*;
 const PORTS: std::ops::Range<u16> = 42000..42999;
 static NEXT_PORT: AtomicU16 = AtomicU16::new(0);
 /// Water that moves by itself (rain, gusts): a step's picture depends on every step before.
-const WATER: &[&str] = &["--rain", "0.05", "--handshake-timeout-ms", "5000", "--size", "120x60"];
+const WATER: &[&str] = &[
+    "--rain",
+    "0.05",
+    "--handshake-timeout-ms",
+    "5000",
+    "--size",
+    "120x60",
+    "--max-per-address",
+    "1000",
+    "--max-clients",
+    "1000",
+];
 
 /// A free loopback port in [`PORTS`], never the same twice in this process.
 fn free_port() -> u16 {
