@@ -5,7 +5,7 @@
 #   scripts/bus_tests.sh --install  install if needed, run nothing (.ci/run does this before
 #                                   `cargo test --all-features`, which runs them)
 #   scripts/bus_tests.sh load       the bus's figures (BUS_EDGES, BUS_PLAYERS per edge,
-#                                   BUS_SECONDS, BUS_STONE_MS: see tests/serve/bus.rs)
+#                                   BUS_SECONDS, BUS_STONE_MS: see tests/serve/bus_load.rs)
 # Without nats-server the tests fail, saying so; they never pass without it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -21,6 +21,6 @@ if [ "${1:-}" = --install ]; then
 fi
 if [ "${1:-}" = load ]; then
     ulimit -n 20000
-    TIDEPOOL_BUS_TRACE=1 exec cargo test --release --features bus --test serve bus_load -- --ignored --nocapture
+    TIDEPOOL_BUS_TRACE=1 exec cargo test --release --features bus --test serve bus_load:: -- --ignored --nocapture
 fi
 exec cargo test --features bus --test serve bus:: "$@"
