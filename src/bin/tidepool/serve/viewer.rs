@@ -66,8 +66,10 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     let ViewerCtx { hub, id, peer, write, mut terminal, mut input, screen, kill, slot } = ctx;
     let now = Instant::now();
     let screen = Screen::new(screen, terminal.borrow().size, now);
-    let player =
-        Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into())).without_screenshots();
+    let mut player = Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into()));
+    if !hub.screenshots {
+        player = player.without_screenshots();
+    }
     let viewing = Viewing { fit: *player.seat.fit(), group: None };
     hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
     let mut frames = hub.frames.clone();
@@ -75,7 +77,7 @@ pub(crate) async fn run(ctx: ViewerCtx) {
         driver: Driver::new(player, Pacing::Pictures),
         membership: Membership::new(),
         viewing,
-        gate: RequestGate::new(&hub.limits),
+        gate: RequestGate::new(&hub.limits, id),
         resizes: hub.limits.resizes_bucket(),
         resize: None,
         deferred: false,
