@@ -23,8 +23,8 @@
 //! budgeted strategies take what a [`ByteBucket`] at the rate allows on a simulated 30 fps clock;
 //! a whole frame goes when the link has carried the previous one and shows when it has arrived
 //! (`bytes / rate` later). Every emitted byte goes through the terminal model
-//! ([`tidepool::terminal::TerminalModel`], exactly 160x48) and the screen is compared with the true
-//! frame at each display instant: SSIM of luma ([`tidepool::terminal::ssim`], Gaussian window of
+//! ([`tidepool::testing::TerminalModel`], exactly 160x48) and the screen is compared with the true
+//! frame at each display instant: SSIM of luma ([`tidepool::testing::ssim`], Gaussian window of
 //! 1.5) and PSNR (8-bit sRGB, both halves of every picture cell, an exact frame counted as
 //! 99 dB), the status row left out.
 //!
@@ -48,9 +48,10 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
-use tidepool::terminal::{
-    self as quality, ByteBucket, Color, ColorMode, EncodeOptions, Frame, Luma, RateEncoder, RateOptions, Shown,
-    SsimReference, Strategy, Target, TerminalModel, UNLIMITED,
+use tidepool::serve::ByteBucket;
+use tidepool::terminal::{Color, ColorMode, EncodeOptions, Frame, Shown};
+use tidepool::testing::{
+    self as quality, Luma, RateEncoder, RateOptions, SsimReference, Strategy, Target, TerminalModel, UNLIMITED,
 };
 use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneSpec, Script};
 use tiny_skia::Pixmap;

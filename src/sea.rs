@@ -25,7 +25,7 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub use crate::render::plot::{sea_spectrum_plot, spectrum_plot};
+pub use crate::render::plot::sea_spectrum_plot;
 pub use crate::render::texture::SEA_TEXTURE_TILE_M;
 pub use crate::sim::looping::LoopPeriod;
 pub use crate::sim::ocean::{DEFAULT_CHOPPINESS, check_choppiness};

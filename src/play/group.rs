@@ -100,7 +100,7 @@ pub struct GroupKey {
     /// Frames a second at most.
     pub fps: u32,
     /// The link's class.
-    pub class: LinkClass,
+    pub(crate) class: LinkClass,
 }
 
 impl GroupKey {
@@ -131,11 +131,6 @@ pub struct GroupFeed {
 }
 
 impl GroupFeed {
-    /// The group's frames, oldest first.
-    pub fn frames(&self) -> &[Arc<GroupFrame>] {
-        &self.frames
-    }
-
     /// The frames after frame `number`, if the feed still holds all of them.
     fn after(&self, number: u64) -> Option<&[Arc<GroupFrame>]> {
         let first = self.frames.first()?.number;

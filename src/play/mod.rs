@@ -11,8 +11,9 @@
 //!   (replies stay in the screen, inputs come out) and appends a frame's bytes; its methods
 //!   are the crate's, the doors reach it through a [`Driver`].
 //!
-//! - [`Groups`]: screens alike enough to share frames, encoded once per group; a player's [`Membership`]
-//!   takes the group's bytes while its terminal shows the group's model.
+//! - [`crate::serve::Groups`]: screens alike enough to share frames, encoded once per group
+//!   (`tidepool serve`); a player's [`crate::serve::Membership`] takes the group's bytes while
+//!   its terminal shows the group's model.
 //!
 //! The surface the doors drive, in quinn-proto's shape (`handle_*` for inputs, `poll_*` for
 //! outputs, time passed in): a [`Driver`] is the one turn of one person at one terminal
@@ -74,12 +75,13 @@ pub(crate) mod session;
 pub use crate::output::graphics::stream::FileWrite;
 pub use driver::{Driver, DriverEvent, Pacing, Transmit};
 pub use fit::Fit;
-pub use group::{GroupFeed, GroupKey, Groups, Membership, Source};
 pub use host::{Effect, Host, HostConfig, Recording, SceneStatus};
 pub use input::Input;
 pub use player::Player;
 pub use request::Request;
-pub use screen::probe::{EnvHints, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
+pub use screen::probe::{
+    EnvHints, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, SixelSupport, WinSize,
+};
 pub use screen::{Bandwidth, LinkPath, Screen, ScreenConfig};
 pub use seat::{Flow, Seat};
 pub use session::{Session, SessionEvent};

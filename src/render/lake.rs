@@ -185,11 +185,13 @@ impl LakeRenderer {
         self.height
     }
 
+    #[cfg(test)]
     /// Supersampling factor per axis.
     pub fn ssaa(&self) -> u32 {
         self.ssaa
     }
 
+    #[cfg(test)]
     /// The camera at the rendering (supersampled) size.
     pub fn camera(&self) -> &Camera {
         &self.camera
@@ -200,6 +202,7 @@ impl LakeRenderer {
         self.mesh.triangle_count()
     }
 
+    #[cfg(test)]
     /// The first row of the output picture that shows water (the far shore's waterline).
     pub fn waterline_row(&self) -> u32 {
         (self.waterline_row as u32).div_ceil(self.ssaa)

@@ -225,15 +225,10 @@ impl OceanRenderer {
         &self.camera
     }
 
+    #[cfg(test)]
     /// The sky.
     pub fn sky(&self) -> &Sky {
         &self.sky
-    }
-
-    /// Moves the camera; the mesh is rebuilt at the next frame.
-    pub fn set_camera(&mut self, pose: CameraPose) {
-        self.view.camera = pose;
-        self.camera = Camera::new(pose, self.camera.width(), self.camera.height());
     }
 
     /// Triangles in the mesh (0 before the first frame).

@@ -56,14 +56,10 @@ impl LakeScene {
         Some(LakeScene { lake: Lake::new(settings.lake), renderer, ssaa: settings.ssaa, time_s: settings.start_time_s })
     }
 
+    #[cfg(test)]
     /// The lake.
-    pub fn lake(&self) -> &Lake {
+    pub(crate) fn lake(&self) -> &Lake {
         &self.lake
-    }
-
-    /// The renderer.
-    pub fn renderer(&self) -> &LakeRenderer {
-        &self.renderer
     }
 
     /// Output width, px.

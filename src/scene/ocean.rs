@@ -92,19 +92,10 @@ impl OceanScene {
         })
     }
 
+    #[cfg(test)]
     /// The sea.
-    pub fn sea(&self) -> &Sea {
+    pub(crate) fn sea(&self) -> &Sea {
         &self.sea
-    }
-
-    /// The renderer (camera, sky, triangle count).
-    pub fn renderer(&self) -> &OceanRenderer {
-        &self.renderer
-    }
-
-    /// The renderer, to move the camera.
-    pub fn renderer_mut(&mut self) -> &mut OceanRenderer {
-        &mut self.renderer
     }
 
     /// Output width, px.

@@ -289,11 +289,7 @@ impl Lake {
         self.hs_m
     }
 
-    /// Peak wavelength, m.
-    pub fn peak_wavelength_m(&self) -> f64 {
-        self.peak_wavelength_m
-    }
-
+    #[cfg(test)]
     /// The animated noise.
     pub fn water(&self) -> &WaterNoise {
         &self.water
@@ -357,6 +353,7 @@ impl LakeFrame {
         self.rms_m
     }
 
+    #[cfg(test)]
     /// The slope variance per axis of all octaves together.
     pub fn slope_variance(&self) -> f32 {
         self.slope_variance.iter().sum()

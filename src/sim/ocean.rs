@@ -267,6 +267,8 @@ struct Tail {
     velocity_m_s: [f64; 2],
     /// In a looping sea: whole tail periods crossed per loop, east and north.
     loop_periods: [i64; 2],
+    /// Its height variance (read by the tests).
+    #[cfg_attr(not(test), allow(dead_code))]
     variance: f64,
     /// Per octave: the slope variance per axis of the field cut off there.
     octave_slope: Vec<f32>,
@@ -347,16 +349,19 @@ impl Sea {
         self.lanes.amp.len()
     }
 
+    #[cfg(test)]
     /// The sines the foam's Jacobian sums (padded), of [`Sea::padded_len`].
     pub fn fold_len(&self) -> usize {
         self.fold.amp.len()
     }
 
+    #[cfg(test)]
     /// The variance carried by the fBm tail, m² (0 for a calm).
     pub fn tail_variance(&self) -> f64 {
         self.tail.as_ref().map_or(0.0, |t| t.variance)
     }
 
+    #[cfg(test)]
     /// The tail's field, if the sea is not calm.
     pub fn tail_field(&self) -> Option<&Fbm> {
         self.tail.as_ref().map(|t| &t.field)
@@ -383,6 +388,7 @@ impl Sea {
         sizing_wavelength_m(&self.params)
     }
 
+    #[cfg(test)]
     /// The moment `time_s` seconds from 0: ticks of the loop for a looping sea.
     pub fn time(&self, time_s: f64) -> SeaTime {
         match self.params.loop_period {
@@ -408,15 +414,10 @@ impl Sea {
         }
     }
 
+    #[cfg(test)]
     /// The sea at `time_s` seconds, ready to sample.
     pub fn frame(&self, time_s: f64) -> SeaFrame<'_> {
         self.frame_at(self.time(time_s), Vec::new())
-    }
-
-    /// [`Sea::frame`] reusing `buffer` (from [`SeaFrame::into_buffer`]), so that a stream of
-    /// frames allocates nothing.
-    pub fn frame_in(&self, time_s: f64, buffer: Vec<f32>) -> SeaFrame<'_> {
-        self.frame_at(self.time(time_s), buffer)
     }
 
     /// The phase of component `i` at `time`, radians in [0, 2π).
@@ -448,7 +449,7 @@ impl Sea {
             };
             [at(0), at(1)]
         });
-        SeaFrame { sea: self, phase, tail_offset, time, time_s: self.seconds(time) }
+        SeaFrame { sea: self, phase, tail_offset, time }
     }
 }
 

@@ -17,6 +17,7 @@ pub struct Footprint {
 }
 
 impl Footprint {
+    #[cfg(test)]
     /// A square footprint of `size_m` metres (axis-aligned); 0 is the full surface.
     pub fn isotropic(size_m: f32) -> Footprint {
         Footprint { across: [size_m, 0.0], along: [0.0, size_m] }

@@ -39,9 +39,15 @@ pub struct Layout {
     pub cell_px: (u16, u16),
 }
 
+impl Layout {
+    /// The largest picture rendered for terminals that scale (kitty, iTerm2), in pixels: the
+    /// usual `cap` of [`layout`].
+    pub const SCALED_CAP: (u32, u32) = SCALED_CAP;
+}
+
 /// The layout for a terminal of `term` cells (columns, rows) with cells of `cell_px` pixels
 /// (`None`: unknown, 8x16 is assumed), the largest sixel image `sixel_max`, and
-/// `cap` for scaling protocols ([`SCALED_CAP`]). Sizes are at least one pixel and one cell.
+/// `cap` for scaling protocols ([`Layout::SCALED_CAP`]). Sizes are at least one pixel and one cell.
 pub fn layout(
     mode: GraphicsMode,
     term: (u16, u16),

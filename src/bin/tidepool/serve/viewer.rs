@@ -18,8 +18,9 @@ use std::time::Instant;
 use bytes::Bytes;
 use russh::ChannelWriteHalf;
 use russh::server::Msg;
-use tidepool::play::{Driver, DriverEvent, Membership, Pacing, Player, Screen, ScreenConfig, Source};
-use tidepool::terminal::ByteBucket;
+use tidepool::play::{Driver, DriverEvent, Pacing, Player, Screen, ScreenConfig};
+use tidepool::serve::ByteBucket;
+use tidepool::serve::{Membership, Source};
 use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
