@@ -57,10 +57,10 @@ const MODES: [&str; 4] = ["kitty", "sixel", "iterm2", "cells"];
 
 /// The fixture at the pixel modes' scene size: one picture per frame.
 fn pictures() -> Vec<Pixmap> {
-    let replay = tidepool::replay::read(std::path::Path::new(FIXTURE)).expect("the committed fixture replay");
+    let replay = tidepool::replay::Replay::read(std::path::Path::new(FIXTURE)).expect("the committed fixture replay");
     let [w0, _] = replay.header.size;
     let scale = f64::from(SCENE.0) / f64::from(w0);
-    let mut scene = replay.spec(tidepool::pool_floor()).build(SCENE.0, SCENE.1).expect("a valid size");
+    let mut scene = replay.spec(tidepool::PoolSettings::default_floor()).build(SCENE.0, SCENE.1).expect("a valid size");
     let events: Vec<(u64, Event)> = replay
         .script()
         .into_iter()

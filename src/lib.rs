@@ -19,9 +19,11 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Features: `cli` (default: the `tidepool` binary), `player` (the play session and the
-//! interactive terminal player, [`tty`]), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
-//! that draws any scene, `widget`).
+//! Features: `cli` (default: the `tidepool` binary), `player` (the play session, [`play`], the
+//! interactive terminal player, [`tty`], and what `tidepool serve` shares between players,
+//! [`serve`]), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
+//! that draws any scene, `widget`), `testing` (the tools the tests and benchmarks check
+//! pictures with, `testing`; not part of the chosen API).
 #![warn(missing_docs)]
 #![warn(unnameable_types)]
 
@@ -89,7 +91,7 @@ pub mod testing {
 }
 
 pub use error::{Error, Result, ValueError};
-pub use render::background::{load as load_image, pool_floor};
+pub use render::background::load as load_image;
 pub use render::camera::CameraPose;
 pub use render::caustics::CausticsLook;
 pub use render::ocean::{OceanView, SeaShading};
@@ -98,7 +100,7 @@ pub use render::supersample::Downsample;
 pub use render::texture::SeaTexture;
 pub use scene::lake::{LakeScene, LakeSettings};
 pub use scene::ocean::{OceanScene, OceanSettings};
-pub use scene::pool::{PoolScene, PoolSettings, showcase as pool_showcase};
+pub use scene::pool::{PoolScene, PoolSettings};
 pub use scene::{Action, Controls, Event, Heightmap, Playable, Scene, SceneKind, SceneSpec, Script};
 pub use sim::breeze::BreezeStyle;
 pub use sim::lake::LakeParams;

@@ -163,6 +163,9 @@ pub struct LakeParams {
 }
 
 impl LakeParams {
+    /// The strongest wind the lake takes, m/s (a storm; beyond it a lake is all spray).
+    pub const MAX_WIND_M_S: f64 = crate::sim::wind::MAX_LAKE_WIND_M_S;
+
     /// The significant wave height (4 standard deviations of the surface) this wind raises, m.
     pub fn significant_height_m(&self) -> f64 {
         Lake::new(*self).significant_height_m()

@@ -132,18 +132,27 @@ pub fn cox_munk_slope_variance(wind_m_s: f64) -> f64 {
     CALM_SLOPE_VARIANCE + 0.00512 * wind_m_s.max(0.0)
 }
 
-/// Checks a choppiness: finite, 0..=4.
-pub fn check_choppiness(value: f64) -> Result<f64, ValueError> {
-    if !value.is_finite() || !(0.0..=MAX_CHOPPINESS).contains(&value) {
-        return Err(ValueError::new(
-            "choppiness",
-            format!(
-                "the choppiness {value} is not a number in 0..={MAX_CHOPPINESS}; 0 moves the water only up and \
-                 down, {DEFAULT_CHOPPINESS} is the physical displacement"
-            ),
-        ));
+impl SeaParams {
+    /// The choppiness a sea has unless told otherwise: the physical displacement.
+    pub const DEFAULT_CHOPPINESS: f64 = DEFAULT_CHOPPINESS;
+    /// The wind a sea has unless told otherwise, m/s.
+    pub const DEFAULT_WIND_M_S: f64 = crate::sim::wind::DEFAULT_SEA_WIND_M_S;
+    /// The direction the wind blows from unless told otherwise, degrees clockwise from north.
+    pub const DEFAULT_WIND_FROM_DEG: f64 = crate::sim::wind::DEFAULT_WIND_FROM_DEG;
+
+    /// Checks a choppiness: finite, 0..=4.
+    pub fn check_choppiness(value: f64) -> Result<f64, ValueError> {
+        if !value.is_finite() || !(0.0..=MAX_CHOPPINESS).contains(&value) {
+            return Err(ValueError::new(
+                "choppiness",
+                format!(
+                    "the choppiness {value} is not a number in 0..={MAX_CHOPPINESS}; 0 moves the water only up and \
+                     down, {DEFAULT_CHOPPINESS} is the physical displacement"
+                ),
+            ));
+        }
+        Ok(value)
     }
-    Ok(value)
 }
 
 /// The z with P(N(0,1) > z) = p, for p in (0, 1); +inf for p <= 0, -inf for p >= 1.

@@ -246,8 +246,12 @@ fn choppiness_sharpens_crests() {
     }
     assert!(choppy >= 0.1, "skewness at Beaufort 6 with λ = 1: {choppy}");
     assert!(choppy - linear > 0.08, "{choppy} vs linear {linear}");
-    assert!(check_choppiness(f64::NAN).is_err() && check_choppiness(-0.1).is_err() && check_choppiness(5.0).is_err());
-    assert_eq!(check_choppiness(1.5), Ok(1.5));
+    assert!(
+        SeaParams::check_choppiness(f64::NAN).is_err()
+            && SeaParams::check_choppiness(-0.1).is_err()
+            && SeaParams::check_choppiness(5.0).is_err()
+    );
+    assert_eq!(SeaParams::check_choppiness(1.5), Ok(1.5));
 }
 
 #[test]

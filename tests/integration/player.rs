@@ -201,7 +201,7 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     assert_restored(&p);
 
     let path = p.dir.join("session.jsonl");
-    let replay = tidepool::replay::read(&path).unwrap();
+    let replay = tidepool::replay::Replay::read(&path).unwrap();
     assert_eq!(replay.header.size, [40, 22]);
     let stones: Vec<Stone> =
         replay.entries.iter().filter_map(|e| if let Event::Stone(s) = e.event { Some(s) } else { None }).collect();
@@ -219,7 +219,7 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     assert!(replay.entries.iter().any(|e| e.event == Event::Resize([30, 18])));
 
     // The picture on screen before the resize is the replay at the screenshot.
-    let spec = replay.spec(tidepool::pool_floor());
+    let spec = replay.spec(tidepool::PoolSettings::default_floor());
     let mut scene = replay.simulate(&spec, Some(step), &mut |_| {}).unwrap();
     let expected = scene.snapshot().unwrap();
     let mut compared = 0;
