@@ -52,7 +52,7 @@
 //! `λ·|B|²/2`, B = Σ a·√k·e^(iθ), which the resting point's height gets added: one more pair
 //! of sums, exact for a single wave (where Gerstner's wave already is Stokes's to second
 //! order and the term only restores the mean level), and narrow-band seas. The skewness
-//! becomes Longuet-Higgins's ≈ 3·k·σ. [`SeaFrame::height`] returns the
+//! becomes Longuet-Higgins's ≈ 3·k·σ. [`SeaSurface::height`] returns the
 //! **Eulerian** height at a fixed point (what a heightmap holds): it finds the resting point
 //! x0 with x0 + λ·D(x0) = x by fixed-point iteration ([`EULER_ITERATIONS`]).
 //!
@@ -78,10 +78,10 @@ use super::trig::fast_sincos;
 
 mod build;
 mod fold;
-mod frame;
+mod surface;
 pub(crate) use fold::{FOLD_ROWS, PhaseRows};
-pub use frame::SeaFrame;
-use frame::resolution_weight;
+pub use surface::SeaSurface;
+use surface::resolution_weight;
 
 /// Lowest frequency of the sines, as a multiple of fp.
 pub const BAND_LOW: f64 = 0.5;
@@ -300,7 +300,7 @@ struct Lanes {
     dxy: Vec<f32>,
 }
 
-/// A sea: its spectrum, its sines and its tail. Immutable; sample it through [`Sea::frame`].
+/// A sea: its spectrum, its sines and its tail. Immutable; sample it through [`Sea::surface`].
 #[derive(Clone, Debug)]
 pub struct Sea {
     params: SeaParams,
@@ -425,8 +425,8 @@ impl Sea {
 
     #[cfg(test)]
     /// The sea at `time_s` seconds, ready to sample.
-    pub fn frame(&self, time_s: f64) -> SeaFrame<'_> {
-        self.frame_at(self.time(time_s), Vec::new())
+    pub fn surface(&self, time_s: f64) -> SeaSurface<'_> {
+        self.surface_at(self.time(time_s), Vec::new())
     }
 
     /// The phase of component `i` at `time`, radians in [0, 2π).
@@ -443,7 +443,7 @@ impl Sea {
     }
 
     /// The sea at a [`SeaTime`], reusing `buffer`.
-    pub fn frame_at(&self, time: SeaTime, mut phase: Vec<f32>) -> SeaFrame<'_> {
+    pub fn surface_at(&self, time: SeaTime, mut phase: Vec<f32>) -> SeaSurface<'_> {
         phase.clear();
         phase.extend(self.components.iter().map(|c| self.phase(c, time)));
         phase.resize(self.padded_len(), 0.0);
@@ -458,7 +458,7 @@ impl Sea {
             };
             [at(0), at(1)]
         });
-        SeaFrame { sea: self, phase, tail_offset, time }
+        SeaSurface { sea: self, phase, tail_offset, time }
     }
 }
 

@@ -16,7 +16,7 @@
 //! so the maps are the same bytes on every machine.
 //!
 //! Heights are resampled at the fixed lattice points (Eulerian: what a height field holds),
-//! like [`super::ocean::SeaFrame::height`]; normals are those of that surface.
+//! like [`super::ocean::SeaSurface::height`]; normals are those of that surface.
 //!
 //! # Foam
 //! Foam follows the model of [`super::foam`] at the resting points of a lattice of its own,

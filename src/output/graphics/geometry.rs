@@ -71,7 +71,7 @@ pub fn layout(
             let covered = (w.div_ceil(u32::from(cell_px.0)) as u16, h.div_ceil(u32::from(cell_px.1)) as u16);
             ((w, h), (w, h), covered)
         }
-        GraphicsMode::Cells => ((u32::from(cells.0), 2 * u32::from(cells.1)), area, cells),
+        GraphicsMode::Cells => (crate::output::halfblock::picture_size(cells.0, cells.1), area, cells),
     };
     Layout { mode, origin: (0, 0), cells, picture, shown_px, cell_px }
 }

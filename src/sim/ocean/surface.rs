@@ -1,4 +1,4 @@
-//! The sea at one moment ([`SeaFrame`]): the sines summed at a resting point for a sample
+//! The sea at one moment ([`SeaSurface`]): the sines summed at a resting point for a sample
 //! standing for a footprint (its height, displacement and the slope it cannot carry), the
 //! Jacobian of the displacement, and the Eulerian height at a fixed point.
 
@@ -11,7 +11,7 @@ use super::fold::PhaseRows;
 
 /// The sea at one moment.
 #[derive(Clone, Debug)]
-pub struct SeaFrame<'a> {
+pub struct SeaSurface<'a> {
     pub(super) sea: &'a Sea,
     pub(super) phase: Vec<f32>,
     pub(super) tail_offset: [f32; 2],
@@ -36,8 +36,8 @@ pub(crate) struct Sums {
 pub(super) const HEIGHT: u8 = 0;
 const DISPLACED: u8 = 1;
 
-impl SeaFrame<'_> {
-    /// Gives back the frame's buffer, for [`Sea::frame_at`].
+impl SeaSurface<'_> {
+    /// Gives back the surface's buffer, for [`Sea::surface_at`].
     pub fn into_buffer(self) -> Vec<f32> {
         self.phase
     }
@@ -164,9 +164,9 @@ impl SeaFrame<'_> {
     }
 }
 
-impl Surface for SeaFrame<'_> {
+impl Surface for SeaSurface<'_> {
     fn sample(&self, x: f32, y: f32, footprint: &Footprint) -> SurfaceSample {
-        SeaFrame::sample(self, x, y, footprint)
+        SeaSurface::sample(self, x, y, footprint)
     }
 }
 
