@@ -88,6 +88,7 @@ pub mod testing {
     pub use crate::output::ssim::{Luma, SsimReference, ssim};
     pub use crate::output::vt::{ModelCell, TerminalModel};
     pub use crate::render::plot::spectrum_plot;
+    pub use crate::sim::spectrum::PiersonMoskowitz;
 }
 
 pub use error::{Error, Result, ValueError};

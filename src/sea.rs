@@ -33,4 +33,3 @@ pub use crate::sim::spectra::swell::{Swell, Swells};
 pub use crate::sim::spectra::{
     Depth, Jonswap, SeaSpectrum, SpectrumChoice, SpectrumChoiceError, SpectrumKind, Spreading,
 };
-pub use crate::sim::spectrum::PiersonMoskowitz;

@@ -191,7 +191,7 @@ pub struct Component {
 }
 
 /// Everything that defines a sea. `Default` is the command line's sea: Pierson–Moskowitz with
-/// the paper's spreading, no swell, the physical choppiness ([`DEFAULT_CHOPPINESS`]), no loop,
+/// the paper's spreading, no swell, the physical choppiness ([`SeaParams::DEFAULT_CHOPPINESS`]), no loop,
 /// a 10 m/s wind from 330°, seed 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SeaParams {
@@ -207,7 +207,7 @@ pub struct SeaParams {
     pub spreading: Spreading,
     /// Swell from distant storms, summed with the wind sea.
     pub swells: Swells,
-    /// λ, the scale of the horizontal displacement ([`check_choppiness`]); 0 = none.
+    /// λ, the scale of the horizontal displacement ([`SeaParams::check_choppiness`]); 0 = none.
     pub choppiness: f64,
     /// Repeat exactly every this many seconds (None = never).
     pub loop_period: Option<LoopPeriod>,

@@ -68,7 +68,7 @@ pub enum Medium {
 /// Where and how the image is shown.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct KittyOptions {
-    /// The image id ([`IMAGE_ID`]).
+    /// The image id ([`KittyOptions::IMAGE_ID`]).
     pub image_id: u32,
     /// The top-left cell of the picture, 0-based (column, row).
     pub origin: (u16, u16),
@@ -90,7 +90,7 @@ impl KittyOptions {
     /// The image id tidepool's pictures use unless told otherwise (`new` sets it).
     pub const IMAGE_ID: u32 = IMAGE_ID;
 
-    /// Direct transmission of [`IMAGE_ID`] over `cells` at the top-left corner; no tmux, no
+    /// Direct transmission of [`KittyOptions::IMAGE_ID`] over `cells` at the top-left corner; no tmux, no
     /// placeholders, no frame edits.
     pub fn new(cells: (u16, u16)) -> KittyOptions {
         KittyOptions {
