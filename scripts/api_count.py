@@ -81,6 +81,23 @@ def use_leaves(tree, prefix=""):
     return names
 
 
+def closing(text, start, open_ch, close_ch, stop_at=None):
+    """The index of the bracket closing the one at or after `start` (or of `stop_at` met at depth
+    0 first); len(text) when there is none."""
+    j, d = start, 0
+    while j < len(text):
+        if text[j] == open_ch:
+            d += 1
+        elif text[j] == close_ch:
+            d -= 1
+            if d == 0:
+                return j
+        elif stop_at and text[j] == stop_at and d == 0:
+            return j
+        j += 1
+    return j
+
+
 def scan(text, path, module, src_dir, feats_above, out, modules):
     """Walks one module's top level: its pub uses, pub items and public submodules."""
     modules.append((module, sorted(feats_above)))
@@ -104,15 +121,7 @@ def scan(text, path, module, src_dir, feats_above, out, modules):
             i = text.find("]", i) + 1
             continue
         if rest.startswith("#["):
-            j, d = i + 1, 0
-            while j < n:
-                if text[j] == "[":
-                    d += 1
-                elif text[j] == "]":
-                    d -= 1
-                    if d == 0:
-                        break
-                j += 1
+            j = closing(text, i + 1, "[", "]")
             raw_cfgs.append(text[i:j + 1])
             i = j + 1
             continue
@@ -149,15 +158,7 @@ def scan(text, path, module, src_dir, feats_above, out, modules):
                 i += m_mod.end()
             else:
                 start = i + m_mod.end() - 1
-                j, d = start, 0
-                while j < n:
-                    if text[j] == "{":
-                        d += 1
-                    elif text[j] == "}":
-                        d -= 1
-                        if d == 0:
-                            break
-                    j += 1
+                j = closing(text, start, "{", "}")
                 scan(text[start + 1:j], path, sub, src_dir, feats, out, modules)
                 i = j + 1
             continue
@@ -165,18 +166,7 @@ def scan(text, path, module, src_dir, feats_above, out, modules):
             if "<test>" not in feats and "<doctest>" not in feats:
                 out.append((module, m_item.group(2), sorted(feats), hidden))
         # Skip to the end of this statement or item: a `;` or a balanced block at this level.
-        j, d = i, 0
-        while j < n:
-            if text[j] == "{":
-                d += 1
-            elif text[j] == "}":
-                d -= 1
-                if d == 0:
-                    break
-            elif text[j] == ";" and d == 0:
-                break
-            j += 1
-        i = j + 1
+        i = closing(text, i, "{", "}", stop_at=";") + 1
 
 
 def cfg_tag(m):
