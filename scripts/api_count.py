@@ -12,7 +12,8 @@
    `union.`, `derive.`, `attr.` *.html) and module page (`index.html`) under `tidepool/`: a
    page whose head holds `http-equiv="refresh"` is a redirect stub, the others are real.
 
-Usage: scripts/api_count.py [--list] [--doc] [--target-dir DIR]   (from the crate's root)
+Usage: scripts/api_count.py [--list] [--doc [--features F,G]] [--target-dir DIR]   (from the
+crate's root; `--features` documents those features instead of all of them)
 """
 import os, re, subprocess, sys
 
@@ -188,11 +189,12 @@ def load(path):
     return strip_comments(raw)
 
 
-def doc_pages(target_dir):
+def doc_pages(target_dir, features):
     out_dir = os.path.join(target_dir, "doc", "tidepool")
     subprocess.run(["rm", "-rf", out_dir], check=True)
     env = dict(os.environ, CARGO_TARGET_DIR=target_dir)
-    subprocess.run(["cargo", "doc", "--no-deps", "--all-features", "-q"], check=True, env=env)
+    chosen = ["--all-features"] if features is None else ["--features", features]
+    subprocess.run(["cargo", "doc", "--no-deps", "-q"] + chosen, check=True, env=env)
     real, stub = [], []
     kinds = re.compile(r"^(struct|enum|fn|trait|constant|static|type|macro|union|derive|attr)\..*\.html$")
     for d, _, files in os.walk(out_dir):
@@ -231,8 +233,10 @@ def main():
         target = "target"
         if "--target-dir" in args:
             target = args[args.index("--target-dir") + 1]
-        real, stub = doc_pages(os.path.abspath(target))
-        print(f"doc pages (cargo doc --no-deps --all-features): {len(real) + len(stub)}: "
+        features = args[args.index("--features") + 1] if "--features" in args else None
+        real, stub = doc_pages(os.path.abspath(target), features)
+        how = "--all-features" if features is None else f"--features {features}"
+        print(f"doc pages (cargo doc --no-deps {how}): {len(real) + len(stub)}: "
               f"{len(real)} real, {len(stub)} redirect stubs")
         if "--list" in args:
             for p in real:

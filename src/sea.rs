@@ -13,14 +13,7 @@
 //! let params = SeaParams { wind_m_s: 12.0, spectrum: choice, choppiness: 1.0, ..SeaParams::default() };
 //! let maps = PatchSea::new(params, 64, 300.0)?.maps(0.0);
 //! assert_eq!(maps.height.len(), 64 * 64);
-//! let fields = tidepool::encode::MapFields {
-//!     size: maps.size,
-//!     height: &maps.height,
-//!     displacement: &maps.displacement,
-//!     normal: &maps.normal,
-//!     foam: &maps.foam,
-//! };
-//! let files = tidepool::encode::sea_maps(&fields, None);
+//! let files = maps.files(None);
 //! assert_eq!(files[0].0, "height.npy");
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```

@@ -8,7 +8,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use tidepool::SeaParams;
-use tidepool::encode::{MapFields, human_bytes, sea_maps, sea_maps_exr};
+use tidepool::encode::human_bytes;
 use tidepool::sea::{PatchMaps, PatchSea};
 
 use super::stats::Stats;
@@ -91,16 +91,9 @@ pub fn write(args: &RenderOcean, dir: &Path, params: SeaParams) -> Result<()> {
         let writer = scope.spawn(move || -> Result<usize> {
             let mut bytes = 0usize;
             for (k, maps) in receive {
-                let fields = MapFields {
-                    size: maps.size,
-                    height: &maps.height,
-                    displacement: &maps.displacement,
-                    normal: &maps.normal,
-                    foam: &maps.foam,
-                };
                 let frame = numbered.then_some(k);
-                let exr_files = if exr { sea_maps_exr(&fields, frame) } else { Vec::new() };
-                for (name, file) in sea_maps(&fields, frame).into_iter().chain(exr_files) {
+                let exr_files = if exr { maps.exr_files(frame) } else { Vec::new() };
+                for (name, file) in maps.files(frame).into_iter().chain(exr_files) {
                     bytes += file.len();
                     files::write_file(&dir.join(name), &file)?;
                 }
