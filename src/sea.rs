@@ -18,7 +18,6 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub use crate::render::plot::sea_spectrum_plot;
 pub use crate::sim::looping::LoopPeriod;
 pub use crate::sim::patch::{PatchMaps, PatchSea};
 pub use crate::sim::sea_state::{beaufort_number, beaufort_speed_m_s, wmo_sea_state, wmo_sea_state_name};

@@ -168,6 +168,15 @@ pub fn spectrum_plot(sea: &PiersonMoskowitz) -> Pixmap {
     sea_spectrum_plot(&SeaParams { wind_m_s: sea.wind_m_s(), ..SeaParams::default() })
 }
 
+impl SeaParams {
+    /// A plot of this sea's spectrum, what `tidepool spectrum --out` draws: the wind sea's
+    /// spectrum (its name, γ, fetch and depth and the spreading law in the heading) summed with
+    /// its swells; left E(f), right the directions.
+    pub fn spectrum_plot(&self) -> Pixmap {
+        sea_spectrum_plot(self)
+    }
+}
+
 /// The plot of any sea: the wind sea's spectrum (its name, γ, fetch and depth and the
 /// spreading law in the heading) summed with its swells. Left, E(f) from 0 to 3 times the
 /// highest peak frequency (each part in grey under the sum); right, D(theta) at the wind
