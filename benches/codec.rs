@@ -23,8 +23,8 @@
 //! budgeted strategies take what a [`ByteBucket`] at the rate allows on a simulated 30 fps clock;
 //! a whole frame goes when the link has carried the previous one and shows when it has arrived
 //! (`bytes / rate` later). Every emitted byte goes through the terminal model
-//! ([`tidepool::terminal::TerminalModel`], exactly 160x48) and the screen is compared with the true
-//! frame at each display instant: SSIM of luma ([`tidepool::terminal::ssim`], Gaussian window of
+//! ([`tidepool::testing::TerminalModel`], exactly 160x48) and the screen is compared with the true
+//! frame at each display instant: SSIM of luma ([`tidepool::testing::ssim`], Gaussian window of
 //! 1.5) and PSNR (8-bit sRGB, both halves of every picture cell, an exact frame counted as
 //! 99 dB), the status row left out.
 //!
@@ -48,9 +48,10 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
-use tidepool::terminal::{
-    self as quality, ByteBucket, Color, ColorMode, EncodeOptions, Frame, Luma, RateEncoder, RateOptions, Shown,
-    SsimReference, Strategy, Target, TerminalModel, UNLIMITED,
+use tidepool::serve::ByteBucket;
+use tidepool::terminal::{Color, ColorMode, EncodeOptions, Frame, Shown};
+use tidepool::testing::{
+    self as quality, Luma, RateEncoder, RateOptions, SsimReference, Strategy, Target, TerminalModel, UNLIMITED,
 };
 use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneSpec, Script};
 use tiny_skia::Pixmap;
@@ -145,9 +146,11 @@ fn quantized(picture: &Pixmap, step: u8) -> Pixmap {
 
 /// A pool clip: the replay re-simulated, a picture at every 30 fps display instant.
 fn pool_clip(name: &'static str, file: &str) -> Clip {
-    let replay = tidepool::replay::read(std::path::Path::new(&fixture(file))).expect("a committed fixture replay");
+    let replay =
+        tidepool::replay::Replay::read(std::path::Path::new(&fixture(file))).expect("a committed fixture replay");
     assert_eq!(replay.header.size, [PICTURE.0, PICTURE.1], "a 160x48-cell recording");
-    let mut scene = replay.spec(tidepool::pool_floor()).build(PICTURE.0, PICTURE.1).expect("a valid size");
+    let mut scene =
+        replay.spec(tidepool::PoolSettings::default_floor()).build(PICTURE.0, PICTURE.1).expect("a valid size");
     let events = replay.script();
     let mut script = Script::new(&events);
     let per_second = scene.steps_per_second();
@@ -486,9 +489,10 @@ fn cpu(c: &mut Criterion) {
     }
     // The whole player's frame: the steps a 30 fps frame covers of the player's pool (gusts,
     // rain, a stone a second), the picture, the cells and the encoder at 250 kB/s.
-    let replay = tidepool::replay::read(std::path::Path::new(&fixture("pool-160x48.jsonl"))).expect("the fixture");
+    let replay =
+        tidepool::replay::Replay::read(std::path::Path::new(&fixture("pool-160x48.jsonl"))).expect("the fixture");
     let [w, h] = replay.header.size;
-    let mut scene = replay.spec(tidepool::pool_floor()).build(w, h).expect("a valid size");
+    let mut scene = replay.spec(tidepool::PoolSettings::default_floor()).build(w, h).expect("a valid size");
     let steps_per_frame = (scene.steps_per_second() / f64::from(FPS)).round().max(1.0) as u64;
     let mut picture = Pixmap::new(w, h).expect("a valid size");
     let mut frame = Frame::new(COLS, ROWS);

@@ -29,7 +29,7 @@ use tidepool::graphics::iterm2::Iterm2Encoder;
 use tidepool::graphics::kitty::{KittyEncoder, KittyOptions, Medium, temp_dir};
 use tidepool::graphics::sixel::{SixelEncoder, SixelPalette};
 use tidepool::graphics::{GraphicsMode, push_rgb};
-use tidepool::graphics::{SCALED_CAP, layout};
+use tidepool::graphics::{Layout, layout};
 use tidepool::{Damping, PoolScene, PoolSettings, Scene, Stone};
 use tiny_skia::Pixmap;
 
@@ -67,8 +67,8 @@ fn rgb(p: &Pixmap) -> Vec<u8> {
 }
 
 fn graphics(c: &mut Criterion) {
-    let sixel = layout(GraphicsMode::Sixel, TERM, Some(CELL_PX), Some((4096, 4096)), SCALED_CAP);
-    let kitty = layout(GraphicsMode::Kitty, TERM, Some(CELL_PX), None, SCALED_CAP);
+    let sixel = layout(GraphicsMode::Sixel, TERM, Some(CELL_PX), Some((4096, 4096)), Layout::SCALED_CAP);
+    let kitty = layout(GraphicsMode::Kitty, TERM, Some(CELL_PX), None, Layout::SCALED_CAP);
     let (sw, sh) = sixel.picture;
     let (kw, kh) = kitty.picture;
     let (sa, sb) = frames(sw, sh);

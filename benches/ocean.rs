@@ -14,7 +14,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use tiny_skia::Pixmap;
 
-use tidepool::sea::{DEFAULT_CHOPPINESS, PatchSea, beaufort_speed_m_s};
+use tidepool::sea::{PatchSea, beaufort_speed_m_s};
 use tidepool::{OceanScene, OceanSettings, OceanView, Scene, SeaParams};
 
 fn scene(width: u32, height: u32, ssaa: u32, sea: SeaParams) -> OceanScene {
@@ -27,9 +27,9 @@ fn render_ocean(c: &mut Criterion) {
     group.sample_size(20);
     let cases = [
         ("160x96_ssaa1", 160, 96, 1, 0.0),
-        ("160x94_ssaa1_chop_foam", 160, 94, 1, DEFAULT_CHOPPINESS),
+        ("160x94_ssaa1_chop_foam", 160, 94, 1, SeaParams::DEFAULT_CHOPPINESS),
         ("1920x1080_ssaa2", 1920, 1080, 2, 0.0),
-        ("1920x1080_ssaa2_chop_foam", 1920, 1080, 2, DEFAULT_CHOPPINESS),
+        ("1920x1080_ssaa2_chop_foam", 1920, 1080, 2, SeaParams::DEFAULT_CHOPPINESS),
     ];
     for (name, w, h, ssaa, choppiness) in cases {
         let mut s = scene(w, h, ssaa, SeaParams { choppiness, ..SeaParams::default() });
@@ -64,7 +64,7 @@ fn render_ocean(c: &mut Criterion) {
 fn maps(c: &mut Criterion) {
     let mut group = c.benchmark_group("maps");
     group.sample_size(10);
-    let params = SeaParams { wind_m_s: 12.0, choppiness: DEFAULT_CHOPPINESS, ..SeaParams::default() };
+    let params = SeaParams { wind_m_s: 12.0, choppiness: SeaParams::DEFAULT_CHOPPINESS, ..SeaParams::default() };
     let mut patch = PatchSea::new(params, 1024, 1000.0).expect("valid patch");
     let mut t = 0.0;
     patch.maps(t);

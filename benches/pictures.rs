@@ -13,7 +13,7 @@
 //! onto a screen-sized canvas at its cell, iTerm2's PNG/JPEG by `image`; cells through the
 //! terminal model), scaled to 1280x752 the way the terminal scales it (kitty and iTerm2:
 //! resampled; sixel: already one pixel a pixel; cells: 8x8 pixels a half block), and compared
-//! with the truth by SSIM of luma (`tidepool::terminal::ssim`) every sixth frame (5 times a
+//! with the truth by SSIM of luma (`tidepool::testing::ssim`) every sixth frame (5 times a
 //! second). Reported: pictures a second, bytes a second, mean and 5th-percentile SSIM, and the
 //! median time the stream (or the cell encoder) took per frame on this machine.
 //!
@@ -32,10 +32,11 @@ use base64::Engine;
 use criterion::Criterion;
 use tidepool::graphics::kitty::KittyOptions;
 use tidepool::graphics::sixel::{Registers, SixelPalette};
-use tidepool::graphics::{Budget, GraphicsMode, PictureStream, Protocol, kitty, kitty_decode};
-use tidepool::graphics::{SCALED_CAP, layout};
-use tidepool::terminal::{
-    ByteBucket, Color, ColorMode, Frame, Luma, RateEncoder, RateOptions, Shown, Target, TerminalModel,
+use tidepool::graphics::{GraphicsMode, Layout, layout};
+use tidepool::serve::ByteBucket;
+use tidepool::terminal::{Color, ColorMode, Frame, Shown};
+use tidepool::testing::{
+    Budget, KittyState, Luma, PictureStream, Protocol, RateEncoder, RateOptions, Target, TerminalModel,
 };
 use tidepool::{Event, Script, Stone};
 use tiny_skia::Pixmap;
@@ -56,10 +57,10 @@ const MODES: [&str; 4] = ["kitty", "sixel", "iterm2", "cells"];
 
 /// The fixture at the pixel modes' scene size: one picture per frame.
 fn pictures() -> Vec<Pixmap> {
-    let replay = tidepool::replay::read(std::path::Path::new(FIXTURE)).expect("the committed fixture replay");
+    let replay = tidepool::replay::Replay::read(std::path::Path::new(FIXTURE)).expect("the committed fixture replay");
     let [w0, _] = replay.header.size;
     let scale = f64::from(SCENE.0) / f64::from(w0);
-    let mut scene = replay.spec(tidepool::pool_floor()).build(SCENE.0, SCENE.1).expect("a valid size");
+    let mut scene = replay.spec(tidepool::PoolSettings::default_floor()).build(SCENE.0, SCENE.1).expect("a valid size");
     let events: Vec<(u64, Event)> = replay
         .script()
         .into_iter()
@@ -95,13 +96,13 @@ fn luma_at(rgb: &[u8], size: (u32, u32), to: (u32, u32), nearest: bool) -> Luma 
         });
     }
     let mut out = Vec::new();
-    tidepool::graphics::resample(rgb, 3, size, to, &mut out);
+    tidepool::testing::resample(rgb, 3, size, to, &mut out);
     Luma::of_rgb(to.0 as usize, to.1 as usize, &out)
 }
 
 /// What the terminal shows of a pixel mode, fed the offers.
 enum Terminal {
-    Kitty(kitty_decode::KittyState),
+    Kitty(KittyState),
     /// The last inline file decoded (RGB at its size).
     Iterm2(Option<(u32, u32, Vec<u8>)>),
     /// The screen's pixels (RGB, 1280x750) painted by each sixel image at its cell.
@@ -149,7 +150,7 @@ impl Terminal {
     fn luma(&self) -> Option<Luma> {
         match self {
             Terminal::Kitty(state) => {
-                let image = state.images.get(&kitty::IMAGE_ID)?;
+                let image = state.images.get(&KittyOptions::IMAGE_ID)?;
                 Some(luma_at(&image.rgb, (image.width, image.height), AREA, false))
             }
             Terminal::Iterm2(shown) => shown.as_ref().map(|(w, h, rgb)| luma_at(rgb, (*w, *h), AREA, false)),
@@ -159,7 +160,7 @@ impl Terminal {
 }
 
 fn stream(mode: &str) -> (PictureStream, Terminal) {
-    let l = |m| layout(m, TERM, Some(CELL_PX), Some((4096, 4096)), SCALED_CAP);
+    let l = |m| layout(m, TERM, Some(CELL_PX), Some((4096, 4096)), Layout::SCALED_CAP);
     match mode {
         "kitty" => {
             let l = l(GraphicsMode::Kitty);
@@ -214,7 +215,7 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
             let started = Instant::now();
             // The half-block picture: the scene at 160x94, as the player would render it.
             let (pw, ph) = (cols as u32, 2 * (rows as u32 - 1));
-            tidepool::graphics::resample(shot.data(), 4, SCENE, (pw, ph), &mut small);
+            tidepool::testing::resample(shot.data(), 4, SCENE, (pw, ph), &mut small);
             let mut pixmap = Pixmap::new(pw, ph).unwrap();
             for (px, p) in pixmap.pixels_mut().iter_mut().zip(small.chunks_exact(3)) {
                 *px = tiny_skia::ColorU8::from_rgba(p[0], p[1], p[2], 255).premultiply();
@@ -297,7 +298,7 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
 fn view_ssim(a: &Luma, b: &Luma) -> f64 {
     let k: usize = std::env::var("PICTURES_VIEW").ok().and_then(|v| v.parse().ok()).unwrap_or(1).max(1);
     if k == 1 {
-        return tidepool::terminal::ssim(a, b);
+        return tidepool::testing::ssim(a, b);
     }
     let shrink = |l: &Luma| {
         Luma::from_fn(l.width() / k, l.height() / k, |x, y| {
@@ -311,7 +312,7 @@ fn view_ssim(a: &Luma, b: &Luma) -> f64 {
             [v, v, v]
         })
     };
-    tidepool::terminal::ssim(&shrink(a), &shrink(b))
+    tidepool::testing::ssim(&shrink(a), &shrink(b))
 }
 
 fn percentile(values: &[f64], p: f64) -> f64 {
@@ -329,7 +330,7 @@ fn table() {
         .map(|(n, p)| {
             if n % SAMPLE_EVERY == SAMPLE_EVERY - 1 {
                 let mut rgb = Vec::new();
-                tidepool::graphics::resample(p.data(), 4, SCENE, SCENE, &mut rgb);
+                tidepool::testing::resample(p.data(), 4, SCENE, SCENE, &mut rgb);
                 luma_at(&rgb, SCENE, AREA, false)
             } else {
                 Luma::from_fn(0, 0, |_, _| [0, 0, 0])

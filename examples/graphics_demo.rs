@@ -17,10 +17,11 @@ use std::time::{Duration, Instant};
 
 use tidepool::graphics::iterm2::Iterm2Encoder;
 use tidepool::graphics::kitty::{self, KittyEncoder, KittyOptions, Medium};
-use tidepool::graphics::sixel::{SixelEncoder, SixelPalette, dithered_rgb};
+use tidepool::graphics::sixel::{SixelEncoder, SixelPalette};
 use tidepool::graphics::{GraphicsMode, push_rgb};
-use tidepool::graphics::{SCALED_CAP, layout};
+use tidepool::graphics::{Layout, layout};
 use tidepool::play::GraphicsRequest;
+use tidepool::testing::dithered_rgb;
 use tiny_skia::{Color, FilterQuality, Pixmap, PixmapPaint, Rect, Transform};
 
 const GOLDEN: &[u8] = include_bytes!("../tests/golden/pool_default.png");
@@ -61,7 +62,7 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
         stdout.flush()
     };
     let sixel_max = support.sixel.and_then(|s| Some((s.max_w?, s.max_h?)));
-    let l = layout(choice.mode, (cols, rows), support.cell_px, sixel_max, SCALED_CAP);
+    let l = layout(choice.mode, (cols, rows), support.cell_px, sixel_max, Layout::SCALED_CAP);
     text.push_str(&format!("{l:#?}\n"));
     let mut picture = Pixmap::new(l.picture.0, l.picture.1).expect("a picture of at least 1x1");
     let golden = image::load_from_memory(GOLDEN).expect("the golden picture decodes").to_rgba8();

@@ -13,7 +13,7 @@ use std::path::{Path, PathBuf};
 
 use tiny_skia::{Pixmap, PixmapPaint, Transform};
 
-use tidepool::sea::{DEFAULT_CHOPPINESS, Depth, Jonswap, PatchSea, SpectrumChoice, Swell, Swells, beaufort_speed_m_s};
+use tidepool::sea::{Depth, Jonswap, PatchSea, SpectrumChoice, Swell, Swells, beaufort_speed_m_s};
 use tidepool::{CameraPose, OceanScene, OceanSettings, OceanView, Scene, SeaParams};
 
 struct Shot {
@@ -72,7 +72,7 @@ fn main() {
     let chop = |wind: f64, from: f64| SeaParams {
         wind_m_s: wind,
         wind_from_deg: from,
-        choppiness: DEFAULT_CHOPPINESS,
+        choppiness: SeaParams::DEFAULT_CHOPPINESS,
         ..SeaParams::default()
     };
     let b = |n: u8| beaufort_speed_m_s(n).expect("a Beaufort number");

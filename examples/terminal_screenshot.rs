@@ -5,7 +5,7 @@
 //! Usage: `cargo run --release --example terminal_screenshot CAPTURE.ans OUT.png COLS ROWS`
 
 use font8x8::UnicodeFonts;
-use tidepool::terminal::TerminalModel;
+use tidepool::testing::TerminalModel;
 use tiny_skia::{Pixmap, PremultipliedColorU8};
 
 const CELL_W: u32 = 8;

@@ -19,10 +19,13 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Features: `cli` (default: the `tidepool` binary), `player` (the play session and the
-//! interactive terminal player, [`tty`]), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
-//! that draws any scene, `widget`).
+//! Features: `cli` (default: the `tidepool` binary), `player` (the play session, [`play`], the
+//! interactive terminal player, [`tty`], and what `tidepool serve` shares between players,
+//! [`serve`]), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
+//! that draws any scene, `widget`), `testing` (the tools the tests and benchmarks check
+//! pictures with, `testing`; not part of the chosen API).
 #![warn(missing_docs)]
+#![warn(unnameable_types)]
 
 mod checks;
 mod error;
@@ -56,8 +59,40 @@ pub mod tty {
     pub use crate::term::tty::{play, probe_for_picture, restore};
 }
 
+/// What `tidepool serve` (the binary's SSH door, feature `serve`) needs beyond one person's
+/// [`play`] session: players whose screens are alike share frames, encoded once per group, and
+/// each player's requests, resizes and bytes are rationed by token buckets. Only serve uses
+/// these; they are here because serve lives in the binary and the groups encode with the
+/// screen's crate-private parts.
+#[cfg(feature = "player")]
+pub mod serve {
+    pub use crate::output::bucket::ByteBucket;
+    pub use crate::play::group::{GroupFeed, GroupKey, Groups, Membership, MembershipStats, Source};
+}
+
+/// The tools tidepool's own tests and benchmarks check pictures with (feature `testing`, off by
+/// default; `tests/`, `benches/` and `examples/` turn it on through a dev-dependency): a terminal
+/// model that plays bytes back and the picture's quality as seen on it (SSIM, PSNR), an
+/// independent decoder of kitty's commands, and the knobs of the encoders the play session runs
+/// under a link's rate. Not part of the chosen API: they change when the tests need them to.
+#[cfg(feature = "testing")]
+pub mod testing {
+    pub use crate::output::diff::{SYNC_BEGIN, SYNC_END};
+    pub use crate::output::graphics::kitty_decode::{Image as KittyImage, KittyState, decode as kitty_decode};
+    pub use crate::output::graphics::pack::Packing;
+    pub use crate::output::graphics::sixel::dithered_rgb;
+    pub use crate::output::graphics::stream::ladder::resample;
+    pub use crate::output::graphics::stream::{Budget, Offer, Part, PictureStream, Protocol, State};
+    pub use crate::output::quality::{Quality, measure, screen_luma};
+    pub use crate::output::rate::{RateEncoder, RateOptions, Report, Strategy, Target, UNLIMITED};
+    pub use crate::output::ssim::{Luma, SsimReference, ssim};
+    pub use crate::output::vt::{ModelCell, TerminalModel};
+    pub use crate::render::plot::spectrum_plot;
+    pub use crate::sim::spectrum::PiersonMoskowitz;
+}
+
 pub use error::{Error, Result, ValueError};
-pub use render::background::{load as load_image, pool_floor};
+pub use render::background::load as load_image;
 pub use render::camera::CameraPose;
 pub use render::caustics::CausticsLook;
 pub use render::ocean::{OceanView, SeaShading};
@@ -66,7 +101,7 @@ pub use render::supersample::Downsample;
 pub use render::texture::SeaTexture;
 pub use scene::lake::{LakeScene, LakeSettings};
 pub use scene::ocean::{OceanScene, OceanSettings};
-pub use scene::pool::{PoolScene, PoolSettings, showcase as pool_showcase};
+pub use scene::pool::{PoolScene, PoolSettings};
 pub use scene::{Action, Controls, Event, Heightmap, Playable, Scene, SceneKind, SceneSpec, Script};
 pub use sim::breeze::BreezeStyle;
 pub use sim::lake::LakeParams;

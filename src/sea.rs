@@ -13,29 +13,15 @@
 //! let params = SeaParams { wind_m_s: 12.0, spectrum: choice, choppiness: 1.0, ..SeaParams::default() };
 //! let maps = PatchSea::new(params, 64, 300.0)?.maps(0.0);
 //! assert_eq!(maps.height.len(), 64 * 64);
-//! let fields = tidepool::encode::MapFields {
-//!     size: maps.size,
-//!     height: &maps.height,
-//!     displacement: &maps.displacement,
-//!     normal: &maps.normal,
-//!     foam: &maps.foam,
-//! };
-//! let files = tidepool::encode::sea_maps(&fields, None);
+//! let files = maps.files(None);
 //! assert_eq!(files[0].0, "height.npy");
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub use crate::render::plot::{sea_spectrum_plot, spectrum_plot};
-pub use crate::render::texture::SEA_TEXTURE_TILE_M;
 pub use crate::sim::looping::LoopPeriod;
-pub use crate::sim::ocean::{DEFAULT_CHOPPINESS, check_choppiness};
-pub use crate::sim::patch::{
-    PatchMaps, PatchSea, check_map_size, check_patch, default_extent_m as default_map_extent_m,
-};
+pub use crate::sim::patch::{PatchMaps, PatchSea};
 pub use crate::sim::sea_state::{beaufort_number, beaufort_speed_m_s, wmo_sea_state, wmo_sea_state_name};
 pub use crate::sim::spectra::swell::{Swell, Swells};
 pub use crate::sim::spectra::{
     Depth, Jonswap, SeaSpectrum, SpectrumChoice, SpectrumChoiceError, SpectrumKind, Spreading,
 };
-pub use crate::sim::spectrum::PiersonMoskowitz;
-pub use crate::sim::wind::{DEFAULT_SEA_WIND_M_S, DEFAULT_WIND_FROM_DEG, MAX_LAKE_WIND_M_S};

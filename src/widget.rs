@@ -42,7 +42,8 @@ impl<'a> SceneWidget<'a> {
 
     /// The picture size in pixels that fills `area`: its width, and two pixels a row.
     pub fn picture_size(area: Rect) -> (u32, u32) {
-        (u32::from(area.width).max(1), (2 * u32::from(area.height)).max(1))
+        let (width, height) = crate::output::halfblock::picture_size(area.width, area.height);
+        (width.max(1), height.max(1))
     }
 }
 

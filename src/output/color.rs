@@ -19,7 +19,6 @@
 //!   (error diffusion would shimmer and defeat the diff).
 
 use crate::output::halfblock::Rgb;
-use crate::output::vt::xterm_256;
 
 /// How many colours the terminal shows.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -171,6 +170,41 @@ pub fn nearest_256(rgb: Rgb) -> u8 {
 /// The basic colour (0..=15, xterm's default values) nearest to `rgb`.
 pub fn nearest_16(rgb: Rgb) -> u8 {
     (0..16u8).min_by_key(|&i| distance2(rgb, xterm_256(i))).unwrap_or(0)
+}
+
+/// The RGB of xterm's 256-colour palette entry `index` (the cube levels are 0, 95, 135, 175,
+/// 215, 255; the grey ramp runs 8..=238 in steps of 10; 0-15 are xterm's defaults).
+pub fn xterm_256(index: u8) -> Rgb {
+    const BASIC: [Rgb; 16] = [
+        [0, 0, 0],
+        [205, 0, 0],
+        [0, 205, 0],
+        [205, 205, 0],
+        [0, 0, 238],
+        [205, 0, 205],
+        [0, 205, 205],
+        [229, 229, 229],
+        [127, 127, 127],
+        [255, 0, 0],
+        [0, 255, 0],
+        [255, 255, 0],
+        [92, 92, 255],
+        [255, 0, 255],
+        [0, 255, 255],
+        [255, 255, 255],
+    ];
+    const LEVELS: [u8; 6] = [0, 95, 135, 175, 215, 255];
+    match index {
+        0..=15 => BASIC[index as usize],
+        16..=231 => {
+            let i = index - 16;
+            [LEVELS[(i / 36) as usize], LEVELS[(i / 6 % 6) as usize], LEVELS[(i % 6) as usize]]
+        }
+        _ => {
+            let v = 8 + 10 * (index - 232);
+            [v, v, v]
+        }
+    }
 }
 
 #[cfg(test)]

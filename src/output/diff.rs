@@ -51,7 +51,7 @@ pub struct Shown {
     /// sent).
     pub frame: Option<Frame>,
     /// The cursor.
-    pub cursor: Cursor,
+    pub(crate) cursor: Cursor,
     /// The foreground colour in effect.
     pub fg: Option<Color>,
     /// The background colour in effect.

@@ -26,6 +26,14 @@ pub fn push_fg(out: &mut Vec<u8>, [r, g, b]: Rgb) {
     let _ = write!(out, "\x1b[38;2;{r};{g};{b}m");
 }
 
+/// The picture, in pixels, that `cols x rows` half-block cells show: a pixel a column, two a
+/// row. The one place this is computed: the play screen's picture and a serve group's
+/// (`play/screen/compose.rs`), the cells layout (`output/graphics/geometry.rs`) and the widget
+/// take it, each with its own minimum.
+pub fn picture_size(cols: u16, rows: u16) -> (u32, u32) {
+    (u32::from(cols), 2 * u32::from(rows))
+}
+
 /// Appends `ESC[48;2;r;g;bm` (background) to `out`.
 pub fn push_bg(out: &mut Vec<u8>, [r, g, b]: Rgb) {
     let _ = write!(out, "\x1b[48;2;{r};{g};{b}m");

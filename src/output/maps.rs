@@ -32,6 +32,7 @@ use image::codecs::png::{CompressionType, FilterType, PngEncoder};
 use rayon::prelude::*;
 
 use super::heightmap::{encode_npy_shaped, levels16};
+use crate::sim::patch::PatchMaps;
 
 /// The fields of one set of maps, each `size x size`, row-major, row 0 the north edge.
 #[derive(Clone, Copy, Debug)]
@@ -46,6 +47,32 @@ pub struct MapFields<'a> {
     pub normal: &'a [[f32; 3]],
     /// Foam cover 0..=1.
     pub foam: &'a [f32],
+}
+
+impl PatchMaps {
+    /// Every file of these maps as (name, bytes): `.npy` arrays and 16-bit PNGs of the height,
+    /// displacement, normal and foam (names from `file_names`; with `frame`, each name gets
+    /// `_NNNN` before its extension).
+    pub fn files(&self, frame: Option<u32>) -> Vec<(String, Vec<u8>)> {
+        encode_maps(&self.fields(), frame)
+    }
+
+    /// The same maps as OpenEXR files (half floats, lossless ZIP), for renderers that read
+    /// EXR.
+    pub fn exr_files(&self, frame: Option<u32>) -> Vec<(String, Vec<u8>)> {
+        encode_exr_maps(&self.fields(), frame)
+    }
+
+    /// A borrowed view of the fields, the form the encoders take.
+    fn fields(&self) -> MapFields<'_> {
+        MapFields {
+            size: self.size,
+            height: &self.height,
+            displacement: &self.displacement,
+            normal: &self.normal,
+            foam: &self.foam,
+        }
+    }
 }
 
 /// PNG levels per metre for heights and displacements: centimetres.

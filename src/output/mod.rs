@@ -2,6 +2,7 @@
 
 #[cfg(feature = "animation")]
 pub mod apng;
+#[cfg(any(test, feature = "player", feature = "testing"))]
 pub mod bucket;
 pub mod color;
 pub mod cursor;
@@ -13,10 +14,15 @@ pub mod graphics;
 pub mod halfblock;
 pub mod heightmap;
 pub mod maps;
+#[cfg(any(test, feature = "player", feature = "testing"))]
 pub mod oklab;
 pub mod png;
+#[cfg(any(test, feature = "testing"))]
 pub mod quality;
+#[cfg(any(test, feature = "player", feature = "testing"))]
 pub mod rate;
+#[cfg(any(test, feature = "testing"))]
 pub mod ssim;
 pub mod units;
+#[cfg(any(test, feature = "testing"))]
 pub mod vt;

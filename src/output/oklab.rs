@@ -37,6 +37,7 @@ impl Lab {
         dl * dl + da * da + db * db
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The Euclidean distance (ΔE_OK).
     pub fn distance(self, other: Lab) -> f32 {
         self.distance2(other).sqrt()

@@ -52,7 +52,7 @@ pub struct Fit {
 impl Fit {
     /// A `scene` (width, height in pixels) shown in a `target` picture whose pixels the
     /// terminal's cells cover as `grid` says.
-    pub fn new(scene: (u32, u32), target: (u32, u32), grid: CellGrid) -> Fit {
+    pub(crate) fn new(scene: (u32, u32), target: (u32, u32), grid: CellGrid) -> Fit {
         let scene = (scene.0.max(1), scene.1.max(1));
         let target = (target.0.max(1), target.1.max(1));
         let scale = (f64::from(target.0) / f64::from(scene.0)).min(f64::from(target.1) / f64::from(scene.1));

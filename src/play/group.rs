@@ -36,7 +36,7 @@ use super::host::SceneStatus;
 use super::player::Player;
 use super::screen::compose::{Figures, half_block_picture};
 use super::screen::probe::GraphicsRequest;
-use super::screen::{Bandwidth, Cells, LinkPath, Screen, ScreenConfig};
+use super::screen::{Bandwidth, CellSource, LinkPath, Screen, ScreenConfig};
 use super::seat::{DEFAULT_STONE_RADIUS, SeatView};
 use crate::output::color::ColorMode;
 use crate::output::diff::{EncodeOptions, Shown};
@@ -100,7 +100,7 @@ pub struct GroupKey {
     /// Frames a second at most.
     pub fps: u32,
     /// The link's class.
-    pub class: LinkClass,
+    pub(crate) class: LinkClass,
 }
 
 impl GroupKey {
@@ -131,11 +131,6 @@ pub struct GroupFeed {
 }
 
 impl GroupFeed {
-    /// The group's frames, oldest first.
-    pub fn frames(&self) -> &[Arc<GroupFrame>] {
-        &self.frames
-    }
-
     /// The frames after frame `number`, if the feed still holds all of them.
     fn after(&self, number: u64) -> Option<&[Arc<GroupFrame>]> {
         let first = self.frames.first()?.number;
@@ -198,7 +193,7 @@ impl Group {
         };
         bytes.clear();
         let len =
-            self.screen.frame_from(now, picture, status, &seat, Cells::Own { figures: Some(figures) }, &mut bytes);
+            self.screen.frame_from(now, picture, status, &seat, CellSource::Own { figures: Some(figures) }, &mut bytes);
         if len == 0 {
             return false;
         }
@@ -389,7 +384,7 @@ impl Membership {
         };
         let latest = feed.frames.last().expect("a feed with frames");
         if !plain {
-            let own = Cells::Own { figures: Some(latest.figures) };
+            let own = CellSource::Own { figures: Some(latest.figures) };
             return (screen.frame_from(now, picture, status, &view, own, out), Source::Own);
         }
         // Plain again: the cells of one of the group's frames? Then its later frames follow.
@@ -400,7 +395,7 @@ impl Membership {
         let Some(model) = &latest.after.frame else {
             return (screen.frame(now, picture, status, &view, out), Source::Own);
         };
-        let len = screen.frame_from(now, picture, status, &view, Cells::Toward(model), out);
+        let len = screen.frame_from(now, picture, status, &view, CellSource::Toward(model), out);
 
         if looks_alike(&latest.after, screen.shown()) {
             self.join(screen, latest.clone(), key);
@@ -438,7 +433,7 @@ impl Membership {
                 joined.as_slice()
             }
         };
-        let len = screen.frame_from(now, picture, status, &SeatView::default(), Cells::Taken(bytes), out);
+        let len = screen.frame_from(now, picture, status, &SeatView::default(), CellSource::Taken(bytes), out);
         self.pinned = frames.last().cloned();
         (len, Source::Group)
     }

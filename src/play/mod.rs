@@ -4,15 +4,18 @@
 //!
 //! - [`Host`]: the only owner of a scene, its clock, its random stones, the scene list and the
 //!   recorder. [`Host::apply`] takes a [`Request`].
-//! - [`Seat`]: one person: aim, stone size, drag, help, messages, and the [`Fit`] between their
-//!   terminal and the scene. [`Seat::handle`] turns an [`Input`] into requests.
+//! - [`Player`]: one person at one terminal: their seat beside their [`Screen`]. The seat
+//!   (crate-private) is what the person holds between frames, apart from any terminal: aim,
+//!   stone size, drag, help, messages, the [`Fit`] between their terminal and the scene, and
+//!   the one place a key or a click gets its meaning (an input becomes [`Request`]s).
 //! - [`Screen`]: one terminal: the graphics probe, the link control and byte budget, the
 //!   rate-controlled cell encoder and the picture encoders. It takes the terminal's bytes
 //!   (replies stay in the screen, inputs come out) and appends a frame's bytes; its methods
 //!   are the crate's, the doors reach it through a [`Driver`].
 //!
-//! - [`Groups`]: screens alike enough to share frames, encoded once per group; a player's [`Membership`]
-//!   takes the group's bytes while its terminal shows the group's model.
+//! - [`crate::serve::Groups`]: screens alike enough to share frames, encoded once per group
+//!   (`tidepool serve`); a player's [`crate::serve::Membership`] takes the group's bytes while
+//!   its terminal shows the group's model.
 //!
 //! The surface the doors drive, in quinn-proto's shape (`handle_*` for inputs, `poll_*` for
 //! outputs, time passed in): a [`Driver`] is the one turn of one person at one terminal
@@ -25,7 +28,7 @@
 //! Two doors drive them: [`crate::tty::run`] (and [`crate::tty::play`], for this process's own
 //! terminal) runs a [`Session`] on one terminal; `tidepool serve` runs one host on a thread and
 //! a [`Driver`] per SSH channel. A key's route is straight: bytes -> [`Driver::handle_bytes`] ->
-//! [`Input`] -> [`Seat::handle`] -> [`Request`] -> [`Host::apply`] -> the scene.
+//! an input -> the seat -> [`Request`] -> [`Host::apply`] -> the scene.
 //!
 //! ```
 //! use std::time::{Duration, Instant};
@@ -74,14 +77,13 @@ pub(crate) mod session;
 pub use crate::output::graphics::stream::FileWrite;
 pub use driver::{Driver, DriverEvent, Pacing, Transmit};
 pub use fit::Fit;
-pub use group::{GroupFeed, GroupKey, Groups, Membership, Source};
 pub use host::{Effect, Host, HostConfig, Recording, SceneStatus};
-pub use input::Input;
 pub use player::Player;
 pub use request::Request;
-pub use screen::probe::{EnvHints, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
+pub use screen::probe::{
+    EnvHints, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, SixelSupport, WinSize,
+};
 pub use screen::{Bandwidth, LinkPath, Screen, ScreenConfig};
-pub use seat::{Flow, Seat};
 pub use session::{Session, SessionEvent};
 
 #[cfg(test)]

@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use tiny_skia::Pixmap;
 
+use super::fit::Fit;
 use super::host::SceneStatus;
 use super::input::Input;
 use super::request::Request;
@@ -29,7 +30,7 @@ pub(crate) struct Turn {
 #[derive(Debug)]
 pub struct Player {
     /// What is theirs: aim, stone size, help, messages.
-    pub seat: Seat,
+    pub(crate) seat: Seat,
     /// Their terminal.
     pub screen: Screen,
     inputs: Vec<Input>,
@@ -43,6 +44,11 @@ impl Player {
     pub fn new(screen: Screen, scene: (u32, u32), greeting: Option<String>) -> Player {
         let seat = Seat::new(screen.fit(scene));
         Player { seat, screen, inputs: Vec::new(), greeting: Some(greeting.unwrap_or_default()) }
+    }
+
+    /// How their terminal's cells map to the scene's pixels (the seat's).
+    pub fn fit(&self) -> &Fit {
+        self.seat.fit()
     }
 
     /// A player whose `s` key says screenshots are off instead of asking the host (a shared

@@ -80,7 +80,7 @@ pub struct ScreenConfig {
 /// Where a frame's cells come from: composed and encoded here (a lone screen), or shared with
 /// the other screens of a group ([`crate::play::group`]).
 #[derive(Clone, Copy, Debug)]
-pub(crate) enum Cells<'a> {
+pub(crate) enum CellSource<'a> {
     /// Composed and encoded here; `figures`: the status line's figures instead of this
     /// screen's own (a group's, so that its members' status lines are alike).
     Own { figures: Option<Figures> },

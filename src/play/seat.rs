@@ -1,5 +1,6 @@
-//! A seat: one person at one terminal. Their aim, stone size, drag, help and messages, and the
-//! [`Fit`] between their terminal and the scene. [`Seat::handle`] turns what they did into
+//! A seat: what one player holds between frames, apart from any terminal (the [`super::screen::Screen`] is
+//! the terminal; a [`super::player::Player`] is the two together). Their aim, stone size, drag,
+//! help and messages, and the [`Fit`] between their terminal and the scene. [`Seat::handle`] turns what they did into
 //! [`Request`]s for the host: the one place a key or a click gets its meaning, for the local
 //! player and every player of a shared pool alike.
 
@@ -44,7 +45,7 @@ pub(crate) struct SeatView<'a> {
     pub stone: u32,
 }
 
-/// One person.
+/// What one player holds: their aim, stone size, drag, help and messages, and their fit.
 #[derive(Clone, Debug)]
 pub struct Seat {
     fit: Fit,
@@ -171,6 +172,7 @@ impl Seat {
     }
 
     /// Whether the help overlay is open.
+    #[cfg(test)]
     pub fn help_open(&self) -> bool {
         self.help.is_some()
     }

@@ -41,7 +41,7 @@ use super::shore::Shore;
 use super::sky::{Environment, Sky};
 use super::supersample::{Downsample, downsample};
 use super::vec3::{Vec3, dot, normalize};
-use crate::sim::lake::{FAR_SHORE_M, LakeFrame};
+use crate::sim::lake::{FAR_SHORE_M, LakeSurface};
 
 /// Where the lake is seen from: 3 m above the water on the south shore (a person on a low
 /// bank), 3° down, 60° wide, looking north across the lake.
@@ -185,11 +185,13 @@ impl LakeRenderer {
         self.height
     }
 
+    #[cfg(test)]
     /// Supersampling factor per axis.
     pub fn ssaa(&self) -> u32 {
         self.ssaa
     }
 
+    #[cfg(test)]
     /// The camera at the rendering (supersampled) size.
     pub fn camera(&self) -> &Camera {
         &self.camera
@@ -200,6 +202,7 @@ impl LakeRenderer {
         self.mesh.triangle_count()
     }
 
+    #[cfg(test)]
     /// The first row of the output picture that shows water (the far shore's waterline).
     pub fn waterline_row(&self) -> u32 {
         (self.waterline_row as u32).div_ceil(self.ssaa)
@@ -209,7 +212,7 @@ impl LakeRenderer {
     ///
     /// # Panics
     /// When `out` has another size (a programming error).
-    pub fn render(&mut self, frame: &LakeFrame, out: &mut Pixmap) {
+    pub fn render(&mut self, frame: &LakeSurface, out: &mut Pixmap) {
         assert_eq!((out.width(), out.height()), (self.width, self.height), "output size");
         let spacing = mesh_spacing_px(self.width, self.height) * self.ssaa as f32;
         self.mesh.prepare(&self.camera, spacing);
@@ -433,7 +436,7 @@ mod tests {
         let lake = Lake::new(LakeParams { wind_m_s: wind, ..LakeParams::default() });
         let mut r = LakeRenderer::new(w, h, ssaa, 1).unwrap();
         let mut out = Pixmap::new(w, h).unwrap();
-        r.render(&lake.frame(time), &mut out);
+        r.render(&lake.surface(time), &mut out);
         (out, r)
     }
 

@@ -1,7 +1,7 @@
 //! The water mesh renderer: "one renderer, two height sources".
 //!
 //! Anything that implements [`crate::sim::surface::Surface`] (the ocean's
-//! [`crate::sim::ocean::SeaFrame`], the lake's noise field) is drawn the same way:
+//! [`crate::sim::ocean::SeaSurface`], the lake's noise field) is drawn the same way:
 //!
 //! 1. **Sampling** ([`MeshTopology::build`], once per camera): points on a jittered triangular
 //!    lattice in screen space, `spacing_px` apart (fixed sampling of the picture), unprojected

@@ -22,7 +22,7 @@ use super::sky::Sky;
 use super::supersample::{Downsample, downsample};
 use super::texture::SeaTexture;
 use crate::sim::foam::FoamTracker;
-use crate::sim::ocean::{Sea, SeaFrame, SeaTime, cox_munk_slope_variance};
+use crate::sim::ocean::{Sea, SeaSurface, SeaTime, cox_munk_slope_variance};
 
 pub mod glitter;
 pub mod shader;
@@ -225,15 +225,10 @@ impl OceanRenderer {
         &self.camera
     }
 
+    #[cfg(test)]
     /// The sky.
     pub fn sky(&self) -> &Sky {
         &self.sky
-    }
-
-    /// Moves the camera; the mesh is rebuilt at the next frame.
-    pub fn set_camera(&mut self, pose: CameraPose) {
-        self.view.camera = pose;
-        self.camera = Camera::new(pose, self.camera.width(), self.camera.height());
     }
 
     /// Triangles in the mesh (0 before the first frame).
@@ -270,7 +265,7 @@ impl OceanRenderer {
     ///
     /// # Panics
     /// When `out` has another size (a programming error).
-    pub fn render(&mut self, frame: &SeaFrame<'_>, out: &mut Pixmap) {
+    pub fn render(&mut self, frame: &SeaSurface<'_>, out: &mut Pixmap) {
         assert_eq!((out.width(), out.height()), (self.width, self.height), "output size");
         let spacing = ocean_spacing_px(self.width, self.height) * self.view.ssaa as f32;
         if self.mesh.prepare(&self.camera, spacing) {
@@ -310,7 +305,7 @@ impl OceanRenderer {
     /// Draws `frame` and returns the mean glitter at every rendering pixel (a multiple of the
     /// sun's colour, before sparkles, haze and tone mapping): what a measurement of the
     /// glitter's spread reads.
-    pub(crate) fn mean_glitter(&mut self, frame: &SeaFrame<'_>) -> Vec<f32> {
+    pub(crate) fn mean_glitter(&mut self, frame: &SeaSurface<'_>) -> Vec<f32> {
         let mut out = Pixmap::new(self.width, self.height).expect("a valid size");
         self.render(frame, &mut out);
         let light = self.sky.light();
@@ -344,7 +339,7 @@ mod tests {
     #[test]
     fn renders_opaque_and_deterministic_and_supersampled() {
         let sea = Sea::new(SeaParams { wind_m_s: 9.0, wind_from_deg: 300.0, seed: 3, ..SeaParams::default() });
-        let frame = sea.frame(2.0);
+        let frame = sea.surface(2.0);
         let draw = |ssaa| {
             let view = OceanView { ssaa, ..OceanView::default() };
             let mut r = OceanRenderer::new(view, 96, 54, SeaTexture::builtin()).unwrap();

@@ -9,6 +9,7 @@ use tiny_skia::{Color, Paint, PathBuilder, Pixmap, Rect, Stroke, Transform};
 use crate::sim::ocean::SeaParams;
 use crate::sim::spectra::swell::SwellSpectrum;
 use crate::sim::spectra::{SeaSpectrum, SpectrumChoice};
+#[cfg(any(test, feature = "testing"))]
 use crate::sim::spectrum::PiersonMoskowitz;
 
 /// Plot width, px.
@@ -161,9 +162,19 @@ fn line(out: &mut Pixmap, a: (f32, f32), b: (f32, f32), rgb: [u8; 3], stroke: &S
     }
 }
 
+#[cfg(any(test, feature = "testing"))]
 /// The plot of `sea`: E(f) from 0 to 3·fm, and D(theta) at fm over -180..180 degrees.
 pub fn spectrum_plot(sea: &PiersonMoskowitz) -> Pixmap {
     sea_spectrum_plot(&SeaParams { wind_m_s: sea.wind_m_s(), ..SeaParams::default() })
+}
+
+impl SeaParams {
+    /// A plot of this sea's spectrum, what `tidepool spectrum --out` draws: the wind sea's
+    /// spectrum (its name, γ, fetch and depth and the spreading law in the heading) summed with
+    /// its swells; left E(f), right the directions.
+    pub fn spectrum_plot(&self) -> Pixmap {
+        sea_spectrum_plot(self)
+    }
 }
 
 /// The plot of any sea: the wind sea's spectrum (its name, γ, fetch and depth and the

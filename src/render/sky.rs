@@ -75,6 +75,7 @@ impl Sky {
         }
     }
 
+    #[cfg(test)]
     /// The unit direction towards the sun.
     pub fn sun_direction(&self) -> Vec3 {
         self.sun_dir

@@ -30,6 +30,9 @@ struct Level {
 }
 
 impl SeaTexture {
+    /// How many metres of sea one copy of the texture covers (east-west and north-south).
+    pub const TILE_M: f32 = SEA_TEXTURE_TILE_M;
+
     /// The built-in sea texture.
     pub fn builtin() -> SeaTexture {
         let pixmap = super::background::decode(SEA_TEXTURE_PNG).expect("the built-in sea texture is a valid PNG");

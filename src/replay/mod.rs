@@ -199,8 +199,24 @@ pub struct Replay {
 }
 
 impl Replay {
+    /// Reads and checks a replay file.
+    pub fn read(path: &Path) -> Result<Replay> {
+        read_with(path, &Limits::default())
+    }
+
+    /// Parses replay text; `path` only names the file in errors.
+    pub fn parse(path: &Path, text: &str) -> Result<Replay> {
+        parse_with(path, text, &Limits::default())
+    }
+
+    /// [`Replay::parse`] with other limits (the fuzz target uses small ones, so every input is
+    /// answered quickly).
+    pub fn parse_with(path: &Path, text: &str, limits: &Limits) -> Result<Replay> {
+        parse_with(path, text, limits)
+    }
+
     /// The replay as a file holds it: the header line, then one line an event (what
-    /// [`parse`] reads back to an equal replay).
+    /// [`Replay::parse`] reads back to an equal replay).
     pub fn to_text(&self) -> String {
         let mut text = header_line(&self.header) + "\n";
         for entry in &self.entries {
@@ -265,12 +281,7 @@ pub(crate) fn event_line(entry: &Entry) -> String {
     serde_json::to_string(entry).expect("an event always serializes")
 }
 
-/// Reads and checks a replay file.
-pub fn read(path: &Path) -> Result<Replay> {
-    read_with(path, &Limits::default())
-}
-
-/// [`read`] with other limits.
+/// [`Replay::read`] with other limits.
 pub(crate) fn read_with(path: &Path, limits: &Limits) -> Result<Replay> {
     let fail = |line: usize, message: String| Error::Replay { path: path.to_owned(), line, message };
     let size = std::fs::metadata(path).map_err(|e| Error::io("cannot read", path, e))?.len();
@@ -288,14 +299,8 @@ pub(crate) fn read_with(path: &Path, limits: &Limits) -> Result<Replay> {
     parse_with(path, &text, limits)
 }
 
-/// Parses replay text; `path` only names the file in errors.
-pub fn parse(path: &Path, text: &str) -> Result<Replay> {
-    parse_with(path, text, &Limits::default())
-}
-
-/// [`parse`] with other limits (the fuzz target uses small ones, so every input is answered
-/// quickly).
-pub fn parse_with(path: &Path, text: &str, limits: &Limits) -> Result<Replay> {
+/// [`Replay::parse_with`].
+pub(crate) fn parse_with(path: &Path, text: &str, limits: &Limits) -> Result<Replay> {
     let fail = |line: usize, message: String| Error::Replay { path: path.to_owned(), line, message };
     let mut lines = text.lines().enumerate().map(|(i, l)| (i + 1, l)).filter(|(_, l)| !l.trim().is_empty());
     let Some((first, line)) = lines.next() else {

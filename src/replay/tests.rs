@@ -16,7 +16,7 @@ fn text(entries: &[Entry]) -> String {
 }
 
 fn err(text: &str) -> String {
-    parse(Path::new("r.jsonl"), text).unwrap_err().to_string()
+    Replay::parse(Path::new("r.jsonl"), text).unwrap_err().to_string()
 }
 
 #[test]
@@ -32,7 +32,7 @@ fn round_trip() {
         Entry { step: 11, event: Event::Noise { octaves: 6, persistence: 0.55, kind: NoiseKind::Gradient } },
         Entry { step: 12, event: Event::End },
     ];
-    let replay = parse(Path::new("r"), &text(&entries)).unwrap();
+    let replay = Replay::parse(Path::new("r"), &text(&entries)).unwrap();
     assert_eq!(replay, Replay { header: header(), entries });
     assert_eq!(replay.end_step(), 12);
 }
@@ -47,7 +47,7 @@ fn a_file_written_by_0_1_0_reads_back() {
 {"clear":true,"step":519}
 {"end":true,"step":598}
 "#;
-    let replay = parse(Path::new("old"), old).unwrap();
+    let replay = Replay::parse(Path::new("old"), old).unwrap();
     assert_eq!(replay.header.options.damping, "4".parse().unwrap());
     assert_eq!(replay.header.options.sun, Sun::default());
     assert_eq!(replay.entries[0].event, Event::Stone(Stone::new(8, 18, 3, 48).unwrap()));
@@ -73,7 +73,7 @@ fn the_coherent_pools_fields_round_trip_and_are_checked() {
     let line = header_line(&header);
     assert!(line.contains(r#""breeze_style":"gusts","grid":2,"steps_per_second":30"#), "{line}");
     let text = format!("{line}\n{}\n", event_line(&Entry { step: 3, event: Event::End }));
-    let replay = parse(Path::new("r"), &text).unwrap();
+    let replay = Replay::parse(Path::new("r"), &text).unwrap();
     assert_eq!(replay.header, header);
     for (bad, needle) in [
         (r#""grid":2"#, r#""grid":9"#),
@@ -130,7 +130,7 @@ fn recorder_hands_out_its_file_once_when_finished() {
     rec.record(2, Event::Clear);
     let (path, text) = rec.finish(7).expect("the file, at the end");
     assert!(rec.finish(9).is_none(), "handed out once");
-    let replay = parse(&path, &text).unwrap();
+    let replay = Replay::parse(&path, &text).unwrap();
     assert_eq!(replay.entries, vec![Entry { step: 2, event: Event::Clear }, Entry { step: 7, event: Event::End }]);
 }
 
@@ -141,6 +141,6 @@ fn a_recorder_finished_early_ends_at_the_last_step_reached() {
     let mut rec = Recorder::new(Path::new("s.jsonl"), &header());
     rec.advance(40);
     let (path, text) = rec.finish(0).unwrap();
-    let replay = parse(&path, &text).unwrap();
+    let replay = Replay::parse(&path, &text).unwrap();
     assert_eq!(replay.end_step(), 40);
 }

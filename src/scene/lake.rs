@@ -56,14 +56,10 @@ impl LakeScene {
         Some(LakeScene { lake: Lake::new(settings.lake), renderer, ssaa: settings.ssaa, time_s: settings.start_time_s })
     }
 
+    #[cfg(test)]
     /// The lake.
-    pub fn lake(&self) -> &Lake {
+    pub(crate) fn lake(&self) -> &Lake {
         &self.lake
-    }
-
-    /// The renderer.
-    pub fn renderer(&self) -> &LakeRenderer {
-        &self.renderer
     }
 
     /// Output width, px.
@@ -98,7 +94,7 @@ impl LakeScene {
 
     /// Draws the lake at the current time into `out` (the scene's size).
     pub fn render(&mut self, out: &mut Pixmap) {
-        let frame = self.lake.frame(self.time_s);
+        let frame = self.lake.surface(self.time_s);
         self.renderer.render(&frame, out);
     }
 
@@ -120,7 +116,7 @@ impl LakeScene {
     /// `FAR_SHORE_M·width/height` east-west, centred on the camera), at cell centres; columns
     /// run east.
     pub fn heightmap(&self, width: usize, height: usize) -> Heightmap {
-        let frame = self.lake.frame(self.time_s);
+        let frame = self.lake.surface(self.time_s);
         let cell = f64::from(FAR_SHORE_M) / height.max(1) as f64;
         let west = -cell * width as f64 / 2.0;
         let north = f64::from(FAR_SHORE_M);
@@ -328,7 +324,7 @@ mod tests {
         let map = LakeScene::heightmap(&s, 40, 20);
         assert_eq!((map.width, map.height, map.values.len()), (40, 20, 800));
         // Cells of 15 m: row 0 is the far shore, column 0 the west edge.
-        let frame = s.lake().frame(0.0);
+        let frame = s.lake().surface(0.0);
         assert_eq!(map.values[0], frame.height(-292.5, 292.5));
         assert_eq!(map.values[19 * 40 + 39], frame.height(292.5, 7.5));
         assert!(map.values.iter().all(|v| v.abs() < 0.2));

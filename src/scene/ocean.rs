@@ -92,19 +92,10 @@ impl OceanScene {
         })
     }
 
+    #[cfg(test)]
     /// The sea.
-    pub fn sea(&self) -> &Sea {
+    pub(crate) fn sea(&self) -> &Sea {
         &self.sea
-    }
-
-    /// The renderer (camera, sky, triangle count).
-    pub fn renderer(&self) -> &OceanRenderer {
-        &self.renderer
-    }
-
-    /// The renderer, to move the camera.
-    pub fn renderer_mut(&mut self) -> &mut OceanRenderer {
-        &mut self.renderer
     }
 
     /// Output width, px.
@@ -147,7 +138,7 @@ impl OceanScene {
     /// Draws the sea at the current time into `out` (the scene's size).
     pub fn render(&mut self, out: &mut Pixmap) {
         let time = self.sea.time_after(self.start_s, self.elapsed_s);
-        let frame = self.sea.frame_at(time, std::mem::take(&mut self.phases));
+        let frame = self.sea.surface_at(time, std::mem::take(&mut self.phases));
         self.renderer.render(&frame, out);
         self.phases = frame.into_buffer();
     }
@@ -171,7 +162,7 @@ impl OceanScene {
     /// east-west and `extent_m·height/width` north-south, centred under the camera, at cell
     /// centres; columns run east, row 0 is the north edge.
     pub fn heightmap(&self, extent_m: f64, width: usize, height: usize) -> Heightmap {
-        let frame = self.sea.frame_at(self.sea.time_after(self.start_s, self.elapsed_s), Vec::new());
+        let frame = self.sea.surface_at(self.sea.time_after(self.start_s, self.elapsed_s), Vec::new());
         let pose = self.renderer.camera().pose();
         let cell = extent_m / width.max(1) as f64;
         let (west, north) = (pose.east_m - extent_m / 2.0, pose.north_m + cell * height as f64 / 2.0);
@@ -345,7 +336,7 @@ mod tests {
         let s = scene(10.0);
         let map = OceanScene::heightmap(&s, 800.0, 40, 20);
         assert_eq!((map.width, map.height, map.values.len()), (40, 20, 800));
-        let frame = s.sea().frame(0.0);
+        let frame = s.sea().surface(0.0);
         // Row 0 is north, column 0 is west: cell (0, 0) is centred at (-390, 190).
         assert_eq!(map.values[0], frame.height(-390.0, 190.0));
         assert_eq!(map.values[19 * 40 + 39], frame.height(390.0, -190.0));

@@ -291,7 +291,7 @@ fn maps_tile_without_a_seam() {
 
 fn render(renderer: &mut OceanRenderer, sea: &Sea, t: f64) -> Pixmap {
     let mut out = Pixmap::new(renderer.width(), renderer.height()).unwrap();
-    renderer.render(&sea.frame(t), &mut out);
+    renderer.render(&sea.surface(t), &mut out);
     out
 }
 

@@ -58,6 +58,14 @@ impl Default for PoolSettings {
     }
 }
 
+impl PoolSettings {
+    /// The built-in pool floor (square tiles with grout, `assets/pool_floor.png`), the floor of
+    /// [`PoolSettings::default`].
+    pub fn default_floor() -> Pixmap {
+        background::pool_floor()
+    }
+}
+
 /// The most simulation steps a second.
 pub const MAX_STEPS_PER_SECOND: u32 = 240;
 
@@ -374,40 +382,42 @@ impl PoolScene {
     }
 }
 
-/// The default picture's stones, as events at their steps, and the step the picture is taken
-/// at, for a `width x height` pool: six stones falling one after another in a cluster, so the
-/// picture shows young and old rings overlapping.
-///
-/// A ring lives about a hundred steps at the papers' damping whatever the picture's size, so
-/// the cluster is laid out in pixels for a 360-pixel picture and shrunk (never enlarged) to fit
-/// smaller ones, and the picture is taken after 90 steps at 360 pixels and above, fewer (at
-/// least 30) for smaller pictures, whose rings have less room.
-pub fn showcase(width: u32, height: u32) -> (Vec<(u64, Event)>, u64) {
-    let scale = (width.min(height) as f32 / 360.0).min(1.0);
-    let steps_scale = scale.max(1.0 / 3.0);
-    let (cx, cy) = (width as f32 / 2.0, height as f32 / 2.0);
-    // (step at scale 1, x, y offsets from the centre and radius, in pixels at scale 1)
-    let script: [(f32, f32, f32, f32); 6] = [
-        (0.0, -70.0, -40.0, 4.0),
-        (0.0, 30.0, -10.0, 4.0),
-        (15.0, -20.0, 45.0, 3.0),
-        (30.0, 95.0, -55.0, 3.0),
-        (50.0, -120.0, 35.0, 3.0),
-        (65.0, 70.0, 55.0, 2.0),
-    ];
-    let stones = script
-        .iter()
-        .map(|&(step, dx, dy, r)| {
-            let stone = Stone::clamped(
-                (cx + dx * scale) as i32,
-                (cy + dy * scale) as i32,
-                (r * scale.sqrt()).round().max(2.0) as u32,
-                160,
-            );
-            ((step * steps_scale) as u64, Event::Stone(stone))
-        })
-        .collect();
-    (stones, (90.0 * steps_scale).round() as u64)
+impl PoolScene {
+    /// The default picture's stones, as events at their steps, and the step the picture is taken
+    /// at, for a `width x height` pool: six stones falling one after another in a cluster, so the
+    /// picture shows young and old rings overlapping.
+    ///
+    /// A ring lives about a hundred steps at the papers' damping whatever the picture's size, so
+    /// the cluster is laid out in pixels for a 360-pixel picture and shrunk (never enlarged) to fit
+    /// smaller ones, and the picture is taken after 90 steps at 360 pixels and above, fewer (at
+    /// least 30) for smaller pictures, whose rings have less room.
+    pub fn showcase(width: u32, height: u32) -> (Vec<(u64, Event)>, u64) {
+        let scale = (width.min(height) as f32 / 360.0).min(1.0);
+        let steps_scale = scale.max(1.0 / 3.0);
+        let (cx, cy) = (width as f32 / 2.0, height as f32 / 2.0);
+        // (step at scale 1, x, y offsets from the centre and radius, in pixels at scale 1)
+        let script: [(f32, f32, f32, f32); 6] = [
+            (0.0, -70.0, -40.0, 4.0),
+            (0.0, 30.0, -10.0, 4.0),
+            (15.0, -20.0, 45.0, 3.0),
+            (30.0, 95.0, -55.0, 3.0),
+            (50.0, -120.0, 35.0, 3.0),
+            (65.0, 70.0, 55.0, 2.0),
+        ];
+        let stones = script
+            .iter()
+            .map(|&(step, dx, dy, r)| {
+                let stone = Stone::clamped(
+                    (cx + dx * scale) as i32,
+                    (cy + dy * scale) as i32,
+                    (r * scale.sqrt()).round().max(2.0) as u32,
+                    160,
+                );
+                ((step * steps_scale) as u64, Event::Stone(stone))
+            })
+            .collect();
+        (stones, (90.0 * steps_scale).round() as u64)
+    }
 }
 
 impl Scene for PoolScene {

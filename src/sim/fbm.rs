@@ -110,6 +110,7 @@ impl Fbm {
         self.levels
     }
 
+    #[cfg(test)]
     /// All values, row-major.
     pub fn values(&self) -> &[f32] {
         &self.values
@@ -141,6 +142,7 @@ impl Fbm {
         top + (bottom - top) * ty
     }
 
+    #[cfg(test)]
     /// The mean of the squared values (the field's variance about zero).
     pub fn mean_square(&self) -> f64 {
         self.values.iter().map(|&v| f64::from(v) * f64::from(v)).sum::<f64>() / self.values.len() as f64

@@ -415,8 +415,8 @@ mod tests {
         assert_eq!(clock.step_at(sea.time(64.0)), (256, 0.0));
         assert_eq!(clock.step_at(sea.time_after(0.3, 64.0)).0, clock.step_at(sea.time(0.3)).0 + 256);
         assert_eq!(
-            sea.frame_at(clock.time_of(256), Vec::new()).into_buffer(),
-            sea.frame_at(clock.time_of(0), Vec::new()).into_buffer()
+            sea.surface_at(clock.time_of(256), Vec::new()).into_buffer(),
+            sea.surface_at(clock.time_of(0), Vec::new()).into_buffer()
         );
         let plain = FoamClock::of(&params);
         let (n, frac) = plain.step_at(SeaTime::Seconds(1.25));

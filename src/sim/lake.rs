@@ -31,7 +31,7 @@
 
 use std::f32::consts::PI;
 
-use super::noise::{Fractal, MAX_OCTAVES, NoiseFrame, NoiseKind, WaterNoise};
+use super::noise::{Fractal, MAX_OCTAVES, NoiseKind, NoiseSurface, WaterNoise};
 use super::ocean::upper_normal_quantile;
 use super::surface::{Footprint, Surface, SurfaceSample};
 use crate::error::ValueError;
@@ -109,7 +109,7 @@ impl Gusts {
 /// [`Gusts`] at one moment.
 #[derive(Clone, Copy, Debug, PartialEq)]
 struct GustFrame {
-    noise: NoiseFrame,
+    noise: NoiseSurface,
     std: f32,
     /// Σ p²ⁱ over the octaves (the variance is this times the noise kind's).
     total_weight: f32,
@@ -163,6 +163,9 @@ pub struct LakeParams {
 }
 
 impl LakeParams {
+    /// The strongest wind the lake takes, m/s (a storm; beyond it a lake is all spray).
+    pub const MAX_WIND_M_S: f64 = crate::sim::wind::MAX_LAKE_WIND_M_S;
+
     /// The significant wave height (4 standard deviations of the surface) this wind raises, m.
     pub fn significant_height_m(&self) -> f64 {
         Lake::new(*self).significant_height_m()
@@ -289,18 +292,14 @@ impl Lake {
         self.hs_m
     }
 
-    /// Peak wavelength, m.
-    pub fn peak_wavelength_m(&self) -> f64 {
-        self.peak_wavelength_m
-    }
-
+    #[cfg(test)]
     /// The animated noise.
     pub fn water(&self) -> &WaterNoise {
         &self.water
     }
 
     /// The water at `time_s` seconds.
-    pub fn frame(&self, time_s: f64) -> LakeFrame {
+    pub fn surface(&self, time_s: f64) -> LakeSurface {
         let noise = self.water.at(time_s);
         let kind = self.water.fractal.kind;
         let mut slope_variance = [0.0f32; MAX_OCTAVES];
@@ -318,14 +317,14 @@ impl Lake {
             threshold: g.threshold,
             gain: g.gain,
         };
-        LakeFrame { noise, gusts, scale_m: self.scale_m, rms_m: (self.hs_m / 4.0) as f32, slope_variance }
+        LakeSurface { noise, gusts, scale_m: self.scale_m, rms_m: (self.hs_m / 4.0) as f32, slope_variance }
     }
 }
 
 /// The lake's surface at one moment.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LakeFrame {
-    noise: NoiseFrame,
+pub struct LakeSurface {
+    noise: NoiseSurface,
     gusts: GustFrame,
     scale_m: f32,
     rms_m: f32,
@@ -333,7 +332,7 @@ pub struct LakeFrame {
     slope_variance: [f32; MAX_OCTAVES],
 }
 
-impl LakeFrame {
+impl LakeSurface {
     /// The full surface height at (east, north) metres, m.
     pub fn height(&self, x_m: f32, y_m: f32) -> f32 {
         if self.scale_m == 0.0 {
@@ -357,6 +356,7 @@ impl LakeFrame {
         self.rms_m
     }
 
+    #[cfg(test)]
     /// The slope variance per axis of all octaves together.
     pub fn slope_variance(&self) -> f32 {
         self.slope_variance.iter().sum()
@@ -369,7 +369,7 @@ impl LakeFrame {
     }
 }
 
-impl Surface for LakeFrame {
+impl Surface for LakeSurface {
     fn sample(&self, x: f32, y: f32, footprint: &Footprint) -> SurfaceSample {
         if self.scale_m == 0.0 {
             return SurfaceSample::default();
@@ -448,7 +448,7 @@ mod tests {
         assert!((rough_fraction(0.0) - MIN_COVER).abs() < 1e-12);
         assert_eq!(rough_fraction(FULL_COVER_M_S), 1.0);
         for wind in [1.0, 2.5] {
-            let frame = Lake::new(LakeParams { wind_m_s: wind, ..LakeParams::default() }).frame(3.0);
+            let frame = Lake::new(LakeParams { wind_m_s: wind, ..LakeParams::default() }).surface(3.0);
             let (mut rough, mut square, n) = (0, 0.0f64, 20_000);
             for i in 0..n {
                 let (x, y) = ((i % 200) as f32 * 7.3 - 700.0, (i / 200) as f32 * 6.1);
@@ -469,14 +469,14 @@ mod tests {
             let mid = frame.gusts.roughness_squared(x, y, 10.0);
             assert!(mid > 0.0 && mid < 1.0, "{mid}");
         }
-        let strong = Lake::new(LakeParams { wind_m_s: 8.0, ..LakeParams::default() }).frame(0.0);
+        let strong = Lake::new(LakeParams { wind_m_s: 8.0, ..LakeParams::default() }).surface(0.0);
         assert_eq!(strong.roughness(12.0, 40.0), 1.0);
     }
 
     #[test]
     fn calm_water_is_flat() {
         let lake = Lake::new(LakeParams { wind_m_s: 0.0, ..LakeParams::default() });
-        let frame = lake.frame(5.0);
+        let frame = lake.surface(5.0);
         assert_eq!(frame.height(3.0, 40.0), 0.0);
         assert_eq!(frame.sample(3.0, 40.0, &Footprint::isotropic(0.0)), SurfaceSample::default());
         assert_eq!(frame.slope_variance(), 0.0);
@@ -487,7 +487,7 @@ mod tests {
         for noise in [NoiseKind::Value, NoiseKind::Gradient] {
             for (octaves, persistence) in [(5, 0.5), (2, 0.8)] {
                 let lake = Lake::new(LakeParams { wind_m_s: 6.0, octaves, persistence, noise, seed: 4 });
-                let frame = lake.frame(1.0);
+                let frame = lake.surface(1.0);
                 let (mut h2, mut s2) = (0.0f64, 0.0f64);
                 let n = 4000;
                 let d = 1e-3;
@@ -513,7 +513,7 @@ mod tests {
     #[test]
     fn footprints_drop_fine_octaves_into_unresolved_slope() {
         let lake = Lake::new(LakeParams { wind_m_s: 8.0, ..LakeParams::default() });
-        let frame = lake.frame(2.0);
+        let frame = lake.surface(2.0);
         let full = frame.sample(1.0, 20.0, &Footprint::isotropic(0.0));
         assert_eq!(full.height_m, frame.height(1.0, 20.0));
         assert!(full.unresolved_slope_variance < 1e-9);
@@ -531,15 +531,15 @@ mod tests {
     #[test]
     fn the_water_moves_and_the_seed_matters() {
         let lake = Lake::new(LakeParams { wind_m_s: 7.0, ..LakeParams::default() });
-        let (a, b) = (lake.frame(0.0), lake.frame(0.5));
+        let (a, b) = (lake.surface(0.0), lake.surface(0.5));
         assert_ne!(a.height(2.0, 30.0), b.height(2.0, 30.0));
-        assert_eq!(a.height(2.0, 30.0), lake.frame(0.0).height(2.0, 30.0));
+        assert_eq!(a.height(2.0, 30.0), lake.surface(0.0).height(2.0, 30.0));
         let other = Lake::new(LakeParams { seed: 2, ..lake.params() });
-        assert_ne!(other.frame(0.0).height(2.0, 30.0), a.height(2.0, 30.0));
+        assert_ne!(other.surface(0.0).height(2.0, 30.0), a.height(2.0, 30.0));
         assert!(lake.water().speed_m_s > 0.5 && lake.water().speed_m_s < 2.0);
         // Gust patches drift too: a light breeze's rough patches move downwind.
         let breeze = Lake::new(LakeParams { wind_m_s: 2.0, ..LakeParams::default() });
-        let (a, b) = (breeze.frame(0.0), breeze.frame(10.0));
+        let (a, b) = (breeze.surface(0.0), breeze.surface(10.0));
         let moved = (0..400).filter(|&i| {
             let (x, y) = ((i % 20) as f32 * 10.0, (i / 20) as f32 * 10.0);
             a.roughness(x, y) != b.roughness(x, y)

@@ -323,7 +323,7 @@ struct OctaveFrame {
 
 /// A [`WaterNoise`] frozen at one time: samples of any point, octave by octave.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct NoiseFrame {
+pub struct NoiseSurface {
     kind: NoiseKind,
     count: usize,
     octaves: [OctaveFrame; MAX_OCTAVES],
@@ -331,7 +331,7 @@ pub struct NoiseFrame {
 
 impl WaterNoise {
     /// The field at time `time_s` seconds.
-    pub fn at(&self, time_s: f64) -> NoiseFrame {
+    pub fn at(&self, time_s: f64) -> NoiseSurface {
         let f = &self.fractal;
         let mut octaves = [OctaveFrame::default(); MAX_OCTAVES];
         let mut amplitude = 1.0f32;
@@ -365,11 +365,11 @@ impl WaterNoise {
             };
             amplitude *= f.persistence;
         }
-        NoiseFrame { kind: f.kind, count: f.octave_count(), octaves }
+        NoiseSurface { kind: f.kind, count: f.octave_count(), octaves }
     }
 }
 
-impl NoiseFrame {
+impl NoiseSurface {
     /// Octaves in the sum.
     pub fn octave_count(&self) -> usize {
         self.count

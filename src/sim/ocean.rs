@@ -52,7 +52,7 @@
 //! `λ·|B|²/2`, B = Σ a·√k·e^(iθ), which the resting point's height gets added: one more pair
 //! of sums, exact for a single wave (where Gerstner's wave already is Stokes's to second
 //! order and the term only restores the mean level), and narrow-band seas. The skewness
-//! becomes Longuet-Higgins's ≈ 3·k·σ. [`SeaFrame::height`] returns the
+//! becomes Longuet-Higgins's ≈ 3·k·σ. [`SeaSurface::height`] returns the
 //! **Eulerian** height at a fixed point (what a heightmap holds): it finds the resting point
 //! x0 with x0 + λ·D(x0) = x by fixed-point iteration ([`EULER_ITERATIONS`]).
 //!
@@ -78,10 +78,10 @@ use super::trig::fast_sincos;
 
 mod build;
 mod fold;
-mod frame;
+mod surface;
 pub(crate) use fold::{FOLD_ROWS, PhaseRows};
-pub use frame::SeaFrame;
-use frame::resolution_weight;
+pub use surface::SeaSurface;
+use surface::resolution_weight;
 
 /// Lowest frequency of the sines, as a multiple of fp.
 pub const BAND_LOW: f64 = 0.5;
@@ -132,18 +132,27 @@ pub fn cox_munk_slope_variance(wind_m_s: f64) -> f64 {
     CALM_SLOPE_VARIANCE + 0.00512 * wind_m_s.max(0.0)
 }
 
-/// Checks a choppiness: finite, 0..=4.
-pub fn check_choppiness(value: f64) -> Result<f64, ValueError> {
-    if !value.is_finite() || !(0.0..=MAX_CHOPPINESS).contains(&value) {
-        return Err(ValueError::new(
-            "choppiness",
-            format!(
-                "the choppiness {value} is not a number in 0..={MAX_CHOPPINESS}; 0 moves the water only up and \
-                 down, {DEFAULT_CHOPPINESS} is the physical displacement"
-            ),
-        ));
+impl SeaParams {
+    /// The choppiness a sea has unless told otherwise: the physical displacement.
+    pub const DEFAULT_CHOPPINESS: f64 = DEFAULT_CHOPPINESS;
+    /// The wind a sea has unless told otherwise, m/s.
+    pub const DEFAULT_WIND_M_S: f64 = crate::sim::wind::DEFAULT_SEA_WIND_M_S;
+    /// The direction the wind blows from unless told otherwise, degrees clockwise from north.
+    pub const DEFAULT_WIND_FROM_DEG: f64 = crate::sim::wind::DEFAULT_WIND_FROM_DEG;
+
+    /// Checks a choppiness: finite, 0..=4.
+    pub fn check_choppiness(value: f64) -> Result<f64, ValueError> {
+        if !value.is_finite() || !(0.0..=MAX_CHOPPINESS).contains(&value) {
+            return Err(ValueError::new(
+                "choppiness",
+                format!(
+                    "the choppiness {value} is not a number in 0..={MAX_CHOPPINESS}; 0 moves the water only up and \
+                     down, {DEFAULT_CHOPPINESS} is the physical displacement"
+                ),
+            ));
+        }
+        Ok(value)
     }
-    Ok(value)
 }
 
 /// The z with P(N(0,1) > z) = p, for p in (0, 1); +inf for p <= 0, -inf for p >= 1.
@@ -182,7 +191,7 @@ pub struct Component {
 }
 
 /// Everything that defines a sea. `Default` is the command line's sea: Pierson–Moskowitz with
-/// the paper's spreading, no swell, the physical choppiness ([`DEFAULT_CHOPPINESS`]), no loop,
+/// the paper's spreading, no swell, the physical choppiness ([`SeaParams::DEFAULT_CHOPPINESS`]), no loop,
 /// a 10 m/s wind from 330°, seed 1.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SeaParams {
@@ -198,7 +207,7 @@ pub struct SeaParams {
     pub spreading: Spreading,
     /// Swell from distant storms, summed with the wind sea.
     pub swells: Swells,
-    /// λ, the scale of the horizontal displacement ([`check_choppiness`]); 0 = none.
+    /// λ, the scale of the horizontal displacement ([`SeaParams::check_choppiness`]); 0 = none.
     pub choppiness: f64,
     /// Repeat exactly every this many seconds (None = never).
     pub loop_period: Option<LoopPeriod>,
@@ -267,6 +276,8 @@ struct Tail {
     velocity_m_s: [f64; 2],
     /// In a looping sea: whole tail periods crossed per loop, east and north.
     loop_periods: [i64; 2],
+    /// Its height variance (read by the tests).
+    #[cfg_attr(not(test), allow(dead_code))]
     variance: f64,
     /// Per octave: the slope variance per axis of the field cut off there.
     octave_slope: Vec<f32>,
@@ -289,7 +300,7 @@ struct Lanes {
     dxy: Vec<f32>,
 }
 
-/// A sea: its spectrum, its sines and its tail. Immutable; sample it through [`Sea::frame`].
+/// A sea: its spectrum, its sines and its tail. Immutable; sample it through [`Sea::surface`].
 #[derive(Clone, Debug)]
 pub struct Sea {
     params: SeaParams,
@@ -347,16 +358,19 @@ impl Sea {
         self.lanes.amp.len()
     }
 
+    #[cfg(test)]
     /// The sines the foam's Jacobian sums (padded), of [`Sea::padded_len`].
     pub fn fold_len(&self) -> usize {
         self.fold.amp.len()
     }
 
+    #[cfg(test)]
     /// The variance carried by the fBm tail, m² (0 for a calm).
     pub fn tail_variance(&self) -> f64 {
         self.tail.as_ref().map_or(0.0, |t| t.variance)
     }
 
+    #[cfg(test)]
     /// The tail's field, if the sea is not calm.
     pub fn tail_field(&self) -> Option<&Fbm> {
         self.tail.as_ref().map(|t| &t.field)
@@ -383,6 +397,7 @@ impl Sea {
         sizing_wavelength_m(&self.params)
     }
 
+    #[cfg(test)]
     /// The moment `time_s` seconds from 0: ticks of the loop for a looping sea.
     pub fn time(&self, time_s: f64) -> SeaTime {
         match self.params.loop_period {
@@ -408,15 +423,10 @@ impl Sea {
         }
     }
 
+    #[cfg(test)]
     /// The sea at `time_s` seconds, ready to sample.
-    pub fn frame(&self, time_s: f64) -> SeaFrame<'_> {
-        self.frame_at(self.time(time_s), Vec::new())
-    }
-
-    /// [`Sea::frame`] reusing `buffer` (from [`SeaFrame::into_buffer`]), so that a stream of
-    /// frames allocates nothing.
-    pub fn frame_in(&self, time_s: f64, buffer: Vec<f32>) -> SeaFrame<'_> {
-        self.frame_at(self.time(time_s), buffer)
+    pub fn surface(&self, time_s: f64) -> SeaSurface<'_> {
+        self.surface_at(self.time(time_s), Vec::new())
     }
 
     /// The phase of component `i` at `time`, radians in [0, 2π).
@@ -433,7 +443,7 @@ impl Sea {
     }
 
     /// The sea at a [`SeaTime`], reusing `buffer`.
-    pub fn frame_at(&self, time: SeaTime, mut phase: Vec<f32>) -> SeaFrame<'_> {
+    pub fn surface_at(&self, time: SeaTime, mut phase: Vec<f32>) -> SeaSurface<'_> {
         phase.clear();
         phase.extend(self.components.iter().map(|c| self.phase(c, time)));
         phase.resize(self.padded_len(), 0.0);
@@ -448,7 +458,7 @@ impl Sea {
             };
             [at(0), at(1)]
         });
-        SeaFrame { sea: self, phase, tail_offset, time, time_s: self.seconds(time) }
+        SeaSurface { sea: self, phase, tail_offset, time }
     }
 }
 

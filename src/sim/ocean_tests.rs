@@ -4,7 +4,7 @@
 use super::*;
 use crate::sim::dispersion;
 use crate::sim::looping::LoopPeriod;
-use crate::sim::ocean::frame::HEIGHT;
+use crate::sim::ocean::surface::HEIGHT;
 use crate::sim::spectra::{Depth, Jonswap};
 use crate::sim::surface::SurfaceSample;
 
@@ -42,7 +42,7 @@ fn measured_phase(sea: &Sea, t: f64) -> f64 {
     let (kx, ky) = (c.wavenumber * ux, c.wavenumber * uy);
     let wavelength = 2.0 * PI / c.wavenumber;
     let fp = Footprint { across: [0.0, 0.0], along: [(uy * 1e5) as f32, (-ux * 1e5) as f32] };
-    let frame = sea.frame(t);
+    let frame = sea.surface(t);
     let (mut cs, mut sn) = (0.0f64, 0.0f64);
     let n = 256;
     for i in 0..n {
@@ -84,7 +84,7 @@ fn the_surface_variance_is_m0() {
     let m0 = s.spectrum().m0();
     let (mut sum, mut n) = (0.0f64, 0usize);
     for t in 0..20 {
-        let frame = s.frame(t as f64 * 7.3);
+        let frame = s.surface(t as f64 * 7.3);
         for i in 0..40 {
             for j in 0..40 {
                 let h = f64::from(frame.height(i as f32 * 23.7 - 400.0, j as f32 * 19.1 + 100.0));
@@ -111,7 +111,7 @@ fn waves_travel_downwind() {
 fn calm_is_flat() {
     let s = sea(0.0);
     assert!(s.components().is_empty() && s.tail_field().is_none() && s.padded_len() == 0);
-    let f = s.frame(12.0);
+    let f = s.surface(12.0);
     assert_eq!(
         f.sample(3.0, 4.0, &Footprint::isotropic(1.0)),
         SurfaceSample { unresolved_slope_variance: 0.0015, ..SurfaceSample::default() }
@@ -122,7 +122,7 @@ fn calm_is_flat() {
 #[test]
 fn footprints_filter_short_waves_and_report_their_slope() {
     let s = sea(10.0);
-    let f = s.frame(0.0);
+    let f = s.surface(0.0);
     let near = f.sample(10.0, 20.0, &Footprint::default());
     let far = f.sample(10.0, 20.0, &Footprint::isotropic(200.0));
     assert!(far.unresolved_slope_variance > near.unresolved_slope_variance);
@@ -155,7 +155,7 @@ fn lanes_are_padded_by_construction_for_any_bin_count() {
     for (fb, db) in [(1, 1), (3, 5), (7, 3), (24, 16), (13, 11)] {
         let s = Sea::with_bins(SeaParams { wind_m_s: 9.0, ..SeaParams::default() }, fb, db);
         assert_eq!(s.padded_len(), s.components().len().next_multiple_of(LANES), "{fb}x{db}");
-        let f = s.frame(3.5);
+        let f = s.surface(3.5);
         // The lanes' sum (the tail is added after it) against a plain sum over exactly the
         // components longer than twice the footprint.
         for size in [0.0f32, 0.4, 3.0] {
@@ -179,8 +179,8 @@ fn a_looping_sea_repeats_bit_for_bit() {
     for c in s.components() {
         assert!(c.harmonic >= 1 && (c.frequency_hz * 100.0 - f64::from(c.harmonic)).abs() < 1e-9);
     }
-    let (a, b, c) = (s.frame(0.0), s.frame(100.0), s.frame(37.0));
-    let d = s.frame(137.0);
+    let (a, b, c) = (s.surface(0.0), s.surface(100.0), s.surface(37.0));
+    let d = s.surface(137.0);
     for (x, y) in [(0.0f32, 0.0f32), (55.0, -310.0), (1234.5, 77.0)] {
         for fp in [Footprint::default(), Footprint::isotropic(7.0)] {
             assert_eq!(a.sample(x, y, &fp), b.sample(x, y, &fp));
@@ -198,7 +198,7 @@ fn a_looping_sea_repeats_bit_for_bit() {
 #[test]
 fn the_eulerian_height_is_the_height_of_the_water_carried_there() {
     let s = Sea::new(SeaParams { wind_m_s: 14.0, choppiness: 1.0, ..SeaParams::default() });
-    let f = s.frame(4.0);
+    let f = s.surface(4.0);
     let full = Footprint::default();
     for (x, y) in [(3.0f32, 4.0f32), (-80.0, 41.0), (250.0, 250.0)] {
         // Find the resting point by brute force on the iteration's answer: it lands on (x, y).
@@ -213,7 +213,7 @@ fn the_eulerian_height_is_the_height_of_the_water_carried_there() {
         assert_eq!(f.height(x, y), s0.height_m);
     }
     let flat = Sea::new(SeaParams { wind_m_s: 14.0, choppiness: 0.0, ..SeaParams::default() });
-    assert_eq!(flat.frame(4.0).sample(3.0, 4.0, &full).displacement_m, [0.0, 0.0]);
+    assert_eq!(flat.surface(4.0).sample(3.0, 4.0, &full).displacement_m, [0.0, 0.0]);
 }
 
 /// The skewness of Eulerian heights on a 128x128 grid over 48 peak wavelengths (about
@@ -222,7 +222,7 @@ pub(crate) fn skewness(sea: &Sea) -> f64 {
     let span = 48.0 * sea.spectrum().peak_wavelength_m().unwrap() as f32;
     let mut h = Vec::new();
     for t in [0.0, 31.0, 67.0, 113.0] {
-        let f = sea.frame(t);
+        let f = sea.surface(t);
         for i in 0..128 {
             for j in 0..128 {
                 h.push(f64::from(f.height(span * (i as f32 + 0.37) / 128.0, span * (j as f32 + 0.61) / 128.0)));
@@ -246,17 +246,21 @@ fn choppiness_sharpens_crests() {
     }
     assert!(choppy >= 0.1, "skewness at Beaufort 6 with λ = 1: {choppy}");
     assert!(choppy - linear > 0.08, "{choppy} vs linear {linear}");
-    assert!(check_choppiness(f64::NAN).is_err() && check_choppiness(-0.1).is_err() && check_choppiness(5.0).is_err());
-    assert_eq!(check_choppiness(1.5), Ok(1.5));
+    assert!(
+        SeaParams::check_choppiness(f64::NAN).is_err()
+            && SeaParams::check_choppiness(-0.1).is_err()
+            && SeaParams::check_choppiness(5.0).is_err()
+    );
+    assert_eq!(SeaParams::check_choppiness(1.5), Ok(1.5));
 }
 
 #[test]
 fn same_seed_same_sea() {
     let (sa, sb) = (sea(9.0), sea(9.0));
-    let (a, b) = (sa.frame(5.0), sb.frame(5.0));
+    let (a, b) = (sa.surface(5.0), sb.surface(5.0));
     assert_eq!(a.sample(1.0, 2.0, &Footprint::isotropic(0.5)), b.sample(1.0, 2.0, &Footprint::isotropic(0.5)));
     let c = Sea::new(SeaParams { wind_m_s: 9.0, wind_from_deg: 270.0, seed: 43, ..SeaParams::default() });
-    assert_ne!(a.height(1.0, 2.0), c.frame(5.0).height(1.0, 2.0));
+    assert_ne!(a.height(1.0, 2.0), c.surface(5.0).height(1.0, 2.0));
 }
 
 #[test]

@@ -16,7 +16,7 @@
 //! so the maps are the same bytes on every machine.
 //!
 //! Heights are resampled at the fixed lattice points (Eulerian: what a height field holds),
-//! like [`super::ocean::SeaFrame::height`]; normals are those of that surface.
+//! like [`super::ocean::SeaSurface::height`]; normals are those of that surface.
 //!
 //! # Foam
 //! Foam follows the model of [`super::foam`] at the resting points of a lattice of its own,
@@ -122,49 +122,57 @@ impl std::fmt::Debug for PatchSea {
     }
 }
 
-/// Checks a patch's side and extent.
-pub fn check_patch(size: usize, extent_m: f64) -> Result<(), ValueError> {
-    if !(PATCH_SIZE_RANGE.0..=PATCH_SIZE_RANGE.1).contains(&size) {
-        return Err(ValueError::new(
-            "map size",
-            format!(
-                "a map {size} points wide is outside {}..={}; give a square size such as 1024x1024",
-                PATCH_SIZE_RANGE.0, PATCH_SIZE_RANGE.1
-            ),
-        ));
+impl PatchSea {
+    /// Checks a patch's side and extent.
+    pub fn check(size: usize, extent_m: f64) -> Result<(), ValueError> {
+        if !(PATCH_SIZE_RANGE.0..=PATCH_SIZE_RANGE.1).contains(&size) {
+            return Err(ValueError::new(
+                "map size",
+                format!(
+                    "a map {size} points wide is outside {}..={}; give a square size such as 1024x1024",
+                    PATCH_SIZE_RANGE.0, PATCH_SIZE_RANGE.1
+                ),
+            ));
+        }
+        if !extent_m.is_finite() || !(PATCH_EXTENT_RANGE_M.0..=PATCH_EXTENT_RANGE_M.1).contains(&extent_m) {
+            return Err(ValueError::new(
+                "map extent",
+                format!(
+                    "the map extent {extent_m} m is outside {}..={} m; give the side of the patch in metres, e.g. 500",
+                    PATCH_EXTENT_RANGE_M.0, PATCH_EXTENT_RANGE_M.1
+                ),
+            ));
+        }
+        Ok(())
     }
-    if !extent_m.is_finite() || !(PATCH_EXTENT_RANGE_M.0..=PATCH_EXTENT_RANGE_M.1).contains(&extent_m) {
-        return Err(ValueError::new(
-            "map extent",
-            format!(
-                "the map extent {extent_m} m is outside {}..={} m; give the side of the patch in metres, e.g. 500",
-                PATCH_EXTENT_RANGE_M.0, PATCH_EXTENT_RANGE_M.1
-            ),
-        ));
-    }
-    Ok(())
 }
 
-/// A map's side when it is square: maps tile, so width and height must agree.
-pub fn check_map_size(width: usize, height: usize) -> Result<usize, ValueError> {
-    if width != height {
-        return Err(ValueError::new(
-            "map size",
-            format!("maps are square so that they tile; give a square size such as 1024x1024 (not {width}x{height})"),
-        ));
+impl PatchSea {
+    /// A map's side when it is square: maps tile, so width and height must agree.
+    pub fn check_map_size(width: usize, height: usize) -> Result<usize, ValueError> {
+        if width != height {
+            return Err(ValueError::new(
+                "map size",
+                format!(
+                    "maps are square so that they tile; give a square size such as 1024x1024 (not {width}x{height})"
+                ),
+            ));
+        }
+        PatchSea::check(width, PATCH_EXTENT_RANGE_M.0)?;
+        Ok(width)
     }
-    check_patch(width, PATCH_EXTENT_RANGE_M.0)?;
-    Ok(width)
 }
 
 /// How many peak wavelengths a map spans when no extent is given.
 pub const DEFAULT_MAP_WAVELENGTHS: f64 = 10.0;
 
-/// The default side of a map of the sea `params` describes, m (10
-/// peak wavelengths of the wind sea, and at least four of the longest swell's; 100 m for a
-/// calm without swell).
-pub fn default_extent_m(params: &SeaParams) -> f64 {
-    sizing_wavelength_m(params).map_or(100.0, |l| DEFAULT_MAP_WAVELENGTHS * l)
+impl PatchSea {
+    /// The default side of a map of the sea `params` describes, m (10
+    /// peak wavelengths of the wind sea, and at least four of the longest swell's; 100 m for a
+    /// calm without swell).
+    pub fn default_extent_m(params: &SeaParams) -> f64 {
+        sizing_wavelength_m(params).map_or(100.0, |l| DEFAULT_MAP_WAVELENGTHS * l)
+    }
 }
 
 /// A lattice index as a signed wavenumber index.
@@ -368,7 +376,7 @@ impl Lattice {
 impl PatchSea {
     /// A `size x size` patch `extent_m` metres across of the sea `params` describes.
     pub fn new(params: SeaParams, size: usize, extent_m: f64) -> Result<PatchSea, ValueError> {
-        check_patch(size, extent_m)?;
+        PatchSea::check(size, extent_m)?;
         let sea = Lattice::of_sea(&params, size, extent_m);
         let model = FoamModel::of(&Sea::new(params));
         let foam = model.is_active().then(|| {

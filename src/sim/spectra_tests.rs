@@ -141,7 +141,7 @@ fn series(sea: &Sea, points: &[[f32; 2]], dt: f64, count: usize) -> Vec<Vec<f64>
     let mut out = vec![Vec::with_capacity(count); points.len()];
     let full = Footprint::default();
     for k in 0..count {
-        let frame = sea.frame(100.0 + k as f64 * dt);
+        let frame = sea.surface(100.0 + k as f64 * dt);
         for (p, s) in points.iter().zip(out.iter_mut()) {
             s.push(f64::from(frame.sample(p[0], p[1], &full).height_m));
         }

@@ -65,6 +65,7 @@ impl PiersonMoskowitz {
         (!self.is_calm()).then(|| PEAK_FACTOR * G / self.wind_m_s)
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The peak period 1/fm in seconds, or `None` for a calm.
     pub fn peak_period_s(&self) -> Option<f64> {
         self.peak_hz().map(|f| 1.0 / f)
@@ -98,6 +99,7 @@ impl PiersonMoskowitz {
         self.m0() * (-1.25 * (fm / f_hz).powi(4)).exp()
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The variance carried by frequencies in `f_lo..f_hi`, m².
     pub fn band_variance(&self, f_lo_hz: f64, f_hi_hz: f64) -> f64 {
         self.cumulative_variance(f_hi_hz) - self.cumulative_variance(f_lo_hz)
@@ -109,6 +111,7 @@ impl PiersonMoskowitz {
         ALPHA * G * G / ((2.0 * PI).powi(4) * 5.0 * fm.powi(4))
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The significant wave height Hs = 4·√m0 = 0.2413·U²/g, in metres.
     pub fn significant_height_m(&self) -> f64 {
         4.0 * self.m0().sqrt()

@@ -1,5 +1,5 @@
 //! The contract between a water simulation and the mesh renderer: "one renderer, two height
-//! sources". The ocean ([`crate::sim::ocean::SeaFrame`]) and the lake implement [`Surface`];
+//! sources". The ocean ([`crate::sim::ocean::SeaSurface`]) and the lake implement [`Surface`];
 //! [`crate::render::mesh::MeshRenderer`] samples it at its mesh vertices, one footprint each.
 
 /// The patch of sea one mesh sample stands for: the ground vectors (east, north metres) of one
@@ -17,6 +17,7 @@ pub struct Footprint {
 }
 
 impl Footprint {
+    #[cfg(test)]
     /// A square footprint of `size_m` metres (axis-aligned); 0 is the full surface.
     pub fn isotropic(size_m: f32) -> Footprint {
         Footprint { across: [size_m, 0.0], along: [0.0, size_m] }

@@ -80,7 +80,7 @@ fn a_gif_of_falling_stones() {
     assert_eq!((w, h, frames.len()), (96, 64, 12));
     assert!(frames.iter().all(|(_, delay)| *delay == 5), "20 fps = 5 cs a frame");
     // Frame k is the pool after k · 60 / 20 = 3k steps, with the default stones.
-    let (script, _) = tidepool::pool_showcase(96, 64);
+    let (script, _) = tidepool::PoolScene::showcase(96, 64);
     let spec = SceneSpec::Pool(PoolSettings::default());
     let exact = |step: u64| rgba(&picture(&spec, 96, 64, &script, step));
     for (k, (frame, _)) in frames.iter().enumerate() {

@@ -14,7 +14,7 @@
 use std::time::{Duration, Instant};
 
 use crate::common::pty::{Player, temp_dir};
-use tidepool::terminal::{SYNC_BEGIN, SYNC_END};
+use tidepool::testing::{SYNC_BEGIN, SYNC_END};
 
 /// The player's settings before the alive defaults: no breeze, rain 0.02 a step, damping 4.
 const STILL_BETWEEN_STONES: &str = "--breeze 0 --rain 0.02 --damping 4 --bandwidth unlimited";

@@ -3,7 +3,7 @@
 //! Each scene is rendered as the player shows it in a 160x48 terminal (160x94 pixels, 30 fps,
 //! the player's defaults) by the command a user types (`tidepool render ... --frames 300 --fps
 //! 30` into PNG files), and the frames are compared by their luma:
-//! - SSIM (`tidepool::terminal::ssim`: Gaussian window of 1.5, the usual constants) between
+//! - SSIM (`tidepool::testing::ssim`: Gaussian window of 1.5, the usual constants) between
 //!   frames 1, 3 and 30 apart (33 ms, 100 ms, 1 s), averaged over every such pair;
 //! - alive: the share of pixels whose luma differs by at least 2 % of full scale (5.1 of 255)
 //!   between frames a second apart, averaged over every such pair.
@@ -20,7 +20,7 @@
 
 use std::path::Path;
 
-use tidepool::terminal::{Luma, ssim};
+use tidepool::testing::{Luma, ssim};
 
 use crate::common::{run, scratch, stderr};
 

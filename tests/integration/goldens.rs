@@ -33,7 +33,7 @@ fn stones(list: &[(i64, i64, i64, i64)]) -> Vec<(u64, Event)> {
 
 #[test]
 fn the_default_pool() {
-    let (script, steps) = tidepool::pool_showcase(640, 360);
+    let (script, steps) = tidepool::PoolScene::showcase(640, 360);
     let p = picture(&SceneSpec::Pool(PoolSettings::default()), 640, 360, &script, steps);
     golden::check_png("pool_default", &rgba(&p), Tolerance::default());
 }

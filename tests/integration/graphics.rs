@@ -7,12 +7,13 @@
 use std::time::Duration;
 
 use crate::common::pty::{DA1_ANSWER, Player, cooked, find, rfind, temp_dir};
-use tidepool::graphics::{kitty, kitty_decode};
+use tidepool::graphics::kitty::KittyOptions;
 use tidepool::play::Screen;
+use tidepool::testing::kitty_decode;
 
 const ENTER: &[u8] = Screen::ENTER;
 const RESTORE: &[u8] = Screen::RESTORE;
-use tidepool::terminal::SYNC_END;
+use tidepool::testing::SYNC_END;
 
 const WAIT: Duration = Duration::from_secs(20);
 /// Still water (no rain, no breeze), so the picture only changes when a key changes it.
@@ -43,8 +44,8 @@ fn after_enter(p: &Player) -> Vec<u8> {
 
 /// The kitty commands in `bytes` that delete the player's image.
 fn deletes(bytes: &[u8]) -> usize {
-    let state = kitty_decode::decode(bytes).expect("kitty commands decode");
-    let id = kitty::IMAGE_ID.to_string();
+    let state = kitty_decode(bytes).expect("kitty commands decode");
+    let id = KittyOptions::IMAGE_ID.to_string();
     state.commands.iter().filter(|c| c.get(&'a').map(String::as_str) == Some("d") && c.get(&'i') == Some(&id)).count()
 }
 
@@ -82,8 +83,8 @@ fn forced_kitty_frames_decode_into_the_scenes_picture() {
     assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
     let out = p.output();
     let frames = &out[find(&out, ENTER).unwrap()..picture_restore_at(&out)];
-    let state = kitty_decode::decode(frames).expect("the frames decode");
-    let image = &state.images[&kitty::IMAGE_ID];
+    let state = kitty_decode(frames).expect("the frames decode");
+    let image = &state.images[&KittyOptions::IMAGE_ID];
     // 100x12 cells of the assumed 8x16 pixels, less the status row: 800x176 over 100x11 cells,
     // rendered within the scene cap (480x300: 480x106) and scaled up by the terminal.
     assert_eq!((image.width, image.height), (480, 106));
@@ -179,8 +180,8 @@ fn render_to_a_kitty_terminal_draws_the_picture_as_one_image() {
     });
     assert_eq!(p.wait_exit(WAIT).exit_code(), 0);
     let out = p.output();
-    let state = kitty_decode::decode(&out).expect("the picture decodes");
-    let image = &state.images[&kitty::IMAGE_ID];
+    let state = kitty_decode(&out).expect("the picture decodes");
+    let image = &state.images[&KittyOptions::IMAGE_ID];
     // The cell area above the prompt's row: 100x11 cells of the assumed 8x16 pixels.
     assert_eq!((image.width, image.height), (800, 176));
     assert!(out.ends_with(b"\x1b[12;1H"), "the cursor is left on the last row for the prompt");
@@ -244,8 +245,8 @@ fn inside_tmux_with_passthrough_kitty_draws_through_unicode_placeholders() {
     let count = |needle: &[u8]| frames.windows(needle.len()).filter(|w| *w == needle).count();
     assert!(count(b"\x1b_G") > 0, "kitty commands");
     assert_eq!(count(b"\x1b_G"), count(b"\x1bPtmux;\x1b\x1b_G"), "every kitty command is wrapped for tmux");
-    let state = kitty_decode::decode(frames).expect("the wrapped commands decode");
-    let image = &state.images[&kitty::IMAGE_ID];
+    let state = kitty_decode(frames).expect("the wrapped commands decode");
+    let image = &state.images[&KittyOptions::IMAGE_ID];
     assert_eq!(image.keys.get(&'U').map(String::as_str), Some("1"), "a virtual placement");
     assert_eq!((image.width, image.height), (480, 106));
     // The placeholder text: 100x11 cells of U+10EEEE, the image id in the foreground colour

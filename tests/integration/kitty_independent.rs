@@ -6,9 +6,10 @@
 
 use std::time::{Duration, Instant};
 
-use tidepool::graphics::kitty::{IMAGE_ID, KittyEncoder, KittyOptions};
-use tidepool::graphics::{Budget, GraphicsMode, Part, PictureStream, Protocol, push_rgb, resample};
-use tidepool::graphics::{SCALED_CAP, layout};
+use tidepool::graphics::kitty::{KittyEncoder, KittyOptions};
+use tidepool::graphics::{GraphicsMode, push_rgb};
+use tidepool::graphics::{Layout, layout};
+use tidepool::testing::{Budget, Part, PictureStream, Protocol, resample};
 use tiny_skia::Pixmap;
 
 use crate::common::fake_terminal::FakeTerminal;
@@ -49,14 +50,14 @@ fn kitty_encoder_frames_and_edits_decode_pixel_for_pixel_through_tmux() {
         let images = decode(if tmux { "encoder-tmux" } else { "encoder" }, &stream);
         assert_eq!(images.len(), 1);
         let (id, iw, ih, pixels) = &images[0];
-        assert_eq!((*id, *iw, *ih), (IMAGE_ID, w, h));
+        assert_eq!((*id, *iw, *ih), (KittyOptions::IMAGE_ID, w, h));
         assert!(*pixels == second, "tmux {tmux}: the decoded picture differs from the encoder's input");
     }
 }
 
 #[test]
 fn picture_stream_offers_decode_to_the_picture_at_its_rung() {
-    let l = layout(GraphicsMode::Kitty, (40, 13), Some((8, 16)), None, SCALED_CAP);
+    let l = layout(GraphicsMode::Kitty, (40, 13), Some((8, 16)), None, Layout::SCALED_CAP);
     let frame = Duration::from_nanos(1_000_000_000 / 30);
     let t0 = Instant::now();
     let (sw, sh) = (120, 72);

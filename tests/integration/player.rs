@@ -12,7 +12,7 @@ const RESTORE: &[u8] = Screen::RESTORE;
 /// Makes the player panic after its first frame (a test hook of the terminal door, not a user
 /// feature).
 const TEST_PANIC_VAR: &str = "TIDEPOOL_TEST_PANIC";
-use tidepool::terminal::{SYNC_BEGIN, SYNC_END};
+use tidepool::testing::{SYNC_BEGIN, SYNC_END};
 
 const WAIT: Duration = Duration::from_secs(20);
 const ARGS: &[&str] = &["play", "--color", "truecolor", "--color-threshold", "0"];
@@ -109,8 +109,8 @@ fn still_water_sends_only_the_status_line() {
     p.wait_for_status("stone 3", WAIT);
     // The first frames may be approximate (the link's rate is still being found); they
     // converge to the exact picture. Ready when a status-only key leaves the picture as it was.
-    let picture = |s: &tidepool::terminal::TerminalModel| (0..s.rows() - 1).map(|y| s.row_text(y)).collect::<Vec<_>>();
-    let cells = |s: &tidepool::terminal::TerminalModel| {
+    let picture = |s: &tidepool::testing::TerminalModel| (0..s.rows() - 1).map(|y| s.row_text(y)).collect::<Vec<_>>();
+    let cells = |s: &tidepool::testing::TerminalModel| {
         (0..s.rows() - 1)
             .flat_map(|y| (0..s.cols()).map(move |x| (x, y)))
             .map(|(x, y)| s.cell(x, y))
@@ -184,7 +184,7 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     let before_resize = p.len();
     p.master.resize(portable_pty::PtySize { rows: 10, cols: 30, pixel_width: 0, pixel_height: 0 }).unwrap();
     // The first whole frame after the resize (the status line on the new last row).
-    let mut resized = tidepool::terminal::TerminalModel::new(30, 10);
+    let mut resized = tidepool::testing::TerminalModel::new(30, 10);
     resized.lf_returns = false;
     let redrawn = |p: &Player| {
         let mut s = resized.clone();
@@ -201,7 +201,7 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     assert_restored(&p);
 
     let path = p.dir.join("session.jsonl");
-    let replay = tidepool::replay::read(&path).unwrap();
+    let replay = tidepool::replay::Replay::read(&path).unwrap();
     assert_eq!(replay.header.size, [40, 22]);
     let stones: Vec<Stone> =
         replay.entries.iter().filter_map(|e| if let Event::Stone(s) = e.event { Some(s) } else { None }).collect();
@@ -219,7 +219,7 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
     assert!(replay.entries.iter().any(|e| e.event == Event::Resize([30, 18])));
 
     // The picture on screen before the resize is the replay at the screenshot.
-    let spec = replay.spec(tidepool::pool_floor());
+    let spec = replay.spec(tidepool::PoolSettings::default_floor());
     let mut scene = replay.simulate(&spec, Some(step), &mut |_| {}).unwrap();
     let expected = scene.snapshot().unwrap();
     let mut compared = 0;

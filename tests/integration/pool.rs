@@ -14,7 +14,7 @@ fn the_command_line_draws_the_librarys_pictures() {
     assert!(out.status.success(), "{}", stderr(&out));
     let file = read_png(&dir.join("pool.png"));
     assert_eq!(file.dimensions(), (640, 360), "the default size");
-    let (script, steps) = tidepool::pool_showcase(640, 360);
+    let (script, steps) = tidepool::PoolScene::showcase(640, 360);
     let spec = SceneSpec::Pool(PoolSettings::default());
     assert!(file == rgba(&picture(&spec, 640, 360, &script, steps)), "the default picture");
     let out = run_in(
@@ -68,7 +68,7 @@ fn grid_pace_and_gusts_given_on_the_command_line_reach_the_scene() {
     let coherent = ["--grid", "2", "--steps-per-second", "30", "--breeze-style", "gusts", "--out", "coherent.png"];
     let out = run_in(&dir, &[&["render", "pool"][..], &flags, &coherent].concat());
     assert!(out.status.success(), "{}", stderr(&out));
-    let (script, _) = tidepool::pool_showcase(96, 64);
+    let (script, _) = tidepool::PoolScene::showcase(96, 64);
     let settings = PoolSettings {
         breeze: 1.0,
         breeze_style: BreezeStyle::Gusts,

@@ -14,8 +14,8 @@ fn fixture(name: &str) -> PathBuf {
 #[test]
 fn a_replay_recorded_by_0_1_0_renders_bit_identically() {
     let path = fixture("replay-v0.1.0.jsonl");
-    let replay = tidepool::replay::read(&path).unwrap();
-    let spec = replay.spec(tidepool::pool_floor());
+    let replay = tidepool::replay::Replay::read(&path).unwrap();
+    let spec = replay.spec(tidepool::PoolSettings::default_floor());
     for (steps, png) in [(None, "replay-v0.1.0-final.png"), (Some(489), "replay-v0.1.0-step489.png")] {
         let mut scene = replay.simulate(&spec, steps, &mut |_| {}).unwrap();
         let picture = rgba(&scene.snapshot().unwrap());
@@ -38,9 +38,9 @@ fn a_replay_recorded_by_0_1_0_renders_bit_identically() {
 
 #[test]
 fn the_new_writer_reads_back_what_the_old_one_wrote() {
-    let replay = tidepool::replay::read(&fixture("replay-v0.1.0.jsonl")).unwrap();
+    let replay = tidepool::replay::Replay::read(&fixture("replay-v0.1.0.jsonl")).unwrap();
     let text = replay.to_text();
-    assert_eq!(tidepool::replay::parse(Path::new("rewritten"), &text).unwrap(), replay);
+    assert_eq!(tidepool::replay::Replay::parse(Path::new("rewritten"), &text).unwrap(), replay);
 }
 
 /// Hostile replays are refused at once, in one line naming the file, the line and the limit:

@@ -26,7 +26,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use portable_pty::{CommandBuilder, PtySize, native_pty_system};
-use tidepool::terminal::TerminalModel;
+use tidepool::testing::TerminalModel;
 
 const DA1_QUESTION: &[u8] = b"\x1b[c";
 const DA1_ANSWER: &[u8] = b"\x1b[?62;22c";

@@ -193,7 +193,7 @@ pub async fn open_shell(h: &Handle<TestClient>, term: &str, cols: u32, rows: u32
 /// A player's terminal: the channel and a terminal model fed with everything it received.
 pub struct Term {
     pub ch: Channel<client::Msg>,
-    pub screen: tidepool::terminal::TerminalModel,
+    pub screen: tidepool::testing::TerminalModel,
     pub frames: usize,
     pub raw: Vec<u8>,
     /// How it answers device-attributes questions.
@@ -216,7 +216,7 @@ pub enum Answers {
 
 impl Term {
     pub fn new(ch: Channel<client::Msg>, cols: usize, rows: usize) -> Term {
-        let mut screen = tidepool::terminal::TerminalModel::new(cols, rows);
+        let mut screen = tidepool::testing::TerminalModel::new(cols, rows);
         // The client's terminal is raw (ssh sets it so) and the server has no pty: a line feed
         // moves down only.
         screen.lf_returns = false;

@@ -8,7 +8,7 @@ use crate::common::*;
 
 /// The frames in `raw` (each from its synchronized-output start to its end).
 fn frames(raw: &[u8]) -> Vec<Vec<u8>> {
-    let end = tidepool::terminal::SYNC_END;
+    let end = tidepool::testing::SYNC_END;
     let mut out = Vec::new();
     let mut rest = raw;
     while let Some(start) = rest.windows(SYNC_BEGIN.len()).position(|w| w == SYNC_BEGIN) {

@@ -50,7 +50,7 @@ fn cell_of(x: f32, y: f32, cols: u32, rows: u32) -> (i32, i32) {
 
 /// The centre of the cells of `t` that look different from `before` (the first cells a stone
 /// changed), in the pixels of a 160x90 scene shown in a `cols x rows` terminal; and how many.
-fn changed_centre(t: &Term, before: &tidepool::terminal::TerminalModel, cols: u32, rows: u32) -> ((f64, f64), usize) {
+fn changed_centre(t: &Term, before: &tidepool::testing::TerminalModel, cols: u32, rows: u32) -> ((f64, f64), usize) {
     let (pw, ph) = (cols as f64, (2 * (rows - 1)) as f64);
     let scale = (pw / 160.0).min(ph / 90.0);
     let (w, h) = ((160.0 * scale).round(), (90.0 * scale).round());
@@ -278,10 +278,10 @@ async fn a_remote_kitty_terminal_gets_kitty_pictures_and_a_silent_one_gets_cells
     // The picture starts small and in parts while the link's rate is found (the ladder's lowest
     // rung), then climbs to the full size on this fast link: read until it has.
     let decoded = |t: &Term| {
-        let from = tidepool::terminal::SYNC_BEGIN;
+        let from = tidepool::testing::SYNC_BEGIN;
         let start = t.raw.windows(from.len()).position(|w| w == from)?;
-        let state = tidepool::graphics::kitty_decode::decode(&t.raw[start..]).ok()?;
-        state.images.get(&tidepool::graphics::kitty::IMAGE_ID).cloned()
+        let state = tidepool::testing::kitty_decode(&t.raw[start..]).ok()?;
+        state.images.get(&tidepool::graphics::kitty::KittyOptions::IMAGE_ID).cloned()
     };
     tk.read_until(|t| decoded(t).is_some_and(|i| i.width == 480)).await;
     let image = decoded(&tk).expect("the kitty image");

@@ -39,9 +39,15 @@ pub struct Layout {
     pub cell_px: (u16, u16),
 }
 
+impl Layout {
+    /// The largest picture rendered for terminals that scale (kitty, iTerm2), in pixels: the
+    /// usual `cap` of [`layout`].
+    pub const SCALED_CAP: (u32, u32) = SCALED_CAP;
+}
+
 /// The layout for a terminal of `term` cells (columns, rows) with cells of `cell_px` pixels
 /// (`None`: unknown, 8x16 is assumed), the largest sixel image `sixel_max`, and
-/// `cap` for scaling protocols ([`SCALED_CAP`]). Sizes are at least one pixel and one cell.
+/// `cap` for scaling protocols ([`Layout::SCALED_CAP`]). Sizes are at least one pixel and one cell.
 pub fn layout(
     mode: GraphicsMode,
     term: (u16, u16),
@@ -65,7 +71,7 @@ pub fn layout(
             let covered = (w.div_ceil(u32::from(cell_px.0)) as u16, h.div_ceil(u32::from(cell_px.1)) as u16);
             ((w, h), (w, h), covered)
         }
-        GraphicsMode::Cells => ((u32::from(cells.0), 2 * u32::from(cells.1)), area, cells),
+        GraphicsMode::Cells => (crate::output::halfblock::picture_size(cells.0, cells.1), area, cells),
     };
     Layout { mode, origin: (0, 0), cells, picture, shown_px, cell_px }
 }

@@ -68,7 +68,7 @@ pub enum Medium {
 /// Where and how the image is shown.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct KittyOptions {
-    /// The image id ([`IMAGE_ID`]).
+    /// The image id ([`KittyOptions::IMAGE_ID`]).
     pub image_id: u32,
     /// The top-left cell of the picture, 0-based (column, row).
     pub origin: (u16, u16),
@@ -87,7 +87,10 @@ pub struct KittyOptions {
 }
 
 impl KittyOptions {
-    /// Direct transmission of [`IMAGE_ID`] over `cells` at the top-left corner; no tmux, no
+    /// The image id tidepool's pictures use unless told otherwise (`new` sets it).
+    pub const IMAGE_ID: u32 = IMAGE_ID;
+
+    /// Direct transmission of [`KittyOptions::IMAGE_ID`] over `cells` at the top-left corner; no tmux, no
     /// placeholders, no frame edits.
     pub fn new(cells: (u16, u16)) -> KittyOptions {
         KittyOptions {
@@ -323,6 +326,7 @@ pub fn push_cursor_to(out: &mut Vec<u8>, (col, row): (u16, u16)) {
 
 /// Appends the command that makes the terminal read raw RGB pixels from the temporary file
 /// `path` (`t=t`, `f=24`) under `keys`, wrapped for tmux if asked.
+#[cfg(any(test, feature = "player", feature = "testing"))]
 pub(crate) fn push_temp_file_command(out: &mut Vec<u8>, keys: &[u8], path: &Path, tmux: bool) {
     push_command(out, &temp_file_command(keys, path), tmux);
 }

@@ -17,11 +17,13 @@
 pub mod geometry;
 pub mod iterm2;
 pub mod kitty;
+#[cfg(any(test, feature = "testing"))]
 pub mod kitty_decode;
 pub mod kitty_placeholder;
 pub mod pack;
 pub mod scan;
 pub mod sixel;
+#[cfg(any(test, feature = "player", feature = "testing"))]
 pub mod stream;
 pub mod tmux;
 

@@ -20,11 +20,14 @@ pub enum Packing {
     /// A PNG of the RGB pixels (row filters chosen per row, fast deflate): kitty's `f=100`,
     /// iTerm2.
     Png,
-    /// A baseline JPEG at this quality (1..=100): iTerm2 only (kitty decodes no JPEG).
+    /// A baseline JPEG at this quality (1..=100): iTerm2 only (kitty decodes no JPEG); the
+    /// picture stream chooses it (feature `player`).
+    #[cfg_attr(not(any(test, feature = "player", feature = "testing")), allow(dead_code))]
     Jpeg(u8),
 }
 
 impl Packing {
+    #[cfg(any(test, feature = "testing"))]
     /// A short name for tables and the status line.
     pub fn name(self) -> String {
         match self {

@@ -51,6 +51,7 @@ pub const MIN_REGISTERS: u16 = 8;
 const BAYER_SIDE: usize = 8;
 /// The most bytes tmux (3.3 to 3.6) reads of one escape sequence: a longer sixel image is dropped.
 /// Kept a little under 1 MiB for the passthrough wrapper's doubled escapes and the cursor move.
+#[cfg(any(test, feature = "player", feature = "testing"))]
 pub const TMUX_MAX_IMAGE_BYTES: usize = (1 << 20) - 4096;
 /// A run of this many equal sixels or more is written `!n` (`!4x` is shorter than `xxxx`).
 const MIN_RUN: usize = 4;
@@ -499,6 +500,7 @@ fn changed_cells(
     Some((x0, y0, x1 - x0, y1 - y0))
 }
 
+#[cfg(any(test, feature = "testing"))]
 /// The picture the terminal shows for `rgb` after dithering with `palette` (each pixel its
 /// register's colour): what a decoded stream must equal.
 pub fn dithered_rgb(palette: &SixelPalette, rgb: &[u8], width: u32, height: u32) -> Vec<u8> {

@@ -33,6 +33,7 @@ pub fn wrap(inner: &[u8]) -> Vec<u8> {
     out
 }
 
+#[cfg(any(test, feature = "testing"))]
 /// Undoes [`wrap`]: the inner sequence of one passthrough sequence at the start of `bytes`
 /// and the length it took, or `None` when `bytes` does not start with a whole one.
 pub fn unwrap(bytes: &[u8]) -> Option<(Vec<u8>, usize)> {

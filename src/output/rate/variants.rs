@@ -6,11 +6,11 @@ use std::sync::LazyLock;
 
 use tiny_skia::Pixmap;
 
+use crate::output::color::xterm_256;
 use crate::output::color::{Color, ColorMode, nearest_256};
 use crate::output::frame::Cell;
 use crate::output::halfblock::Rgb;
 use crate::output::oklab::{self, Lab};
-use crate::output::vt::xterm_256;
 
 /// `rgb` packed with a valid bit, as a memo key (0: nothing memoized).
 fn key(rgb: Rgb) -> u32 {

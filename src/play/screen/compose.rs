@@ -40,7 +40,8 @@ pub fn big_enough((cols, rows): (u16, u16)) -> bool {
 /// above the status line (at least 3x3, so a scene always has an inside). Screens and groups
 /// both size their pictures by it, so a group's frame is a member's.
 pub fn half_block_picture((cols, rows): (u16, u16)) -> (u32, u32) {
-    (u32::from(cols).max(3), (2 * u32::from(rows).saturating_sub(1)).max(3))
+    let (width, height) = crate::output::halfblock::picture_size(cols, rows.saturating_sub(1));
+    (width.max(3), height.max(3))
 }
 
 /// Builds frames, reusing its buffers.

@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 use tiny_skia::Pixmap;
 
 use super::compose::{Figures, big_enough};
-use super::{APPROXIMATE_BELOW, Cells, Screen, link, picture};
+use super::{APPROXIMATE_BELOW, CellSource, Screen, link, picture};
 use crate::output::color::ColorMode;
 use crate::output::cursor::Cursor;
 use crate::output::graphics::stream::Budget;
@@ -39,7 +39,7 @@ impl Screen {
         seat: &SeatView<'_>,
         out: &mut Vec<u8>,
     ) -> usize {
-        self.frame_from(now, picture, status, seat, Cells::Own { figures: None }, out)
+        self.frame_from(now, picture, status, seat, CellSource::Own { figures: None }, out)
     }
 
     /// [`Screen::frame`] with its cells from `cells`: everything else (the byte bucket, the
@@ -50,7 +50,7 @@ impl Screen {
         picture: &Pixmap,
         status: &SceneStatus,
         seat: &SeatView<'_>,
-        cells: Cells<'_>,
+        cells: CellSource<'_>,
         out: &mut Vec<u8>,
     ) -> usize {
         let start = out.len();
@@ -125,13 +125,13 @@ impl Screen {
         picture: &Pixmap,
         status: &SceneStatus,
         seat: &SeatView<'_>,
-        cells: Cells<'_>,
+        cells: CellSource<'_>,
         plan: &Plan,
         bytes: &mut Vec<u8>,
         out: &mut Vec<u8>,
     ) -> Report {
         match cells {
-            Cells::Own { figures: given } => {
+            CellSource::Own { figures: given } => {
                 let figures = given.unwrap_or(plan.figures);
                 let frame = self.builder.compose(self.term, picture, self.config.color, status, seat, &figures);
                 let target = match self.config.color {
@@ -140,12 +140,12 @@ impl Screen {
                 };
                 self.encoder.encode_into(&mut self.shown, target, plan.budget, plan.options, bytes)
             }
-            Cells::Toward(model) => {
+            CellSource::Toward(model) => {
                 // Exactly (no colour threshold), so that the model becomes equal, not close.
                 let exact = RateOptions { threshold: 0, ..plan.options };
                 self.encoder.encode_into(&mut self.shown, Target::new(model), plan.budget, exact, bytes)
             }
-            Cells::Taken(taken) => {
+            CellSource::Taken(taken) => {
                 // Straight to the caller: the group's bytes never pass through the scratch
                 // buffer, which a member in step has freed (it would grow back to a group
                 // frame's size, and the caller's buffer with it).

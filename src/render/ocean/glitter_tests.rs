@@ -50,7 +50,7 @@ pub(crate) fn glitter_spread(wind_m_s: f64, shading: SeaShading) -> (f64, f64) {
     let (mut w, mut m1, mut m2) = (0.0f64, [0.0f64; 2], 0.0f64);
     let moments = [0.0, 7.3, 19.1, 41.7];
     for t in moments {
-        let glitter = renderer.mean_glitter(&sea.frame(t));
+        let glitter = renderer.mean_glitter(&sea.surface(t));
         for y in 0..size {
             for x in 0..size {
                 let g = glitter[(y * size + x) as usize];

@@ -162,7 +162,7 @@ fn actions_resolve_to_events_that_apply() {
 #[test]
 fn the_showcase_stays_inside_small_pictures() {
     for (w, h) in [(1, 1), (80, 48), (4000, 300)] {
-        let (stones, steps) = showcase(w, h);
+        let (stones, steps) = PoolScene::showcase(w, h);
         assert!((30..=90).contains(&steps));
         for (at, event) in stones {
             let Event::Stone(s) = event else { panic!("stones only") };

@@ -106,7 +106,7 @@ pub fn decode_ansi(text: &[u8]) -> RgbaImage {
     let lines = text.split(|&b| b == b'\n').filter(|l| !l.is_empty()).count();
     let cols = String::from_utf8_lossy(text).lines().map(|l| l.matches('\u{2580}').count()).max().unwrap_or(0);
     // One spare row so the final newline does not scroll the picture away.
-    let mut screen = tidepool::terminal::TerminalModel::new(cols, lines + 1);
+    let mut screen = tidepool::testing::TerminalModel::new(cols, lines + 1);
     screen.feed(text);
     let mut image = RgbaImage::new(cols as u32, 2 * lines as u32);
     for (x, y, pixel) in image.enumerate_pixels_mut() {

@@ -7,7 +7,7 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use portable_pty::{Child, CommandBuilder, ExitStatus, MasterPty, PtySize, native_pty_system};
-use tidepool::terminal::TerminalModel;
+use tidepool::testing::TerminalModel;
 
 /// The primary device attributes question the player asks after frames, and a VT220-like
 /// answer (as xterm gives).

@@ -5,8 +5,8 @@ use std::path::PathBuf;
 use clap::Args;
 
 use tidepool::sea::{
-    DEFAULT_CHOPPINESS, DEFAULT_SEA_WIND_M_S, DEFAULT_WIND_FROM_DEG, Jonswap, LoopPeriod, SpectrumChoice,
-    SpectrumChoiceError, SpectrumKind, Spreading, Swell, Swells, beaufort_speed_m_s, check_choppiness,
+    Jonswap, LoopPeriod, SpectrumChoice, SpectrumChoiceError, SpectrumKind, Spreading, Swell, Swells,
+    beaufort_speed_m_s,
 };
 use tidepool::{CameraPose, SeaParams, SeaShading};
 
@@ -50,7 +50,7 @@ pub struct WindArgs {
 impl WindArgs {
     /// The wind speed, m/s.
     pub fn speed_m_s(&self) -> f64 {
-        self.given_m_s().unwrap_or(DEFAULT_SEA_WIND_M_S)
+        self.given_m_s().unwrap_or(SeaParams::DEFAULT_WIND_M_S)
     }
 
     /// The wind speed given by `--wind` or `--beaufort`, if any.
@@ -241,7 +241,7 @@ impl SeaShapeArgs {
             spectrum: self.spectrum.choice_or(preset)?,
             spreading: self.swell.spreading.unwrap_or_default(),
             swells: self.swell.swells_or(preset)?,
-            choppiness: self.choppiness.unwrap_or(DEFAULT_CHOPPINESS),
+            choppiness: self.choppiness.unwrap_or(SeaParams::DEFAULT_CHOPPINESS),
             loop_period: None,
         })
     }
@@ -457,7 +457,8 @@ pub fn parse_swell(text: &str) -> Result<Swell, String> {
 /// The wind speed and direction of a command line with an optional preset: each flag given
 /// wins over the preset's value, the preset's over the defaults.
 pub fn wind_of(preset: Option<Preset>, wind: &WindArgs, direction: Option<f64>) -> (f64, f64) {
-    let (preset_speed, preset_from) = preset.map_or((DEFAULT_SEA_WIND_M_S, DEFAULT_WIND_FROM_DEG), Preset::wind);
+    let (preset_speed, preset_from) =
+        preset.map_or((SeaParams::DEFAULT_WIND_M_S, SeaParams::DEFAULT_WIND_FROM_DEG), Preset::wind);
     (wind.given_m_s().unwrap_or(preset_speed), direction.unwrap_or(preset_from))
 }
 
@@ -468,7 +469,7 @@ fn parse_plain_number(text: &str) -> Result<f64, String> {
 
 /// Parses a choppiness, 0..=4.
 pub fn parse_choppiness(text: &str) -> Result<f64, String> {
-    check_choppiness(parse_plain_number(text)?).map_err(|e| e.to_string())
+    SeaParams::check_choppiness(parse_plain_number(text)?).map_err(|e| e.to_string())
 }
 
 fn in_range(v: f64, lo: f64, hi: f64, what: &str, unit: &str) -> Result<f64, String> {
@@ -548,7 +549,7 @@ mod tests {
         }
         let w = WindArgs { wind: None, beaufort: Some(8) };
         assert_eq!(w.speed_m_s(), 18.95);
-        assert_eq!(WindArgs { wind: None, beaufort: None }.speed_m_s(), DEFAULT_SEA_WIND_M_S);
+        assert_eq!(WindArgs { wind: None, beaufort: None }.speed_m_s(), SeaParams::DEFAULT_WIND_M_S);
     }
 
     #[test]

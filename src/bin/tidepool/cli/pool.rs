@@ -140,7 +140,7 @@ impl PoolArgs {
     pub fn floor(&self) -> crate::error::Result<tiny_skia::Pixmap> {
         match &self.background {
             Some(path) => tidepool::load_image(path).map_err(crate::error::Error::flag("--background")),
-            None => Ok(tidepool::pool_floor()),
+            None => Ok(tidepool::PoolSettings::default_floor()),
         }
     }
 

@@ -12,6 +12,7 @@ use std::time::{Duration, Instant};
 
 use tidepool::Action;
 use tidepool::encode::{halfblock, png};
+use tidepool::graphics::{GraphicsMode, Layout, layout};
 use tidepool::play::{Bandwidth, GraphicsRequest, Host, HostConfig, Player, Request, Screen, ScreenConfig};
 use tidepool::terminal::{ColorMode, EncodeOptions};
 use tidepool::{Damping, LakeSettings, OceanSettings, OceanView, PoolSettings, RipplePool, SceneSpec, Simd, Stone};
@@ -208,7 +209,8 @@ fn player_rows(
 /// A whole frame of half-block text, for a resize or a first frame (`None` when the
 /// terminal's pool cannot be made).
 fn text_row(budget: Duration, (cols, rows_cells): (u16, u16)) -> Result<Option<Row>> {
-    let (w, h) = (u32::from(cols), 2 * u32::from(rows_cells - 1));
+    // The half-block picture above the status line, as the cells layout sizes it.
+    let (w, h) = layout(GraphicsMode::Cells, (cols, rows_cells), None, None, Layout::SCALED_CAP).picture;
     let Ok(mut pool) = scenes(1)[0].1.build(w, h) else { return Ok(None) };
     pool.advance(30);
     let frame = pool.snapshot()?;

@@ -13,7 +13,7 @@ use tidepool::graphics::iterm2::Iterm2Encoder;
 use tidepool::graphics::kitty::{KittyEncoder, KittyOptions};
 use tidepool::graphics::sixel::{SixelEncoder, SixelPalette};
 use tidepool::graphics::{GraphicsMode, push_rgb};
-use tidepool::graphics::{Layout, SCALED_CAP, layout};
+use tidepool::graphics::{Layout, layout};
 use tidepool::play::{GraphicsChoice, GraphicsSupport};
 use tiny_skia::Pixmap;
 
@@ -38,7 +38,7 @@ impl Inline {
         }
         let (cols, rows) = crossterm::terminal::size().ok()?;
         let sixel_max = support.sixel.and_then(|s| Some((s.max_w?, s.max_h?)));
-        let layout = layout(choice.mode, (cols, rows), support.cell_px, sixel_max, SCALED_CAP);
+        let layout = layout(choice.mode, (cols, rows), support.cell_px, sixel_max, Layout::SCALED_CAP);
         Some(Inline { choice, support, layout, rows })
     }
 

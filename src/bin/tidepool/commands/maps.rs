@@ -8,8 +8,8 @@ use std::path::Path;
 use std::time::Instant;
 
 use tidepool::SeaParams;
-use tidepool::encode::{MapFields, human_bytes, sea_maps, sea_maps_exr};
-use tidepool::sea::{PatchMaps, PatchSea, check_map_size, check_patch, default_map_extent_m};
+use tidepool::encode::human_bytes;
+use tidepool::sea::{PatchMaps, PatchSea};
 
 use super::stats::Stats;
 use crate::cli::ocean::{MapFormat, RenderOcean};
@@ -59,12 +59,12 @@ pub fn write(args: &RenderOcean, dir: &Path, params: SeaParams) -> Result<()> {
     }
     check_folder(dir)?;
     let n = match args.output.size {
-        Some(size) => check_map_size(size.width() as usize, size.height() as usize)
+        Some(size) => PatchSea::check_map_size(size.width() as usize, size.height() as usize)
             .map_err(|e| Error::arg("--size", e.to_string()))?,
         None => DEFAULT_MAP_SIDE,
     };
-    let extent = args.extent.unwrap_or_else(|| default_map_extent_m(&params));
-    check_patch(n, extent)
+    let extent = args.extent.unwrap_or_else(|| PatchSea::default_extent_m(&params));
+    PatchSea::check(n, extent)
         .map_err(|e| Error::arg(if e.what() == "map size" { "--size" } else { "--extent" }, e.to_string()))?;
     let frames = args.animation.frames.unwrap_or(1);
     let texels = u64::from(frames) * (n * n) as u64;
@@ -91,16 +91,9 @@ pub fn write(args: &RenderOcean, dir: &Path, params: SeaParams) -> Result<()> {
         let writer = scope.spawn(move || -> Result<usize> {
             let mut bytes = 0usize;
             for (k, maps) in receive {
-                let fields = MapFields {
-                    size: maps.size,
-                    height: &maps.height,
-                    displacement: &maps.displacement,
-                    normal: &maps.normal,
-                    foam: &maps.foam,
-                };
                 let frame = numbered.then_some(k);
-                let exr_files = if exr { sea_maps_exr(&fields, frame) } else { Vec::new() };
-                for (name, file) in sea_maps(&fields, frame).into_iter().chain(exr_files) {
+                let exr_files = if exr { maps.exr_files(frame) } else { Vec::new() };
+                for (name, file) in maps.files(frame).into_iter().chain(exr_files) {
                     bytes += file.len();
                     files::write_file(&dir.join(name), &file)?;
                 }

@@ -5,7 +5,6 @@ use std::io::IsTerminal;
 
 use tiny_skia::Pixmap;
 
-use tidepool::sea::SEA_TEXTURE_TILE_M;
 use tidepool::{CameraPose, Downsample, OceanScene, OceanSettings, OceanView, SceneSpec, SeaParams, SeaTexture};
 
 use super::animate::{AnimationTarget, FrameSource, check_animation_flags, render_frames};
@@ -31,7 +30,7 @@ fn settings(args: &RenderOcean, format: Format) -> Result<OceanSettings> {
     let sea = sea_params(args)?;
     let texture = match &args.texture {
         Some(path) => {
-            SeaTexture::from_pixmap(&tidepool::load_image(path).map_err(Error::flag("--texture"))?, SEA_TEXTURE_TILE_M)
+            SeaTexture::from_pixmap(&tidepool::load_image(path).map_err(Error::flag("--texture"))?, SeaTexture::TILE_M)
         }
         None => SeaTexture::builtin(),
     };

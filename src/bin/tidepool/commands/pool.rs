@@ -28,7 +28,7 @@ pub fn render(args: RenderPool) -> Result<()> {
 /// ([`tidepool::pool_showcase`]).
 fn script(args: &RenderPool, size: Size) -> Vec<(u64, Event)> {
     if args.stones.is_empty() {
-        tidepool::pool_showcase(size.width(), size.height()).0
+        tidepool::PoolScene::showcase(size.width(), size.height()).0
     } else {
         args.stones.iter().map(|&s| (0, Event::Stone(s))).collect()
     }
@@ -36,7 +36,7 @@ fn script(args: &RenderPool, size: Size) -> Vec<(u64, Event)> {
 
 /// Steps before the picture is taken when `--steps` is not given (see [`tidepool::pool_showcase`]).
 fn default_pool_steps(size: Size) -> u64 {
-    tidepool::pool_showcase(size.width(), size.height()).1
+    tidepool::PoolScene::showcase(size.width(), size.height()).1
 }
 
 /// `tidepool render pool --frames N`: the stones (given or default) land at their steps, the

@@ -8,7 +8,7 @@ use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
 
-use tidepool::replay::{self, Replay};
+use tidepool::replay::Replay;
 use tidepool::{SceneSpec, Size};
 
 use super::animate::{Animation, AnimationTarget, animate};
@@ -20,7 +20,7 @@ use crate::progress::Progress;
 
 /// Runs `tidepool render pool --replay FILE`.
 pub fn render(args: &RenderPool, path: &Path) -> Result<()> {
-    let replay = replay::read(path)?;
+    let replay = Replay::read(path)?;
     let spec = spec(&replay)?;
     if let Some(frames) = args.animation.frames {
         return animate_replay(args, &replay, &spec, frames);
@@ -56,7 +56,7 @@ pub fn render(args: &RenderPool, path: &Path) -> Result<()> {
 fn spec(replay: &Replay) -> Result<SceneSpec> {
     let floor = match &replay.header.options.background {
         Some(file) => tidepool::load_image(file).map_err(Error::flag("--replay (its background)"))?,
-        None => tidepool::pool_floor(),
+        None => tidepool::PoolSettings::default_floor(),
     };
     Ok(replay.spec(floor))
 }

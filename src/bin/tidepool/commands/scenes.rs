@@ -1,8 +1,7 @@
 //! The scenes a live session cycles through with `tab`, built from the scene flags that
 //! `play` and `serve` share, so both start the same water from the same flags.
 
-use tidepool::sea::{DEFAULT_WIND_FROM_DEG, MAX_LAKE_WIND_M_S};
-use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneKind, SceneSpec};
+use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneKind, SceneSpec, SeaParams};
 
 use crate::cli::{LiveSceneArgs, PlayScene};
 use crate::error::Result;
@@ -20,7 +19,7 @@ pub fn specs(first: PlayScene, flags: &LiveSceneArgs) -> Result<Vec<SceneSpec>> 
     let ocean = OceanSettings {
         sea: flags.sea.shape().params(
             flags.wind.speed_m_s(),
-            flags.direction.unwrap_or(DEFAULT_WIND_FROM_DEG),
+            flags.direction.unwrap_or(SeaParams::DEFAULT_WIND_FROM_DEG),
             flags.seed,
         )?,
         view: OceanView {
@@ -34,7 +33,7 @@ pub fn specs(first: PlayScene, flags: &LiveSceneArgs) -> Result<Vec<SceneSpec>> 
     };
     let mut lake = lake_settings(flags.seed);
     if flags.wind.wind.is_some() || flags.wind.beaufort.is_some() {
-        lake.lake.wind_m_s = flags.wind.speed_m_s().min(MAX_LAKE_WIND_M_S);
+        lake.lake.wind_m_s = flags.wind.speed_m_s().min(LakeParams::MAX_WIND_M_S);
     }
     // Tab goes through the scenes in their order, starting from the one asked for.
     let all = [SceneSpec::Pool(pool), SceneSpec::Ocean(ocean), SceneSpec::Lake(lake)];

@@ -7,7 +7,7 @@
 //! significant height and the sea state are the whole sea's.
 
 use tidepool::SeaParams;
-use tidepool::sea::{SpectrumChoice, beaufort_number, sea_spectrum_plot, wmo_sea_state, wmo_sea_state_name};
+use tidepool::sea::{SpectrumChoice, beaufort_number, wmo_sea_state, wmo_sea_state_name};
 
 use crate::cli::ocean::{SpectrumCommand, wind_of};
 use crate::error::{Error, Result};
@@ -134,7 +134,7 @@ pub fn run(args: SpectrumCommand) -> Result<()> {
         if ext.as_deref() != Some("png") {
             return Err(Error::arg("--out", format!("'{}' must end in .png; the plot is a PNG", path.display())));
         }
-        let picture = sea_spectrum_plot(&sea);
+        let picture = sea.spectrum_plot();
         files::write_file(path, &tidepool::encode::png(&picture))?;
     }
     let body = if args.json { json(&sea) } else { text(&sea) };

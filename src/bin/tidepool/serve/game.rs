@@ -18,7 +18,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
-use tidepool::play::{Fit, GroupFeed, GroupKey, Groups, Host, Request, SceneStatus};
+use tidepool::play::{Fit, Host, Request, SceneStatus};
+use tidepool::serve::{GroupFeed, GroupKey, Groups};
 use tiny_skia::Pixmap;
 use tokio::sync::{mpsc, watch};
 

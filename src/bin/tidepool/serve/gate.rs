@@ -8,7 +8,7 @@ use std::time::Instant;
 
 use tidepool::Action;
 use tidepool::play::Request;
-use tidepool::terminal::ByteBucket;
+use tidepool::serve::ByteBucket;
 
 use super::hub::Hub;
 use super::limits::Limits;

@@ -13,7 +13,7 @@ use tokio_util::task::TaskTracker;
 
 use super::authorized_keys::AllowList;
 use tidepool::play::Request;
-use tidepool::terminal::ByteBucket;
+use tidepool::serve::ByteBucket;
 
 use super::game::{Fits, GameStats, SharedFrame};
 use super::limits::{ConnTracker, Limits, PlayerSlots};

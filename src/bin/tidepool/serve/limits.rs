@@ -8,7 +8,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use tidepool::play::Bandwidth;
-use tidepool::terminal::ByteBucket;
+use tidepool::serve::ByteBucket;
 
 /// Default players in the pool at once (`--max-clients`).
 pub const DEFAULT_MAX_CLIENTS: usize = 64;

@@ -2,7 +2,7 @@
 
 use std::net::SocketAddr;
 
-use tidepool::play::Membership;
+use tidepool::serve::Membership;
 
 use super::game::SharedFrame;
 use super::gate::Gated;

@@ -18,8 +18,9 @@ use std::time::Instant;
 use bytes::Bytes;
 use russh::ChannelWriteHalf;
 use russh::server::Msg;
-use tidepool::play::{Driver, DriverEvent, Membership, Pacing, Player, Screen, ScreenConfig, Source};
-use tidepool::terminal::ByteBucket;
+use tidepool::play::{Driver, DriverEvent, Pacing, Player, Screen, ScreenConfig};
+use tidepool::serve::ByteBucket;
+use tidepool::serve::{Membership, Source};
 use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
@@ -70,7 +71,7 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     if !hub.screenshots {
         player = player.without_screenshots();
     }
-    let viewing = Viewing { fit: *player.seat.fit(), group: None };
+    let viewing = Viewing { fit: *player.fit(), group: None };
     hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
     let mut frames = hub.frames.clone();
     let mut v = Viewer {
@@ -212,7 +213,7 @@ impl Viewer {
             }
         }
         let screen = &self.driver.player().screen;
-        let now_viewing = Viewing { fit: *self.driver.player().seat.fit(), group: self.membership.key(screen) };
+        let now_viewing = Viewing { fit: *self.driver.player().fit(), group: self.membership.key(screen) };
         if (now_viewing.fit, now_viewing.group) != (self.viewing.fit, self.viewing.group) {
             self.viewing = now_viewing;
             self.hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(self.id, self.viewing);
@@ -229,7 +230,7 @@ impl Viewer {
         }
         self.tally.count(shared);
         // Just resized: the next shared frame has this size.
-        let Some(picture) = shared.pictures.get(&self.driver.player().seat.fit().target()).cloned() else {
+        let Some(picture) = shared.pictures.get(&self.driver.player().fit().target()).cloned() else {
             return false;
         };
         if !self.hub.outbound.lock().unwrap_or_else(|p| p.into_inner()).try_take(0.0, now) {

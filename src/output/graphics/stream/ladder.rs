@@ -138,6 +138,7 @@ impl Resampler {
     }
 }
 
+#[cfg(any(test, feature = "testing"))]
 /// `source` resampled to `to` as RGB into `out` (`Resampler::resample` without keeping its
 /// weights): for measurements that scale a picture the way a terminal does.
 pub fn resample(source: &[u8], bpp: usize, from: (u32, u32), to: (u32, u32), out: &mut Vec<u8>) {

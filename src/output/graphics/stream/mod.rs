@@ -147,11 +147,13 @@ pub struct Budget {
 }
 
 impl Budget {
+    #[cfg(any(test, feature = "testing"))]
     /// No limit, frames every `frame_interval`.
     pub fn unlimited(frame_interval: Duration) -> Budget {
         Budget { available: usize::MAX, rate: None, frame_interval, overdraw: false }
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// `available` bytes now at `rate`, frames every `frame_interval`, no overdraw.
     pub fn new(available: usize, rate: Option<f64>, frame_interval: Duration) -> Budget {
         Budget { available, rate, frame_interval, overdraw: false }
@@ -163,7 +165,8 @@ impl Budget {
 pub struct Offer<'a> {
     /// The bytes, at most the budget's `available`.
     pub bytes: &'a [u8],
-    /// What they show.
+    /// What they show (read by the tests and benchmarks, feature `testing`).
+    #[cfg_attr(not(any(test, feature = "testing")), allow(dead_code))]
     pub state: State,
 }
 
@@ -301,6 +304,7 @@ impl PictureStream {
         &self.layout
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// What the stream did last.
     pub fn state(&self) -> State {
         self.state

@@ -26,7 +26,7 @@ use std::collections::BTreeMap;
 
 use base64::Engine;
 use base64::engine::general_purpose::STANDARD as BASE64;
-use tidepool::terminal::TerminalModel;
+use tidepool::testing::TerminalModel;
 
 mod canvas;
 mod profiles;

@@ -10,7 +10,7 @@ use std::time::{Duration, Instant};
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tidepool::terminal::ByteBucket;
+use tidepool::serve::ByteBucket;
 
 use super::protocol::{self, MAX_EVENTS_PER_TICK, Refusal, Stamped, Tick, Wire};
 

@@ -1,4 +1,4 @@
-//! The sea at one moment ([`SeaFrame`]): the sines summed at a resting point for a sample
+//! The sea at one moment ([`SeaSurface`]): the sines summed at a resting point for a sample
 //! standing for a footprint (its height, displacement and the slope it cannot carry), the
 //! Jacobian of the displacement, and the Eulerian height at a fixed point.
 
@@ -6,16 +6,16 @@ use super::{EULER_ITERATIONS, LANES, Sea, SeaTime};
 use crate::sim::surface::{Footprint, Surface, SurfaceSample};
 use crate::sim::trig::{fast_cos, fast_sincos};
 
+#[cfg(test)]
 use super::fold::PhaseRows;
 
 /// The sea at one moment.
 #[derive(Clone, Debug)]
-pub struct SeaFrame<'a> {
+pub struct SeaSurface<'a> {
     pub(super) sea: &'a Sea,
     pub(super) phase: Vec<f32>,
     pub(super) tail_offset: [f32; 2],
     pub(super) time: SeaTime,
-    pub(super) time_s: f64,
 }
 
 /// The sums of one pass over the components: height, resolved slope variance,
@@ -36,8 +36,8 @@ pub(crate) struct Sums {
 pub(super) const HEIGHT: u8 = 0;
 const DISPLACED: u8 = 1;
 
-impl SeaFrame<'_> {
-    /// Gives back the frame's buffer, for [`Sea::frame_in`].
+impl SeaSurface<'_> {
+    /// Gives back the surface's buffer, for [`Sea::surface_at`].
     pub fn into_buffer(self) -> Vec<f32> {
         self.phase
     }
@@ -50,12 +50,6 @@ impl SeaFrame<'_> {
     /// Its moment.
     pub fn time(&self) -> SeaTime {
         self.time
-    }
-
-    /// Its moment in seconds, as given to [`Sea::frame_in`] (for a frame made from a
-    /// [`SeaTime::Tick`], the time within the loop).
-    pub fn time_s(&self) -> f64 {
-        self.time_s
     }
 
     /// One pass over the components a footprint keeps, in eight lanes of independent sums
@@ -140,6 +134,7 @@ impl SeaFrame<'_> {
         }
     }
 
+    #[cfg(test)]
     /// The Jacobian J of the displacement at the resting point (x, y) from the sines a
     /// sample standing for `footprint` keeps: the area the water resting there now covers,
     /// per unit of its area at rest (below 0 the surface has folded over).
@@ -169,9 +164,9 @@ impl SeaFrame<'_> {
     }
 }
 
-impl Surface for SeaFrame<'_> {
+impl Surface for SeaSurface<'_> {
     fn sample(&self, x: f32, y: f32, footprint: &Footprint) -> SurfaceSample {
-        SeaFrame::sample(self, x, y, footprint)
+        SeaSurface::sample(self, x, y, footprint)
     }
 }
 
