@@ -68,6 +68,12 @@
 
 use std::time::{Duration, Instant};
 
+mod path;
+mod questions;
+
+pub use path::LinkPath;
+use questions::{Question, Questions};
+
 /// The question: primary device attributes.
 pub const PROBE: &[u8] = b"\x1b[c";
 /// The question inside tmux over SSH: a device status report wrapped for tmux's passthrough
@@ -150,147 +156,6 @@ pub enum Change {
     Up,
     /// The rate fell: empty the byte bucket so the backlog drains.
     Down,
-}
-
-/// What sits between the player and the screen, as far as the player can tell
-/// ([`LinkPath::detect`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum LinkPath {
-    /// The terminal at the far end answers (plain SSH, a local terminal, a multiplexer on this
-    /// machine's own screen): the round trip measures the link.
-    #[default]
-    Direct,
-    /// A multiplexer (`tmux`, `screen`, `zellij`) over SSH: it answers DA1 itself from its
-    /// local pane, and its output goes into SSH's buffers unpaced. tmux and screen pass a
-    /// wrapped question on to the terminal ([`LinkPath::question`]); zellij's link cannot be
-    /// measured in band.
-    Multiplexer(&'static str),
-    /// mosh: mosh-server is the terminal; it answers DA1 at once and sends the client only the
-    /// latest screen, paced to the link, so the program never sees the link. What it does see
-    /// of the picture still crosses the link: each screen it sends carries every cell changed
-    /// since the last one the client acknowledged.
-    Mosh,
-}
-
-impl LinkPath {
-    /// Reads the path from the environment (`var` looks a variable up) and the names of the
-    /// process's ancestors, nearest first (`/proc/PID/comm` on Linux; none elsewhere).
-    ///
-    /// mosh sets nothing of its own in the environment (only `TERM` and
-    /// `NCURSES_NO_UTF8_ACS`, and it removes `STY`), but `mosh-server` is the ancestor of every
-    /// program it runs. A multiplexer counts only over SSH (`SSH_CONNECTION`, `SSH_CLIENT` or
-    /// `SSH_TTY`, which tmux's default `update-environment` refreshes on every attach): on this
-    /// machine's own screen its answers come from a local terminal anyway.
-    pub fn detect<'a>(var: impl Fn(&str) -> Option<String>, ancestors: impl IntoIterator<Item = &'a str>) -> LinkPath {
-        let set = |name: &str| var(name).is_some_and(|v| !v.is_empty());
-        if ancestors.into_iter().any(|name| name.trim() == "mosh-server") {
-            return LinkPath::Mosh;
-        }
-        let remote = set("SSH_CONNECTION") || set("SSH_CLIENT") || set("SSH_TTY");
-        let multiplexer = [("TMUX", "tmux"), ("STY", "screen"), ("ZELLIJ", "zellij")]
-            .into_iter()
-            .find(|(variable, _)| set(variable))
-            .map(|(_, name)| name);
-        match multiplexer {
-            Some(name) if remote => LinkPath::Multiplexer(name),
-            _ => LinkPath::Direct,
-        }
-    }
-}
-
-impl LinkPath {
-    /// The link's question on this path: DA1, or inside tmux and screen a device status
-    /// report wrapped for their passthrough (answered by the terminal, not the multiplexer).
-    pub fn question(self) -> &'static [u8] {
-        match self {
-            LinkPath::Multiplexer("tmux") => TMUX_QUESTION,
-            LinkPath::Multiplexer("screen") => SCREEN_QUESTION,
-            _ => PROBE,
-        }
-    }
-
-    /// Whether the link's answers are device status reports (`ESC[0n`) rather than device
-    /// attributes: the wrapped question.
-    pub fn asks_status(self) -> bool {
-        self.question() != PROBE
-    }
-
-    /// Whether an answer to the link's question comes from the terminal at the far end.
-    fn answered_at_far_end(self) -> bool {
-        self == LinkPath::Direct || self.asks_status()
-    }
-}
-
-/// A question in flight, in the order asked.
-#[derive(Clone, Copy, Debug)]
-struct Question {
-    /// When it went out.
-    asked: Instant,
-    /// The bytes sent up to it (0 for a foreign one).
-    bytes: u64,
-    /// Asked by somebody else (the graphics probe): its answer is dropped.
-    foreign: bool,
-    /// Unanswered for longer than the loss timeout: counted as congestion once, its bytes
-    /// taken as delivered; it keeps its place for its late answer.
-    overdue: bool,
-    /// Every frame since the question before it left most of its budget unspent: the player,
-    /// not the link, set the pace, so its answer says little of the link (see
-    /// [`LinkControl::frame_sent`]).
-    app_limited: bool,
-}
-
-/// The questions in flight, oldest first (a fixed array: steady-state frames allocate nothing).
-#[derive(Clone, Debug)]
-struct Questions {
-    list: [Option<Question>; MAX_QUESTIONS],
-    len: usize,
-}
-
-impl Questions {
-    fn iter(&self) -> impl Iterator<Item = &Question> {
-        self.list[..self.len].iter().flatten()
-    }
-
-    fn push(&mut self, question: Question) -> bool {
-        if self.len == MAX_QUESTIONS {
-            return false;
-        }
-        self.list[self.len] = Some(question);
-        self.len += 1;
-        true
-    }
-
-    fn pop_oldest(&mut self) -> Option<Question> {
-        let oldest = self.list[..self.len].first().copied().flatten()?;
-        self.list.copy_within(1..self.len, 0);
-        self.len -= 1;
-        self.list[self.len] = None;
-        Some(oldest)
-    }
-
-    /// Takes the oldest of the link's own questions out, the foreign ones keeping their places
-    /// (a device status answer is never the probe's).
-    fn pop_oldest_own(&mut self) -> Option<Question> {
-        let i = self.list[..self.len].iter().position(|q| q.is_some_and(|q| !q.foreign))?;
-        let own = self.list[i];
-        self.list.copy_within(i + 1..self.len, i);
-        self.len -= 1;
-        self.list[self.len] = None;
-        own
-    }
-
-    /// Drops the questions `forget` says to, keeping the others in order.
-    fn forget(&mut self, mut forget: impl FnMut(&Question) -> bool) {
-        let mut kept = 0;
-        for i in 0..self.len {
-            if let Some(q) = self.list[i].filter(|q| !forget(q)) {
-                self.list[kept] = Some(q);
-                kept += 1;
-            }
-        }
-        self.list[kept..].fill(None);
-        self.len = kept;
-    }
 }
 
 /// The marks the queue is held between for a base round trip `base`: the high one is one
