@@ -15,7 +15,9 @@
 //! seen to take (the bytes between two answers over the time between them: while a queue
 //! stands, that is the link's own rate; [`DEEP_DRAIN_SHARE`] of it for a deep queue), or by
 //! [`DECREASE`] when that is not known yet, and the byte bucket is emptied, so the backlog
-//! drains; in between it holds. The marks scale with the shortest round trip
+//! drains; in between it holds. The terminal's own time to answer is not queue: it is learned
+//! from answers the bytes in flight cannot explain and taken off (see `answer_time`), and one
+//! late answer alone never lowers the rate unless those bytes explain it. The marks scale with the shortest round trip
 //! ([`queue_marks`]): a queue of one round trip, never more than [`QUEUE_HIGH`], so a key's frame
 //! waits behind at most that. The first answer starts the rate from what the first frame was
 //! seen to take (never under [`SAFE_RATE`]): a base round trip taken while the start rate's
@@ -68,9 +70,12 @@
 
 use std::time::{Duration, Instant};
 
+mod answer_time;
 mod path;
 mod questions;
+mod screen_side;
 
+use answer_time::{AnswerTime, Flight};
 pub use path::LinkPath;
 use questions::{Question, Questions};
 
@@ -188,7 +193,7 @@ pub struct LinkControl {
     sample_count: usize,
     /// The queue the last answer showed (two answers in a row over the high mark make a fall,
     /// so one late read of an answer does not).
-    last_queue: Option<Duration>,
+    last_queue: Option<(Duration, bool)>,
     /// Whether any link question was ever answered.
     answered: bool,
     /// The terminal has not answered for [`SILENCE`]: [`SAFE_RATE`] and no window.
@@ -207,6 +212,12 @@ pub struct LinkControl {
     asked_up_to: u64,
     /// Every frame since the last question left most of its budget unspent.
     spare_since_question: bool,
+    /// The terminal's own answer times, which widen the queue's marks.
+    answer_time: AnswerTime,
+    /// The bytes sent, as the link would carry them at the capacity seen.
+    flight: Flight,
+    /// The bytes of the last frame sent.
+    last_frame: u64,
     /// Answers to foreign questions seen, and answers nobody asked for.
     foreign_answers: u64,
     stray_answers: u64,
@@ -249,6 +260,9 @@ impl LinkControl {
             acknowledged: 0,
             asked_up_to: 0,
             spare_since_question: true,
+            answer_time: AnswerTime::default(),
+            flight: Flight::default(),
+            last_frame: 0,
             foreign_answers: 0,
             stray_answers: 0,
         }
@@ -275,7 +289,15 @@ impl LinkControl {
     pub fn probed(&mut self, now: Instant, bytes_sent: u64) {
         self.asked_up_to = self.asked_up_to.max(bytes_sent);
         let app_limited = std::mem::replace(&mut self.spare_since_question, true);
-        self.questions.push(Question { asked: now, bytes: bytes_sent, foreign: false, overdue: false, app_limited });
+        let in_flight = self.flight.sent(now, bytes_sent, self.last_frame, self.capacity.unwrap_or(self.rate));
+        self.questions.push(Question {
+            asked: now,
+            bytes: bytes_sent,
+            foreign: false,
+            overdue: false,
+            app_limited,
+            in_flight,
+        });
     }
 
     /// A frame went out that spent `spent` of the `budget` it was given. A sender that leaves
@@ -286,6 +308,7 @@ impl LinkControl {
     /// seen to deliver (measured over SSH: kitty's pictures on their lowest rung, 5.4 kB/s
     /// read as the link on a 250 kB/s link, and `auto` left pixels for cells).
     pub fn frame_sent(&mut self, spent: usize, budget: usize) {
+        self.last_frame = spent as u64;
         if spent.saturating_mul(2) >= budget {
             self.spare_since_question = false;
         }
@@ -350,13 +373,25 @@ impl LinkControl {
         self.sample_count += 1;
         let base = self.base().unwrap_or(rtt);
         let queue = rtt.saturating_sub(base);
-        let last_queue = self.last_queue.replace(queue);
         let (low, high) = queue_marks(base);
+        // The queue the bytes ahead of the question would have made on the link as seen, and
+        // the terminal's own time, learned where they made none (see `answer_time`).
+        let in_flight = question.in_flight;
+        self.flight.answered(now, bytes);
+        self.answer_time.record(queue, in_flight, high);
+        let link_queue = queue.saturating_sub(self.answer_time.usual());
+        // Over the high mark, and either the bytes in flight explain it (a queue grows with
+        // them; the terminal's time does not) or it is beyond the terminal's slow answers too.
+        let explained = 2 * in_flight >= link_queue;
+        let over = link_queue > high && (explained || queue > high + self.answer_time.slow());
+        let last_queue = self.last_queue.replace((link_queue, over));
         if let Some(took) = took {
             self.capacity = Some(match self.capacity {
-                // Only a standing queue says the link was the limit; a few late reads of an
-                // answer on a busy machine must not shrink the window to one frame's take.
-                Some(c) if queue <= high => c.max(took),
+                // Only a standing queue (two answers over the mark in a row) says the link was
+                // the limit; a late answer (a busy machine's late read, a terminal drawing)
+                // must not shrink the window to one frame's take, nor the capacity the bytes in
+                // flight are timed by.
+                Some(c) if !(over && last_queue.is_some_and(|(_, was_over)| was_over)) => c.max(took),
                 _ => took,
             });
         }
@@ -397,17 +432,21 @@ impl LinkControl {
         // A queue that is not draining, over the high mark twice in a row, or once when it
         // is beyond what a busy machine's late reads of an answer make (a long link then
         // falls a round trip sooner).
-        let not_draining = last_queue.is_none_or(|last| queue >= last);
-        let confirmed = last_queue.is_some_and(|last| last > high) || queue > 2 * QUEUE_HIGH_MIN;
+        let not_draining = last_queue.is_none_or(|(last, _)| link_queue >= last);
+        // One answer alone confirms a queue only when the bytes in flight explain it: a single
+        // late answer is the terminal's (kitty 0.26 under llvmpipe took up to a second now and
+        // then), never a collapse of the link.
+        let confirmed =
+            last_queue.is_some_and(|(_, was_over)| was_over) || (link_queue > 2 * QUEUE_HIGH_MIN && explained);
         // A sender that left its budget unspent cannot have built a queue of a few marks: only
         // a deep one lowers the rate then.
-        let caused = !app_limited || queue > 2 * high;
-        if queue > high && not_draining && confirmed && caused {
+        let caused = !app_limited || link_queue > 2 * high;
+        if over && not_draining && confirmed && caused {
             // A queue of several marks drains faster: at 15 % under the link, a second of
             // queue would take six to go.
-            self.fall(now, if queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE });
+            self.fall(now, if link_queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE });
             Change::Down
-        } else if queue < low && self.rate < self.ceiling {
+        } else if link_queue < low && self.rate < self.ceiling {
             // Only a sender that used its budget learns that the link carries more: one that
             // left it unspent (cells of calm water) would grow the rate without evidence, to
             // "no limit" on a 250 kB/s link, and `auto` then switched to pixels that queued
@@ -505,92 +544,6 @@ impl LinkControl {
         } else {
             Change::Hold
         }
-    }
-}
-
-/// What the Screen calls besides the loop above: the path, the status line's hint, the probe's
-/// answers, the answers to wait for at the end.
-impl LinkControl {
-    /// A few words for the status line when the link cannot be measured and the rate is a
-    /// guess ([`SAFE_RATE`]): how to set it. At most 67 characters: on a 160-column status
-    /// line they leave the rate and the stone size beside them.
-    pub fn hint(&self) -> Option<&'static str> {
-        match self.path {
-            // The wrapped question is answered (or has not waited long yet).
-            LinkPath::Multiplexer(_) if self.path.asks_status() && !self.silent => None,
-            LinkPath::Multiplexer("tmux") => {
-                Some("tmux: set -g allow-passthrough on, or --bandwidth (250k = 2 Mbit/s)")
-            }
-            LinkPath::Multiplexer("screen") => {
-                Some("screen: terminal not answering, set --bandwidth (250k = 2 Mbit/s)")
-            }
-            LinkPath::Multiplexer(_) => {
-                Some("multiplexer over SSH: link not measured, set --bandwidth (250k = 2 Mbit/s)")
-            }
-            LinkPath::Mosh => Some("mosh: link not measured, set --bandwidth (250k = 2 Mbit/s)"),
-            LinkPath::Direct if self.silent => Some("the terminal does not answer: set --bandwidth (250k = 2 Mbit/s)"),
-            LinkPath::Direct => None,
-        }
-    }
-
-    /// The link's question, to follow a frame ([`LinkPath::question`]).
-    pub fn question(&self) -> &'static [u8] {
-        self.path.question()
-    }
-
-    /// Whether the link's answers are device status reports ([`LinkControl::status_answered`])
-    /// rather than device attributes ([`LinkControl::answered`]).
-    pub fn asks_status(&self) -> bool {
-        self.path.asks_status()
-    }
-
-    /// The last round trip measured.
-    #[cfg(test)]
-    pub fn last_rtt(&self) -> Option<Duration> {
-        self.last_rtt
-    }
-
-    /// Answers counted as foreign ([`LinkControl::expect_foreign`]) and answers that came with
-    /// no question waiting, so far.
-    #[cfg(test)]
-    pub fn dropped_answers(&self) -> (u64, u64) {
-        (self.foreign_answers, self.stray_answers)
-    }
-
-    /// How many answers are still expected (link and foreign questions): at the end, wait a
-    /// little for them, or they reach the shell as typed text.
-    pub fn awaiting(&self) -> usize {
-        self.questions.len
-    }
-
-    /// `count` DA1 questions somebody else asked (the graphics probe) are still to be answered,
-    /// ahead of every link question asked from now on: their answers are counted and dropped.
-    /// Until they come, or [`FOREIGN_WAIT`] has passed, no link question is asked, so an answer
-    /// that never comes cannot shift the pairing.
-    pub fn expect_foreign(&mut self, now: Instant, count: usize) {
-        // (Called by the Screen when the probe's questions go out.)
-        for _ in 0..count {
-            if !self.questions.push(Question {
-                asked: now,
-                bytes: 0,
-                foreign: true,
-                overdue: false,
-                app_limited: false,
-            }) {
-                break;
-            }
-        }
-    }
-
-    /// Whether a question of the link's own is waiting for its answer.
-    pub fn asking(&self) -> bool {
-        self.questions.iter().any(|q| !q.foreign)
-    }
-
-    /// Whether an answer to somebody else's question is still due here (the Screen then gives
-    /// the next device-attributes answer to the probe and lets this queue drop its place).
-    pub fn foreign_due(&self) -> bool {
-        self.questions.iter().next().is_some_and(|q| q.foreign)
     }
 }
 

@@ -21,6 +21,9 @@ pub(super) struct Question {
     /// not the link, set the pace, so its answer says little of the link (see
     /// [`super::LinkControl::frame_sent`]).
     pub(super) app_limited: bool,
+    /// The queue the bytes sent up to it would have made on the link, at the capacity seen
+    /// ([`super::answer_time::Flight`]): the part of its round trip the bytes can explain.
+    pub(super) in_flight: std::time::Duration,
 }
 
 /// The questions in flight, oldest first (a fixed array: steady-state frames allocate nothing).
