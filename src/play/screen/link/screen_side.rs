@@ -3,9 +3,7 @@
 //! to wait for at the end.
 
 use super::{LinkControl, LinkPath, Question};
-#[cfg(test)]
-use std::time::Duration;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// What the Screen calls besides the loop above: the path, the status line's hint, the probe's
 /// answers, the answers to wait for at the end.
