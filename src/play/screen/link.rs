@@ -446,27 +446,17 @@ impl LinkControl {
             // queue would take six to go.
             self.fall(now, if link_queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE });
             Change::Down
-        } else if link_queue < low && self.rate < self.ceiling.min(self.evidence(app_limited)) {
+        } else if link_queue < low && self.rate < self.ceiling {
+            // Only a sender that used its budget learns that the link carries more: one that
+            // left it unspent (cells of calm water) would grow the rate without evidence, to
+            // "no limit" on a 250 kB/s link, and `auto` then switched to pixels that queued
+            // for seconds.
             let growth = if self.fell { INCREASE_AFTER_LIMIT } else { INCREASE };
-            self.rate = (self.rate * growth).min(self.ceiling).min(self.evidence(app_limited).max(self.rate));
+            self.rate = (self.rate * growth).min(self.ceiling);
             self.decided_at = Some(now);
             Change::Up
         } else {
             Change::Hold
-        }
-    }
-
-    /// How far an answer may grow the rate. A sender that used its budget is the evidence that
-    /// the link carries more. One that left it unspent (cells of calm water, a group's frames
-    /// through serve) only shows what the link carried: it may grow the rate to twice that
-    /// (so a rate that fell comes back, and a serve player's frames keep fitting), never on to
-    /// "no limit" without evidence (calm water grew it to 64 MB/s on a 250 kB/s link, and `auto`
-    /// switched to pixels that queued for seconds). Stopping growth altogether there (fa96bed)
-    /// left serve's players, whose group frames rarely spend half a budget, at a fallen rate.
-    fn evidence(&self, app_limited: bool) -> f64 {
-        match self.capacity {
-            Some(carried) if app_limited => (2.0 * carried).max(SAFE_RATE),
-            _ => f64::INFINITY,
         }
     }
 

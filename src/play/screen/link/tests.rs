@@ -530,39 +530,3 @@ fn a_terminal_slow_to_answer_is_not_taken_for_a_queue() {
         assert!(p90 <= bound.as_secs_f64() + 2.0 / FPS, "{rtt:?}: the queue's p90 is {:.0} ms", p90 * 1e3);
     }
 }
-
-#[test]
-fn a_sender_that_leaves_its_budget_unspent_grows_the_rate_only_to_twice_what_the_link_carried() {
-    // Cells of calm water over a 250 kB/s link: a tenth of each budget spent, every answer
-    // quick. The rate grew 25 % an answer to "no limit" (mlterm over the shaped link: `auto`
-    // switched to sixel that queued for four seconds).
-    let link = Link { spend_share: 0.1, ..Link::far(250_000.0, ms(5)) };
-    let run = simulate(LinkPath::Direct, link, 10.0, busy);
-    let highest = run.rates.iter().copied().fold(0.0, f64::max);
-    let carried = run.throughput(250_000.0, 1.0, 10.0);
-    println!("calm water: highest rate {highest:.0} B/s, carried {carried:.0} B/s");
-    assert!(highest < MAX_RATE, "the rate grew to no limit without being used");
-    assert!(highest <= 4.0 * START_RATE, "the rate grew to {highest:.0} B/s on {carried:.0} B/s carried");
-    // And a rate that fell comes back while the sender is calm (serve's players, whose group
-    // frames spend little of their budget, stopped getting frames when it did not).
-    let mut control = LinkControl::new();
-    let t0 = Instant::now();
-    let (mut sent, mut t) = (0u64, t0);
-    let mut fallen = START_RATE;
-    for i in 0..200u64 {
-        // Quick answers (the base round trip), a deep queue (the rate falls), quick again.
-        let deep = (5..25).contains(&i);
-        sent += 2_000;
-        control.frame_sent(2_000, if deep { 2_500 } else { 20_000 });
-        control.probed(t, sent);
-        t += if deep { ms(400) } else { ms(5) };
-        control.answered(t);
-        t += ms(33);
-        if i < 25 {
-            fallen = control.rate().unwrap_or(MAX_RATE);
-        }
-    }
-    let rate = control.rate().unwrap_or(MAX_RATE);
-    println!("a calm sender's rate: {fallen:.0} B/s after the queue, {rate:.0} B/s after 180 quick answers");
-    assert!(rate >= 4.0 * fallen, "a calm sender's rate stayed at {rate:.0} B/s (it fell to {fallen:.0})");
-}
