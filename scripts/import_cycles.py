@@ -6,7 +6,12 @@
 2. The layers (ARCHITECTURE.md, "The layers"), by top-level folder of src/: a folder never
    imports the folders LAYERS lists for it (any file in it, any depth, `crate::x` or
    `crate::{x, ..}`). The rule that matters most: the play session (src/play/) imports no door
-   (src/term/; the SSH door lives in the binary and cannot be named).
+   (src/term/; the SSH door lives in the binary and cannot be named). Test files (`tests.rs`,
+   `*_tests.rs`, anything under a `tests/` folder) are the harness and may use any layer.
+3. The sans-IO core (ARCHITECTURE.md, "The play session"): no file of src/play/ or src/output/
+   (the encoders the session calls) names the file system, the environment, /proc, threads,
+   sockets, the clock or sleep outside its tests; NO_IO_EXCEPTIONS lists the files that may,
+   each with its reason.
 
 Usage: scripts/import_cycles.py src src/bin/tidepool   (prints each problem; exit 1 if any)"""
 import os,re,sys
@@ -26,6 +31,37 @@ LAYERS = {
     "terminal": {"play"} | DOORS,
     "replay": {"play"} | DOORS,
 }
+
+# What the sans-IO core never names outside its tests: the file system, the environment, /proc,
+# threads (and their sleep), sockets, the standard streams, the clock.
+CORE = ("play", "output")
+NO_IO = re.compile(r"\bstd::(fs|env|thread|net|process::Command)\b|\bfs::|\benv::|\bFile::|\"/proc|"
+                   r"\bInstant::now\b|\bSystemTime\b|\bsleep(_until)?\(|\bstd(in|out|err)\(\)|"
+                   r"\bstd::\{[^}]*\b(fs|env|thread|net)\b")
+NO_IO_EXCEPTIONS = {
+    # kitty's temporary files on disk: the door writes the session's (handed out as data) with
+    # it, and a picture written once (`render --out -`, KittyEncoder) writes its own.
+    "output/graphics/kitty/files.rs",
+    # A test tool (feature `testing` in spirit): decodes what a terminal would read, files too.
+    "output/graphics/kitty_decode.rs",
+}
+
+def is_test_file(path):
+    base=os.path.basename(path)
+    return base=="tests.rs" or base.endswith("_tests.rs") or (os.sep+"tests"+os.sep) in path
+
+def io_problems(root):
+    """Each line of the sans-IO core that names I/O or the clock: (file, line, text)."""
+    problems=[]
+    for top in CORE:
+        for d,_,fs in os.walk(os.path.join(root, top)):
+            for f in fs:
+                path=os.path.join(d,f)
+                rel=os.path.relpath(path,root).replace(os.sep,"/")
+                if not f.endswith(".rs") or is_test_file(path) or rel in NO_IO_EXCEPTIONS: continue
+                for n,l in enumerate(code_of(path).split("\n"),1):
+                    if NO_IO.search(l): problems.append((path,n,l.strip()))
+    return problems
 
 def code_of(path):
     """The file's text without its test module and its comment lines."""
@@ -54,6 +90,7 @@ def layer_problems(root):
         for f in fs:
             if not f.endswith('.rs'): continue
             path=os.path.join(d,f)
+            if is_test_file(path): continue
             top=os.path.relpath(path,root).split(os.sep)[0]
             top=top[:-3] if top.endswith('.rs') else top
             forbidden=LAYERS.get(top,set())
@@ -108,4 +145,8 @@ for root in sys.argv[1:]:
     for path,line,top,name in layer_problems(root):
         found = True
         print(f"{path}:{line}: src/{top}/ imports crate::{name}, a layer above it (ARCHITECTURE.md, The layers)")
+    if os.path.isdir(os.path.join(root, "play")):
+        for path,line,text in io_problems(root):
+            found = True
+            print(f"{path}:{line}: the sans-IO core does I/O or reads the clock: `{text}` (the door does it; ARCHITECTURE.md)")
 sys.exit(1 if found else 0)

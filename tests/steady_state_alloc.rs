@@ -131,7 +131,7 @@ fn player_frames(scene: SceneSpec) -> usize {
     let quit = Arc::new(AtomicBool::new(false));
     let marks = Arc::new(Mutex::new(Vec::with_capacity(2)));
     let config = PlayConfig {
-        host: HostConfig { scenes: vec![scene], seed: 1, record: None, storage: None },
+        host: HostConfig { scenes: vec![scene], seed: 1, record: None, screenshots: false },
         screen: ScreenConfig {
             fps: 60,
             bandwidth: Bandwidth::Unlimited,
@@ -143,6 +143,7 @@ fn player_frames(scene: SceneSpec) -> usize {
             link_path: tidepool::play::LinkPath::Direct,
         },
         greeting: Some("a greeting in the status line".into()),
+        storage: None,
         quit: Arc::clone(&quit),
     };
     let output = FrameCounter { frames: 0, marks: Arc::clone(&marks), quit };

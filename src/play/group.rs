@@ -26,7 +26,6 @@
 
 use std::collections::{HashMap, VecDeque};
 use std::hash::Hash;
-use std::io;
 use std::sync::Arc;
 use std::time::Instant;
 
@@ -185,7 +184,7 @@ impl Group {
     /// Encodes the frame for now: `picture` (of [`GroupKey::picture_size`]) under the status
     /// line of `status`, with no one's overlay. Returns whether the frame changed anything (a
     /// frame that sends nothing is no new group frame).
-    pub fn frame(&mut self, now: Instant, picture: &Pixmap, status: &SceneStatus) -> io::Result<bool> {
+    pub fn frame(&mut self, now: Instant, picture: &Pixmap, status: &SceneStatus) -> bool {
         self.screen.forget_pen();
         let (fps, bytes_per_second) = self.screen.figures();
         let bandwidth = (self.screen.config().bandwidth != Bandwidth::Unlimited).then(|| self.key.class.rate());
@@ -199,14 +198,14 @@ impl Group {
         };
         bytes.clear();
         let len =
-            self.screen.frame_from(now, picture, status, &seat, Cells::Own { figures: Some(figures) }, &mut bytes)?;
+            self.screen.frame_from(now, picture, status, &seat, Cells::Own { figures: Some(figures) }, &mut bytes);
         if len == 0 {
-            return Ok(false);
+            return false;
         }
         after.clone_from(self.screen.shown());
         self.number += 1;
         self.frames.push_back(Arc::new(GroupFrame { number: self.number, bytes, after, figures }));
-        Ok(true)
+        true
     }
 
     /// The last frames, for the members.
@@ -255,8 +254,7 @@ impl Groups {
         let mut work: Vec<&mut Group> = self.groups.values_mut().collect();
         work.par_iter_mut()
             .map(|group| match pictures.get(&group.key().picture_size()) {
-                // A group frame fails only for kitty's temporary file, which cells never write.
-                Some(picture) => u64::from(group.frame(now, picture, status).unwrap_or(false)),
+                Some(picture) => u64::from(group.frame(now, picture, status)),
                 None => 0,
             })
             .sum()
@@ -366,7 +364,7 @@ impl Membership {
         status: &SceneStatus,
         feed: Option<&GroupFeed>,
         out: &mut Vec<u8>,
-    ) -> io::Result<(usize, Source)> {
+    ) -> (usize, Source) {
         let key = self.key(&player.screen);
         let feed = feed.filter(|f| Some(f.key) == key && !f.frames.is_empty());
         let Player { seat, screen, .. } = player;
@@ -387,12 +385,12 @@ impl Membership {
             self.leave(screen);
         }
         let Some(feed) = feed else {
-            return Ok((screen.frame(now, picture, status, &view, out)?, Source::Own));
+            return (screen.frame(now, picture, status, &view, out), Source::Own);
         };
         let latest = feed.frames.last().expect("a feed with frames");
         if !plain {
             let own = Cells::Own { figures: Some(latest.figures) };
-            return Ok((screen.frame_from(now, picture, status, &view, own, out)?, Source::Own));
+            return (screen.frame_from(now, picture, status, &view, own, out), Source::Own);
         }
         // Plain again: the cells of one of the group's frames? Then its later frames follow.
         if let Some(at) = feed.frames.iter().rposition(|f| looks_alike(&f.after, screen.shown())) {
@@ -400,14 +398,14 @@ impl Membership {
             return self.take(screen, now, picture, status, &feed.frames[at + 1..], out);
         }
         let Some(model) = &latest.after.frame else {
-            return Ok((screen.frame(now, picture, status, &view, out)?, Source::Own));
+            return (screen.frame(now, picture, status, &view, out), Source::Own);
         };
-        let len = screen.frame_from(now, picture, status, &view, Cells::Toward(model), out)?;
+        let len = screen.frame_from(now, picture, status, &view, Cells::Toward(model), out);
 
         if looks_alike(&latest.after, screen.shown()) {
             self.join(screen, latest.clone(), key);
         }
-        Ok((len, Source::Own))
+        (len, Source::Own)
     }
 
     /// Sends as many of the group's `frames` (those following the one pinned) as the link takes
@@ -420,7 +418,7 @@ impl Membership {
         status: &SceneStatus,
         frames: &[Arc<GroupFrame>],
         out: &mut Vec<u8>,
-    ) -> io::Result<(usize, Source)> {
+    ) -> (usize, Source) {
         let budget = screen.budget(now);
         let mut sum = 0;
         let fit = frames.iter().take_while(|f| {
@@ -429,7 +427,7 @@ impl Membership {
         });
         let frames = &frames[..fit.count()];
         if frames.is_empty() {
-            return Ok((0, Source::Nothing));
+            return (0, Source::Nothing);
         }
         self.stats.taken += 1;
         let joined: Vec<u8>;
@@ -440,9 +438,9 @@ impl Membership {
                 joined.as_slice()
             }
         };
-        let len = screen.frame_from(now, picture, status, &SeatView::default(), Cells::Taken(bytes), out)?;
+        let len = screen.frame_from(now, picture, status, &SeatView::default(), Cells::Taken(bytes), out);
         self.pinned = frames.last().cloned();
-        Ok((len, Source::Group))
+        (len, Source::Group)
     }
 
     /// In step from `frame` on: the screen's own model and buffers go.

@@ -4,10 +4,11 @@
 //! seat -> host -> scene, and a replay applies the same events through the same `Scene::apply`.
 //!
 //! The local player owns a host next to its seat and screen; `tidepool serve` runs one host on
-//! its own thread for everyone. Time comes in as an argument.
+//! its own thread for everyone. Time comes in as an argument, and files go out as data: a
+//! screenshot is an [`Effect`] the door saves ([`Host::poll_effect`], then
+//! [`Host::handle_saved`]), the recording is the text [`Host::finish`] hands out.
 
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::path::PathBuf;
 use std::time::Instant;
 
 use rand::{Rng, SeedableRng};
@@ -19,7 +20,6 @@ use super::request::Request;
 use crate::error::{Result, ValueError};
 use crate::replay::{FORMAT, Header, PoolOptions, Recorder};
 use crate::scene::{Action, Event, Playable, SceneKind, SceneSpec};
-use crate::storage::Storage;
 
 /// Random stones use their own generator, seeded from the seed xor this, so that pressing
 /// `space` does not change the rain.
@@ -36,8 +36,8 @@ pub struct HostConfig {
     pub seed: u64,
     /// Record the session (the pool only) to this file.
     pub record: Option<Recording>,
-    /// Where screenshots and recordings are saved; without one, screenshots are off.
-    pub storage: Option<Arc<dyn Storage>>,
+    /// Whether `s` takes screenshots (the door has somewhere to save them).
+    pub screenshots: bool,
 }
 
 impl std::fmt::Debug for HostConfig {
@@ -46,7 +46,29 @@ impl std::fmt::Debug for HostConfig {
             .field("scenes", &self.scenes.iter().map(SceneSpec::kind).collect::<Vec<_>>())
             .field("seed", &self.seed)
             .field("record", &self.record)
-            .finish_non_exhaustive()
+            .field("screenshots", &self.screenshots)
+            .finish()
+    }
+}
+
+/// What the host asks its door to do: the host writes no file.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Effect {
+    /// Save the scene's picture, a PNG, as `BASE.png` (or, when that is taken, the first free
+    /// `BASE-N.png` for N up to 1000: [`Effect::names`]), then tell the host
+    /// ([`Host::handle_saved`]).
+    Screenshot {
+        /// The name without its extension (`tidepool-pool-000120`).
+        base: String,
+        /// The PNG's bytes.
+        png: Vec<u8>,
+    },
+}
+
+impl Effect {
+    /// The names a screenshot tries, in order.
+    pub fn names(base: &str) -> impl Iterator<Item = String> + '_ {
+        (1..=SCREENSHOT_NAMES).map(move |i| if i == 1 { format!("{base}.png") } else { format!("{base}-{i}.png") })
     }
 }
 
@@ -85,7 +107,8 @@ pub struct Host {
     clock: SimClock,
     rng: ChaCha8Rng,
     recorder: Option<Recorder>,
-    storage: Option<Arc<dyn Storage>>,
+    screenshots: bool,
+    effects: Vec<Effect>,
     step: u64,
     status: SceneStatus,
 }
@@ -104,17 +127,13 @@ impl Host {
     /// The first scene of `config` at `size` pixels, its clock starting at `now`.
     ///
     /// Fails when there is no scene, the size cannot be allocated, or a recording is asked for
-    /// a scene other than the pool or without a storage.
+    /// a scene other than the pool.
     pub fn new(config: HostConfig, size: (u32, u32), now: Instant) -> Result<Host> {
         let first =
             config.scenes.first().ok_or_else(|| ValueError::new("scenes", "a host needs at least one scene"))?;
         let scene = first.build(size.0, size.1)?;
         let recorder = match (&config.record, first) {
             (Some(recording), SceneSpec::Pool(settings)) => {
-                let storage = config
-                    .storage
-                    .clone()
-                    .ok_or_else(|| ValueError::new("record", "recording needs somewhere to save the file"))?;
                 let header = Header {
                     format: FORMAT,
                     version: env!("CARGO_PKG_VERSION").into(),
@@ -123,7 +142,7 @@ impl Host {
                     size: [size.0, size.1],
                     options: PoolOptions::of(settings, recording.background.clone()),
                 };
-                Some(Recorder::new(&recording.path, &header, storage))
+                Some(Recorder::new(&recording.path, &header))
             }
             (Some(_), _) => return Err(ValueError::new("record", "replays hold the pool only").into()),
             (None, _) => None,
@@ -135,11 +154,13 @@ impl Host {
             scenes: config.scenes,
             current: 0,
             recorder,
-            storage: config.storage,
+            screenshots: config.screenshots,
+            effects: Vec::new(),
             step: 0,
             status: SceneStatus::default(),
         };
         host.describe_scene();
+        host.refresh_status();
         Ok(host)
     }
 
@@ -173,9 +194,14 @@ impl Host {
                 self.clock.set_paused(!self.clock.paused(), now);
                 self.status.paused = self.clock.paused();
             }
-            Request::NextScene => return self.next_scene(now),
-            Request::Screenshot => return Some(self.screenshot()),
+            Request::NextScene => {
+                let message = self.next_scene(now);
+                self.refresh_status();
+                return message;
+            }
+            Request::Screenshot => return self.screenshot(),
         }
+        self.refresh_status();
         None
     }
 
@@ -184,6 +210,7 @@ impl Host {
     pub fn resize(&mut self, width: u32, height: u32) {
         if (width, height) != self.scene.size() {
             self.apply_event(Event::Resize([width, height]));
+            self.refresh_status();
         }
     }
 
@@ -195,6 +222,7 @@ impl Host {
         if let Some(r) = &mut self.recorder {
             r.advance(self.step);
         }
+        self.refresh_status();
         due
     }
 
@@ -206,22 +234,45 @@ impl Host {
     /// Draws the scene into `out`, which has the scene's size.
     pub fn render(&mut self, out: &mut Pixmap) {
         self.scene.render(out);
+        self.refresh_status();
     }
 
-    /// What the status line and the help say now (the scene's summary is refreshed in place:
-    /// no allocation once its text has grown).
-    pub fn status(&mut self) -> &SceneStatus {
-        self.status.detail.clear();
-        self.scene.status(&mut self.status.detail);
+    /// What the status line and the help say now (kept current by every change the host
+    /// makes to the scene).
+    pub fn status(&self) -> &SceneStatus {
         &self.status
     }
 
-    /// Ends the session: the recording is saved whole (once; later calls do nothing).
-    pub fn finish(&mut self) -> Result<()> {
-        match &mut self.recorder {
-            Some(r) => r.finish(self.step),
-            None => Ok(()),
+    /// The scene's summary, refreshed in place (no allocation once its text has grown) after
+    /// anything that may change it: the scene changes only through the host's own methods.
+    fn refresh_status(&mut self) {
+        self.status.detail.clear();
+        self.scene.status(&mut self.status.detail);
+    }
+
+    /// What the door must do for the host (a screenshot to save), oldest first.
+    pub fn poll_effect(&mut self) -> Option<Effect> {
+        (!self.effects.is_empty()).then(|| self.effects.remove(0))
+    }
+
+    /// The door saved the screenshot as `name` (`Ok`), or could not (`Err`, why): recorded in
+    /// the replay at the step it was asked at when saved. Returns the message for the person.
+    pub fn handle_saved(&mut self, outcome: std::result::Result<String, String>) -> String {
+        match outcome {
+            Ok(name) => {
+                let message = format!("saved {name}");
+                self.apply_event(Event::Screenshot(name));
+                self.refresh_status();
+                message
+            }
+            Err(e) => format!("screenshot failed: {e}"),
         }
+    }
+
+    /// Ends the session: the recording's file (its path and its whole text) to save, once;
+    /// `None` without a recording or on later calls.
+    pub fn finish(&mut self) -> Option<(PathBuf, String)> {
+        self.recorder.as_mut()?.finish(self.step)
     }
 
     fn act(&mut self, action: Action) {
@@ -273,27 +324,18 @@ impl Host {
         }
     }
 
-    /// Saves the scene's picture as `tidepool-SCENE-STEP.png` (a free name), and records it.
-    fn screenshot(&mut self) -> String {
-        let Some(storage) = self.storage.clone() else {
-            return "screenshots are off here".into();
-        };
+    /// Asks the door to save the scene's picture as `tidepool-SCENE-STEP.png` (a free name,
+    /// recorded once saved); a message when it cannot be asked.
+    fn screenshot(&mut self) -> Option<String> {
+        if !self.screenshots {
+            return Some("screenshots are off here".into());
+        }
         let shot = match self.scene.snapshot() {
             Ok(shot) => shot,
-            Err(e) => return format!("screenshot failed: {e}"),
+            Err(e) => return Some(format!("screenshot failed: {e}")),
         };
         let base = format!("tidepool-{}-{:06}", self.scene.kind(), self.step);
-        let name = (1..=SCREENSHOT_NAMES)
-            .map(|i| if i == 1 { format!("{base}.png") } else { format!("{base}-{i}.png") })
-            .find(|n| !storage.exists(Path::new(n)))
-            .unwrap_or_else(|| format!("{base}.png"));
-        match storage.save(name.as_ref(), &crate::output::png::encode(&shot)) {
-            Ok(()) => {
-                let message = format!("saved {name}");
-                self.apply_event(Event::Screenshot(name));
-                message
-            }
-            Err(e) => format!("screenshot failed: {e}"),
-        }
+        self.effects.push(Effect::Screenshot { base, png: crate::output::png::encode(&shot) });
+        None
     }
 }

@@ -7,21 +7,29 @@
 //! - [`Seat`]: one person: aim, stone size, drag, help, messages, and the [`Fit`] between their
 //!   terminal and the scene. [`Seat::handle`] turns an [`Input`] into requests.
 //! - [`Screen`]: one terminal: the graphics probe, the link control and byte budget, the
-//!   rate-controlled cell encoder and the picture encoders. [`Screen::feed`] takes the
-//!   terminal's bytes (replies stay in the screen, inputs come out); `Screen::frame` appends a
-//!   frame's bytes.
+//!   rate-controlled cell encoder and the picture encoders. It takes the terminal's bytes
+//!   (replies stay in the screen, inputs come out) and appends a frame's bytes; its methods
+//!   are the crate's, the doors reach it through a [`Driver`].
 //!
 //! - [`Groups`]: screens alike enough to share frames, encoded once per group; a player's [`Membership`]
 //!   takes the group's bytes while its terminal shows the group's model.
 //!
-//! Two doors drive them: [`crate::tty::run`] (and [`crate::tty::play`], for this process's own terminal) puts a host,
-//! a seat and a screen on one terminal; `tidepool serve` runs one host on a thread and a seat
-//! and a screen per SSH channel. A key's route is straight: bytes -> [`Screen::feed`] ->
+//! The surface the doors drive, in quinn-proto's shape (`handle_*` for inputs, `poll_*` for
+//! outputs, time passed in): a [`Driver`] is the one turn of one person at one terminal
+//! (`handle_bytes`, `handle_resize`, `handle_picture`, `handle_timeout(now)`; `poll_event`
+//! for the seat's requests, a new layout, quit; `poll_timeout`; `poll_frame` and
+//! `transmit`); a [`Session`] is a driver beside its own host (`poll_event` adds the host's
+//! [`Effect`]s, files to save, and `poll_transmit` hands out a [`Transmit`]: the frame's bytes
+//! and the [`FileWrite`]s to do before them). Files, the clock and sockets are the doors'.
+//!
+//! Two doors drive them: [`crate::tty::run`] (and [`crate::tty::play`], for this process's own
+//! terminal) runs a [`Session`] on one terminal; `tidepool serve` runs one host on a thread and
+//! a [`Driver`] per SSH channel. A key's route is straight: bytes -> [`Driver::handle_bytes`] ->
 //! [`Input`] -> [`Seat::handle`] -> [`Request`] -> [`Host::apply`] -> the scene.
 //!
 //! ```
 //! use std::time::{Duration, Instant};
-//! use tidepool::play::{Bandwidth, Flow, Host, HostConfig, Player, Screen, ScreenConfig};
+//! use tidepool::play::{Bandwidth, HostConfig, Screen, ScreenConfig, Session, Transmit};
 //! use tidepool::{PoolSettings, SceneSpec};
 //!
 //! let t0 = Instant::now();
@@ -35,30 +43,23 @@
 //!     probe: None,
 //!     link_path: Default::default(),
 //! };
-//! let screen = Screen::new(config, (40, 12), t0);
 //! let scenes = vec![SceneSpec::Pool(PoolSettings::default())];
-//! let host_config = HostConfig { scenes, seed: 1, record: None, storage: None };
-//! let mut host = Host::new(host_config, screen.picture_size(), t0)?;
-//! let mut player = Player::new(screen, host.size(), None);
-//! // The person presses space: a stone.
-//! player.feed(b" ", t0);
-//! let mut requests = Vec::new();
-//! let turn = player.turn(t0, host.status(), &mut requests);
-//! assert_eq!(turn.flow, Flow::Continue);
-//! for request in requests {
-//!     host.apply(request, t0);
-//! }
+//! let host = HostConfig { scenes, seed: 1, record: None, screenshots: false };
+//! let mut session = Session::new(config, host, (40, 12), None, t0);
+//! // The person presses space: a stone. Then a turn, 100 ms later.
+//! session.handle_bytes(b" ", t0);
 //! let now = t0 + Duration::from_millis(100);
-//! host.advance(now);
-//! let mut picture = tiny_skia::Pixmap::new(host.size().0, host.size().1).unwrap();
-//! host.render(&mut picture);
-//! let mut bytes = Vec::new();
-//! player.frame(now, &picture, host.status(), &mut bytes)?;
-//! assert!(bytes.starts_with(Screen::ENTER));
+//! session.handle_timeout(now)?;
+//! assert!(session.poll_event().is_some(), "the restore prefix, once the host is made");
+//! let mut out = Transmit::default();
+//! assert!(session.poll_transmit(now, true, &mut out)?);
+//! assert!(out.bytes.starts_with(Screen::ENTER) && out.files.is_empty());
+//! assert!(session.poll_timeout().is_some_and(|t| t > now), "the next frame, the next step");
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 pub(crate) mod clock;
+pub(crate) mod driver;
 pub(crate) mod fit;
 pub(crate) mod group;
 pub(crate) mod host;
@@ -68,16 +69,20 @@ pub(crate) mod replies;
 pub(crate) mod request;
 pub(crate) mod screen;
 pub(crate) mod seat;
+pub(crate) mod session;
 
+pub use crate::output::graphics::stream::FileWrite;
+pub use driver::{Driver, DriverEvent, Pacing, Transmit};
 pub use fit::Fit;
 pub use group::{GroupFeed, GroupKey, Groups, Membership, Source};
-pub use host::{Host, HostConfig, Recording, SceneStatus};
+pub use host::{Effect, Host, HostConfig, Recording, SceneStatus};
 pub use input::Input;
-pub use player::{Player, Turn};
+pub use player::Player;
 pub use request::Request;
-pub use screen::probe::{Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
+pub use screen::probe::{EnvHints, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize};
 pub use screen::{Bandwidth, LinkPath, Screen, ScreenConfig};
 pub use seat::{Flow, Seat};
+pub use session::{Session, SessionEvent};
 
 #[cfg(test)]
-mod tests;
+pub(crate) mod tests;

@@ -1,9 +1,8 @@
-//! A player: one person at one terminal, a [`Seat`] and a [`Screen`] driven together. Every door
-//! does the same with them on each turn (the terminal's bytes to the screen, its deadlines, a
-//! new layout, its notices, the person's inputs to the seat, the seat's requests out, a frame
-//! with the seat's overlay); this is that turn once, so a door is its I/O and nothing else.
+//! A player: one person at one terminal, a [`Seat`] and a [`Screen`] together. The turn every
+//! door takes with them (the terminal's bytes to the screen, its deadlines, a new layout, its
+//! notices, the person's inputs to the seat, the seat's requests out, a frame with the seat's
+//! overlay) is [`super::driver::Driver`]'s, built on the steps here.
 
-use std::io;
 use std::time::Instant;
 
 use tiny_skia::Pixmap;
@@ -16,7 +15,7 @@ use super::seat::{Flow, Seat};
 
 /// What a turn found.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Turn {
+pub(crate) struct Turn {
     /// Whether the person stays.
     pub flow: Flow,
     /// The picture's layout changed (a resize, the probe's answer): the door makes the scene
@@ -55,23 +54,22 @@ impl Player {
 
     /// Takes the terminal's bytes; says whether the person did something (the terminal's own
     /// answers are no sign of life: an idle timeout must not count them).
-    pub fn feed(&mut self, bytes: &[u8], now: Instant) -> bool {
+    pub(crate) fn feed(&mut self, bytes: &[u8], now: Instant) -> bool {
         let before = self.inputs.len();
         self.screen.feed(bytes, now, &mut self.inputs);
         self.inputs.len() > before
     }
 
     /// While the screen is asking the terminal what it draws (before a door can size its
-    /// scene): takes the terminal's bytes and looks at the clock; keys typed meanwhile wait for
-    /// the first [`Player::turn`].
-    pub fn settle(&mut self, bytes: &[u8], now: Instant) {
-        self.screen.feed(bytes, now, &mut self.inputs);
+    /// scene): looks at the clock (the probe's deadline); keys typed meanwhile wait for the
+    /// first [`Player::turn`].
+    pub(crate) fn settle(&mut self, now: Instant) {
         self.screen.tick(now, &mut self.inputs);
     }
 
     /// One turn at `now`: the screen's deadlines, its layout and notices, and the person's
     /// inputs as requests for the host (appended to `requests`). `status` is the scene's.
-    pub fn turn(&mut self, now: Instant, status: &SceneStatus, requests: &mut Vec<Request>) -> Turn {
+    pub(crate) fn turn(&mut self, now: Instant, status: &SceneStatus, requests: &mut Vec<Request>) -> Turn {
         self.screen.tick(now, &mut self.inputs);
         let layout_changed = self.screen.take_layout_change();
         if !self.screen.probing()
@@ -97,24 +95,18 @@ impl Player {
     }
 
     /// The scene (of `scene` pixels) fits the screen's new layout.
-    pub fn refit(&mut self, scene: (u32, u32)) {
+    pub(crate) fn refit(&mut self, scene: (u32, u32)) {
         self.seat.set_fit(self.screen.fit(scene));
     }
 
     /// A message from the host for this person (a screenshot's name).
-    pub fn say(&mut self, message: String, now: Instant) {
+    pub(crate) fn say(&mut self, message: String, now: Instant) {
         self.seat.say(message, now);
     }
 
     /// Appends the frame for now: `picture` (of the screen's picture size) with the seat's
     /// overlay and `status`'s status line. Returns the bytes appended.
-    pub fn frame(
-        &mut self,
-        now: Instant,
-        picture: &Pixmap,
-        status: &SceneStatus,
-        out: &mut Vec<u8>,
-    ) -> io::Result<usize> {
+    pub fn frame(&mut self, now: Instant, picture: &Pixmap, status: &SceneStatus, out: &mut Vec<u8>) -> usize {
         let view = self.seat.view(now, status);
         self.screen.frame(now, picture, status, &view, out)
     }

@@ -13,16 +13,14 @@
 //! probe's deadline is still the probe's and never shifts the link's round trips.
 
 pub(crate) mod compose;
+mod frame;
 pub(crate) mod link;
 mod picture;
 pub mod probe;
 mod routing;
 mod ui;
 
-use std::io;
 use std::time::{Duration, Instant};
-
-use tiny_skia::Pixmap;
 
 use self::compose::{Figures, FrameBuilder, big_enough, half_block_picture};
 pub use self::link::LinkPath;
@@ -30,19 +28,17 @@ use self::link::{Change, LinkControl};
 use self::picture::Picture;
 use self::probe::{GraphicsChoice, GraphicsRequest, GraphicsSupport, Probe, ProbeOptions};
 use super::fit::{CellGrid, Fit};
-use super::host::SceneStatus;
 use super::input::{Input, InputParser, Received};
 use super::replies::Reply;
-use super::seat::SeatView;
 use crate::output::bucket::ByteBucket;
 use crate::output::color::ColorMode;
 use crate::output::cursor::Cursor;
 use crate::output::diff::{EncodeOptions, Shown};
 use crate::output::frame::Frame;
 use crate::output::graphics::GraphicsMode;
-use crate::output::graphics::stream::Budget;
+use crate::output::graphics::stream::FileWrite;
 use crate::output::graphics::stream::crossover::AutoSwitch;
-use crate::output::rate::{RateEncoder, RateOptions, Report, Target, budget_after};
+use crate::output::rate::RateEncoder;
 use crate::play::clock::{FramePacer, Meter};
 
 /// How many bytes a second a screen may send.
@@ -108,6 +104,12 @@ pub(crate) fn colour_hint(mode: ColorMode) -> String {
     format!("{} colours (the terminal did not say more): try --color truecolor", mode.name())
 }
 
+/// Where the door writes kitty's temporary files: beside the probe's file, which the door
+/// wrote there to ask the terminal whether it reads them (`None`: no file medium).
+fn files_dir(config: &ScreenConfig) -> Option<std::path::PathBuf> {
+    config.probe.as_ref()?.kitty_file.as_ref()?.parent().map(|d| d.to_path_buf())
+}
+
 /// The probe's progress.
 #[derive(Debug)]
 enum Asking {
@@ -164,7 +166,7 @@ impl Screen {
     /// (buttons and drags only, mode 1002, not every motion; SGR coordinates, mode 1006),
     /// screen cleared.
     pub const ENTER: &'static [u8] = b"\x1b[?1049h\x1b[?25l\x1b[?1000h\x1b[?1002h\x1b[?1006h\x1b[0m\x1b[2J";
-    /// Sent when the session ends (after [`Screen::restore_prefix`]): abort any cut sequence,
+    /// Sent when the session ends (after the restore prefix, see [`Screen::farewell`]): abort any cut sequence,
     /// end synchronized output, reset colours, mouse off, cursor on, back to the normal screen.
     pub const RESTORE: &'static [u8] = b"\x18\x1b[?2026l\x1b[0m\x1b[?1006l\x1b[?1002l\x1b[?1000l\x1b[?25h\x1b[?1049l";
 
@@ -180,7 +182,7 @@ impl Screen {
             Bandwidth::Unlimited => ByteBucket::unlimited(),
         };
         Screen {
-            picture: Picture::new(&choice, &support, term),
+            picture: Picture::new(&choice, &support, term, files_dir(&config)),
             pacer: FramePacer::new(config.fps, now),
             meter: Meter::new(now),
             config,
@@ -211,7 +213,7 @@ impl Screen {
     /// Starts the session: appends the probe's questions to `out` when the terminal is to be
     /// asked (nothing otherwise). No frame is drawn until the answers are in or
     /// `PROBE_BUDGET` (500 ms) has passed.
-    pub fn start(&mut self, now: Instant, out: &mut Vec<u8>) {
+    pub(crate) fn start(&mut self, now: Instant, out: &mut Vec<u8>) {
         let Some(mut options) = self.config.probe.clone().filter(|_| matches!(self.asking, Asking::No)) else {
             self.settle_colours(false);
             return;
@@ -230,14 +232,14 @@ impl Screen {
     }
 
     /// Whether the probe's first answers are still awaited (no frame is drawn meanwhile).
-    pub fn probing(&self) -> bool {
+    pub(crate) fn probing(&self) -> bool {
         matches!(self.asking, Asking::First { .. })
     }
 
     /// Takes bytes the terminal sent at `now`: replies are used here, the person's inputs are
     /// appended to `inputs` (keys typed during the probe come once it is over; a run of drags
     /// is merged into its last position).
-    pub fn feed(&mut self, bytes: &[u8], now: Instant, inputs: &mut Vec<Input>) {
+    pub(crate) fn feed(&mut self, bytes: &[u8], now: Instant, inputs: &mut Vec<Input>) {
         if let Asking::First { probe, .. } = &mut self.asking {
             probe.count_bytes(bytes.len());
         }
@@ -247,7 +249,7 @@ impl Screen {
 
     /// Looks at the clock: a lone Escape that waited long enough, the probe's deadline, the
     /// link's lost questions.
-    pub fn tick(&mut self, now: Instant, inputs: &mut Vec<Input>) {
+    pub(crate) fn tick(&mut self, now: Instant, inputs: &mut Vec<Input>) {
         self.parser.flush_stale(now, &mut self.received);
         self.route(now, inputs);
         match &self.asking {
@@ -274,7 +276,7 @@ impl Screen {
 
     /// When [`Screen::tick`] must next look at the clock (a lone Escape's wait, the probe's
     /// deadline), if at all.
-    pub fn next_tick(&self) -> Option<Instant> {
+    pub(crate) fn next_tick(&self) -> Option<Instant> {
         let asking = match &self.asking {
             Asking::First { deadline, .. } => Some(*deadline),
             Asking::Late { until, .. } => Some(*until),
@@ -287,12 +289,12 @@ impl Screen {
     }
 
     /// When the next frame is due (frames are drawn at most `fps` a second).
-    pub fn next_frame(&self) -> Instant {
+    pub(crate) fn next_frame(&self) -> Instant {
         self.pacer.next_due()
     }
 
     /// The terminal is now `term` cells: the next frame repaints everything.
-    pub fn resize(&mut self, term: (u16, u16)) {
+    pub(crate) fn resize(&mut self, term: (u16, u16)) {
         if term == self.term {
             return;
         }
@@ -305,24 +307,24 @@ impl Screen {
     }
 
     /// The terminal's size in cells.
-    pub fn term(&self) -> (u16, u16) {
+    pub(crate) fn term(&self) -> (u16, u16) {
         self.term
     }
 
     /// Whether the terminal is big enough for the picture and the status line (a smaller one
     /// shows a notice, and the scene need not be drawn).
-    pub fn drawable(&self) -> bool {
+    pub(crate) fn drawable(&self) -> bool {
         big_enough(self.term)
     }
 
     /// Whether the picture's size or place changed (a resize, the probe's answer) since this
     /// was last asked: the door then makes a new fit (and the local player resizes its scene).
-    pub fn take_layout_change(&mut self) -> bool {
+    pub(crate) fn take_layout_change(&mut self) -> bool {
         std::mem::take(&mut self.layout_changed)
     }
 
     /// Something to tell the person (which protocol draws, how to get pictures), once.
-    pub fn take_notice(&mut self) -> Option<String> {
+    pub(crate) fn take_notice(&mut self) -> Option<String> {
         let colours = std::mem::take(&mut self.colour_hint).then(|| colour_hint(self.config.color));
         match (self.notice.take(), colours) {
             (Some(notice), Some(colours)) => Some(format!("{notice}; {colours}")),
@@ -341,7 +343,7 @@ impl Screen {
     }
 
     /// How a scene of `scene` pixels sits in this terminal's picture.
-    pub fn fit(&self, scene: (u32, u32)) -> Fit {
+    pub(crate) fn fit(&self, scene: (u32, u32)) -> Fit {
         let grid = match &self.picture {
             _ if !big_enough(self.term) => CellGrid::HalfBlocks { cols: 0, rows: 0 },
             Some(p) => CellGrid::Pixels { layout: *p.layout(), mouse_pixels: self.mouse_pixels },
@@ -352,157 +354,29 @@ impl Screen {
 
     /// Whether a frame should be drawn now: the probe is not holding the screen, and the frame
     /// is due or `urgent` (a key's frame goes out at once).
-    pub fn ready(&self, now: Instant, urgent: bool) -> bool {
+    pub(crate) fn ready(&self, now: Instant, urgent: bool) -> bool {
         !self.probing() && (urgent || self.pacer.ready(now))
     }
 
     /// A due frame was not drawn (the door's writer was still busy): the cadence moves on.
-    pub fn skip(&mut self, now: Instant) {
+    pub(crate) fn skip(&mut self, now: Instant) {
         self.pacer.sent(now);
     }
 
-    /// Appends the frame for now to `out`: `picture` (of [`Screen::picture_size`]), the seat's
-    /// overlay, the status line. Returns the bytes appended (0 when nothing changed). Nothing
-    /// in it fails today (a kitty temporary file that cannot be written falls back to direct
-    /// transmission); the `Result` is the doors' contract.
-    pub(crate) fn frame(
-        &mut self,
-        now: Instant,
-        picture: &Pixmap,
-        status: &SceneStatus,
-        seat: &SeatView<'_>,
-        out: &mut Vec<u8>,
-    ) -> io::Result<usize> {
-        self.frame_from(now, picture, status, seat, Cells::Own { figures: None }, out)
-    }
-
-    /// [`Screen::frame`] with its cells from `cells`: everything else (the byte bucket, the
-    /// link's questions, the meter, the pacer, real pixels) as for any frame.
-    pub(crate) fn frame_from(
-        &mut self,
-        now: Instant,
-        picture: &Pixmap,
-        status: &SceneStatus,
-        seat: &SeatView<'_>,
-        cells: Cells<'_>,
-        out: &mut Vec<u8>,
-    ) -> io::Result<usize> {
-        let start = out.len();
-        if !self.entered {
-            out.extend_from_slice(Self::ENTER);
-            self.entered = true;
-        }
-        if std::mem::take(&mut self.mouse_pixels_pending) {
-            out.extend_from_slice(picture::PIXEL_MOUSE_ON);
-        }
-        if self.auto() {
-            self.bucket.set_rate(self.link.rate());
-        }
-        self.bucket.refill(now);
-        self.follow_link(now, out);
-        let rate = self.bucket.rate();
-        let figures = Figures {
-            fps: self.meter.fps,
-            bytes_per_second: self.meter.bytes_per_second,
-            bandwidth: rate.map(|r| r as u64),
-            pixels_elsewhere: self.picture.is_some(),
-            note: if self.auto() { self.link.hint() } else { None },
-        };
-        // On an auto link the unanswered bytes are capped too (see `link`: the first seconds).
-        let window_left = if self.auto() { self.link.window_left(now, self.bytes_sent) } else { usize::MAX };
-        let budget = self.bucket.budget().min(window_left);
-        // The bucket as full as it gets and nothing big unanswered: a picture bigger than both
-        // may go now (and is owed), so a picture that never fits them still shows.
-        let overdraw =
-            self.bucket.budget() as f64 + 1.0 >= self.bucket.capacity() && window_left >= link::MIN_WINDOW as usize / 2;
-        let options = RateOptions {
-            approximate: rate.is_some_and(|r| r < APPROXIMATE_BELOW),
-            ..RateOptions::from(self.config.encode)
-        };
-        let resized = self.shown.frame.is_none();
-        let mut bytes = std::mem::take(&mut self.scratch);
-        bytes.clear();
-        let report = match cells {
-            Cells::Own { figures: given } => {
-                let figures = given.unwrap_or(figures);
-                let frame = self.builder.compose(self.term, picture, self.config.color, status, seat, &figures);
-                let target = match self.config.color {
-                    ColorMode::TrueColor => Target::new(frame),
-                    mode => Target::with_truth(frame, picture, mode),
-                };
-                self.encoder.encode_into(&mut self.shown, target, budget, options, &mut bytes)
-            }
-            Cells::Toward(model) => {
-                // Exactly (no colour threshold), so that the model becomes equal, not close.
-                let exact = RateOptions { threshold: 0, ..options };
-                self.encoder.encode_into(&mut self.shown, Target::new(model), budget, exact, &mut bytes)
-            }
-            Cells::Taken(taken) => {
-                // Straight to the caller: the group's bytes never pass through the scratch
-                // buffer, which a member in step has freed (it would grow back to a group
-                // frame's size, and the caller's buffer with it).
-                out.extend_from_slice(taken);
-                Report { bytes: taken.len(), drawn: 0, pending: 0 }
-            }
-        };
-        self.bucket.spend(report.bytes);
-        let mut spent = report.bytes;
+    /// Moves the temporary files the frames handed out so far name (kitty's file medium) to
+    /// `out`: the door writes them before it sends those frames' bytes.
+    pub(crate) fn take_files(&mut self, out: &mut Vec<FileWrite>) {
         if let Some(p) = &mut self.picture {
-            let frame = picture::FrameFacts {
-                resized,
-                help_open: seat.help.is_some(),
-                cells_shown: report.pending == 0,
-                drawable: big_enough(self.term),
-                sync: options.sync,
-            };
-            // What the cells left of this frame's budget: the picture is never owed.
-            let left = Budget {
-                available: budget_after(budget, report.bytes),
-                rate,
-                frame_interval: Duration::from_secs(1) / self.config.fps.max(1),
-                overdraw,
-            };
-            let sent = p.add_to_frame(picture, &frame, left, now, &mut bytes);
-            if sent > 0 {
-                // Beyond the budget when overdrawn: the bucket is in debt until the rate has
-                // repaid it.
-                self.bucket.owe(sent);
-                self.shown.cursor = Cursor::Unknown;
-            }
-            spent += sent;
+            p.take_files(out);
         }
-        if self.auto() {
-            self.link.frame_sent(spent, budget);
-        }
-        // Room for the largest frame at once (the scratch buffer has it), so the caller's
-        // buffers stop growing after the first frames: steady frames allocate nothing.
-        out.reserve(bytes.capacity());
-        out.extend_from_slice(&bytes);
-        self.scratch = bytes;
-        let unasked = self.link.unasked(self.bytes_sent + (out.len() - start) as u64);
-        if self.auto() && self.link.probe_due() && (out.len() > start || unasked) {
-            // The question goes after the frame: its answer says the frame has arrived.
-            out.extend_from_slice(self.link.question());
-            self.link.probed(now, self.bytes_sent + (out.len() - start) as u64);
-        }
-        let len = out.len() - start;
-        self.bytes_sent += len as u64;
-        self.meter.frame(now, len);
-        self.pacer.sent(now);
-        Ok(len)
     }
 
-    /// The bytes a frame may send now (the byte bucket, and on an auto link the window of
-    /// unanswered bytes): whether a group's frame fits this screen's link.
-    pub(crate) fn budget(&mut self, now: Instant) -> usize {
-        if self.auto() {
-            self.bucket.set_rate(self.link.rate());
-        }
-        self.bucket.refill(now);
-        if self.auto() {
-            self.bucket.budget().min(self.link.window_left(now, self.bytes_sent))
-        } else {
-            self.bucket.budget()
+    /// The door could not write a temporary file: pixels go directly from now on (the next
+    /// picture whole).
+    pub(crate) fn handle_file_error(&mut self) {
+        self.config.probe.iter_mut().for_each(|p| p.kitty_file = None);
+        if let Some(p) = &mut self.picture {
+            p.files_failed();
         }
     }
 
@@ -551,35 +425,30 @@ impl Screen {
 
     /// Whether link questions are still unanswered (a door that is closing waits a little for
     /// their answers, so they do not reach the shell as typed text).
-    pub fn awaiting_answers(&self) -> bool {
+    pub(crate) fn awaiting_answers(&self) -> bool {
         self.link.awaiting() > 0 || matches!(self.asking, Asking::Late { .. })
-    }
-
-    /// What sits between the program and the terminal, as the door said.
-    pub fn link_path(&self) -> LinkPath {
-        self.config.link_path
     }
 
     /// What must be undone before [`Screen::RESTORE`] when the session ends: kitty's image
     /// deleted, pixel mouse reports off. A door writes it on every way out (a signal too).
-    pub fn restore_prefix(&self) -> Vec<u8> {
+    pub(crate) fn restore_prefix(&self) -> Vec<u8> {
         picture::restore_bytes(&self.choice, self.mouse_pixels)
     }
 
-    /// The bytes that hand the terminal back: [`Screen::restore_prefix`], then
-    /// [`Screen::RESTORE`].
+    /// The bytes that hand the terminal back: what the picture needs undone (kitty's image
+    /// deleted, pixel mouse reports off), then [`Screen::RESTORE`].
     pub fn farewell(&self, out: &mut Vec<u8>) {
         out.extend_from_slice(&self.restore_prefix());
         out.extend_from_slice(Self::RESTORE);
     }
 
     /// Frames and bytes a second over the last whole second.
-    pub fn figures(&self) -> (u32, u64) {
+    pub(crate) fn figures(&self) -> (u32, u64) {
         (self.meter.fps, self.meter.bytes_per_second)
     }
 
     /// The protocol drawing the picture.
-    pub fn mode(&self) -> GraphicsMode {
+    pub(crate) fn mode(&self) -> GraphicsMode {
         self.choice.mode
     }
 }

@@ -2,19 +2,16 @@
 
 use std::time::{Duration, Instant};
 
-use tiny_skia::Pixmap;
-
 use super::*;
 use crate::PoolSettings;
 use crate::output::vt::TerminalModel as Vt;
 use crate::scene::SceneSpec;
 
-const FRAME: Duration = Duration::from_nanos(1_000_000_000 / 30);
+pub(crate) const FRAME: Duration = Duration::from_nanos(1_000_000_000 / 30);
 
-/// Plays `script` (bytes the terminal sends, at frame numbers) for `frames` frames of a 30 fps
-/// clock from `t0` on a 100x20 terminal; returns every byte the screen produced.
-fn session(t0: Instant, script: &[(u32, &[u8])], frames: u32) -> Vec<u8> {
-    let config = ScreenConfig {
+/// The screen every test session uses: 30 fps, 60 kB/s, no probe.
+pub(crate) fn screen_config() -> ScreenConfig {
+    ScreenConfig {
         fps: 30,
         bandwidth: Bandwidth::Fixed(60_000),
         color: Default::default(),
@@ -23,35 +20,34 @@ fn session(t0: Instant, script: &[(u32, &[u8])], frames: u32) -> Vec<u8> {
         graphics: GraphicsRequest::Auto,
         probe: None,
         link_path: crate::play::LinkPath::Direct,
-    };
-    let mut screen = Screen::new(config, (100, 20), t0);
+    }
+}
+
+/// The host every test session uses: a rainy, breezy pool, seed 3.
+pub(crate) fn host_config() -> HostConfig {
     let pool = PoolSettings { rain_rate: 0.05, breeze: 1.0, seed: 3, ..PoolSettings::default() };
-    let host_config = HostConfig { scenes: vec![SceneSpec::Pool(pool)], seed: 3, record: None, storage: None };
-    let mut host = Host::new(host_config, screen.picture_size(), t0).unwrap();
-    let mut seat = Seat::new(screen.fit(host.size()));
-    let mut picture = Pixmap::new(host.size().0, host.size().1).unwrap();
-    let (mut inputs, mut requests, mut out) = (Vec::new(), Vec::new(), Vec::new());
+    HostConfig { scenes: vec![SceneSpec::Pool(pool)], seed: 3, record: None, screenshots: false }
+}
+
+/// Plays `script` (bytes the terminal sends, at frame numbers) for `frames` frames of a 30 fps
+/// clock from `t0` on a 100x20 terminal, one turn a frame, the writer always free; returns
+/// every byte the session handed out. The test harness of the canonical turn.
+pub(crate) fn session(t0: Instant, script: &[(u32, &[u8])], frames: u32) -> Vec<u8> {
+    let mut session = Session::new(screen_config(), host_config(), (100, 20), None, t0);
+    let mut out = Transmit::default();
     for k in 0..frames {
         let now = t0 + FRAME * k;
         for (_, bytes) in script.iter().filter(|(at, _)| *at == k) {
-            screen.feed(bytes, now, &mut inputs);
+            session.handle_bytes(bytes, now);
         }
-        screen.tick(now, &mut inputs);
-        for input in inputs.drain(..) {
-            assert_eq!(seat.handle(input, now, host.status(), &mut requests), Flow::Continue);
-            for request in requests.drain(..) {
-                host.apply(request, now);
-            }
+        session.handle_resize((100, 20));
+        session.handle_timeout(now).unwrap();
+        while let Some(event) = session.poll_event() {
+            assert!(!matches!(event, SessionEvent::Quit), "no one quits");
         }
-        host.advance(now);
-        if screen.ready(now, false) {
-            host.render(&mut picture);
-            let status = host.status();
-            let view = seat.view(now, status);
-            screen.frame(now, &picture, status, &view, &mut out).unwrap();
-        }
+        session.poll_transmit(now, true, &mut out).unwrap();
     }
-    out
+    out.bytes
 }
 
 /// What a 100x20 terminal shows after `bytes`.

@@ -1,21 +1,19 @@
-//! Recording a session: events collected in memory, saved whole when the session ends.
+//! Recording a session: events collected in memory, handed out whole when the session ends.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
 use super::{Entry, Header, event_line, header_line};
-use crate::error::Result;
 use crate::scene::Event;
-use crate::storage::Storage;
 
-/// Collects a session's events and saves them through a [`Storage`] when the session ends
-/// (on `q`, on a signal, or when dropped during a panic), so a replay on disk is always whole.
+/// Collects a session's events; [`Recorder::finish`] hands out the whole replay file (its path
+/// and its text) once, and the door saves it (on `q`, on a signal, or when the session ends
+/// by a panic: the door's guard finishes the recording), so a replay on disk is always whole.
+/// It writes nothing itself.
 pub struct Recorder {
     path: PathBuf,
     text: String,
     finished: bool,
     step: u64,
-    storage: Arc<dyn Storage>,
 }
 
 impl std::fmt::Debug for Recorder {
@@ -25,11 +23,11 @@ impl std::fmt::Debug for Recorder {
 }
 
 impl Recorder {
-    /// A recorder that will save to `path` through `storage`.
-    pub fn new(path: &Path, header: &Header, storage: Arc<dyn Storage>) -> Recorder {
+    /// A recorder of a replay to be saved at `path`.
+    pub fn new(path: &Path, header: &Header) -> Recorder {
         let mut text = header_line(header);
         text.push('\n');
-        Recorder { path: path.to_owned(), text, finished: false, step: 0, storage }
+        Recorder { path: path.to_owned(), text, finished: false, step: 0 }
     }
 
     /// Records `event` at `step`.
@@ -46,20 +44,14 @@ impl Recorder {
         self.step = self.step.max(step);
     }
 
-    /// Adds the end line and saves the file (once; later calls do nothing).
-    pub fn finish(&mut self, step: u64) -> Result<()> {
+    /// Adds the end line (at `step`, or the last step reached if later) and hands out the
+    /// file to save: its path and its text. Once: later calls return `None`.
+    pub fn finish(&mut self, step: u64) -> Option<(PathBuf, String)> {
         if self.finished {
-            return Ok(());
+            return None;
         }
-        self.record(step, Event::End);
+        self.record(step.max(self.step), Event::End);
         self.finished = true;
-        self.storage.save(&self.path, self.text.as_bytes())
-    }
-}
-
-impl Drop for Recorder {
-    /// A session cut short by a panic still leaves a complete replay of what happened.
-    fn drop(&mut self) {
-        let _ = self.finish(self.step);
+        Some((self.path.clone(), std::mem::take(&mut self.text)))
     }
 }

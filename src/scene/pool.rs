@@ -532,5 +532,6 @@ impl Controls for PoolScene {
 }
 
 mod compose;
+mod state;
 #[cfg(test)]
 mod tests;

@@ -164,7 +164,8 @@ const SEED_SALT: u64 = 0x6272_6565_7a65; // "breeze"
 #[derive(Clone, Debug)]
 pub struct Breeze {
     level: f64,
-    rng: ChaCha8Rng,
+    /// Read and set by the pool's snapshot (`scene/pool/state.rs`).
+    pub(crate) rng: ChaCha8Rng,
     shape: BreezeShape,
 }
 

@@ -69,16 +69,14 @@ pub struct PatchMaps {
     pub foam: Vec<f32>,
 }
 
-/// The lattice fields of one moment before resampling.
+/// The lattice fields of one moment before resampling, two real fields to a complex buffer as
+/// the inverse transforms leave them (re, im): (h, dx), (dy, hx), (hy, gxy), (gxx, gyy).
+/// Read in place, they cost no copy into fields of their own.
 struct Lagrangian {
-    h: Vec<f32>,
-    dx: Vec<f32>,
-    dy: Vec<f32>,
-    hx: Vec<f32>,
-    hy: Vec<f32>,
-    gxx: Vec<f32>,
-    gyy: Vec<f32>,
-    gxy: Vec<f32>,
+    h_dx: Vec<Complex32>,
+    dy_hx: Vec<Complex32>,
+    hy_gxy: Vec<Complex32>,
+    gxx_gyy: Vec<Complex32>,
 }
 
 /// The waves of a square lattice: per point (row-major, FFT order) a·e^(iφ), ω, the loop
@@ -297,22 +295,15 @@ impl Lattice {
             .collect()
     }
 
-    /// The inverse 2-D FFT, in place, of a spectrum laid out transposed (`buf[kx·n + ky]`, see
-    /// [`Lattice::transposed`]): along ky on rows, one transpose, along kx on rows, which
-    /// leaves the field in row-major order (one transpose fewer than from the natural layout).
-    /// Rows in parallel: the same result on any number of cores.
+    /// The inverse 2-D FFT, in place, of a spectrum laid out transposed (`buf[kx·n + ky]`:
+    /// buffer row c is the lattice's column c): along ky on rows, one transpose, along kx on
+    /// rows, which leaves the field in row-major order (one transpose fewer than from the
+    /// natural layout). Rows in parallel: the same result on any number of cores.
     fn ifft2_transposed(&self, buf: &mut [Complex32]) {
         let n = self.n;
         buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
         transpose_square(buf, n);
         buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
-    }
-
-    /// The lattice index (row-major, row = ky) of position `j` of a transposed spectrum.
-    #[inline(always)]
-    fn transposed(&self, j: usize) -> usize {
-        let n = self.n;
-        (j % n) * n + j / n
     }
 
     /// Two real fields from one complex transform. `coefficients(i, w)` gives, for the
@@ -325,22 +316,38 @@ impl Lattice {
         waves: &[Complex32],
         coefficients: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
     ) -> (Vec<f32>, Vec<f32>) {
+        let buf = self.real_fields_packed(waves, coefficients);
+        // Element by element, so in parallel with the same bits.
+        (buf.par_iter().map(|c| c.re).collect(), buf.par_iter().map(|c| c.im).collect())
+    }
+
+    /// As [`Lattice::real_fields`], the two fields left packed as the transform gives them:
+    /// f in the real parts, g in the imaginary ones.
+    fn real_fields_packed(
+        &self,
+        waves: &[Complex32],
+        coefficients: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
+    ) -> Vec<Complex32> {
         let n = self.n;
-        let mut buf: Vec<Complex32> = (0..n * n)
-            .into_par_iter()
-            .map(|j| {
-                let i = self.transposed(j);
-                let (r, c) = (i / n, i % n);
-                let mirror = ((n - r) % n) * n + (n - c) % n;
+        // Filled in the lattice's order, row by row (no index needs a division, and the reads
+        // run along rows: walking columns missed the cache at every point), then transposed
+        // in blocks into the layout the transform wants.
+        let mut buf = vec![Complex32::new(0.0, 0.0); n * n];
+        buf.par_chunks_mut(n).enumerate().for_each(|(r, row)| {
+            let r_mirror = if r == 0 { 0 } else { n - r };
+            for (c, out) in row.iter_mut().enumerate() {
+                let i = r * n + c;
+                let mirror = r_mirror * n + if c == 0 { 0 } else { n - c };
                 let (f, g) = coefficients(i, waves[i]);
                 let (fm, gm) = coefficients(mirror, waves[mirror]);
                 let sf = (f + fm.conj()) * 0.5;
                 let sg = (g + gm.conj()) * 0.5;
-                sf + Complex32::new(0.0, 1.0) * sg
-            })
-            .collect();
+                *out = sf + Complex32::new(0.0, 1.0) * sg;
+            }
+        });
+        transpose_square(&mut buf, n);
         self.ifft2_transposed(&mut buf);
-        (buf.iter().map(|c| c.re).collect(), buf.iter().map(|c| c.im).collect())
+        buf
     }
 
     /// The displacement's gradient per unit λ, each times -1: g_ab = Σ a·(k_a·k_b/k)·cos θ.
@@ -411,23 +418,26 @@ impl PatchSea {
         let unit = |i: usize| (l.kx[i] / l.k[i], l.ky[i] / l.k[i], l.k[i]);
         let waves = l.waves(time);
         // The displacement per unit λ is -Σ a·û·sin θ = re Σ (i·û·w)·e^(ik·x); slopes re Σ (i·k·w)·e^(ik·x).
-        let (h, dx) = l.real_fields(&waves, |i, w| (w, i_unit * w * unit(i).0));
-        let (dy, hx) = l.real_fields(&waves, |i, w| (i_unit * w * unit(i).1, i_unit * w * l.kx[i]));
+        let h_dx = l.real_fields_packed(&waves, |i, w| (w, i_unit * w * unit(i).0));
+        let dy_hx = l.real_fields_packed(&waves, |i, w| (i_unit * w * unit(i).1, i_unit * w * l.kx[i]));
         // The displacement's gradient per unit λ, each times -1: g_ab = Σ a·(k_a·k_b/k)·cos θ.
         let (k, kx, ky) = (l.k.as_slice(), l.kx.as_slice(), l.ky.as_slice());
-        let (hy, gxy) = l.real_fields(&waves, |i, w| (i_unit * w * ky[i], w * (kx[i] * ky[i] / k[i])));
-        let (gxx, gyy) = l.real_fields(&waves, |i, w| (w * (kx[i] * kx[i] / k[i]), w * (ky[i] * ky[i] / k[i])));
+        let hy_gxy = l.real_fields_packed(&waves, |i, w| (i_unit * w * ky[i], w * (kx[i] * ky[i] / k[i])));
+        let gxx_gyy = l.real_fields_packed(&waves, |i, w| (w * (kx[i] * kx[i] / k[i]), w * (ky[i] * ky[i] / k[i])));
         // B = Σ a·√k·e^(iθ): the waves themselves, a complex field.
         let n = self.size;
-        let mut b: Vec<Complex32> = (0..n * n)
-            .into_par_iter()
-            .map(|j| {
-                let i = l.transposed(j);
-                if l.amp[i].norm_sqr() == 0.0 { Complex32::new(0.0, 0.0) } else { waves[i] * unit(i).2.sqrt() }
-            })
-            .collect();
+        let mut b = vec![Complex32::new(0.0, 0.0); n * n];
+        b.par_chunks_mut(n).enumerate().for_each(|(r, row)| {
+            for (c, out) in row.iter_mut().enumerate() {
+                let i = r * n + c;
+                if l.amp[i].norm_sqr() != 0.0 {
+                    *out = waves[i] * unit(i).2.sqrt();
+                }
+            }
+        });
+        transpose_square(&mut b, n);
         l.ifft2_transposed(&mut b);
-        (Lagrangian { h, dx, dy, hx, hy, gxx, gyy, gxy }, b)
+        (Lagrangian { h_dx, dy_hx, hy_gxy, gxx_gyy }, b)
     }
 
     /// The maps at `time_s`. Foam continues from the previous call when time moved forward
@@ -462,15 +472,21 @@ impl PatchSea {
         let (lag, b) = self.lagrangian(time);
         let (n, cell) = (self.size, (self.extent_m / self.size as f64) as f32);
         let lambda = self.params.choppiness as f32;
-        let h_l: Vec<f32> = (0..n * n).map(|i| lag.h[i] + 0.5 * lambda * b[i].norm_sqr()).collect();
+        // Element by element below, so in parallel with the same bits on any number of cores.
+        let Lagrangian { h_dx, dy_hx, hy_gxy, gxx_gyy } = &lag;
+        let h_l: Vec<f32> = (0..n * n).into_par_iter().map(|i| h_dx[i].re + 0.5 * lambda * b[i].norm_sqr()).collect();
         let displacement: Vec<[f32; 3]> =
-            (0..n * n).map(|i| [lambda * lag.dx[i], lambda * lag.dy[i], h_l[i]]).collect();
+            (0..n * n).into_par_iter().map(|i| [lambda * h_dx[i].im, lambda * dy_hx[i].re, h_l[i]]).collect();
         // The fields read together, side by side: the displacement in lattice units (the Euler
         // iterations read it four times a texel), and the slopes and gradient at the end.
         let to_cell = lambda / cell;
-        let carried: Vec<[f32; 2]> = (0..n * n).map(|i| [lag.dx[i] * to_cell, lag.dy[i] * to_cell]).collect();
-        let gradients: Vec<[f32; 5]> =
-            (0..n * n).map(|i| [lag.hx[i], lag.hy[i], lag.gxx[i], lag.gyy[i], lag.gxy[i]]).collect();
+        let carried: Vec<[f32; 2]> =
+            (0..n * n).into_par_iter().map(|i| [h_dx[i].im * to_cell, dy_hx[i].re * to_cell]).collect();
+        let gradients: Vec<[f32; 5]> = (0..n * n)
+            .into_par_iter()
+            .map(|i| [dy_hx[i].im, hy_gxy[i].re, gxx_gyy[i].re, gxx_gyy[i].im, hy_gxy[i].im])
+            .collect();
+        drop((lag, b));
         let mut height = vec![0.0f32; n * n];
         let mut normal = vec![[0.0f32; 3]; n * n];
         let mut foam = vec![0.0f32; n * n];

@@ -42,7 +42,8 @@ fn check(v: f64, shown: &str) -> Result<f64, ValueError> {
 #[derive(Clone, Debug)]
 pub struct Rain {
     rate: f64,
-    rng: ChaCha8Rng,
+    /// Read and set by the pool's snapshot (`scene/pool/state.rs`).
+    pub(crate) rng: ChaCha8Rng,
 }
 
 impl Rain {

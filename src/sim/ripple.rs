@@ -96,6 +96,26 @@ impl RipplePool {
         self.damping
     }
 
+    /// Puts back the water a snapshot held (`scene/pool/state.rs`): both states and the step
+    /// count. Returns `false`, changing nothing, when the sizes differ from this pool's.
+    pub(crate) fn restore(&mut self, current: &[i16], previous: &[i16], steps: u64) -> bool {
+        if current.len() != self.current.len() || previous.len() != self.previous.len() {
+            return false;
+        }
+        self.current.copy_from_slice(current);
+        self.previous.copy_from_slice(previous);
+        // Each row's exact largest magnitude is a bound the step accepts (see `RowMax`).
+        let bound = |cells: &[i16], row: usize| {
+            cells[row * self.width..(row + 1) * self.width].iter().map(|v| v.unsigned_abs()).max().unwrap_or(0)
+        };
+        for row in 0..self.height {
+            self.current_max[row] = bound(&self.current, row);
+            self.previous_max[row] = bound(&self.previous, row);
+        }
+        self.steps = steps;
+        true
+    }
+
     /// Changes the damping from the next step on.
     pub fn set_damping(&mut self, damping: Damping) {
         self.damping = damping;

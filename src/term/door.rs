@@ -1,23 +1,26 @@
-//! The loop that drives a play session on one terminal: read its bytes, step the host's scene,
-//! draw a frame when the screen says one is due and the writer is free.
+//! The door of one terminal: the I/O around a [`Session`] and nothing else. It reads the
+//! terminal's bytes (waiting at most until the session's [`Session::poll_timeout`]), hands
+//! them, the terminal's size and the time to the session, does what the session asks (the
+//! restore prefix, a screenshot to save) and writes what [`Session::poll_transmit`] hands out:
+//! the files first (kitty's temporary files), then the bytes, through a writer thread
+//! ([`super::writer`]) that never queues frames.
 //!
 //! The loop knows nothing of the device: input comes from a [`TerminalInput`] (bytes and the
-//! terminal's size; [`super::tty`] reads this process's terminal, a test a script) and frames go
-//! to any `Write` through a writer thread ([`super::writer`]). Input is waited for with a
-//! timeout that ends at the next due step or frame, so a key press is handled at once.
+//! terminal's size; [`super::tty`] reads this process's terminal, a test a script), frames go
+//! to a [`Sink`] and the time comes from a clock (the real one, or a test's).
 
+use std::path::Path;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
-use tiny_skia::Pixmap;
-
 use super::writer::FrameWriter;
 use crate::error::{Error, Result};
-use crate::play::host::{Host, HostConfig};
-use crate::play::player::Player;
-use crate::play::screen::{Screen, ScreenConfig};
-use crate::play::seat::{Flow, Seat};
+use crate::output::graphics::kitty;
+use crate::play::host::{Effect, HostConfig};
+use crate::play::screen::ScreenConfig;
+use crate::play::{FileWrite, Session, SessionEvent, Transmit};
+use crate::storage::Storage;
 
 /// How long the door waits, when the person quits, for the answers to the screen's last
 /// questions (so that they do not reach the shell).
@@ -47,7 +50,7 @@ pub trait TerminalInput: Send {
 }
 
 /// A session on one terminal.
-#[derive(Clone, Debug)]
+#[derive(Clone)]
 pub struct PlayConfig {
     /// The scene, its list, its seed, the recording.
     pub host: HostConfig,
@@ -55,8 +58,48 @@ pub struct PlayConfig {
     pub screen: ScreenConfig,
     /// A message for the status line's first seconds (e.g. how to get true colour).
     pub greeting: Option<String>,
+    /// Where screenshots and the recording are saved (`None`: nowhere; then the host's
+    /// screenshots should be off).
+    pub storage: Option<Arc<dyn Storage>>,
     /// Set from outside (a signal handler) to end the session as if the person quit.
     pub quit: Arc<AtomicBool>,
+}
+
+impl std::fmt::Debug for PlayConfig {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PlayConfig")
+            .field("host", &self.host)
+            .field("screen", &self.screen)
+            .field("greeting", &self.greeting)
+            .finish_non_exhaustive()
+    }
+}
+
+/// Where the door's frames go: a writer thread ([`FrameWriter`]) or, in a test, memory.
+pub trait Sink {
+    /// Whether the last frame has been written (a frame is drawn only then).
+    fn idle(&self) -> bool;
+    /// Hands over a frame to write.
+    fn send(&mut self, bytes: Vec<u8>);
+    /// An empty buffer for the next frame (a written one, for reuse).
+    fn buffer(&mut self) -> Vec<u8>;
+    /// The error that stopped the writing, if one did.
+    fn error(&mut self) -> Option<std::io::Error>;
+}
+
+impl Sink for FrameWriter {
+    fn idle(&self) -> bool {
+        FrameWriter::idle(self)
+    }
+    fn send(&mut self, bytes: Vec<u8>) {
+        FrameWriter::send(self, bytes);
+    }
+    fn buffer(&mut self) -> Vec<u8> {
+        FrameWriter::buffer(self)
+    }
+    fn error(&mut self) -> Option<std::io::Error> {
+        FrameWriter::error(self)
+    }
 }
 
 /// Runs a session until the person quits (or the input closes, or `config.quit` is set),
@@ -68,136 +111,143 @@ pub fn run_door(
     config: PlayConfig,
     restore_prefix: &mut (dyn FnMut(Vec<u8>) + Send),
 ) -> Result<()> {
-    let read_error = |source| Error::Terminal { action: "cannot read the terminal", source };
     let mut output = output;
-    let writer = FrameWriter::spawn(move |bytes| output.write_all(bytes).and_then(|()| output.flush()))
+    let mut writer = FrameWriter::spawn(move |bytes| output.write_all(bytes).and_then(|()| output.flush()))
         .map_err(Error::Output)?;
-    let now = Instant::now();
-    let mut screen = Screen::new(config.screen, input.size().map_err(read_error)?, now);
-    let mut bytes = Vec::new();
-    // The probe first: its answer decides the picture's size, so the scene waits for it.
-    let mut asked = writer.buffer();
-    screen.start(now, &mut asked);
-    if !asked.is_empty() {
-        writer.send(asked);
-    }
-    let provisional = screen.picture_size();
-    let mut player = Player::new(screen, provisional, config.greeting);
-    while player.screen.probing() && !config.quit.load(Ordering::SeqCst) {
-        let now = Instant::now();
-        let wait = player.screen.next_tick().map_or(MAX_WAIT, |t| t.saturating_duration_since(now).min(MAX_WAIT));
-        bytes.clear();
-        if !input.read(&mut bytes, wait).map_err(read_error)? {
-            return Ok(());
-        }
-        player.settle(&bytes, input.arrived().unwrap_or_else(Instant::now));
-    }
-    player.screen.resize(input.size().map_err(read_error)?);
-    restore_prefix(player.screen.restore_prefix());
-    let mut host = Host::new(config.host, player.screen.picture_size(), Instant::now())?;
-    // The seat starts on the scene as the probe's answer sized it (the aim in its middle).
-    player.seat = Seat::new(player.screen.fit(host.size()));
-    let (w, h) = host.size();
-    let mut picture = Pixmap::new(w, h).ok_or(Error::TooLarge { what: "picture", width: w, height: h })?;
     let test_panic = std::env::var_os(TEST_PANIC_VAR).is_some();
-    let mut requests = Vec::new();
-    // A key or click whose frame has not gone out yet.
-    let mut owed = false;
-    // A buffer kept back from a frame that had nothing to send.
-    let mut unused: Option<Vec<u8>> = None;
     // The loop runs on a rayon worker: the parallel parts of a frame (simulation bands,
     // picture rows) then go to the worker's own queue instead of rayon's global injector,
     // which allocates a block every 63 jobs. Steady-state frames allocate nothing.
-    let played = rayon::scope(|_| -> Result<()> {
-        while !config.quit.load(Ordering::SeqCst) {
-            let now = Instant::now();
-            let screen = &player.screen;
-            let wake =
-                [host.next_due(), screen.next_tick()].into_iter().flatten().fold(screen.next_frame(), Instant::min);
-            // A key's frame waits for the writer: look again soon, not at the next tick.
-            let wait = if owed { Duration::from_millis(1) } else { MAX_WAIT };
+    rayon::scope(|_| drive(input, &mut writer, config, restore_prefix, &Instant::now, test_panic))
+}
+
+/// The door's loop over any input, sink and clock (see the module documentation). A panic
+/// in it still saves the recording, then goes on.
+pub fn drive(
+    input: &mut dyn TerminalInput,
+    sink: &mut dyn Sink,
+    config: PlayConfig,
+    restore_prefix: &mut (dyn FnMut(Vec<u8>) + Send),
+    clock: &dyn Fn() -> Instant,
+    test_panic: bool,
+) -> Result<()> {
+    let size = input.size().map_err(read_error)?;
+    let (storage, quit) = (config.storage.clone(), config.quit.clone());
+    let mut session = Session::new(config.screen, config.host, size, config.greeting, clock());
+    let played = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        let mut io = DoorIo { input, sink, restore_prefix, storage: storage.as_deref(), clock };
+        io.play(&mut session, &quit, test_panic)
+    }));
+    // The recording is saved on every way out: a quit, a closed input, an error, a panic.
+    let saved = save_recording(&mut session, storage.as_deref());
+    match played {
+        Ok(played) => played.and(saved),
+        Err(panic) => std::panic::resume_unwind(panic),
+    }
+}
+
+fn read_error(source: std::io::Error) -> Error {
+    Error::Terminal { action: "cannot read the terminal", source }
+}
+
+/// The door's I/O: what the loop reads from and writes to.
+struct DoorIo<'a> {
+    input: &'a mut dyn TerminalInput,
+    sink: &'a mut dyn Sink,
+    restore_prefix: &'a mut (dyn FnMut(Vec<u8>) + Send),
+    storage: Option<&'a dyn Storage>,
+    clock: &'a dyn Fn() -> Instant,
+}
+
+impl DoorIo<'_> {
+    /// Reads, hands over, does what the session asks and writes, until the person quits.
+    fn play(&mut self, session: &mut Session, quit: &AtomicBool, test_panic: bool) -> Result<()> {
+        let mut bytes = Vec::new();
+        let mut transmit = Transmit::default();
+        while !quit.load(Ordering::SeqCst) {
+            let now = (self.clock)();
+            let wait = session.poll_timeout().map_or(MAX_WAIT, |t| t.saturating_duration_since(now).min(MAX_WAIT));
             bytes.clear();
-            if !input.read(&mut bytes, wake.saturating_duration_since(now).min(wait)).map_err(read_error)? {
+            if !self.input.read(&mut bytes, wait).map_err(read_error)? {
                 return Ok(());
             }
-            let now = Instant::now();
-            player.feed(&bytes, input.arrived().unwrap_or(now));
-            player.screen.resize(input.size().map_err(read_error)?);
-            let turn = player.turn(now, host.status(), &mut requests);
-            if turn.flow == Flow::Quit {
-                break;
-            }
-            for request in requests.drain(..) {
-                if let Some(message) = host.apply(request, now) {
-                    player.say(message, now);
+            let now = (self.clock)();
+            session.handle_bytes(&bytes, self.input.arrived().unwrap_or(now));
+            session.handle_resize(self.input.size().map_err(read_error)?);
+            session.handle_timeout(now)?;
+            while let Some(event) = session.poll_event() {
+                match event {
+                    SessionEvent::Quit => return self.linger(session),
+                    SessionEvent::RestorePrefix(prefix) => (self.restore_prefix)(prefix),
+                    SessionEvent::Effect(Effect::Screenshot { base, png }) => {
+                        let saved = save_screenshot(self.storage, &base, &png);
+                        session.handle_saved(saved, now);
+                    }
                 }
             }
-            if turn.layout_changed {
-                restore_prefix(player.screen.restore_prefix());
-                let (w, h) = player.screen.picture_size();
-                if player.screen.drawable() {
-                    host.resize(w, h);
-                }
-                player.refit(host.size());
-            }
-            // A key's frame (or a repaint) is owed until it is sent, even when the writer is busy.
-            owed |= turn.urgent || turn.layout_changed;
-            host.advance(Instant::now());
-            if let Some(e) = writer.error() {
+            if let Some(e) = self.sink.error() {
                 return Err(Error::Output(e));
             }
-            let now = Instant::now();
-            if !player.screen.ready(now, owed) {
+            if transmit.bytes.capacity() == 0 {
+                transmit.bytes = self.sink.buffer();
+            }
+            if !session.poll_transmit((self.clock)(), self.sink.idle(), &mut transmit)? {
+                // Nothing to send: the buffer is kept for the next frame instead of being lost.
                 continue;
             }
-            if !writer.idle() {
-                // The terminal is still busy with the last frame: drop this one (a key's frame
-                // goes as soon as the writer is free).
-                if !owed {
-                    player.screen.skip(now);
-                }
-                continue;
+            if write_files(&mut transmit.files).is_err() {
+                session.handle_file_error();
             }
-            owed = false;
-            let (w, h) = host.size();
-            if (picture.width(), picture.height()) != (w, h) {
-                picture = Pixmap::new(w, h).ok_or(Error::TooLarge { what: "picture", width: w, height: h })?;
-            }
-            if player.screen.drawable() {
-                host.render(&mut picture);
-            }
-            let mut out = unused.take().unwrap_or_else(|| writer.buffer());
-            let len = player.frame(now, &picture, host.status(), &mut out).map_err(Error::Output)?;
-            if len > 0 {
-                writer.send(out);
-            } else {
-                // Nothing changed: the buffer is kept for the next frame instead of being lost.
-                unused = Some(out);
-            }
-            if test_panic && len > 0 {
+            self.sink.send(std::mem::take(&mut transmit.bytes));
+            // After the first frame (not the probe's questions, which go before the host).
+            if test_panic && session.host().is_some() {
                 panic!("{TEST_PANIC_VAR} is set: panicking on purpose to test the terminal restore");
             }
         }
         Ok(())
-    });
-    // A question asked but not yet answered would reach the shell as typed text once the
-    // terminal is restored: wait a little for the answers (and for the last frame, which
-    // carries the question, to be written).
-    let grace = Instant::now() + REPLY_GRACE;
-    while played.is_ok() && player.screen.awaiting_answers() && Instant::now() < grace {
-        let wait = grace.saturating_duration_since(Instant::now());
-        if !writer.idle() {
-            std::thread::sleep(wait.min(Duration::from_millis(2)));
-            continue;
-        }
-        bytes.clear();
-        if !input.read(&mut bytes, wait.min(MAX_WAIT)).map_err(read_error)? {
-            break;
-        }
-        player.feed(&bytes, input.arrived().unwrap_or_else(Instant::now));
     }
-    let finished = host.finish();
-    played.and(finished)
+
+    /// A question asked but not yet answered would reach the shell as typed text once the
+    /// terminal is restored: wait a little for the answers (and for the last frame, which
+    /// carries the question, to be written).
+    fn linger(&mut self, session: &mut Session) -> Result<()> {
+        let mut bytes = Vec::new();
+        let grace = (self.clock)() + REPLY_GRACE;
+        while session.awaiting_answers() && (self.clock)() < grace {
+            let wait = grace.saturating_duration_since((self.clock)());
+            if !self.sink.idle() {
+                std::thread::sleep(wait.min(Duration::from_millis(2)));
+                continue;
+            }
+            bytes.clear();
+            if !self.input.read(&mut bytes, wait.min(MAX_WAIT)).map_err(read_error)? {
+                break;
+            }
+            session.handle_bytes(&bytes, self.input.arrived().unwrap_or_else(self.clock));
+        }
+        Ok(())
+    }
+}
+
+/// Writes each file (new: an existing file of that name is not followed or overwritten);
+/// the list is emptied either way. Fails at the first that cannot be written.
+fn write_files(files: &mut Vec<FileWrite>) -> std::io::Result<()> {
+    files.drain(..).try_for_each(|file| kitty::write_new_file(&file.path, &file.bytes))
+}
+
+/// Saves a screenshot under the first free name for `base`: the name, or why not.
+fn save_screenshot(storage: Option<&dyn Storage>, base: &str, png: &[u8]) -> std::result::Result<String, String> {
+    let storage = storage.ok_or_else(|| "nowhere to save it".to_string())?;
+    let name = Effect::names(base).find(|n| !storage.exists(Path::new(n))).unwrap_or_else(|| format!("{base}.png"));
+    storage.save(name.as_ref(), png).map(|()| name).map_err(|e| e.to_string())
+}
+
+/// Saves the session's recording, if it has one (once).
+fn save_recording(session: &mut Session, storage: Option<&dyn Storage>) -> Result<()> {
+    match (session.finish(), storage) {
+        (Some((path, text)), Some(storage)) => storage.save(&path, text.as_bytes()),
+        _ => Ok(()),
+    }
 }
 
 /// Runs a session on any terminal until the person quits (or the input closes, or
@@ -211,3 +261,6 @@ pub fn run(
 ) -> Result<()> {
     run_door(input, output, config, &mut |_| {})
 }
+
+#[cfg(test)]
+mod tests;

@@ -5,5 +5,6 @@
 
 mod arrivals;
 pub mod door;
+pub(crate) mod probe;
 pub mod tty;
 pub mod writer;

@@ -33,7 +33,7 @@ use super::door::{PlayConfig, TerminalInput, run_door};
 use crate::error::{Error, Result};
 use crate::output::graphics::{GraphicsMode, kitty};
 use crate::play::screen::probe::{
-    self, Environment, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize,
+    self, EnvHints, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, WinSize,
 };
 use crate::play::screen::{LinkPath, Screen};
 
@@ -111,7 +111,7 @@ pub fn probe_for_picture(request: GraphicsRequest) -> (GraphicsChoice, GraphicsS
 /// The probe's starting point for this process's terminal: its environment and window size,
 /// and (when `file_medium` and not over SSH) a temporary file for the kitty file-medium query.
 fn probe_options(winsize: WinSize, file_medium: bool) -> ProbeOptions {
-    let env = Environment::from_lookup(|name| std::env::var(name).ok());
+    let env = EnvHints::from_lookup(|name| std::env::var(name).ok());
     let kitty_file = (file_medium && !env.ssh)
         .then(|| kitty::write_temp_file(&kitty::temp_dir(), PROBE_FILE_NUMBER, &[0, 0, 0]).ok())
         .flatten();
@@ -130,7 +130,7 @@ fn ask(options: &ProbeOptions) -> io::Result<GraphicsSupport> {
             None => Ok(()),
         }
     };
-    Ok(probe::run_probe(options, &mut write, &mut read, &Instant::now, probe::PROBE_BUDGET)?.support)
+    Ok(super::probe::run_probe(options, &mut write, &mut read, &Instant::now, probe::PROBE_BUDGET)?.support)
 }
 
 /// What sits between this process and the terminal: the environment (a multiplexer over SSH)
@@ -174,7 +174,7 @@ fn drop_late_replies() {
     }
 }
 
-/// A `read_with_deadline` for the probe's [`probe::run_probe`] on a terminal (or any pollable descriptor): waits
+/// A `read_with_deadline` for the probe's [`super::probe::run_probe`] on a terminal (or any pollable descriptor): waits
 /// until input is there or `deadline` has passed (`poll`), then reads what is there. Returns 0
 /// when the deadline passed with nothing to read. Unlike a reader thread, it leaves nothing
 /// blocked on the terminal for the player's own input reader to compete with.
@@ -366,7 +366,9 @@ mod tests {
         let mut read = |buf: &mut [u8], deadline: Instant| read_fd_with_deadline(reader.as_fd(), buf, deadline);
         let options =
             ProbeOptions { winsize: WinSize { cols: 80, rows: 24, x_px: 0, y_px: 0 }, ..ProbeOptions::default() };
-        let outcome = probe::run_probe(&options, &mut write, &mut read, &Instant::now, Duration::from_secs(5)).unwrap();
+        let outcome =
+            crate::term::probe::run_probe(&options, &mut write, &mut read, &Instant::now, Duration::from_secs(5))
+                .unwrap();
         assert!(outcome.support.answered && outcome.support.kitty);
         assert!(sent.ends_with(b"\x1b[c"));
         // Nothing more to read: it returns 0 once the deadline has passed.

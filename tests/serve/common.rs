@@ -3,7 +3,7 @@
 #![allow(dead_code)]
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
@@ -27,7 +27,9 @@ pub const TEST_FLAGS: &[&str] = &["--rain", "0", "--breeze", "0", "--handshake-t
 pub struct Server {
     pub child: Child,
     pub port: u16,
-    pub dir: PathBuf,
+    /// The host key's directory when the server made its own: removed when the server is
+    /// dropped (after the process is killed), so runs leave no keys behind in /tmp.
+    own_dir: Option<tempfile::TempDir>,
     /// Everything the server wrote to standard error so far, line by line.
     pub log: Arc<Mutex<Vec<String>>>,
     pub first_line: String,
@@ -36,8 +38,10 @@ pub struct Server {
 impl Server {
     /// Starts the server with `args` added to `--listen 127.0.0.1:0 --host-key DIR/host_key`.
     pub fn start(args: &[&str]) -> Server {
-        let dir = tempfile::tempdir().unwrap().keep();
-        Server::start_in(&dir, args)
+        let dir = tempfile::tempdir().unwrap();
+        let mut server = Server::start_in(dir.path(), args);
+        server.own_dir = Some(dir);
+        server
     }
 
     /// As [`Server::start`], with the host key in `dir`.
@@ -70,7 +74,7 @@ impl Server {
             .and_then(|r| r.split_whitespace().next())
             .and_then(|p| p.parse().ok())
             .unwrap_or_else(|| panic!("no port in {first_line:?} {second:?}; log {:?}", log.lock().unwrap()));
-        Server { child, port, dir: dir.to_path_buf(), log, first_line }
+        Server { child, port, own_dir: None, log, first_line }
     }
 
     /// Sends `signal` and waits for the exit status.

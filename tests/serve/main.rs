@@ -2,6 +2,12 @@
 //! real OpenSSH client where it is installed).
 
 mod bad_input;
+/// One pool across machines over NATS (needs nats-server: scripts/bus_tests.sh).
+#[cfg(feature = "bus")]
+mod bus;
+/// The bus's figures (ignored: scripts/bus_tests.sh load).
+#[cfg(feature = "bus")]
+mod bus_load;
 mod common;
 /// Fake graphics terminals (shared with the integration tests).
 #[allow(dead_code)]

@@ -21,6 +21,8 @@ pub use pool::{PoolArgs, PoolDefaults};
 pub use values::{parse_breeze, parse_grid, parse_rate, parse_steps_per_second};
 #[cfg(feature = "serve")]
 pub mod serve;
+#[cfg(feature = "bus")]
+pub mod serve_bus;
 
 const ABOUT: &str = "Water you can play with in any terminal: a ripple pool, an ocean and a lake, \
 simulated and drawn on the CPU.";

@@ -339,29 +339,10 @@ fn temp_file_command(keys: &[u8], path: &Path) -> Vec<u8> {
     command
 }
 
-/// Where temporary files go: `/dev/shm` when it exists (memory, not disk), else the system's
-/// temporary directory (which kitty also accepts).
-pub fn temp_dir() -> PathBuf {
-    let shm = Path::new("/dev/shm");
-    if shm.is_dir() { shm.to_path_buf() } else { std::env::temp_dir() }
-}
-
 /// The name of temporary file `n` of this process: it carries [`TEMP_FILE_MARKER`], which the
 /// terminal needs before it deletes a file.
 pub fn temp_file_path(dir: &Path, n: u64) -> PathBuf {
     dir.join(format!("tidepool-{}-{n}-{TEMP_FILE_MARKER}.rgb", std::process::id()))
-}
-
-/// Writes `data` to temporary file `n` in `dir` (created new: an existing file of that name is
-/// not followed or overwritten) and returns its path.
-pub fn write_temp_file(dir: &Path, n: u64, data: &[u8]) -> io::Result<PathBuf> {
-    let path = temp_file_path(dir, n);
-    let mut file = std::fs::OpenOptions::new().write(true).create_new(true).open(&path)?;
-    if let Err(e) = file.write_all(data) {
-        let _ = std::fs::remove_file(&path);
-        return Err(e);
-    }
-    Ok(path)
 }
 
 /// The bounding box (x, y, width, height) of the pixels that differ between two RGB pictures of
@@ -369,6 +350,11 @@ pub fn write_temp_file(dir: &Path, n: u64, data: &[u8]) -> io::Result<PathBuf> {
 pub fn changed_rect(old: &[u8], new: &[u8], width: u32, height: u32) -> Option<(u32, u32, u32, u32)> {
     scan::changed_box(old, new, width, 3, 0..height)
 }
+
+mod files;
+#[cfg(feature = "player")]
+pub use files::write_new_file;
+pub use files::{temp_dir, write_temp_file};
 
 #[cfg(test)]
 mod tests;

@@ -57,7 +57,7 @@ fn play_with(frames: u32, keys: &[(u32, &[u8])], stones: bool) -> (Vec<Member>, 
         })
         .collect();
     let pool = PoolSettings { rain_rate: 0.0, breeze: 0.0, seed: 5, ..PoolSettings::default() };
-    let config = HostConfig { scenes: vec![SceneSpec::Pool(pool)], seed: 5, record: None, storage: None };
+    let config = HostConfig { scenes: vec![SceneSpec::Pool(pool)], seed: 5, record: None, screenshots: false };
     let size = members[0].player.screen.picture_size();
     let mut host = Host::new(config, size, t0).unwrap();
     let mut picture = Pixmap::new(size.0, size.1).unwrap();
@@ -75,7 +75,7 @@ fn play_with(frames: u32, keys: &[(u32, &[u8])], stones: bool) -> (Vec<Member>, 
         host.advance(now);
         host.render(&mut picture);
         let status = host.status().clone();
-        group.frame(now, &picture, &status).unwrap();
+        group.frame(now, &picture, &status);
         encoded.push(group.number);
         let feed = group.feed();
         for (i, m) in members.iter_mut().enumerate() {
@@ -87,8 +87,7 @@ fn play_with(frames: u32, keys: &[(u32, &[u8])], stones: bool) -> (Vec<Member>, 
             m.player.turn(now, &status, &mut requests);
             assert_eq!(m.membership.key(&m.player.screen), Some(key));
             let mut out = Vec::new();
-            let (len, source) =
-                m.membership.frame(&mut m.player, now, &picture, &status, Some(&feed), &mut out).unwrap();
+            let (len, source) = m.membership.frame(&mut m.player, now, &picture, &status, Some(&feed), &mut out);
             assert_eq!(len, out.len());
             m.vt.feed(&out);
             m.frames.push((out, source));

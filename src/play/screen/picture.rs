@@ -9,6 +9,7 @@
 //! bytes). The layout says where the picture goes (mouse reports map to scene pixels through
 //! the seat's [`crate::play::fit::Fit`]).
 
+use std::path::PathBuf;
 use std::time::Instant;
 
 use tiny_skia::Pixmap;
@@ -20,7 +21,7 @@ use crate::output::graphics::geometry::{self, Layout};
 use crate::output::graphics::kitty::{self, KittyOptions, Medium};
 use crate::output::graphics::sixel::{Registers, SixelPalette};
 use crate::output::graphics::stream::crossover::{AutoSwitch, crossover};
-use crate::output::graphics::stream::{Budget, PictureStream, Protocol};
+use crate::output::graphics::stream::{Budget, FileWrite, PictureStream, Protocol};
 use crate::output::rate::budget_after;
 use crate::output::units::write_human_rate;
 
@@ -28,7 +29,7 @@ use crate::output::units::write_human_rate;
 /// grid is its picture, and its breeze costs about 33 ns a cell a step (`tidepool render pool
 /// --breeze 1 --stats`): at the full 1280x752 of a 160x48 window, 60 steps a second would need
 /// two cores. Within this size the pool (simulation, picture, encoding) stays near half a core
-/// (`scripts/measure_graphics.py`); kitty and iTerm2 scale the picture up to the cell area
+/// (`scripts/pixel_cpu.py`); kitty and iTerm2 scale the picture up to the cell area
 /// themselves, the sixel stream repeats its pixels.
 pub const SCENE_CAP: (u32, u32) = (480, 300);
 
@@ -41,6 +42,8 @@ pub const KITTY_Z_INDEX: i32 = -1;
 pub struct Picture {
     choice: GraphicsChoice,
     support: GraphicsSupport,
+    /// Where the door writes kitty's temporary files (`None`: it writes none).
+    files_dir: Option<PathBuf>,
     stream: PictureStream,
     /// The size the scene renders at: the layout's picture within [`SCENE_CAP`].
     scene: (u32, u32),
@@ -51,14 +54,21 @@ pub struct Picture {
 
 impl Picture {
     /// The picture for `choice` in a terminal of `term` cells, or `None` for `cells` mode (the
-    /// cell frame is the picture then).
-    pub fn new(choice: &GraphicsChoice, support: &GraphicsSupport, term: (u16, u16)) -> Option<Picture> {
+    /// cell frame is the picture then). `files_dir`: where the door writes kitty's temporary
+    /// files, when the terminal reads them.
+    pub fn new(
+        choice: &GraphicsChoice,
+        support: &GraphicsSupport,
+        term: (u16, u16),
+        files_dir: Option<PathBuf>,
+    ) -> Option<Picture> {
         if choice.mode == GraphicsMode::Cells {
             return None;
         }
         let layout = layout_for(choice.mode, support, term);
         Some(Picture {
-            stream: PictureStream::new(protocol(choice, support, &layout), layout),
+            stream: PictureStream::new(protocol(choice, support, &layout, files_dir.as_deref()), layout),
+            files_dir,
             scene: fit(layout.picture, SCENE_CAP),
             choice: choice.clone(),
             support: support.clone(),
@@ -86,8 +96,20 @@ impl Picture {
     /// the screen in the same frame).
     pub fn resize(&mut self, term: (u16, u16)) {
         let layout = layout_for(self.choice.mode, &self.support, term);
-        self.stream = PictureStream::new(protocol(&self.choice, &self.support, &layout), layout);
+        let protocol = protocol(&self.choice, &self.support, &layout, self.files_dir.as_deref());
+        self.stream = PictureStream::new(protocol, layout);
         self.scene = fit(layout.picture, SCENE_CAP);
+    }
+
+    /// Moves the temporary files the sent pictures name to `out` (the door writes them first).
+    pub fn take_files(&mut self, out: &mut Vec<FileWrite>) {
+        self.stream.take_files(out);
+    }
+
+    /// The door could not write a temporary file: pixels go directly from now on.
+    pub fn files_failed(&mut self) {
+        self.files_dir = None;
+        self.stream.files_failed();
     }
 
     /// Whether text written over the picture erases its pixels (sixel, iTerm2), so the picture
@@ -247,14 +269,22 @@ fn layout_for(mode: GraphicsMode, support: &GraphicsSupport, term: (u16, u16)) -
 /// edits and the temporary-file medium the terminal answered for, sixel with a palette for its
 /// registers (each image defines the registers it uses: that works in every terminal),
 /// iTerm2; each wrapped for tmux when the choice says so.
-fn protocol(choice: &GraphicsChoice, support: &GraphicsSupport, layout: &Layout) -> Protocol {
+fn protocol(
+    choice: &GraphicsChoice,
+    support: &GraphicsSupport,
+    layout: &Layout,
+    files_dir: Option<&std::path::Path>,
+) -> Protocol {
     match choice.mode {
         GraphicsMode::Kitty => Protocol::Kitty(KittyOptions {
             origin: layout.origin,
             tmux: choice.tmux_wrap,
             placeholders: choice.kitty_placeholders,
             frame_edits: support.kitty_frame_edits,
-            medium: if support.kitty_temp_file { Medium::TempFile(kitty::temp_dir()) } else { Medium::Direct },
+            medium: match files_dir {
+                Some(dir) if support.kitty_temp_file => Medium::TempFile(dir.to_path_buf()),
+                _ => Medium::Direct,
+            },
             z_index: KITTY_Z_INDEX,
             ..KittyOptions::new(layout.cells)
         }),

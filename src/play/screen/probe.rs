@@ -49,16 +49,15 @@
 //! **Environment hints** are used only where no query answers: iTerm2 without its cell-size
 //! reply (`TERM_PROGRAM=iTerm.app`), and to skip the file query over SSH.
 
-use std::io;
 use std::path::Path;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 use base64::Engine;
 use base64::engine::general_purpose::STANDARD as BASE64;
 
 use crate::output::graphics::GraphicsMode;
 use crate::output::graphics::{kitty, tmux};
-use crate::play::input::{Input, InputParser, Received};
+use crate::play::input::{Input, Received};
 use crate::play::replies::Reply;
 
 /// The longest the probe waits for the terminal's answers before the first frame. Every
@@ -94,9 +93,11 @@ pub const NO_SIXEL: &str = "the terminal does not say it draws sixel: half-block
 /// A 1x1 black RGB pixel, base64.
 const ONE_PIXEL: &str = "AAAA";
 
-/// The environment variables the probe looks at.
+/// What the process's environment variables say about the terminal (the door reads them):
+/// hints the probe uses where no answer comes. (Named apart from the renderer's
+/// `Environment`, the sky and light a scene is lit by.)
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
-pub struct Environment {
+pub struct EnvHints {
     /// Inside tmux (`TMUX` is set).
     pub tmux: bool,
     /// Over SSH (`SSH_CONNECTION` or `SSH_TTY` is set): no temporary-file query.
@@ -105,11 +106,11 @@ pub struct Environment {
     pub term_program: Option<String>,
 }
 
-impl Environment {
+impl EnvHints {
     /// Reads the variables through `var` (`std::env::var` in the player, a table in tests).
-    pub fn from_lookup(var: impl Fn(&str) -> Option<String>) -> Environment {
+    pub fn from_lookup(var: impl Fn(&str) -> Option<String>) -> EnvHints {
         let set = |name: &str| var(name).is_some_and(|v| !v.is_empty());
-        Environment {
+        EnvHints {
             tmux: set("TMUX"),
             ssh: set("SSH_CONNECTION") || set("SSH_TTY"),
             term_program: var("TERM_PROGRAM").filter(|v| !v.is_empty()),
@@ -143,7 +144,7 @@ impl WinSize {
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ProbeOptions {
     /// The environment hints.
-    pub env: Environment,
+    pub env: EnvHints,
     /// The window size.
     pub winsize: WinSize,
     /// A temporary file holding one RGB pixel (3 bytes) whose name carries
@@ -478,34 +479,6 @@ impl Probe {
         }
         support
     }
-}
-
-/// Sends the queries with `write`, reads the answers with `read_with_deadline` until they are
-/// complete or `budget` has passed (measured with `now`), and folds them. `read_with_deadline`
-/// reads what is available into the buffer, waiting at most until the deadline, and returns 0
-/// when the deadline passed with nothing to read (a real one polls the tty's descriptor).
-pub fn run_probe(
-    options: &ProbeOptions,
-    write: &mut dyn FnMut(&[u8]) -> io::Result<()>,
-    read_with_deadline: &mut dyn FnMut(&mut [u8], Instant) -> io::Result<usize>,
-    now: &dyn Fn() -> Instant,
-    budget: Duration,
-) -> io::Result<ProbeOutcome> {
-    let deadline = now() + budget;
-    write(&queries(options))?;
-    let mut probe = Probe::new(options.clone());
-    let mut parser = InputParser::new();
-    let mut received = Vec::new();
-    let mut buf = [0u8; 4096];
-    while !probe.done() && now() < deadline {
-        let n = read_with_deadline(&mut buf, deadline)?;
-        probe.count_bytes(n);
-        parser.feed(&buf[..n], now(), &mut received);
-        for r in received.drain(..) {
-            probe.receive(r);
-        }
-    }
-    Ok(probe.finish())
 }
 
 /// What `--graphics` asks for.

@@ -195,7 +195,7 @@ impl Screen {
     /// Draws with `choice` from the next frame on (a repaint), telling `notice` and which
     /// protocol draws.
     pub(super) fn draw_with(&mut self, choice: GraphicsChoice, mut notice: Vec<String>, late: &str) {
-        self.picture = Picture::new(&choice, &self.support, self.term);
+        self.picture = Picture::new(&choice, &self.support, self.term, super::files_dir(&self.config));
         let mouse_pixels = picture::pixel_mouse(&choice, &self.support);
         self.mouse_pixels_pending = mouse_pixels && !self.mouse_pixels;
         self.mouse_pixels = mouse_pixels;

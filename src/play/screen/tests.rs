@@ -1,7 +1,10 @@
+use tiny_skia::Pixmap;
+
 use super::*;
 use crate::play::fit::Fit;
 use crate::play::host::SceneStatus;
-use crate::play::screen::probe::{Environment, WinSize};
+use crate::play::screen::probe::{EnvHints, WinSize};
+use crate::play::seat::SeatView;
 
 const MS: Duration = Duration::from_millis(1);
 const KITTY_OK: &[u8] = b"\x1b_Gi=31;OK\x1b\\";
@@ -16,7 +19,7 @@ fn config(bandwidth: Bandwidth, probe: bool) -> ScreenConfig {
         encode: EncodeOptions::default(),
         graphics: GraphicsRequest::Auto,
         probe: probe.then(|| ProbeOptions {
-            env: Environment { ssh: true, ..Environment::default() },
+            env: EnvHints { ssh: true, ..EnvHints::default() },
             winsize: WinSize { cols: 40, rows: 12, x_px: 320, y_px: 192 },
             kitty_file: None,
             colours: false,
@@ -35,7 +38,7 @@ fn frame(screen: &mut Screen, now: Instant, shade: u8) -> Vec<u8> {
     let mut picture = Pixmap::new(w, h).unwrap();
     picture.fill(tiny_skia::Color::from_rgba8(shade, 90, 160, 255));
     let mut out = Vec::new();
-    screen.frame(now, &picture, &status(), &SeatView { stone: 3, ..SeatView::default() }, &mut out).unwrap();
+    screen.frame(now, &picture, &status(), &SeatView { stone: 3, ..SeatView::default() }, &mut out);
     out
 }
 

@@ -90,34 +90,37 @@ pub const MAX_PACKETS: usize = 64;
 pub const GUST_LANES: usize = 16;
 
 /// One packet: where it was born, where it goes, its wave and its strength.
+// Its fields are the crate's so that the pool's snapshot (`scene/pool/state.rs`) can hold it.
 #[derive(Clone, Copy, Debug, PartialEq)]
-struct Packet {
+pub(crate) struct Packet {
     /// Its centre at birth, in cells.
-    origin: (f32, f32),
+    pub(crate) origin: (f32, f32),
     /// The unit direction it travels, in picture coordinates (x right, y down).
-    direction: (f32, f32),
-    wavenumber: f32,
+    pub(crate) direction: (f32, f32),
+    pub(crate) wavenumber: f32,
     /// The envelope's half-width (it is 0 beyond), in cells.
-    radius: f32,
+    pub(crate) radius: f32,
     /// The crest amplitude at the peak of its life.
-    amplitude: f32,
+    pub(crate) amplitude: f32,
     /// The phase of its crests at birth.
-    phase: f32,
+    pub(crate) phase: f32,
     /// The step count it was born at (before 0 for the packets the gusts start with).
-    born: i64,
+    pub(crate) born: i64,
 }
 
 /// Deterministic gusts: packets born at a steady rate, their strength set by the level.
 #[derive(Clone, Debug)]
 pub struct Gusts {
     level: f64,
-    rng: ChaCha8Rng,
+    // The random source, the packets, the step and `primed` are the crate's so that the pool's
+    // snapshot (`scene/pool/state.rs`) can hold them.
+    pub(crate) rng: ChaCha8Rng,
     shape: GustShape,
-    packets: Vec<Packet>,
+    pub(crate) packets: Vec<Packet>,
     /// Steps run.
-    step: i64,
+    pub(crate) step: i64,
     /// Whether the first packets were drawn (the gusts start as if the breeze had always blown).
-    primed: bool,
+    pub(crate) primed: bool,
     /// The live packets' factors for the picture being drawn.
     factors: GustFactors,
 }

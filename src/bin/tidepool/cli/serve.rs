@@ -101,4 +101,9 @@ pub struct ServeCommand {
     /// The scenes' water, wind and seed (as for `play`).
     #[command(flatten)]
     pub water: crate::cli::LiveSceneArgs,
+
+    /// The bus's flags (`--bus`, `--pool`, ...): one pool across many machines.
+    #[cfg(feature = "bus")]
+    #[command(flatten)]
+    pub bus: super::serve_bus::BusArgs,
 }

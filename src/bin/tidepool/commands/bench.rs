@@ -171,7 +171,7 @@ fn player_rows(
             link_path: tidepool::play::LinkPath::Direct,
         };
         let screen = Screen::new(config, (cols, rows_cells), t0);
-        let host_config = HostConfig { scenes: vec![spec], seed: 1, record: None, storage: None };
+        let host_config = HostConfig { scenes: vec![spec], seed: 1, record: None, screenshots: false };
         let Ok(mut host) = Host::new(host_config, screen.picture_size(), t0) else { continue };
         let mut player = Player::new(screen, host.size(), None);
         let (w, h) = host.size();
@@ -190,7 +190,7 @@ fn player_rows(
             host.advance(now);
             host.render(&mut picture);
             bytes.clear();
-            sent = player.frame(now, &picture, host.status(), &mut bytes).unwrap_or(0);
+            sent = player.frame(now, &picture, host.status(), &mut bytes);
         });
         black_box(sent);
         let core = median.as_secs_f64() * PLAYER_FPS * 100.0;

@@ -56,7 +56,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
             .record
             .clone()
             .map(|path| Recording { path, background: command.water.pool.background.clone() }),
-        storage: Some(Arc::new(crate::files::AtomicStorage)),
+        screenshots: true,
     };
     let screen = ScreenConfig {
         fps: command.fps,
@@ -70,7 +70,8 @@ pub fn run(command: PlayCommand) -> Result<()> {
         probe: None,
         link_path: tidepool::play::LinkPath::Direct,
     };
-    let config = PlayConfig { host, screen, greeting: None, quit: Arc::clone(&quit) };
+    let storage: Arc<dyn tidepool::Storage> = Arc::new(crate::files::AtomicStorage);
+    let config = PlayConfig { host, screen, greeting: None, storage: Some(storage), quit: Arc::clone(&quit) };
     let _stop_on_signal = crate::signals::StopOnSignal::new(quit);
     tidepool::tty::play(config).map_err(|e| match e {
         tidepool::Error::TooLarge { what, width, height } => {

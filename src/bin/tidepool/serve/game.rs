@@ -69,8 +69,8 @@ pub struct GameStats {
 
 /// What the game thread reads and writes.
 pub struct GameLinks {
-    /// Requests from the players.
-    pub requests: mpsc::Receiver<Request>,
+    /// Requests from the players, with the player's id.
+    pub requests: mpsc::Receiver<(u64, Request)>,
     /// The fits to draw.
     pub fits: Fits,
     /// Players now (for the status line).
@@ -83,18 +83,64 @@ pub struct GameLinks {
     pub stop: Arc<AtomicBool>,
 }
 
+/// Publishes frames: the scene fitted once per picture size the players asked for, the
+/// groups' frames, the status. Its buffers are kept between frames. Shared by the single
+/// machine's game and the bus's edge (`bus/edge.rs`).
+#[derive(Default)]
+pub struct Publisher {
+    number: u64,
+    pictures: HashMap<(u32, u32), Arc<Pixmap>>,
+    groups: Groups,
+}
+
+impl Publisher {
+    /// Publishes `scene` (just rendered) with `status` to every player of `links`.
+    pub fn publish(&mut self, scene: &Pixmap, status: SceneStatus, links: &GameLinks, now: Instant) {
+        self.number += 1;
+        let viewing: Vec<Viewing> = links.fits.lock().unwrap_or_else(|p| p.into_inner()).values().copied().collect();
+        let mut drawn = HashMap::with_capacity(viewing.len());
+        for fit in viewing.iter().map(|v| v.fit) {
+            if drawn.contains_key(&fit.target()) {
+                continue;
+            }
+            // Last frame's picture of this size, when no player holds it any more.
+            let old = self.pictures.remove(&fit.target()).and_then(|p| Arc::try_unwrap(p).ok());
+            if let Some(picture) = fit.fitted(scene, old) {
+                drawn.insert(fit.target(), Arc::new(picture));
+                links.stats.pictures.fetch_add(1, Ordering::Relaxed);
+            }
+        }
+        self.groups.keep(viewing.iter().filter_map(|v| v.group), now);
+        let encoded = self.groups.encode(&drawn, &status, now);
+        links.stats.group_frames.fetch_add(encoded, Ordering::Relaxed);
+        let feeds = self.groups.feeds();
+        links.stats.frames.fetch_add(1, Ordering::Relaxed);
+        // Never waits: a player still busy with an older picture simply sees a later one.
+        let frame = SharedFrame { number: self.number, status: Arc::new(status), pictures: drawn, groups: feeds };
+        let previous = links.publish.send_replace(Arc::new(frame));
+        // Last frame's pictures come back for reuse once no player holds them.
+        self.pictures = Arc::try_unwrap(previous).map(|f| f.pictures).unwrap_or_default();
+    }
+}
+
+/// The status line's detail with the player count first (a passing message may cover the end
+/// of a narrow status line): `3 playing · ` and then `rest`.
+pub fn with_players(players: usize, rest: &str) -> String {
+    let mut detail = String::with_capacity(rest.len() + 16);
+    let _ = write!(detail, "{players} playing \u{b7} {rest}");
+    detail
+}
+
 /// Runs `host` on this thread at `fps` frames a second until `links.stop` is set.
 pub fn run(mut host: Host, fps: u32, mut links: GameLinks) {
     let (w, h) = host.size();
     let Some(mut scene) = Pixmap::new(w, h) else { return };
     let frame_period = Duration::from_secs_f64(1.0 / f64::from(fps.max(1)));
     let mut next_frame = Instant::now();
-    let mut number = 0u64;
-    let mut pictures: HashMap<(u32, u32), Arc<Pixmap>> = HashMap::new();
-    let mut groups = Groups::default();
+    let mut publisher = Publisher::default();
     while !links.stop.load(Ordering::Relaxed) {
         let now = Instant::now();
-        while let Ok(request) = links.requests.try_recv() {
+        while let Ok((_, request)) = links.requests.try_recv() {
             links.stats.requests.fetch_add(1, Ordering::Relaxed);
             // A message would go to one person: the shared pool has nobody to say it to.
             let _ = host.apply(request, now);
@@ -103,37 +149,11 @@ pub fn run(mut host: Host, fps: u32, mut links: GameLinks) {
         if now >= next_frame {
             // A late frame is not made up for: the next one is a period from now.
             next_frame = (next_frame + frame_period).max(now);
-            number += 1;
             host.render(&mut scene);
             let players = links.players.count();
             let mut status = host.status().clone();
-            // The count first: a passing message may cover the end of a narrow status line.
-            status.detail.clear();
-            let _ = write!(status.detail, "{players} playing \u{b7} {}", host.status().detail);
-            let viewing: Vec<Viewing> =
-                links.fits.lock().unwrap_or_else(|p| p.into_inner()).values().copied().collect();
-            let mut drawn = HashMap::with_capacity(viewing.len());
-            for fit in viewing.iter().map(|v| v.fit) {
-                if drawn.contains_key(&fit.target()) {
-                    continue;
-                }
-                // Last frame's picture of this size, when no player holds it any more.
-                let old = pictures.remove(&fit.target()).and_then(|p| Arc::try_unwrap(p).ok());
-                if let Some(picture) = fit.fitted(&scene, old) {
-                    drawn.insert(fit.target(), Arc::new(picture));
-                    links.stats.pictures.fetch_add(1, Ordering::Relaxed);
-                }
-            }
-            groups.keep(viewing.iter().filter_map(|v| v.group), now);
-            let encoded = groups.encode(&drawn, &status, now);
-            links.stats.group_frames.fetch_add(encoded, Ordering::Relaxed);
-            let feeds = groups.feeds();
-            links.stats.frames.fetch_add(1, Ordering::Relaxed);
-            // Never waits: a player still busy with an older picture simply sees a later one.
-            let frame = SharedFrame { number, status: Arc::new(status), pictures: drawn, groups: feeds };
-            let previous = links.publish.send_replace(Arc::new(frame));
-            // Last frame's pictures come back for reuse once no player holds them.
-            pictures = Arc::try_unwrap(previous).map(|f| f.pictures).unwrap_or_default();
+            status.detail = with_players(players, &host.status().detail);
+            publisher.publish(&scene, status, &links, now);
         }
         let wake = host.next_due().map_or(next_frame, |s| s.min(next_frame));
         let sleep = wake.saturating_duration_since(Instant::now()).min(MAX_SLEEP);

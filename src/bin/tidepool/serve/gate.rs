@@ -24,6 +24,7 @@ pub enum Gated {
 
 /// One player's buckets.
 pub struct RequestGate {
+    player: u64,
     actions: ByteBucket,
     scene_keys: ByteBucket,
 }
@@ -34,9 +35,9 @@ fn costs_the_game(request: &Request) -> bool {
 }
 
 impl RequestGate {
-    /// Full buckets at `limits`.
-    pub fn new(limits: &Limits) -> RequestGate {
-        RequestGate { actions: limits.actions_bucket(), scene_keys: limits.scene_keys_bucket() }
+    /// Player `player`'s full buckets at `limits`.
+    pub fn new(limits: &Limits, player: u64) -> RequestGate {
+        RequestGate { player, actions: limits.actions_bucket(), scene_keys: limits.scene_keys_bucket() }
     }
 
     /// Sends `request` to `hub`'s game if the limits allow it now; counts what is dropped.
@@ -59,7 +60,7 @@ impl RequestGate {
         if !allowed {
             return Gated::Dropped;
         }
-        if hub.requests.try_send(request).is_err() {
+        if hub.requests.try_send((self.player, request)).is_err() {
             hub.stats.actions_dropped.fetch_add(1, Ordering::Relaxed);
             return Gated::Dropped;
         }

@@ -17,7 +17,7 @@ use russh::{Channel, ChannelId, ChannelOpenFailure, ChannelWriteHalf, Pty};
 use tokio::sync::watch;
 use tokio_util::sync::CancellationToken;
 
-use tidepool::play::{Environment, GraphicsRequest, ProbeOptions, ScreenConfig, WinSize};
+use tidepool::play::{EnvHints, GraphicsRequest, ProbeOptions, ScreenConfig, WinSize};
 use tidepool::terminal::{ColorMode, EncodeOptions};
 use tokio::sync::mpsc;
 
@@ -329,7 +329,7 @@ impl russh::server::Handler for ClientHandler {
             graphics: GraphicsRequest::Auto,
             // A remote terminal: no file medium; its TMUX is not ours to see.
             probe: Some(ProbeOptions {
-                env: Environment { ssh: true, ..Environment::default() },
+                env: EnvHints { ssh: true, ..EnvHints::default() },
                 winsize,
                 kitty_file: None,
                 colours: false,

@@ -94,7 +94,8 @@ pub(crate) struct Hub {
     pub cut_all: CancellationToken,
     pub frames: watch::Receiver<Arc<SharedFrame>>,
     pub fits: Fits,
-    pub requests: mpsc::Sender<Request>,
+    /// Players' requests with the player's id, to the game.
+    pub requests: mpsc::Sender<(u64, Request)>,
     /// All players' frames together, bytes a second.
     pub outbound: Mutex<ByteBucket>,
     /// All players' scene keys together.
@@ -106,4 +107,7 @@ pub(crate) struct Hub {
     pub scene_size: (u32, u32),
     /// Frames per second of the shared scene (each player's screen draws at most as often).
     pub fps: u32,
+    /// Whether `s` asks the game for a screenshot (a bus edge with `--bus-shots`); otherwise
+    /// players are told screenshots are off.
+    pub screenshots: bool,
 }

@@ -13,6 +13,8 @@
 
 pub mod address_pattern;
 pub mod authorized_keys;
+#[cfg(feature = "bus")]
+pub mod bus;
 pub mod game;
 mod gate;
 pub mod handler;
@@ -135,14 +137,26 @@ pub fn run(args: ServeCommand) -> Result<()> {
         tokio::runtime::Builder::new_multi_thread().enable_all().thread_name("tidepool-serve").build().map_err(
             |e| Error::Usage(format!("cannot start the server's threads ({e}); free some memory and try again")),
         )?;
-    let options =
-        server::ServerOptions { listen, host_key: key, allow, limits, game, compression: !args.no_compression };
+    #[cfg(feature = "bus")]
+    let bus = bus_options(&args, &limits)?;
+    let options = server::ServerOptions {
+        listen,
+        host_key: key,
+        allow,
+        limits,
+        game,
+        compression: !args.no_compression,
+        #[cfg(feature = "bus")]
+        bus,
+    };
     let interrupted = runtime.block_on(async move {
         let running = server::start(options).await.map_err(|e| match e {
             server::StartError::Bind(e) => {
                 Error::arg("--listen", format!("cannot listen on {listen} ({e}); pick a free port or another address"))
             }
             server::StartError::Scene(e) => Error::Lib(e),
+            #[cfg(feature = "bus")]
+            server::StartError::Bus(e) => Error::arg("--bus", e),
         })?;
         let verb = match origin {
             host_key::Origin::Created => "created",
@@ -165,6 +179,59 @@ pub fn run(args: ServeCommand) -> Result<()> {
         std::process::exit(EXIT_INTERRUPTED);
     }
     Ok(())
+}
+
+/// The bus's options from the flags (`None` without `--bus`), each checked.
+#[cfg(feature = "bus")]
+fn bus_options(args: &ServeCommand, limits: &Limits) -> Result<Option<bus::BusOptions>> {
+    use bus::protocol::{MAX_EDGE_NAME, Names, valid_name};
+    let flags = &args.bus;
+    let Some(url) = &flags.bus else { return Ok(None) };
+    if !(url.starts_with("nats://") || url.starts_with("tls://")) {
+        return Err(Error::arg(
+            "--bus",
+            format!("'{url}' is not a NATS address; use nats://HOST:4222 or tls://HOST:4222"),
+        ));
+    }
+    if args.scene != crate::cli::PlayScene::Pool {
+        return Err(Error::arg("--scene", "--bus runs the pool only; leave --scene out or give --scene pool"));
+    }
+    Names::of(&flags.pool).map_err(|e| Error::arg("--pool", e.0))?;
+    let edge = match &flags.bus_edge {
+        Some(name) if valid_name(name, MAX_EDGE_NAME) => name.clone(),
+        Some(name) => {
+            return Err(Error::arg(
+                "--bus-edge",
+                format!("'{name}' is not an edge name; use 1 to {MAX_EDGE_NAME} letters, digits, '-' or '_'"),
+            ));
+        }
+        None => default_edge_name(),
+    };
+    if let Some(dir) = flags.bus_shots.as_ref().filter(|d| !d.is_dir()) {
+        return Err(Error::arg("--bus-shots", format!("{} is not a folder; make it first", dir.display())));
+    }
+    Ok(Some(bus::BusOptions {
+        url: url.clone(),
+        pool: flags.pool.clone(),
+        edge,
+        credentials: flags.bus_credentials.clone(),
+        ca: flags.bus_ca.clone(),
+        shots: flags.bus_shots.clone(),
+        limits: bus::sequencer::SequencerLimits {
+            actions_per_second: f64::from(limits.actions_per_second),
+            scene_keys_per_second: f64::from(limits.scene_keys_per_second),
+            pool_scene_keys_per_second: limits::SCENE_KEYS_ALL_PLAYERS_PER_SECOND,
+        },
+    }))
+}
+
+/// This machine's name and the process id, in the characters an edge name may have.
+#[cfg(feature = "bus")]
+fn default_edge_name() -> String {
+    let host = std::fs::read_to_string("/etc/hostname").unwrap_or_default();
+    let host: String = host.trim().chars().filter(|c| c.is_ascii_alphanumeric() || *c == '-').take(40).collect();
+    let host = if host.is_empty() { "edge".to_owned() } else { host };
+    format!("{host}-{}", std::process::id())
 }
 
 /// Waits for SIGTERM (false) or SIGINT, Ctrl-C (true).

@@ -50,6 +50,9 @@ pub struct ServerOptions {
     pub game: GameOptions,
     /// Offer `zlib@openssh.com` compression to clients that ask for it.
     pub compression: bool,
+    /// Share the pool with other machines over this bus (`--bus`).
+    #[cfg(feature = "bus")]
+    pub bus: Option<super::bus::BusOptions>,
 }
 
 /// A running server.
@@ -133,14 +136,14 @@ impl GameOptions {
     /// The host of the first scene (so a bad scene setting fails before the server starts).
     /// Nothing is recorded and no file is saved on a player's behalf.
     pub fn host(&self) -> tidepool::Result<Host> {
-        let config = HostConfig { scenes: self.scenes.clone(), seed: self.seed, record: None, storage: None };
+        let config = HostConfig { scenes: self.scenes.clone(), seed: self.seed, record: None, screenshots: false };
         Host::new(config, self.size, Instant::now())
     }
 }
 
 /// Binds and starts serving. Errors only for the bind (e.g. port in use) and the first scene.
 pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
-    let mut host = opts.game.host().map_err(StartError::Scene)?;
+    let host = opts.game.host().map_err(StartError::Scene)?;
     let listener = TcpListener::bind(opts.listen).await.map_err(StartError::Bind)?;
     let local_addr = listener.local_addr().map_err(StartError::Bind)?;
     let config = Arc::new(russh_config(opts.host_key, opts.allow.is_some(), &opts.limits, opts.compression));
@@ -171,6 +174,10 @@ pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
         next_id: AtomicU64::new(1),
         scene_size: opts.game.size,
         fps: opts.game.fps,
+        #[cfg(feature = "bus")]
+        screenshots: opts.bus.as_ref().is_some_and(|b| b.shots.is_some()),
+        #[cfg(not(feature = "bus"))]
+        screenshots: false,
     });
     let stop = Arc::new(AtomicBool::new(false));
     let fps = opts.game.fps;
@@ -183,10 +190,19 @@ pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
         stop: stop.clone(),
     };
     // The simulation and rendering are CPU work on their own thread, off the async workers.
-    let game = std::thread::Builder::new()
-        .name("tidepool-game".into())
-        .spawn(move || game::run(host, fps, links))
-        .map_err(StartError::Bind)?;
+    #[cfg(feature = "bus")]
+    let game = match opts.bus {
+        Some(bus) => {
+            let Some(SceneSpec::Pool(settings)) = opts.game.scenes.first().cloned() else {
+                return Err(StartError::Bus("--bus runs the pool only".into()));
+            };
+            let spec = super::bus::PoolSpec { settings, size: opts.game.size, fps, seed: opts.game.seed };
+            super::bus::start(bus, spec, links, players.clone(), shutdown.clone()).await.map_err(StartError::Bus)?
+        }
+        None => spawn_game(host, fps, links)?,
+    };
+    #[cfg(not(feature = "bus"))]
+    let game = spawn_game(host, fps, links)?;
     let join = tokio::spawn(async move {
         accept_loop(&hub, listener).await;
         finish(&hub).await;
@@ -196,6 +212,14 @@ pub async fn start(opts: ServerOptions) -> Result<Running, StartError> {
     Ok(Running { local_addr, stats, game_stats, shutdown, join })
 }
 
+/// Runs the single machine's game on its own thread.
+fn spawn_game(host: Host, fps: u32, links: GameLinks) -> Result<std::thread::JoinHandle<()>, StartError> {
+    std::thread::Builder::new()
+        .name("tidepool-game".into())
+        .spawn(move || game::run(host, fps, links))
+        .map_err(StartError::Bind)
+}
+
 /// Why the server could not start.
 #[derive(Debug)]
 pub enum StartError {
@@ -203,6 +227,9 @@ pub enum StartError {
     Bind(std::io::Error),
     /// The first scene could not be built.
     Scene(tidepool::Error),
+    /// The bus could not be reached or the pool joined (one line for the user).
+    #[cfg(feature = "bus")]
+    Bus(String),
 }
 
 async fn accept_loop(hub: &Arc<Hub>, listener: TcpListener) {

@@ -1,8 +1,9 @@
-//! One task per player: the play session's [`Seat`] and [`Screen`] on an SSH channel. The
-//! channel's bytes go to the screen (the terminal's answers stay there: the graphics probe, the
-//! link's round trips), the person's inputs to the seat, the seat's requests to the shared host;
-//! the newest shared picture becomes this player's frame. Never more than one frame in flight,
-//! so a slow player skips pictures, and the link control finds each player's own rate.
+//! One task per player: the play session's [`Driver`] (the turn every door takes) on an SSH
+//! channel, paced by the shared pictures. The channel's bytes go to the driver (the terminal's
+//! answers stay in its screen: the graphics probe, the link's round trips), the seat's
+//! requests to the shared host through the player's gate; the newest shared picture becomes
+//! this player's frame. Never more than one frame in flight, so a slow player skips pictures,
+//! and the link control finds each player's own rate. This file is the channel's I/O only.
 //!
 //! Bounded everywhere: the pictures are the one `watch` slot every player shares (newest wins),
 //! input is a bounded queue of the channel's packets (the SSH window bounds each), and below us
@@ -17,11 +18,12 @@ use std::time::Instant;
 use bytes::Bytes;
 use russh::ChannelWriteHalf;
 use russh::server::Msg;
-use tidepool::play::{Flow, Membership, Player, Screen, ScreenConfig, Source};
+use tidepool::play::{Driver, DriverEvent, Membership, Pacing, Player, Screen, ScreenConfig, Source};
+use tidepool::terminal::ByteBucket;
 use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
-use super::game::Viewing;
+use super::game::{SharedFrame, Viewing};
 use super::gate::RequestGate;
 use super::hub::Hub;
 use super::leave::{self, Leave};
@@ -62,153 +64,220 @@ const RESIZE_RETRY: std::time::Duration = std::time::Duration::from_millis(100);
 /// Runs the player until it leaves, then says goodbye (bounded in time) and frees its place.
 pub(crate) async fn run(ctx: ViewerCtx) {
     let ViewerCtx { hub, id, peer, write, mut terminal, mut input, screen, kill, slot } = ctx;
-    let stats = hub.stats.clone();
     let now = Instant::now();
     let screen = Screen::new(screen, terminal.borrow().size, now);
-    let mut player =
-        Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into())).without_screenshots();
-    let mut membership = Membership::new();
-    let mut viewing = Viewing { fit: *player.seat.fit(), group: None };
+    let mut player = Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into()));
+    if !hub.screenshots {
+        player = player.without_screenshots();
+    }
+    let viewing = Viewing { fit: *player.seat.fit(), group: None };
     hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
     let mut frames = hub.frames.clone();
-    let mut gate = RequestGate::new(&hub.limits);
-    let mut resizes = hub.limits.resizes_bucket();
-    // A new terminal size waiting for the resize rate.
-    let mut resize: Option<(u16, u16)> = None;
-    let mut requests = Vec::new();
-    let mut out = Vec::new();
-    let (mut last_input, mut owed, mut deferred) = (now, false, false);
-    let mut tally = Tally::default();
-    let mut scene_name = frames.borrow().status.name;
+    let mut v = Viewer {
+        driver: Driver::new(player, Pacing::Pictures),
+        membership: Membership::new(),
+        viewing,
+        gate: RequestGate::new(&hub.limits, id),
+        resizes: hub.limits.resizes_bucket(),
+        resize: None,
+        deferred: false,
+        last_input: now,
+        out: Vec::new(),
+        from_group: false,
+        tally: Tally::default(),
+        scene_name: frames.borrow().status.name,
+        hub,
+        id,
+    };
+    let reason = v.play(&write, &mut terminal, &mut input, &mut frames, &kill).await;
+    let Viewer { hub, driver, membership, tally, scene_name, .. } = v;
+    hub.fits.lock().unwrap_or_else(|p| p.into_inner()).remove(&id);
+    drop(slot); // the place is free as soon as the game ends
+    let published = frames.borrow().number;
+    hub.stats.frames_skipped.fetch_add(tally.skipped(published), Ordering::Relaxed);
+    let rate = driver.player().screen.rate();
+    eprintln!("{}", tally.report(peer, id, reason, published, rate, &membership));
+    let mut goodbye = Vec::new();
+    driver.player().screen.farewell(&mut goodbye);
+    leave::say_goodbye(reason, scene_name, goodbye, &write, &kill).await;
+}
 
-    let reason = 'game: {
+/// One player's state beside its driver: its group membership, what it views, its limits.
+struct Viewer {
+    hub: Arc<Hub>,
+    id: u64,
+    driver: Driver,
+    membership: Membership,
+    viewing: Viewing,
+    gate: RequestGate,
+    resizes: ByteBucket,
+    /// A new terminal size waiting for the resize rate, and whether that was counted.
+    resize: Option<(u16, u16)>,
+    deferred: bool,
+    last_input: Instant,
+    /// The frame buffer, kept from frame to frame, and whether its bytes are the group's.
+    out: Vec<u8>,
+    from_group: bool,
+    tally: Tally,
+    scene_name: &'static str,
+}
+
+impl Viewer {
+    /// The channel's loop: wait for bytes, a new size, a new picture or a deadline; take the
+    /// turn; send the frame when one goes. Returns why the player left.
+    async fn play(
+        &mut self,
+        write: &ChannelWriteHalf<Msg>,
+        terminal: &mut watch::Receiver<TerminalState>,
+        input: &mut mpsc::Receiver<(Instant, Vec<u8>)>,
+        frames: &mut watch::Receiver<Arc<SharedFrame>>,
+        kill: &CancellationToken,
+    ) -> Leave {
+        let hub = self.hub.clone();
         let mut asked = Vec::new();
-        player.screen.start(now, &mut asked);
+        self.driver.start(Instant::now(), &mut asked);
         if !asked.is_empty() && write.data_bytes(Bytes::from(asked)).await.is_err() {
-            break 'game Leave::Cut;
+            return Leave::Cut;
         }
         loop {
-            let idle_at = last_input + hub.limits.idle_timeout;
-            // The screen's own deadlines only: frames follow the shared pictures.
-            let tick = player.screen.next_tick();
-            let mut fresh = false;
+            let idle_at = self.last_input + hub.limits.idle_timeout;
+            // The driver's own deadlines only: frames follow the shared pictures.
+            let tick = self.driver.poll_timeout();
             tokio::select! {
                 biased;
-                _ = kill.cancelled() => break 'game Leave::Cut,
-                _ = hub.shutdown.cancelled() => break 'game Leave::Shutdown,
+                _ = kill.cancelled() => return Leave::Cut,
+                _ = hub.shutdown.cancelled() => return Leave::Shutdown,
                 changed = terminal.changed() => {
-                    if changed.is_err() { break 'game Leave::Cut; }
+                    if changed.is_err() { return Leave::Cut; }
                     let state = *terminal.borrow_and_update();
-                    if state.closed { break 'game Leave::ClientClosed; }
-                    resize = Some(state.size);
+                    if state.closed { return Leave::ClientClosed; }
+                    self.resize = Some(state.size);
                 }
-                _ = tokio::time::sleep(RESIZE_RETRY), if resize.is_some() => {}
+                _ = tokio::time::sleep(RESIZE_RETRY), if self.resize.is_some() => {}
                 bytes = input.recv() => {
-                    let Some((arrived, bytes)) = bytes else { break 'game Leave::Cut };
-                    if player.feed(&bytes, arrived) {
-                        last_input = Instant::now();
+                    let Some((arrived, bytes)) = bytes else { return Leave::Cut };
+                    if self.driver.handle_bytes(&bytes, arrived) {
+                        self.last_input = Instant::now();
                     }
                 }
                 _ = tokio::time::sleep_until(tick.unwrap_or(idle_at).into()), if tick.is_some() => {}
                 _ = tokio::time::sleep_until(idle_at.into()) => {
-                    if last_input + hub.limits.idle_timeout <= Instant::now() {
-                        stats.idle_kicks.fetch_add(1, Ordering::Relaxed);
-                        break 'game Leave::Idle;
+                    if self.last_input + hub.limits.idle_timeout <= Instant::now() {
+                        hub.stats.idle_kicks.fetch_add(1, Ordering::Relaxed);
+                        return Leave::Idle;
                     }
                 }
                 changed = frames.changed() => {
-                    if changed.is_err() { break 'game Leave::Shutdown; }
-                    fresh = true;
+                    if changed.is_err() { return Leave::Shutdown; }
+                    self.driver.handle_picture();
                 }
             }
             let now = Instant::now();
-            if let Some(size) = resize {
-                if resizes.try_take(1.0, now) {
-                    player.screen.resize(size);
-                    tally.resizes += 1;
-                    resize = None;
-                } else if !deferred {
-                    stats.resizes_deferred.fetch_add(1, Ordering::Relaxed);
-                }
-                deferred = resize.is_some();
-            }
             let shared = frames.borrow().clone();
-            scene_name = shared.status.name;
-            let turn = player.turn(now, &shared.status, &mut requests);
-            if turn.flow == Flow::Quit {
-                break 'game Leave::Quit;
+            if let Some(leave) = self.turn(now, &shared) {
+                return leave;
             }
-            for request in requests.drain(..) {
-                tally.request(gate.send(request, &hub, now));
-            }
-            if turn.layout_changed {
-                player.refit(hub.scene_size);
-                membership.reset();
-            }
-            let now_viewing = Viewing { fit: *player.seat.fit(), group: membership.key(&player.screen) };
-            if (now_viewing.fit, now_viewing.group) != (viewing.fit, viewing.group) {
-                viewing = now_viewing;
-                hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
-            }
-            owed |= turn.urgent || turn.layout_changed;
-            // A new shared picture or a key's frame: the game's rate paces the frames.
-            if !(fresh || owed) || !player.screen.ready(now, true) {
+            if !self.frame(now, &shared) {
                 continue;
             }
-            tally.count(&shared);
-            // Just resized: the next shared frame has this size.
-            let Some(picture) = shared.pictures.get(&player.seat.fit().target()).cloned() else { continue };
-            if !hub.outbound.lock().unwrap_or_else(|p| p.into_inner()).try_take(0.0, now) {
-                stats.frames_dropped_rate.fetch_add(1, Ordering::Relaxed);
-                continue;
+            if let Some(leave) = self.send(write, kill).await {
+                return leave;
             }
-            owed = false;
-            // The frame is built in a buffer kept from frame to frame (the screen reserves room
-            // for its largest frame in it) and copied out at its own size: handing the buffer
-            // itself to russh would hold that reservation per frame in flight.
-            out.clear();
-            let feed = viewing.group.and_then(|key| shared.groups.get(&key));
-            let Ok((len, source)) = membership.frame(&mut player, now, &picture, &shared.status, feed, &mut out) else {
-                continue;
-            };
-            if len == 0 {
-                continue;
+        }
+    }
+
+    /// The turn at `now`: a waiting resize within its rate, the driver's turn, the seat's
+    /// requests through the gate, a new layout; `Some` when the player leaves.
+    fn turn(&mut self, now: Instant, shared: &SharedFrame) -> Option<Leave> {
+        if let Some(size) = self.resize {
+            if self.resizes.try_take(1.0, now) {
+                self.driver.handle_resize(size);
+                self.tally.resizes += 1;
+                self.resize = None;
+            } else if !self.deferred {
+                self.hub.stats.resizes_deferred.fetch_add(1, Ordering::Relaxed);
             }
-            let from_group = source == Source::Group;
-            hub.outbound.lock().unwrap_or_else(|p| p.into_inner()).owe(len);
-            // data_bytes waits for the client's SSH window and for room in russh's queue: that
-            // wait is the backpressure. Meanwhile newer pictures replace older ones in the slot.
-            tokio::select! {
-                biased;
-                _ = kill.cancelled() => break 'game Leave::Cut,
-                _ = hub.shutdown.cancelled() => break 'game Leave::Shutdown,
-                done = write.data_bytes(Bytes::copy_from_slice(&out)) => {
-                    if done.is_err() { break 'game Leave::Cut; }
-                    tally.sent += 1;
-                    tally.from_group += u64::from(from_group);
-                    if membership.in_step() && out.capacity() > IN_STEP_BUFFER {
-                        // Room for a whole frame of its own is not needed while the group's
-                        // bytes come: give it back (it comes again if the player leaves).
-                        out = Vec::new();
-                    }
-                    tally.bytes += len as u64;
-                    stats.frames_sent.fetch_add(1, Ordering::Relaxed);
-                }
-                _ = tokio::time::sleep(hub.limits.stall_timeout) => {
-                    stats.stall_kicks.fetch_add(1, Ordering::Relaxed);
-                    break 'game Leave::Stalled;
+            self.deferred = self.resize.is_some();
+        }
+        self.scene_name = shared.status.name;
+        self.driver.handle_timeout(now, &shared.status);
+        while let Some(event) = self.driver.poll_event() {
+            match event {
+                DriverEvent::Quit => return Some(Leave::Quit),
+                DriverEvent::Request(request) => self.tally.request(self.gate.send(request, &self.hub, now)),
+                DriverEvent::Layout => {
+                    self.driver.refit(self.hub.scene_size);
+                    self.membership.reset();
                 }
             }
         }
-    };
+        let screen = &self.driver.player().screen;
+        let now_viewing = Viewing { fit: *self.driver.player().seat.fit(), group: self.membership.key(screen) };
+        if (now_viewing.fit, now_viewing.group) != (self.viewing.fit, self.viewing.group) {
+            self.viewing = now_viewing;
+            self.hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(self.id, self.viewing);
+        }
+        None
+    }
 
-    hub.fits.lock().unwrap_or_else(|p| p.into_inner()).remove(&id);
-    drop(slot); // the place is free as soon as the game ends
-    let published = frames.borrow().number;
-    stats.frames_skipped.fetch_add(tally.skipped(published), Ordering::Relaxed);
-    let rate = player.screen.rate();
-    eprintln!("{}", tally.report(peer, id, reason, published, rate, &membership));
-    let mut goodbye = Vec::new();
-    player.screen.farewell(&mut goodbye);
-    leave::say_goodbye(reason, scene_name, goodbye, &write, &kill).await;
+    /// Builds the frame for `now` into `self.out` when one goes (a new shared picture or a
+    /// key's frame, within the server's outbound rate); whether there is one to send.
+    fn frame(&mut self, now: Instant, shared: &SharedFrame) -> bool {
+        // One frame in flight: the writer is idle here, the last write was awaited.
+        if !self.driver.poll_frame(now, true) {
+            return false;
+        }
+        self.tally.count(shared);
+        // Just resized: the next shared frame has this size.
+        let Some(picture) = shared.pictures.get(&self.driver.player().seat.fit().target()).cloned() else {
+            return false;
+        };
+        if !self.hub.outbound.lock().unwrap_or_else(|p| p.into_inner()).try_take(0.0, now) {
+            self.hub.stats.frames_dropped_rate.fetch_add(1, Ordering::Relaxed);
+            return false;
+        }
+        self.driver.sent();
+        // The frame is built in a buffer kept from frame to frame (the screen reserves room
+        // for its largest frame in it) and copied out at its own size: handing the buffer
+        // itself to russh would hold that reservation per frame in flight.
+        self.out.clear();
+        let feed = self.viewing.group.and_then(|key| shared.groups.get(&key));
+        let player = self.driver.player_mut();
+        let (len, source) = self.membership.frame(player, now, &picture, &shared.status, feed, &mut self.out);
+        if len == 0 {
+            return false;
+        }
+        self.from_group = source == Source::Group;
+        self.hub.outbound.lock().unwrap_or_else(|p| p.into_inner()).owe(len);
+        true
+    }
+
+    /// Sends `self.out`. data_bytes waits for the client's SSH window and for room in russh's
+    /// queue: that wait is the backpressure (newer pictures replace older ones in the slot
+    /// meanwhile). `Some` when the player is cut.
+    async fn send(&mut self, write: &ChannelWriteHalf<Msg>, kill: &CancellationToken) -> Option<Leave> {
+        let (hub, len) = (&self.hub, self.out.len());
+        tokio::select! {
+            biased;
+            _ = kill.cancelled() => Some(Leave::Cut),
+            _ = hub.shutdown.cancelled() => Some(Leave::Shutdown),
+            done = write.data_bytes(Bytes::copy_from_slice(&self.out)) => {
+                if done.is_err() { return Some(Leave::Cut); }
+                self.tally.sent += 1;
+                self.tally.from_group += u64::from(self.from_group);
+                if self.membership.in_step() && self.out.capacity() > IN_STEP_BUFFER {
+                    // Room for a whole frame of its own is not needed while the group's
+                    // bytes come: give it back (it comes again if the player leaves).
+                    self.out = Vec::new();
+                }
+                self.tally.bytes += len as u64;
+                hub.stats.frames_sent.fetch_add(1, Ordering::Relaxed);
+                None
+            }
+            _ = tokio::time::sleep(hub.limits.stall_timeout) => {
+                hub.stats.stall_kicks.fetch_add(1, Ordering::Relaxed);
+                Some(Leave::Stalled)
+            }
+        }
+    }
 }

@@ -6,8 +6,11 @@
 //! or JPEG) and the picture rate — so that a picture never costs more than the bytes the caller
 //! has now.
 //!
-//! Pure and clock-injected: no terminal, no clock. Time comes in as an argument. (The one
-//! side effect: kitty's temporary files, when the terminal is on this machine.)
+//! Pure and clock-injected: no terminal, no clock, no file. Time comes in as an argument.
+//! kitty's temporary files (a terminal on this machine reads the pixels from them) are data
+//! too: a committed offer's file is handed out by [`PictureStream::take_files`] and the door
+//! writes it before the offer's bytes; a file it cannot write is reported back
+//! ([`PictureStream::files_failed`]) and the stream sends pixels directly from then on.
 //!
 //! # The contract (how the Screen calls it)
 //!
@@ -60,10 +63,10 @@ use tiny_skia::Pixmap;
 use self::ladder::Resampler;
 use crate::output::bucket::{MAX_BURST, MIN_CAPACITY};
 use crate::output::graphics::geometry::Layout;
-use crate::output::graphics::kitty::{self, KittyOptions, Medium};
-use crate::output::graphics::pack::{Packing, pack};
+use crate::output::graphics::kitty::{KittyOptions, Medium};
+use crate::output::graphics::pack::Packing;
+use crate::output::graphics::scan;
 use crate::output::graphics::sixel::{Registers, SixelEncoder, SixelPalette, TMUX_MAX_IMAGE_BYTES};
-use crate::output::graphics::{iterm2, scan};
 
 /// The share of a picture interval's bytes a picture may take: the rest is left for the status
 /// line and the cells' own changes.
@@ -190,6 +193,16 @@ pub enum Part {
     Tile(u32, u32, u32, u32),
 }
 
+/// A file the door writes before it sends the bytes that name it (kitty's temporary-file
+/// medium: the terminal reads the pixels from it and deletes it).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct FileWrite {
+    /// Where the file goes (a new file: an existing one of that name is not followed).
+    pub path: PathBuf,
+    /// Its bytes.
+    pub bytes: Vec<u8>,
+}
+
 /// What is pending until [`PictureStream::commit`].
 #[derive(Clone, Copy, Debug)]
 struct Pending {
@@ -230,10 +243,12 @@ pub struct PictureStream {
     sixel: Option<Box<SixelEncoder>>,
     /// kitty's placeholder text must be (re)printed after the next whole image.
     placeholders_due: bool,
-    /// kitty's temporary files: how many were written, and the one the pending offer names
-    /// (removed when the offer is not committed: no terminal will read it).
+    /// kitty's temporary files: how many were named, the one the pending offer names (dropped
+    /// when the offer is not committed: it is never written), and the committed ones the door
+    /// has not taken yet.
     files: u64,
-    pending_file: Option<PathBuf>,
+    pending_file: Option<FileWrite>,
+    committed_files: Vec<FileWrite>,
 }
 
 impl PictureStream {
@@ -275,6 +290,7 @@ impl PictureStream {
             placeholders_due: true,
             files: 0,
             pending_file: None,
+            committed_files: Vec::new(),
         };
         stream.build_ladder(layout.picture);
         stream
@@ -421,19 +437,6 @@ impl PictureStream {
         self.offer(rung, part, limited, now + interval)
     }
 
-    /// Fills the candidate with its mean colour.
-    fn flatten_candidate(&mut self) {
-        let n = (self.candidate.len() / 3).max(1) as u64;
-        let mut sum = [0u64; 3];
-        for p in self.candidate.chunks_exact(3) {
-            (0..3).for_each(|c| sum[c] += u64::from(p[c]));
-        }
-        let mean = sum.map(|s| (s / n) as u8);
-        for p in self.candidate.chunks_exact_mut(3) {
-            p.copy_from_slice(&mean);
-        }
-    }
-
     /// Offers `self.bytes` (the caller has checked they fit).
     fn offer(&mut self, rung: usize, part: Part, limited: bool, next: Instant) -> Option<Offer<'_>> {
         self.pending = Some(Pending { rung, part });
@@ -445,7 +448,7 @@ impl PictureStream {
     /// The offer was written: the terminal shows it from now on.
     pub fn commit(&mut self) {
         let Some(Pending { rung, part }) = self.pending.take() else { return };
-        self.pending_file = None;
+        self.committed_files.extend(self.pending_file.take());
         let sixel = matches!(self.protocol, Protocol::Sixel { .. });
         let (stride, bpp) = self.stride(rung);
         match (part, &mut self.shown) {
@@ -468,12 +471,25 @@ impl PictureStream {
         self.rung = rung;
     }
 
-    /// An offer not committed: its temporary file is removed (no terminal will read it).
+    /// An offer not committed: its temporary file is never written.
     fn forget_pending(&mut self) {
         self.pending = None;
-        if let Some(path) = self.pending_file.take() {
-            let _ = std::fs::remove_file(path);
+        self.pending_file = None;
+    }
+
+    /// Moves the files the committed offers name to `out`: the door writes them before it
+    /// sends those offers' bytes.
+    pub fn take_files(&mut self, out: &mut Vec<FileWrite>) {
+        out.append(&mut self.committed_files);
+    }
+
+    /// The door could not write a file (a full or read-only `/dev/shm`): pixels go directly
+    /// from now on, and the next picture is sent whole (the terminal did not get the last one).
+    pub fn files_failed(&mut self) {
+        if let Protocol::Kitty(options) = &mut self.protocol {
+            options.medium = Medium::Direct;
         }
+        self.invalidate();
     }
 
     /// Bytes a row of the shown picture at `rung` takes, and bytes a pixel.
@@ -541,155 +557,9 @@ impl PictureStream {
         let c = &mut self.cost[rung];
         *c = Some(c.map_or(bpp, |old| old + LEARN * (bpp - old)));
     }
-
-    /// Encodes `picture` at `rung` into `self.bytes` (whole, or the changed box when that is
-    /// cheaper) and its pixels into `self.candidate`; `None` when the terminal shows it already.
-    fn encode(&mut self, picture: &Pixmap, rung: usize, limited: bool) -> Option<Part> {
-        let size = self.rungs[rung];
-        let from = (picture.width(), picture.height());
-        self.bytes.clear();
-        if let Protocol::Sixel { .. } = self.protocol {
-            let screen = self.layout.picture;
-            let sixel = self.sixel.as_mut().expect("a sixel stream has its encoder");
-            // Dithered straight from the pixmap (opaque: its bytes are straight RGB) when the
-            // rung is the picture's size; otherwise resampled to the rung first. Each rung
-            // pixel becomes a block of screen pixels.
-            // The top rung (a link that carries whole pictures) gets the fine pattern; the
-            // others the flat blocks that cost fewer bytes.
-            let fine = rung == 0;
-            if size == from {
-                sixel.dither_scaled(picture.data(), 4, from, screen, fine, &mut self.candidate);
-            } else {
-                self.resampler.resample(picture.data(), 4, from, size, &mut self.rgb);
-                sixel.dither_scaled(&self.rgb, 3, size, screen, fine, &mut self.candidate);
-            }
-            let part = match &self.shown {
-                Some((_, old)) => sixel_part(old, &self.candidate, screen, self.layout.cell_px)?,
-                None => Part::Whole,
-            };
-            let (x, y, w, h) = part_box(part, screen);
-            sixel.push_block(
-                &mut self.bytes,
-                &self.candidate,
-                screen.0,
-                (x, y, w, h),
-                self.layout.origin,
-                self.layout.cell_px,
-            );
-            return Some(part);
-        }
-        self.resampler.resample(picture.data(), 4, from, size, &mut self.candidate);
-        let part = match &self.shown {
-            Some((r, old)) if *r == rung => match scan::changed_box(old, &self.candidate, size.0, 3, 0..size.1) {
-                None => return None,
-                Some(b) if self.protocol.edits() && 2 * b.2 * b.3 <= size.0 * size.1 => {
-                    Part::Changed(b.0, b.1, b.2, b.3)
-                }
-                Some(_) => Part::Whole,
-            },
-            _ => Part::Whole,
-        };
-        let packing = self.packing(limited, rung);
-        self.push_part(part, rung, packing);
-        Some(part)
-    }
-
-    /// Appends the command(s) for `part` of the candidate at `rung` (kitty and iTerm2), packed
-    /// with `packing` (`None`: kitty's raw RGB in a temporary file).
-    fn push_part(&mut self, part: Part, rung: usize, packing: Option<Packing>) {
-        let size = self.rungs[rung];
-        let (x, y, w, h) = part_box(part, size);
-        let pixels: &[u8] = if (w, h) == size {
-            &self.candidate
-        } else {
-            self.part_rgb.clear();
-            for row in y..y + h {
-                let from = (row as usize * size.0 as usize + x as usize) * 3;
-                self.part_rgb.extend_from_slice(&self.candidate[from..from + w as usize * 3]);
-            }
-            &self.part_rgb
-        };
-        match &self.protocol {
-            Protocol::Kitty(options) => {
-                let o = KittyOptions { origin: self.layout.origin, cells: self.layout.cells, ..options.clone() };
-                let mut keys = Vec::with_capacity(96);
-                let whole = part == Part::Whole;
-                if whole {
-                    kitty::image_keys(&mut keys, &o, size);
-                    if !o.placeholders {
-                        kitty::push_cursor_to(&mut self.bytes, o.origin);
-                    }
-                } else {
-                    kitty::edit_keys(&mut keys, o.image_id, (x, y, w, h));
-                }
-                let through_file = match (&o.medium, packing) {
-                    (Medium::TempFile(dir), None) => {
-                        self.files += 1;
-                        match kitty::write_temp_file(dir, self.files, pixels) {
-                            Ok(path) => {
-                                kitty::push_temp_file_command(&mut self.bytes, &keys, &path, o.tmux);
-                                self.pending_file = Some(path);
-                                true
-                            }
-                            Err(_) => false,
-                        }
-                    }
-                    _ => false,
-                };
-                if !through_file {
-                    if matches!(o.medium, Medium::TempFile(_)) {
-                        // The file could not be written (a full or read-only /dev/shm): direct
-                        // from now on, and this picture directly too.
-                        if let Protocol::Kitty(options) = &mut self.protocol {
-                            options.medium = Medium::Direct;
-                        }
-                    }
-                    let packing = packing.unwrap_or(Packing::Zlib(1));
-                    pack(packing, pixels, w, h, &mut self.packed);
-                    let more: &[u8] = if whole { b"" } else { b"a=f," };
-                    kitty::push_chunks(&mut self.bytes, &keys, more, packing, &self.packed, o.tmux);
-                }
-                if whole && o.placeholders && self.placeholders_due {
-                    kitty::push_placeholders(&mut self.bytes, o.image_id, o.origin.0, o.origin.1, o.cells.0, o.cells.1);
-                }
-            }
-            Protocol::Iterm2 { tmux } => {
-                pack(packing.unwrap_or(Packing::Png), pixels, w, h, &mut self.packed);
-                iterm2::push_file(&mut self.bytes, self.layout.origin, self.layout.cells, *tmux, &self.packed)
-            }
-            Protocol::Sixel { .. } => unreachable!("sixel is encoded by its encoder"),
-        }
-    }
 }
 
-impl Drop for PictureStream {
-    fn drop(&mut self) {
-        self.forget_pending();
-    }
-}
-
-/// The box a part covers in a picture of `size`.
-fn part_box(part: Part, size: (u32, u32)) -> (u32, u32, u32, u32) {
-    match part {
-        Part::Whole => (0, 0, size.0, size.1),
-        Part::Changed(x, y, w, h) | Part::Tile(x, y, w, h) => (x, y, w, h),
-    }
-}
-
-/// The part of a sixel picture to send: the block of whole cells around the changes (its last
-/// band may be partial: mlterm blanks the rest of a row of cells an image reaches into), the
-/// whole picture when that block is all of it; `None` when nothing changed.
-fn sixel_part(old: &[u8], new: &[u8], screen: (u32, u32), cell_px: (u16, u16)) -> Option<Part> {
-    let (cw, ch) = (u32::from(cell_px.0.max(1)), u32::from(cell_px.1.max(1)));
-    let (left, top, bw, bh) = scan::changed_box(old, new, screen.0, 1, 0..screen.1)?;
-    let (x0, y0) = (left / cw * cw, top / ch * ch);
-    let x1 = ((left + bw).div_ceil(cw) * cw).min(screen.0);
-    let h = ((top + bh).div_ceil(ch) * ch).min(screen.1) - y0;
-    if (x0, y0, x1 - x0, h) == (0, 0, screen.0, screen.1) {
-        return Some(Part::Whole);
-    }
-    Some(Part::Changed(x0, y0, x1 - x0, h))
-}
+mod encode;
 
 #[cfg(test)]
 mod tests;

@@ -2,7 +2,7 @@ use super::*;
 use crate::output::bucket::ByteBucket;
 use crate::output::graphics::GraphicsMode;
 use crate::output::graphics::geometry::{SCALED_CAP, layout};
-use crate::output::graphics::kitty::KittyOptions;
+use crate::output::graphics::kitty::{self, KittyOptions};
 use crate::output::graphics::kitty_decode;
 use crate::output::graphics::test_pictures::golden_pool;
 

@@ -32,7 +32,7 @@ impl PictureStream {
             (1, 1)
         };
         // Bytes a pixel of what was just encoded, and the pixels a tile may hold.
-        let (_, _, pw, ph) = super::part_box(part, (w, h));
+        let (_, _, pw, ph) = super::encode::part_box(part, (w, h));
         let density = self.bytes.len() as f64 / (f64::from(pw) * f64::from(ph)).max(1.0);
         let area = TILE_SHARE * room as f64 / density.max(1e-9);
         let (tw, th) = if area >= f64::from(w) * f64::from(uy) {

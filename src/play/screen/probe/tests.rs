@@ -1,7 +1,9 @@
 use std::cell::{Cell, RefCell};
+use std::time::Instant;
 
 use super::*;
 use crate::output::graphics::kitty_decode;
+use crate::term::probe::run_probe;
 
 const MS: Duration = Duration::from_millis(1);
 
@@ -61,7 +63,7 @@ impl FakeTerminal {
 
 fn options(tmux: bool) -> ProbeOptions {
     ProbeOptions {
-        env: Environment { tmux, ..Environment::default() },
+        env: EnvHints { tmux, ..EnvHints::default() },
         winsize: WinSize { cols: 160, rows: 48, x_px: 0, y_px: 0 },
         kitty_file: None,
         colours: true,
@@ -301,13 +303,13 @@ fn no_terminal_no_query() {
     assert!(!should_probe(true, false) && !should_probe(false, true) && should_probe(true, true));
     assert_eq!(choose(GraphicsRequest::Auto, None).mode, GraphicsMode::Cells);
     assert_eq!(choose(GraphicsRequest::Force(GraphicsMode::Sixel), None).mode, GraphicsMode::Sixel);
-    let env = Environment::from_lookup(|k| match k {
+    let env = EnvHints::from_lookup(|k| match k {
         "TMUX" => Some("/tmp/tmux-0/default,1,0".into()),
         "SSH_TTY" => Some("/dev/pts/1".into()),
         "TERM_PROGRAM" => Some(String::new()),
         _ => None,
     });
-    assert_eq!(env, Environment { tmux: true, ssh: true, term_program: None });
+    assert_eq!(env, EnvHints { tmux: true, ssh: true, term_program: None });
 }
 
 /// Through the Screen, as a player meets its terminal: answers at made-up times.
@@ -318,7 +320,7 @@ mod through_the_screen {
     use crate::output::diff::EncodeOptions;
     use crate::output::graphics::GraphicsMode;
     use crate::play::input::Input;
-    use crate::play::screen::probe::{Environment, GraphicsRequest, PROBE_BUDGET, ProbeOptions, WinSize};
+    use crate::play::screen::probe::{EnvHints, GraphicsRequest, PROBE_BUDGET, ProbeOptions, WinSize};
     use crate::play::screen::{Bandwidth, LATE_ANSWERS, Screen, ScreenConfig};
 
     const MS: Duration = Duration::from_millis(1);
@@ -334,7 +336,7 @@ mod through_the_screen {
             encode: EncodeOptions::default(),
             graphics: GraphicsRequest::Auto,
             probe: Some(ProbeOptions {
-                env: Environment { ssh: true, ..Environment::default() },
+                env: EnvHints { ssh: true, ..EnvHints::default() },
                 winsize: WinSize { cols: 40, rows: 12, x_px: 320, y_px: 192 },
                 kitty_file: None,
                 colours: false,

@@ -1,0 +1,154 @@
+//! Encoding one picture for a [`PictureStream`]: resampled to the rung, compared with what the
+//! terminal shows, and written as the protocol's commands (kitty and iTerm2 packed, kitty's
+//! pixels perhaps in a temporary file that is handed out as data, sixel through its encoder).
+
+use tiny_skia::Pixmap;
+
+use super::{FileWrite, Part, PictureStream, Protocol};
+use crate::output::graphics::kitty::{self, KittyOptions, Medium};
+use crate::output::graphics::pack::{Packing, pack};
+use crate::output::graphics::{iterm2, scan};
+
+impl PictureStream {
+    /// Fills the candidate with its mean colour.
+    pub(super) fn flatten_candidate(&mut self) {
+        let n = (self.candidate.len() / 3).max(1) as u64;
+        let mut sum = [0u64; 3];
+        for p in self.candidate.chunks_exact(3) {
+            (0..3).for_each(|c| sum[c] += u64::from(p[c]));
+        }
+        let mean = sum.map(|s| (s / n) as u8);
+        for p in self.candidate.chunks_exact_mut(3) {
+            p.copy_from_slice(&mean);
+        }
+    }
+
+    /// Encodes `picture` at `rung` into `self.bytes` (whole, or the changed box when that is
+    /// cheaper) and its pixels into `self.candidate`; `None` when the terminal shows it already.
+    pub(super) fn encode(&mut self, picture: &Pixmap, rung: usize, limited: bool) -> Option<Part> {
+        let size = self.rungs[rung];
+        let from = (picture.width(), picture.height());
+        self.bytes.clear();
+        if let Protocol::Sixel { .. } = self.protocol {
+            let screen = self.layout.picture;
+            let sixel = self.sixel.as_mut().expect("a sixel stream has its encoder");
+            // Dithered straight from the pixmap (opaque: its bytes are straight RGB) when the
+            // rung is the picture's size; otherwise resampled to the rung first. Each rung
+            // pixel becomes a block of screen pixels.
+            // The top rung (a link that carries whole pictures) gets the fine pattern; the
+            // others the flat blocks that cost fewer bytes.
+            let fine = rung == 0;
+            if size == from {
+                sixel.dither_scaled(picture.data(), 4, from, screen, fine, &mut self.candidate);
+            } else {
+                self.resampler.resample(picture.data(), 4, from, size, &mut self.rgb);
+                sixel.dither_scaled(&self.rgb, 3, size, screen, fine, &mut self.candidate);
+            }
+            let part = match &self.shown {
+                Some((_, old)) => sixel_part(old, &self.candidate, screen, self.layout.cell_px)?,
+                None => Part::Whole,
+            };
+            let (x, y, w, h) = part_box(part, screen);
+            sixel.push_block(
+                &mut self.bytes,
+                &self.candidate,
+                screen.0,
+                (x, y, w, h),
+                self.layout.origin,
+                self.layout.cell_px,
+            );
+            return Some(part);
+        }
+        self.resampler.resample(picture.data(), 4, from, size, &mut self.candidate);
+        let part = match &self.shown {
+            Some((r, old)) if *r == rung => match scan::changed_box(old, &self.candidate, size.0, 3, 0..size.1) {
+                None => return None,
+                Some(b) if self.protocol.edits() && 2 * b.2 * b.3 <= size.0 * size.1 => {
+                    Part::Changed(b.0, b.1, b.2, b.3)
+                }
+                Some(_) => Part::Whole,
+            },
+            _ => Part::Whole,
+        };
+        let packing = self.packing(limited, rung);
+        self.push_part(part, rung, packing);
+        Some(part)
+    }
+
+    /// Appends the command(s) for `part` of the candidate at `rung` (kitty and iTerm2), packed
+    /// with `packing` (`None`: kitty's raw RGB in a temporary file).
+    pub(super) fn push_part(&mut self, part: Part, rung: usize, packing: Option<Packing>) {
+        let size = self.rungs[rung];
+        let (x, y, w, h) = part_box(part, size);
+        let pixels: &[u8] = if (w, h) == size {
+            &self.candidate
+        } else {
+            self.part_rgb.clear();
+            for row in y..y + h {
+                let from = (row as usize * size.0 as usize + x as usize) * 3;
+                self.part_rgb.extend_from_slice(&self.candidate[from..from + w as usize * 3]);
+            }
+            &self.part_rgb
+        };
+        match &self.protocol {
+            Protocol::Kitty(options) => {
+                let o = KittyOptions { origin: self.layout.origin, cells: self.layout.cells, ..options.clone() };
+                let mut keys = Vec::with_capacity(96);
+                let whole = part == Part::Whole;
+                if whole {
+                    kitty::image_keys(&mut keys, &o, size);
+                    if !o.placeholders {
+                        kitty::push_cursor_to(&mut self.bytes, o.origin);
+                    }
+                } else {
+                    kitty::edit_keys(&mut keys, o.image_id, (x, y, w, h));
+                }
+                match (&o.medium, packing) {
+                    (Medium::TempFile(dir), None) => {
+                        self.files += 1;
+                        let path = kitty::temp_file_path(dir, self.files);
+                        kitty::push_temp_file_command(&mut self.bytes, &keys, &path, o.tmux);
+                        self.pending_file = Some(FileWrite { path, bytes: pixels.to_vec() });
+                    }
+                    _ => {
+                        let packing = packing.unwrap_or(Packing::Zlib(1));
+                        pack(packing, pixels, w, h, &mut self.packed);
+                        let more: &[u8] = if whole { b"" } else { b"a=f," };
+                        kitty::push_chunks(&mut self.bytes, &keys, more, packing, &self.packed, o.tmux);
+                    }
+                }
+                if whole && o.placeholders && self.placeholders_due {
+                    kitty::push_placeholders(&mut self.bytes, o.image_id, o.origin.0, o.origin.1, o.cells.0, o.cells.1);
+                }
+            }
+            Protocol::Iterm2 { tmux } => {
+                pack(packing.unwrap_or(Packing::Png), pixels, w, h, &mut self.packed);
+                iterm2::push_file(&mut self.bytes, self.layout.origin, self.layout.cells, *tmux, &self.packed)
+            }
+            Protocol::Sixel { .. } => unreachable!("sixel is encoded by its encoder"),
+        }
+    }
+}
+
+/// The box a part covers in a picture of `size`.
+pub(super) fn part_box(part: Part, size: (u32, u32)) -> (u32, u32, u32, u32) {
+    match part {
+        Part::Whole => (0, 0, size.0, size.1),
+        Part::Changed(x, y, w, h) | Part::Tile(x, y, w, h) => (x, y, w, h),
+    }
+}
+
+/// The part of a sixel picture to send: the block of whole cells around the changes (its last
+/// band may be partial: mlterm blanks the rest of a row of cells an image reaches into), the
+/// whole picture when that block is all of it; `None` when nothing changed.
+fn sixel_part(old: &[u8], new: &[u8], screen: (u32, u32), cell_px: (u16, u16)) -> Option<Part> {
+    let (cw, ch) = (u32::from(cell_px.0.max(1)), u32::from(cell_px.1.max(1)));
+    let (left, top, bw, bh) = scan::changed_box(old, new, screen.0, 1, 0..screen.1)?;
+    let (x0, y0) = (left / cw * cw, top / ch * ch);
+    let x1 = ((left + bw).div_ceil(cw) * cw).min(screen.0);
+    let h = ((top + bh).div_ceil(ch) * ch).min(screen.1) - y0;
+    if (x0, y0, x1 - x0, h) == (0, 0, screen.0, screen.1) {
+        return Some(Part::Whole);
+    }
+    Some(Part::Changed(x0, y0, x1 - x0, h))
+}

@@ -1,0 +1,208 @@
+//! A frame's bytes: the cells (composed here, or a group's), the picture in real pixels, the
+//! link's question, within the byte bucket and the link's window of unanswered bytes.
+
+use std::time::{Duration, Instant};
+
+use tiny_skia::Pixmap;
+
+use super::compose::{Figures, big_enough};
+use super::{APPROXIMATE_BELOW, Cells, Screen, link, picture};
+use crate::output::color::ColorMode;
+use crate::output::cursor::Cursor;
+use crate::output::graphics::stream::Budget;
+use crate::output::rate::{RateOptions, Report, Target, budget_after};
+use crate::play::host::SceneStatus;
+use crate::play::seat::SeatView;
+
+/// What a frame may spend, found once at its start.
+struct Plan {
+    /// The link's rate in effect (`None`: no limit).
+    rate: Option<f64>,
+    /// The status line's figures.
+    figures: Figures,
+    /// The bytes the frame may send now.
+    budget: usize,
+    /// A picture bigger than the budget may go now and be owed.
+    overdraw: bool,
+    options: RateOptions,
+}
+
+impl Screen {
+    /// Appends the frame for now to `out`: `picture` (of [`Screen::picture_size`]), the seat's
+    /// overlay, the status line. Returns the bytes appended (0 when nothing changed). Nothing
+    /// in it can fail: it writes to memory (kitty's temporary files are data the door writes).
+    pub(crate) fn frame(
+        &mut self,
+        now: Instant,
+        picture: &Pixmap,
+        status: &SceneStatus,
+        seat: &SeatView<'_>,
+        out: &mut Vec<u8>,
+    ) -> usize {
+        self.frame_from(now, picture, status, seat, Cells::Own { figures: None }, out)
+    }
+
+    /// [`Screen::frame`] with its cells from `cells`: everything else (the byte bucket, the
+    /// link's questions, the meter, the pacer, real pixels) as for any frame.
+    pub(crate) fn frame_from(
+        &mut self,
+        now: Instant,
+        picture: &Pixmap,
+        status: &SceneStatus,
+        seat: &SeatView<'_>,
+        cells: Cells<'_>,
+        out: &mut Vec<u8>,
+    ) -> usize {
+        let start = out.len();
+        if !self.entered {
+            out.extend_from_slice(Self::ENTER);
+            self.entered = true;
+        }
+        if std::mem::take(&mut self.mouse_pixels_pending) {
+            out.extend_from_slice(picture::PIXEL_MOUSE_ON);
+        }
+        if self.auto() {
+            self.bucket.set_rate(self.link.rate());
+        }
+        self.bucket.refill(now);
+        self.follow_link(now, out);
+        let plan = self.plan(now);
+        let resized = self.shown.frame.is_none();
+        let mut bytes = std::mem::take(&mut self.scratch);
+        bytes.clear();
+        let report = self.encode_cells(picture, status, seat, cells, &plan, &mut bytes, out);
+        self.bucket.spend(report.bytes);
+        let sent = self.add_picture(now, picture, seat, resized, &report, &plan, &mut bytes);
+        if self.auto() {
+            self.link.frame_sent(report.bytes + sent, plan.budget);
+        }
+        // Room for the largest frame at once (the scratch buffer has it), so the caller's
+        // buffers stop growing after the first frames: steady frames allocate nothing.
+        out.reserve(bytes.capacity());
+        out.extend_from_slice(&bytes);
+        self.scratch = bytes;
+        let unasked = self.link.unasked(self.bytes_sent + (out.len() - start) as u64);
+        if self.auto() && self.link.probe_due() && (out.len() > start || unasked) {
+            // The question goes after the frame: its answer says the frame has arrived.
+            out.extend_from_slice(self.link.question());
+            self.link.probed(now, self.bytes_sent + (out.len() - start) as u64);
+        }
+        let len = out.len() - start;
+        self.bytes_sent += len as u64;
+        self.meter.frame(now, len);
+        self.pacer.sent(now);
+        len
+    }
+
+    /// What the frame at `now` may spend (the bucket refilled already).
+    fn plan(&self, now: Instant) -> Plan {
+        let rate = self.bucket.rate();
+        let figures = Figures {
+            fps: self.meter.fps,
+            bytes_per_second: self.meter.bytes_per_second,
+            bandwidth: rate.map(|r| r as u64),
+            pixels_elsewhere: self.picture.is_some(),
+            note: if self.auto() { self.link.hint() } else { None },
+        };
+        // On an auto link the unanswered bytes are capped too (see `link`: the first seconds).
+        let window_left = if self.auto() { self.link.window_left(now, self.bytes_sent) } else { usize::MAX };
+        let budget = self.bucket.budget().min(window_left);
+        // The bucket as full as it gets and nothing big unanswered: a picture bigger than both
+        // may go now (and is owed), so a picture that never fits them still shows.
+        let overdraw =
+            self.bucket.budget() as f64 + 1.0 >= self.bucket.capacity() && window_left >= link::MIN_WINDOW as usize / 2;
+        let options = RateOptions {
+            approximate: rate.is_some_and(|r| r < APPROXIMATE_BELOW),
+            ..RateOptions::from(self.config.encode)
+        };
+        Plan { rate, figures, budget, overdraw, options }
+    }
+
+    /// The frame's cells into `bytes` (a group's taken bytes straight into `out`).
+    #[allow(clippy::too_many_arguments)]
+    fn encode_cells(
+        &mut self,
+        picture: &Pixmap,
+        status: &SceneStatus,
+        seat: &SeatView<'_>,
+        cells: Cells<'_>,
+        plan: &Plan,
+        bytes: &mut Vec<u8>,
+        out: &mut Vec<u8>,
+    ) -> Report {
+        match cells {
+            Cells::Own { figures: given } => {
+                let figures = given.unwrap_or(plan.figures);
+                let frame = self.builder.compose(self.term, picture, self.config.color, status, seat, &figures);
+                let target = match self.config.color {
+                    ColorMode::TrueColor => Target::new(frame),
+                    mode => Target::with_truth(frame, picture, mode),
+                };
+                self.encoder.encode_into(&mut self.shown, target, plan.budget, plan.options, bytes)
+            }
+            Cells::Toward(model) => {
+                // Exactly (no colour threshold), so that the model becomes equal, not close.
+                let exact = RateOptions { threshold: 0, ..plan.options };
+                self.encoder.encode_into(&mut self.shown, Target::new(model), plan.budget, exact, bytes)
+            }
+            Cells::Taken(taken) => {
+                // Straight to the caller: the group's bytes never pass through the scratch
+                // buffer, which a member in step has freed (it would grow back to a group
+                // frame's size, and the caller's buffer with it).
+                out.extend_from_slice(taken);
+                Report { bytes: taken.len(), drawn: 0, pending: 0 }
+            }
+        }
+    }
+
+    /// The picture in real pixels after the cells, within what they left; returns its bytes.
+    #[allow(clippy::too_many_arguments)]
+    fn add_picture(
+        &mut self,
+        now: Instant,
+        picture: &Pixmap,
+        seat: &SeatView<'_>,
+        resized: bool,
+        report: &Report,
+        plan: &Plan,
+        bytes: &mut Vec<u8>,
+    ) -> usize {
+        let Some(p) = &mut self.picture else { return 0 };
+        let frame = picture::FrameFacts {
+            resized,
+            help_open: seat.help.is_some(),
+            cells_shown: report.pending == 0,
+            drawable: big_enough(self.term),
+            sync: plan.options.sync,
+        };
+        // What the cells left of this frame's budget: the picture is never owed.
+        let left = Budget {
+            available: budget_after(plan.budget, report.bytes),
+            rate: plan.rate,
+            frame_interval: Duration::from_secs(1) / self.config.fps.max(1),
+            overdraw: plan.overdraw,
+        };
+        let sent = p.add_to_frame(picture, &frame, left, now, bytes);
+        if sent > 0 {
+            // Beyond the budget when overdrawn: the bucket is in debt until the rate has
+            // repaid it.
+            self.bucket.owe(sent);
+            self.shown.cursor = Cursor::Unknown;
+        }
+        sent
+    }
+
+    /// The bytes a frame may send now (the byte bucket, and on an auto link the window of
+    /// unanswered bytes): whether a group's frame fits this screen's link.
+    pub(crate) fn budget(&mut self, now: Instant) -> usize {
+        if self.auto() {
+            self.bucket.set_rate(self.link.rate());
+        }
+        self.bucket.refill(now);
+        if self.auto() {
+            self.bucket.budget().min(self.link.window_left(now, self.bytes_sent))
+        } else {
+            self.bucket.budget()
+        }
+    }
+}
