@@ -15,9 +15,10 @@
 //! seen to take (the bytes between two answers over the time between them: while a queue
 //! stands, that is the link's own rate; [`DEEP_DRAIN_SHARE`] of it for a deep queue), or by
 //! [`DECREASE`] when that is not known yet, and the byte bucket is emptied, so the backlog
-//! drains; in between it holds. The terminal's own time to answer is not queue: it is learned
-//! from answers the bytes in flight cannot explain and taken off (see `answer_time`), and one
-//! late answer alone never lowers the rate unless those bytes explain it. The marks scale with the shortest round trip
+//! drains; in between it holds. The terminal's own time to answer is not queue: it is measured
+//! now and then with a bare question asked with nothing in flight (see `answer_time`); its
+//! usual time is taken off every answer's queue and its slow answers raise the high mark. The
+//! marks scale with the shortest round trip
 //! ([`queue_marks`]): a queue of one round trip, never more than [`QUEUE_HIGH`], so a key's frame
 //! waits behind at most that. The first answer starts the rate from what the first frame was
 //! seen to take (never under [`SAFE_RATE`]): a base round trip taken while the start rate's
@@ -71,11 +72,13 @@
 use std::time::{Duration, Instant};
 
 mod answer_time;
+mod flight;
 mod path;
 mod questions;
 mod screen_side;
 
-use answer_time::{AnswerTime, Flight};
+use answer_time::AnswerTime;
+use flight::Flight;
 pub use path::LinkPath;
 use questions::{Question, Questions};
 
@@ -214,6 +217,10 @@ pub struct LinkControl {
     spare_since_question: bool,
     /// The terminal's own answer times, which widen the queue's marks.
     answer_time: AnswerTime,
+    /// When the next measurement of the terminal's own time is due (frames are held from
+    /// then until a bare question has gone out, at most [`answer_time::HOLD_MAX`]); `None`
+    /// until the first answer, and while a bare question waits for its answer.
+    clean_due: Option<Instant>,
     /// The bytes sent, as the link would carry them at the capacity seen.
     flight: Flight,
     /// The bytes of the last frame sent.
@@ -261,6 +268,7 @@ impl LinkControl {
             asked_up_to: 0,
             spare_since_question: true,
             answer_time: AnswerTime::default(),
+            clean_due: None,
             flight: Flight::default(),
             last_frame: 0,
             foreign_answers: 0,
@@ -289,6 +297,11 @@ impl LinkControl {
     pub fn probed(&mut self, now: Instant, bytes_sent: u64) {
         self.asked_up_to = self.asked_up_to.max(bytes_sent);
         let app_limited = std::mem::replace(&mut self.spare_since_question, true);
+        let clean = self.holding(now) && bytes_sent.saturating_sub(self.acknowledged) <= answer_time::CLEAN_BYTES;
+        if clean {
+            // Frames may go again: they follow the question, so they cannot delay its answer.
+            self.clean_due = None;
+        }
         let in_flight = self.flight.sent(now, bytes_sent, self.last_frame, self.capacity.unwrap_or(self.rate));
         self.questions.push(Question {
             asked: now,
@@ -296,6 +309,7 @@ impl LinkControl {
             foreign: false,
             overdue: false,
             app_limited,
+            clean,
             in_flight,
         });
     }
@@ -373,24 +387,42 @@ impl LinkControl {
         self.sample_count += 1;
         let base = self.base().unwrap_or(rtt);
         let queue = rtt.saturating_sub(base);
-        let (low, high) = queue_marks(base);
-        // The queue the bytes ahead of the question would have made on the link as seen, and
-        // the terminal's own time, learned where they made none (see `answer_time`).
-        let in_flight = question.in_flight;
         self.flight.answered(now, bytes);
-        self.answer_time.record(queue, in_flight, high);
-        let link_queue = queue.saturating_sub(self.answer_time.usual());
+        if question.clean {
+            // Nothing was in flight under it: its delay beyond the base is the terminal's own
+            // time, and it says nothing of what the link carries (no frames crossed).
+            self.answer_time.record(queue);
+            let gap = answer_time::next_gap(
+                self.answer_time.bare_count(),
+                self.answer_time.slow(),
+                queue_marks(base).0,
+                base,
+            );
+            self.clean_due = Some(now + gap);
+            return Change::Hold;
+        }
+        if first && self.path.answered_at_far_end() {
+            // The first measurement of the terminal's own time comes right after: holding the
+            // frames until the first answer is in also drains what the start rate queued, so
+            // the bare question's round trip is the link's own.
+            self.clean_due = Some(now);
+        }
+        let (low, high) = queue_marks(base);
+        self.answer_time.infer(queue, question.in_flight, low);
+        // The terminal's usual time to answer is not queue; its slow answers raise the high
+        // mark (a queue must stand beyond them to be the link's).
+        let (usual, slow) = (self.answer_time.usual(), self.answer_time.slow());
+        let link_queue = queue.saturating_sub(usual);
         // Over the high mark, and either the bytes in flight explain it (a queue grows with
         // them; the terminal's time does not) or it is beyond the terminal's slow answers too.
-        let explained = 2 * in_flight >= link_queue;
-        let over = link_queue > high && (explained || queue > high + self.answer_time.slow());
+        let explained = 2 * question.in_flight >= link_queue;
+        let over = link_queue > high && (explained || queue > high + slow);
         let last_queue = self.last_queue.replace((link_queue, over));
         if let Some(took) = took {
             self.capacity = Some(match self.capacity {
                 // Only a standing queue (two answers over the mark in a row) says the link was
                 // the limit; a late answer (a busy machine's late read, a terminal drawing)
-                // must not shrink the window to one frame's take, nor the capacity the bytes in
-                // flight are timed by.
+                // must not shrink the window to one frame's take.
                 Some(c) if !(over && last_queue.is_some_and(|(_, was_over)| was_over)) => c.max(took),
                 _ => took,
             });
@@ -485,6 +517,11 @@ impl LinkControl {
         if self.is_silent(now) {
             return usize::MAX;
         }
+        if self.holding(now) {
+            // The terminal's own time is being measured: nothing more until the bytes in
+            // flight are answered for and the bare question has gone out.
+            return 0;
+        }
         let window = if self.answered {
             // The bandwidth-delay product: one question at a time, so two round trips (each
             // with the queue the window allows) and a frame; never below what the rate sends
@@ -504,10 +541,22 @@ impl LinkControl {
         usize::try_from(window.saturating_sub(bytes_sent.saturating_sub(self.acknowledged))).unwrap_or(usize::MAX)
     }
 
-    /// Whether bytes went out after the last question: with none in flight, a question must
-    /// follow them even without a frame, or a closed window would never open.
-    pub fn unasked(&self, bytes_sent: u64) -> bool {
+    /// Whether a question should follow even a frame that wrote nothing, `bytes_sent`
+    /// counting every byte written so far: bytes went out after the last question (with none
+    /// in flight, or a closed window would never open), or the terminal's own time is being
+    /// measured and everything sent is answered for (the bare question, [`answer_time`]).
+    pub fn question_wanted(&self, now: Instant, bytes_sent: u64) -> bool {
         bytes_sent > self.asked_up_to
+            || (self.holding(now) && bytes_sent.saturating_sub(self.acknowledged) <= answer_time::CLEAN_BYTES)
+    }
+
+    /// Whether frames are held for a measurement of the terminal's own time: it is due, for
+    /// at most [`answer_time::HOLD_MAX`] (a question in flight slow to be answered skips it).
+    fn holding(&self, now: Instant) -> bool {
+        let base = self.base().unwrap_or(Duration::ZERO);
+        self.clean_due.is_some_and(|due| now >= due && now < answer_time::hold_end(due, base))
+            && !self.silent
+            && self.path.answered_at_far_end()
     }
 
     /// Looks at the clock: a question unanswered too long is congestion (once per question); a
@@ -516,6 +565,14 @@ impl LinkControl {
     pub fn tick(&mut self, now: Instant) -> Change {
         let age = |q: &Question| now.saturating_duration_since(q.asked);
         self.questions.forget(|q| age(q) > GIVE_UP || (q.foreign && age(q) > FOREIGN_WAIT));
+        let base = self.base().unwrap_or(Duration::ZERO);
+        if let Some(due) = self.clean_due
+            && now >= answer_time::hold_end(due, base)
+        {
+            // The question in flight took too long: measure another time, frames go on.
+            let gap = answer_time::next_gap(0, Duration::ZERO, Duration::ZERO, base);
+            self.clean_due = Some(now + gap);
+        }
         let limit = self.base().map_or(PROBE_TIMEOUT, |b| (4 * b).max(PROBE_TIMEOUT));
         let mut lost = false;
         for q in self.questions.list[..self.questions.len].iter_mut().flatten() {

@@ -7,95 +7,143 @@
 //! and up to a second. Read as queue against a high mark of 30 ms, those answers lowered the
 //! rate to the 2 kB/s floor within 5 s on a 250 kB/s link.
 //!
-//! What tells them apart is the bytes in flight: a queue is a delay that grows with the bytes
-//! sent ahead of the question, the terminal's time is not. [`Flight`] follows the bytes as the
-//! link would carry them at the capacity seen (each question's `in_flight`: the queue they
-//! would have made); the answers whose bytes made no queue to speak of (under the low mark)
-//! show the terminal's own time, their delay beyond the base round trip less that queue.
-//! [`AnswerTime`] keeps the last [`SAMPLES`] of them, like BBR's filter of the round trip with
-//! nothing queued: its median ([`AnswerTime::usual`]) is taken off every answer's queue, and an
-//! answer over the high mark counts as queue only when the bytes in flight explain it, or when
-//! it is later than the terminal's slow answers ([`AnswerTime::slow`]) too.
+//! **Measured, not modelled.** The only answer that shows the terminal's own time alone is one
+//! to a question asked with nothing in flight: every byte before it already answered for. So
+//! now and then ([`CLEAN_EVERY`]; the first ones sooner, [`CLEAN_FIRST_EVERY`]) the link holds
+//! its frames until the question in flight is answered, asks a bare question, and sends frames
+//! again at once (they follow the question, so they cannot delay its answer): a pause of about a
+//! round trip, like BBR's probe of the round trip with nothing queued. That answer's delay
+//! beyond the base round trip is the terminal's own. [`AnswerTime`] keeps the last [`SAMPLES`]
+//! of them; its median ([`AnswerTime::usual`]) is taken off every answer's queue, and its slow
+//! answers ([`AnswerTime::slow`]) widen the high mark.
+//!
+//! An earlier version (round 4) inferred the terminal's time from the bytes in flight, timed at
+//! the link's capacity as seen. A terminal slow because it is still *reading* (a Python
+//! terminal on a loaded machine, a sixel decoder in the reading thread) then looked like a fast
+//! link with a slow terminal: its backlog was learned as "own time", up to 100 ms of queue went
+//! unseen, and the link harness's key-to-effect p90 went from 16-104 ms to 169-374 ms. A
+//! terminal still reading answers a bare question at once, so here its backlog stays a queue.
 
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// Answers remembered.
 pub const SAMPLES: usize = 16;
 /// The most the terminal's own time is allowed: beyond it the answers are too slow for keys
 /// to show within a round trip anyway, and a queue must not hide behind them.
 pub const OWN_MAX: Duration = Duration::from_millis(100);
+/// How often the terminal's own time is measured once [`FIRST_SAMPLES`] are known, while it
+/// is seen to matter (slow answers past the low mark): a terminal that draws slowly may draw
+/// more slowly later. At least [`CLEAN_RTTS`] base round trips apart, so the pauses cost a few
+/// per cent of the link.
+pub const CLEAN_EVERY: Duration = Duration::from_secs(5);
+/// How often while the terminal answers at once (its slow answers under the low mark).
+pub const CLEAN_RARELY: Duration = Duration::from_secs(20);
+/// How often it is measured until then: the first seconds decide whether the rate collapses.
+pub const CLEAN_FIRST_EVERY: Duration = Duration::from_millis(700);
+/// Measurements taken at the faster pace.
+pub const FIRST_SAMPLES: usize = 4;
+/// The least gap between two measurements, in base round trips.
+pub const CLEAN_RTTS: u32 = 40;
+/// The longest the link holds its frames for a measurement beyond the base round trip; past it
+/// the measurement is skipped until the next one is due (a terminal slow to answer the question
+/// in flight must not freeze the picture).
+pub const HOLD_MAX: Duration = Duration::from_millis(200);
 
-/// The terminal's own answer times, from answers with (almost) nothing in flight.
+/// When a measurement due at `due` is given up, on a base round trip of `base`.
+pub fn hold_end(due: std::time::Instant, base: Duration) -> std::time::Instant {
+    due + base + HOLD_MAX
+}
+
+/// The gap to the next measurement after one that came with `count` learned, the terminal's
+/// slow answers `slow` against the low mark `low`, on a base round trip of `base`.
+pub fn next_gap(count: usize, slow: Duration, low: Duration, base: Duration) -> Duration {
+    let every = if count < FIRST_SAMPLES {
+        CLEAN_FIRST_EVERY
+    } else if slow > low {
+        CLEAN_EVERY
+    } else {
+        CLEAN_RARELY
+    };
+    every.max(base * CLEAN_RTTS)
+}
+/// Bytes that may be in flight under a bare question (a status line's worth): the set-up and
+/// cursor bytes a frame with no budget still writes.
+pub const CLEAN_BYTES: u64 = 512;
+
+/// Bare questions' answers remembered, to judge whether the terminal answers slowly at all.
+pub const CLEAN_SAMPLES: usize = 8;
+
+/// The terminal's own answer times: from answers to questions asked with nothing in flight,
+/// and, once those show a terminal slow to answer at all, from answers the bytes in flight
+/// cannot explain.
 #[derive(Clone, Debug, Default)]
 pub struct AnswerTime {
     samples: [Duration; SAMPLES],
     count: usize,
+    clean: [Duration; CLEAN_SAMPLES],
+    clean_count: usize,
 }
 
 impl AnswerTime {
-    /// An answer came `excess` after the base round trip, behind bytes that would have queued
-    /// `in_flight` on the link; `low` is the queue's low mark. Only answers whose bytes queued
-    /// less than that are the terminal's to learn from.
-    pub fn record(&mut self, excess: Duration, in_flight: Duration, low: Duration) {
-        if in_flight <= low {
-            self.samples[self.count % SAMPLES] = excess.saturating_sub(in_flight);
-            self.count += 1;
+    /// A bare question's answer came `excess` after the base round trip.
+    pub fn record(&mut self, excess: Duration) {
+        self.clean[self.clean_count % CLEAN_SAMPLES] = excess;
+        self.clean_count += 1;
+        self.push(excess);
+    }
+
+    /// An answer came `excess` after the base round trip behind bytes that would have queued
+    /// `in_flight` at the capacity seen; `low` is the queue's low mark. It teaches only when
+    /// those bytes made no queue to speak of and the bare questions have shown the terminal
+    /// slow to answer (their median past the low mark): a few bare answers cannot show a
+    /// heavy tail (kitty 0.26: a median of 18 ms, a 90th percentile of 98 ms), and a terminal
+    /// that answers bare questions at once is late only because it is still reading.
+    pub fn infer(&mut self, excess: Duration, in_flight: Duration, low: Duration) {
+        let n = self.clean_count.min(CLEAN_SAMPLES);
+        if n == 0 || in_flight > low {
+            return;
+        }
+        let mut clean = self.clean;
+        clean[..n].sort_unstable();
+        if clean[n / 2] > low {
+            self.push(excess.saturating_sub(in_flight));
         }
     }
 
-    /// The last samples, sorted (none until a few were learned).
+    fn push(&mut self, excess: Duration) {
+        self.samples[self.count % SAMPLES] = excess;
+        self.count += 1;
+    }
+
+    /// How many bare questions' answers were learned from (all time).
+    pub fn bare_count(&self) -> usize {
+        self.clean_count
+    }
+
+    /// The last samples, sorted, and how many there are.
     fn sorted(&self) -> ([Duration; SAMPLES], usize) {
         let n = self.count.min(SAMPLES);
         let mut sorted = self.samples;
         sorted[..n].sort_unstable();
-        (sorted, if n < 4 { 0 } else { n })
+        (sorted, n)
     }
 
-    /// The terminal's usual time to answer (the median), at most [`OWN_MAX`].
+    /// The terminal's usual time to answer (the median), at most [`OWN_MAX`]; zero until
+    /// one is known.
     pub fn usual(&self) -> Duration {
         let (sorted, n) = self.sorted();
         if n == 0 { Duration::ZERO } else { sorted[n / 2].min(OWN_MAX) }
     }
 
     /// The terminal's slow answers: the second slowest of the last [`SAMPLES`] (about the
-    /// 90th percentile; one very slow answer in sixteen is passed over), at most [`OWN_MAX`].
+    /// 90th percentile; one very slow answer in sixteen is passed over; the slowest while
+    /// fewer than four are known), at most [`OWN_MAX`].
     pub fn slow(&self) -> Duration {
         let (sorted, n) = self.sorted();
-        if n == 0 { Duration::ZERO } else { sorted[n - 2].min(OWN_MAX) }
-    }
-}
-
-/// The bytes sent, as a link of the capacity seen would carry them: when it would have carried
-/// everything sent so far.
-#[derive(Clone, Debug, Default)]
-pub struct Flight {
-    /// When the link would have carried everything sent up to the last question.
-    drained: Option<Instant>,
-    /// The last question: when, and the bytes sent up to it.
-    last: Option<(Instant, u64)>,
-}
-
-impl Flight {
-    /// A question went out at `now` after `bytes_sent` bytes in all, the last frame's
-    /// `frame` of them just before it, the link seen to carry `capacity` bytes a second: the
-    /// queue those bytes would have made. The bytes since the last question are taken as sent
-    /// evenly since it (the frames between are not timed here), the last frame's at once.
-    pub fn sent(&mut self, now: Instant, bytes_sent: u64, frame: u64, capacity: f64) -> Duration {
-        let (then, before) = self.last.unwrap_or((now, 0));
-        let time = |bytes: u64| Duration::from_secs_f64((bytes as f64 / capacity.max(1.0)).min(60.0));
-        let carried = time(bytes_sent.saturating_sub(before));
-        let drained = (self.drained.map_or(then, |d| d.max(then)) + carried).max(now + time(frame));
-        self.drained = Some(drained);
-        self.last = Some((now, bytes_sent));
-        drained.saturating_duration_since(now)
-    }
-
-    /// The answer to the question after `bytes` bytes came at `now`: the link had carried
-    /// them by then, whatever the model said (it follows the link from what it was seen to
-    /// do, not from a guess that runs on).
-    pub fn answered(&mut self, now: Instant, bytes: u64) {
-        if self.last.is_some_and(|(_, last)| bytes >= last) {
-            self.drained = self.drained.map(|d| d.min(now));
+        match n {
+            0 => Duration::ZERO,
+            1..=3 => sorted[n - 1].min(OWN_MAX),
+            _ => sorted[n - 2].min(OWN_MAX),
         }
     }
 }
@@ -109,37 +157,28 @@ mod tests {
     }
 
     #[test]
-    fn the_terminal_s_time_is_learned_where_no_bytes_queue() {
-        let low = ms(10);
+    fn the_usual_and_slow_answers_come_from_the_samples_within_own_max() {
         let mut time = AnswerTime::default();
         assert_eq!((time.usual(), time.slow()), (ms(0), ms(0)), "nothing learned yet");
-        // A queue: answers behind bytes that queue longer than the low mark teach nothing.
-        for _ in 0..SAMPLES {
-            time.record(ms(400), ms(390), low);
-        }
-        assert_eq!((time.usual(), time.slow()), (ms(0), ms(0)));
-        // The terminal's own times: 1..=14 ms beyond their bytes, and two of 100 and 900 ms.
+        time.record(ms(7));
+        assert_eq!((time.usual(), time.slow()), (ms(7), ms(7)), "one sample is both");
+        let mut time = AnswerTime::default();
+        // The terminal's own times: 2..=15 ms, and two of 101 and 901 ms.
         for i in 0..14 {
-            time.record(ms(2 + i), ms(1), low);
+            time.record(ms(2 + i));
         }
-        time.record(ms(101), ms(1), low);
-        time.record(ms(901), ms(1), low);
-        assert_eq!(time.usual(), ms(9), "the median of 1..=14, 100 and 900 ms");
-        assert_eq!(time.slow(), ms(100), "the second slowest: one slow answer in sixteen is passed over");
-        time.record(ms(2_000), ms(0), low);
-        time.record(ms(2_000), ms(0), low);
-        assert_eq!(time.slow(), OWN_MAX, "never more than OWN_MAX");
-    }
-
-    #[test]
-    fn bytes_in_flight_queue_only_past_what_the_link_carries() {
-        let t0 = Instant::now();
-        let mut flight = Flight::default();
-        // 25 kB at 250 kB/s: 100 ms to cross.
-        assert_eq!(flight.sent(t0, 25_000, 25_000, 250_000.0), ms(100));
-        // 50 ms later 5 kB more: the first 25 kB have 50 ms to go, then 20 ms.
-        assert_eq!(flight.sent(t0 + ms(50), 30_000, 1_000, 250_000.0), ms(70));
-        // A second later the link has carried everything: only the last frame's 2.5 kB queue.
-        assert_eq!(flight.sent(t0 + ms(1_050), 100_000, 2_500, 250_000.0), ms(10));
+        time.record(ms(101));
+        time.record(ms(901));
+        assert_eq!(time.usual(), ms(10), "the median of 2..=15, 101 and 901 ms");
+        assert_eq!(
+            time.slow(),
+            ms(100),
+            "the second slowest, within OWN_MAX: one slow answer in sixteen is passed over"
+        );
+        // Old samples leave as new ones come.
+        for _ in 0..SAMPLES {
+            time.record(ms(1));
+        }
+        assert_eq!((time.usual(), time.slow(), time.bare_count()), (ms(1), ms(1), 2 * SAMPLES));
     }
 }

@@ -21,8 +21,11 @@ pub(super) struct Question {
     /// not the link, set the pace, so its answer says little of the link (see
     /// [`super::LinkControl::frame_sent`]).
     pub(super) app_limited: bool,
+    /// Asked with nothing in flight (every byte before it answered for): its answer's delay
+    /// beyond the base round trip is the terminal's own time ([`super::answer_time`]).
+    pub(super) clean: bool,
     /// The queue the bytes sent up to it would have made on the link, at the capacity seen
-    /// ([`super::answer_time::Flight`]): the part of its round trip the bytes can explain.
+    /// ([`super::flight::Flight`]): the part of its round trip the bytes can explain.
     pub(super) in_flight: std::time::Duration,
 }
 

@@ -73,6 +73,7 @@ impl LinkControl {
                 foreign: true,
                 overdue: false,
                 app_limited: false,
+                clean: false,
                 in_flight: Duration::ZERO,
             }) {
                 break;
