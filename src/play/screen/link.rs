@@ -408,22 +408,29 @@ impl LinkControl {
             self.clean_due = Some(now);
         }
         let (low, high) = queue_marks(base);
-        self.answer_time.infer(queue, question.in_flight, low);
+        self.answer_time.infer(queue, question.in_flight, (low, high));
         // The terminal's usual time to answer is not queue; its slow answers raise the high
         // mark (a queue must stand beyond them to be the link's).
         let (usual, slow) = (self.answer_time.usual(), self.answer_time.slow());
         let link_queue = queue.saturating_sub(usual);
         // Over the high mark, and either the bytes in flight explain it (a queue grows with
         // them; the terminal's time does not) or it is beyond the terminal's slow answers too.
-        let explained = 2 * question.in_flight >= link_queue;
+        // Only a terminal the bare questions showed slow on its own is asked for that
+        // explanation: any other is late because it is still reading, a queue.
+        // (Until a few bare answers are in, it is taken for one: main's rules collapsed kitty
+        // 0.26 to 2 kB/s within the first second.)
+        let slow_terminal =
+            self.answer_time.is_slow(low, high) || self.answer_time.bare_count() < answer_time::FIRST_SAMPLES;
+        let explained = !slow_terminal || 2 * question.in_flight >= link_queue;
         let over = link_queue > high && (explained || queue > high + slow);
         let last_queue = self.last_queue.replace((link_queue, over));
+        let was_over = last_queue.is_some_and(|(_, was_over)| was_over);
         if let Some(took) = took {
             self.capacity = Some(match self.capacity {
-                // Only a standing queue (two answers over the mark in a row) says the link was
-                // the limit; a late answer (a busy machine's late read, a terminal drawing)
-                // must not shrink the window to one frame's take.
-                Some(c) if !(over && last_queue.is_some_and(|(_, was_over)| was_over)) => c.max(took),
+                // A queue says the link was the limit; from a terminal slow on its own only a
+                // standing one (two answers over the mark in a row): its late answers must not
+                // shrink the window to one frame's take.
+                Some(c) if !(over && (was_over || !slow_terminal)) => c.max(took),
                 _ => took,
             });
         }
@@ -468,8 +475,7 @@ impl LinkControl {
         // One answer alone confirms a queue only when the bytes in flight explain it: a single
         // late answer is the terminal's (kitty 0.26 under llvmpipe took up to a second now and
         // then), never a collapse of the link.
-        let confirmed =
-            last_queue.is_some_and(|(_, was_over)| was_over) || (link_queue > 2 * QUEUE_HIGH_MIN && explained);
+        let confirmed = was_over || (link_queue > 2 * QUEUE_HIGH_MIN && explained);
         // A sender that left its budget unspent cannot have built a queue of a few marks: only
         // a deep one lowers the rate then.
         let caused = !app_limited || link_queue > 2 * high;

@@ -39,7 +39,7 @@ pub const CLEAN_EVERY: Duration = Duration::from_secs(5);
 /// How often while the terminal answers at once (its slow answers under the low mark).
 pub const CLEAN_RARELY: Duration = Duration::from_secs(20);
 /// How often it is measured until then: the first seconds decide whether the rate collapses.
-pub const CLEAN_FIRST_EVERY: Duration = Duration::from_millis(700);
+pub const CLEAN_FIRST_EVERY: Duration = Duration::from_millis(300);
 /// Measurements taken at the faster pace.
 pub const FIRST_SAMPLES: usize = 4;
 /// The least gap between two measurements, in base round trips.
@@ -93,21 +93,28 @@ impl AnswerTime {
     }
 
     /// An answer came `excess` after the base round trip behind bytes that would have queued
-    /// `in_flight` at the capacity seen; `low` is the queue's low mark. It teaches only when
+    /// `in_flight` at the capacity seen, with the queue's marks `low` and `high`. It teaches only when
     /// those bytes made no queue to speak of and the bare questions have shown the terminal
-    /// slow to answer (their median past the low mark): a few bare answers cannot show a
+    /// slow to answer ([`AnswerTime::is_slow`]): a few bare answers cannot show a
     /// heavy tail (kitty 0.26: a median of 18 ms, a 90th percentile of 98 ms), and a terminal
     /// that answers bare questions at once is late only because it is still reading.
-    pub fn infer(&mut self, excess: Duration, in_flight: Duration, low: Duration) {
-        let n = self.clean_count.min(CLEAN_SAMPLES);
-        if n == 0 || in_flight > low {
-            return;
-        }
-        let mut clean = self.clean;
-        clean[..n].sort_unstable();
-        if clean[n / 2] > low {
+    pub fn infer(&mut self, excess: Duration, in_flight: Duration, (low, high): (Duration, Duration)) {
+        if in_flight <= low && self.is_slow(low, high) {
             self.push(excess.saturating_sub(in_flight));
         }
+    }
+
+    /// Whether the last bare questions have shown the terminal slow to answer on its own,
+    /// with the queue's marks `low` and `high`: two of their answers past the low mark, or one
+    /// past the high mark (kitty 0.26: three answers in four past 10 ms, one in five past
+    /// 60 ms; the harness's Python terminal: 0-11 ms). Only such a terminal's late answers are
+    /// weighed against the bytes in flight; one that answers bare questions at once is late
+    /// only because it is still reading, and is treated as a queue at once.
+    pub fn is_slow(&self, low: Duration, high: Duration) -> bool {
+        let n = self.clean_count.min(CLEAN_SAMPLES);
+        let mut clean = self.clean;
+        clean[..n].sort_unstable();
+        n > 0 && (clean[n - 1] > high || (n > 1 && clean[n - 2] > low))
     }
 
     fn push(&mut self, excess: Duration) {
