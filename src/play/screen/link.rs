@@ -580,6 +580,13 @@ impl LinkControl {
             self.clean_due = Some(now + gap);
         }
         let limit = self.base().map_or(PROBE_TIMEOUT, |b| (4 * b).max(PROBE_TIMEOUT));
+        // A terminal slow on its own (or not known yet) that stalls for a second with few
+        // bytes in flight is busy, not congested (kitty 0.26 under llvmpipe, setting up its
+        // first pictures): its lost question lowers the rate only when those bytes explain the
+        // wait, as for a late answer.
+        let (low, high) = queue_marks(base);
+        let slow_terminal =
+            self.answer_time.is_slow(low, high) || self.answer_time.bare_count() < answer_time::FIRST_SAMPLES;
         let mut lost = false;
         for q in self.questions.list[..self.questions.len].iter_mut().flatten() {
             // A terminal that has never answered is not congested: it is silent (below).
@@ -588,7 +595,7 @@ impl LinkControl {
                 // keeps its place, so its late answer is still paired with it.
                 self.acknowledged = self.acknowledged.max(q.bytes);
                 q.overdue = true;
-                lost = true;
+                lost |= !slow_terminal || 2 * q.in_flight >= age(q);
             }
         }
         if !self.silent && self.is_silent(now) {

@@ -336,6 +336,7 @@ fn the_path_is_read_from_the_environment_and_the_ancestors() {
 fn an_overdue_question_keeps_its_place_for_its_late_answer() {
     let t0 = Instant::now();
     let mut link = LinkControl::new();
+    link.known_fast();
     link.probed(t0, 1000);
     link.answered(t0 + ms(50));
     link.probed(t0 + ms(60), 2000);
@@ -406,6 +407,22 @@ fn still_water_does_not_shrink_the_window() {
 }
 
 #[test]
+fn a_terminal_slow_on_its_own_that_stalls_with_little_in_flight_is_busy_not_congested() {
+    // Kitty 0.26 under llvmpipe setting up its first pictures stalled for more than a second
+    // now and then: read as lost questions, each stall lowered the rate, and `auto` fell to
+    // cells at 9.1 kB/s on a 250 kB/s link (1 real run in 3).
+    let t0 = Instant::now();
+    let mut link = LinkControl::new();
+    link.probed(t0, 30_000);
+    link.answered(t0 + ms(120));
+    let rate = link.rate();
+    link.probed(t0 + ms(130), 31_000);
+    assert_eq!(link.tick(t0 + ms(130) + PROBE_TIMEOUT + ms(1)), Change::Hold, "a stall, not a loss");
+    assert_eq!(link.rate(), rate);
+    assert!(link.probe_due(), "the overdue question is replaced all the same");
+}
+
+#[test]
 fn a_local_terminal_grows_to_no_limit() {
     let run = simulate(LinkPath::Direct, Link::far(1e9, ms(0)), 3.0, busy);
     assert_eq!(*run.rates.last().unwrap(), MAX_RATE, "a fast link ends unlimited");
@@ -419,6 +436,7 @@ fn lost_answers_slow_down_and_silence_gets_the_safe_rate() {
     assert_eq!(link.tick(t0 + SILENCE - ms(1)), Change::Hold, "a first answer may take a while");
     assert!(link.rate().is_none_or(|r| r >= START_RATE), "{:?}", link.rate());
     link.answered(t0 + ms(5));
+    link.known_fast();
     link.probed(t0 + ms(10), 200);
     assert_eq!(link.tick(t0 + ms(10) + PROBE_TIMEOUT + ms(1)), Change::Down);
     assert!(link.rate().unwrap() < START_RATE * INCREASE);
