@@ -200,3 +200,55 @@ fn every_graphics_terminal_gets_pictures_in_the_protocol_it_speaks_locally_and_o
     }
     assert!(failed.is_empty(), "{} of {seen} runs wrong:\n{}", failed.len(), failed.join("\n"));
 }
+
+/// The DA1 questions in `chunk` (the probe's and the link's).
+fn da1_questions(chunk: &[u8]) -> usize {
+    chunk.windows(3).filter(|w| w == b"\x1b[c").count()
+}
+
+#[test]
+fn a_kitty_slow_to_answer_keeps_its_rate_over_ssh() {
+    // Debian's kitty 0.26 under llvmpipe answers in its own time (median 18 ms, p90 98 ms); the
+    // link control read that as the link's queue and the rate fell to the 2 kB/s floor within
+    // 5 s: a black or half-painted picture, then cells in palette colours. Here the fake is
+    // busy for that long at each question, over SSH (`SSH_CONNECTION`: pictures in band).
+    use crate::common::fake_terminal::kitty_026_answer_time;
+    let mut failed = Vec::new();
+    for run in 0..runs() {
+        let fake = Arc::new(Mutex::new(FakeTerminal::new(Profile::kitty_026(), COLS, ROWS)));
+        let env = [("TERM", "xterm-kitty"), ("COLORTERM", ""), SSH];
+        let args = ["play", "--rain", "0.05", "--graphics", "kitty"];
+        let terminal = Arc::clone(&fake);
+        let mut asked = 0u32;
+        let respond = move |chunk: &[u8]| {
+            for _ in 0..da1_questions(chunk) {
+                asked += 1;
+                std::thread::sleep(kitty_026_answer_time(asked));
+            }
+            terminal.lock().unwrap().feed(chunk)
+        };
+        let mut p =
+            Player::spawn_responding(&temp_dir("fake-slow-kitty"), COLS as u16, ROWS as u16, &args, &env, respond);
+        std::thread::sleep(Duration::from_secs(4));
+        let before = fake.lock().unwrap().raw.len();
+        std::thread::sleep(Duration::from_secs(8));
+        let (after, status) = {
+            let f = fake.lock().unwrap();
+            (f.raw.len(), f.status())
+        };
+        p.send(b"q");
+        let _ = p.wait_exit(HANG);
+        let rate = (after - before) as f64 / 8.0;
+        println!(
+            "slow kitty 0.26, pty over SSH, run {run}: {:.1} kB/s from 4 to 12 s; status {:?}",
+            rate / 1e3,
+            status.trim_end()
+        );
+        // At the floor it was 1-3 kB/s; a pty carries megabytes a second.
+        let allowed = crate::common::fake_terminal::status_rate(&status);
+        if rate < 20_000.0 || allowed.is_some_and(|r| r < 20_000.0) {
+            failed.push(format!("run {run}: {:.1} kB/s from 4 to 12 s, status {:?}", rate / 1e3, status.trim_end()));
+        }
+    }
+    assert!(failed.is_empty(), "the rate fell:\n{}", failed.join("\n"));
+}

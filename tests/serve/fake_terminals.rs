@@ -123,3 +123,58 @@ async fn serve_finds_true_colour_by_asking_the_terminal() {
         assert_eq!(hint, !true_colour, "{what}: the hint");
     }
 }
+
+#[tokio::test]
+async fn a_kitty_slow_to_answer_keeps_its_rate_through_serve() {
+    // kitty 0.26 under llvmpipe, busy for its own answer time at each device-attributes
+    // question (median 18 ms, p90 98 ms; reading nothing meanwhile): through serve the rate fell
+    // to the 2 kB/s floor within 5 s (round 3, real kitty over the shaped link).
+    use crate::fake_terminal::kitty_026_answer_time;
+    use std::time::Duration;
+    let mut failed = Vec::new();
+    for run in 0..runs() {
+        // Busy water, so every frame has something to send.
+        let server = Server::start(&["--rain", "0.05", "--breeze", "0", "--handshake-timeout-ms", "5000"]);
+        let h = connect_none(server.port).await;
+        let profile = Profile::kitty_026();
+        let mut ch = open_shell(&h, profile.term, COLS, ROWS).await;
+        let mut fake = FakeTerminal::new(profile, COLS as usize, ROWS as usize);
+        let start = Instant::now();
+        let (mut asked, mut at_4s) = (0u32, None);
+        while start.elapsed() < Duration::from_secs(12) {
+            let left = Duration::from_secs(12).saturating_sub(start.elapsed());
+            match tokio::time::timeout(left, ch.wait()).await {
+                Ok(Some(ChannelMsg::Data { data })) => {
+                    for _ in 0..data.windows(3).filter(|w| w == b"\x1b[c").count() {
+                        asked += 1;
+                        tokio::time::sleep(kitty_026_answer_time(asked)).await;
+                    }
+                    let answers = fake.feed(&data);
+                    if !answers.is_empty() {
+                        ch.data(&answers[..]).await.expect("the answers go back");
+                    }
+                }
+                Ok(Some(_)) => {}
+                Ok(None) => panic!("the channel closed; status {:?}", fake.status()),
+                Err(_) => {}
+            }
+            if at_4s.is_none() && start.elapsed() >= Duration::from_secs(4) {
+                at_4s = Some((fake.raw.len(), start.elapsed()));
+            }
+        }
+        let (before, from) = at_4s.expect("four seconds passed");
+        let rate = (fake.raw.len() - before) as f64 / (start.elapsed() - from).as_secs_f64();
+        let status = fake.status();
+        println!(
+            "slow kitty 0.26 through serve, run {run}: {:.1} kB/s from 4 to 12 s; status {:?}",
+            rate / 1e3,
+            status.trim_end()
+        );
+        // At the floor it was 1-3 kB/s; the loopback carries megabytes a second.
+        let allowed = crate::fake_terminal::status_rate(&status);
+        if rate < 20_000.0 || allowed.is_some_and(|r| r < 20_000.0) {
+            failed.push(format!("run {run}: {:.1} kB/s, status {:?}", rate / 1e3, status.trim_end()));
+        }
+    }
+    assert!(failed.is_empty(), "the rate fell:\n{}", failed.join("\n"));
+}

@@ -329,20 +329,6 @@ async fn read_slowly(
     }
 }
 
-/// The link rate the status line says is in effect (`… of 40.0 kB/s …`), in bytes a second.
-fn rate_in_effect(status: &str) -> Option<f64> {
-    let after = status.split(" of ").nth(1)?;
-    let mut words = after.split_whitespace();
-    let number: f64 = words.next()?.parse().ok()?;
-    let unit = match words.next()? {
-        "B/s" => 1.0,
-        "kB/s" => 1e3,
-        "MB/s" => 1e6,
-        _ => return None,
-    };
-    Some(number * unit)
-}
-
 #[tokio::test]
 async fn a_slow_client_gets_a_budget_of_its_own_and_no_long_backlog() {
     const RATE: f64 = 40_000.0;
@@ -369,7 +355,7 @@ async fn a_slow_client_gets_a_budget_of_its_own_and_no_long_backlog() {
         // The bytes that had to be read after the key before its frame: the backlog ahead of it.
         worst = worst.max(read - at);
     }
-    let rate = rate_in_effect(&t.status()).expect("the status line shows the rate in effect");
+    let rate = crate::fake_terminal::status_rate(&t.status()).expect("the status line shows the rate in effect");
     eprintln!("slow client: rate in effect {rate:.0} B/s, worst backlog {worst} bytes ({:.2} s)", worst as f64 / RATE);
     assert!(rate < 256_000.0, "below the old fixed budget: {rate}");
     assert!((worst as f64) < RATE / 2.0, "at most half a second queued: {worst} bytes at {RATE} B/s");

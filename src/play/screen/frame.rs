@@ -81,8 +81,8 @@ impl Screen {
         out.reserve(bytes.capacity());
         out.extend_from_slice(&bytes);
         self.scratch = bytes;
-        let unasked = self.link.unasked(self.bytes_sent + (out.len() - start) as u64);
-        if self.auto() && self.link.probe_due() && (out.len() > start || unasked) {
+        let wanted = self.link.question_wanted(now, self.bytes_sent + (out.len() - start) as u64);
+        if self.auto() && self.link.probe_due() && (out.len() > start || wanted) {
             // The question goes after the frame: its answer says the frame has arrived.
             out.extend_from_slice(self.link.question());
             self.link.probed(now, self.bytes_sent + (out.len() - start) as u64);

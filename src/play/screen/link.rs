@@ -15,7 +15,10 @@
 //! seen to take (the bytes between two answers over the time between them: while a queue
 //! stands, that is the link's own rate; [`DEEP_DRAIN_SHARE`] of it for a deep queue), or by
 //! [`DECREASE`] when that is not known yet, and the byte bucket is emptied, so the backlog
-//! drains; in between it holds. The marks scale with the shortest round trip
+//! drains; in between it holds. The terminal's own time to answer is not queue: it is measured
+//! now and then with a bare question asked with nothing in flight (see `answer_time`); its
+//! usual time is taken off every answer's queue and its slow answers raise the high mark. The
+//! marks scale with the shortest round trip
 //! ([`queue_marks`]): a queue of one round trip, never more than [`QUEUE_HIGH`], so a key's frame
 //! waits behind at most that. The first answer starts the rate from what the first frame was
 //! seen to take (never under [`SAFE_RATE`]): a base round trip taken while the start rate's
@@ -67,6 +70,18 @@
 //! Time comes in as an argument: the tests run on made-up clocks.
 
 use std::time::{Duration, Instant};
+
+mod answer_time;
+mod flight;
+mod path;
+mod questions;
+mod screen_side;
+mod window;
+
+use answer_time::AnswerTime;
+use flight::Flight;
+pub use path::LinkPath;
+use questions::{Question, Questions};
 
 /// The question: primary device attributes.
 pub const PROBE: &[u8] = b"\x1b[c";
@@ -126,6 +141,8 @@ pub const WINDOW_RTT_MAX: Duration = Duration::from_millis(500);
 pub const FIRST_TRICKLE: f64 = 2_000.0;
 /// The window's room for the frame that goes out between an answer and the next question.
 pub const FRAME_ALLOWANCE: Duration = Duration::from_millis(50);
+/// The fewest bytes between two answers that measure what the link carries.
+pub const DELIVERY_BYTES: u64 = 2_000;
 /// The smallest window once the terminal answers: a status line and a few cells.
 pub const MIN_WINDOW: u64 = 4_000;
 /// How long a question may wait with no answer at all before the terminal is taken not to
@@ -150,147 +167,6 @@ pub enum Change {
     Up,
     /// The rate fell: empty the byte bucket so the backlog drains.
     Down,
-}
-
-/// What sits between the player and the screen, as far as the player can tell
-/// ([`LinkPath::detect`]).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum LinkPath {
-    /// The terminal at the far end answers (plain SSH, a local terminal, a multiplexer on this
-    /// machine's own screen): the round trip measures the link.
-    #[default]
-    Direct,
-    /// A multiplexer (`tmux`, `screen`, `zellij`) over SSH: it answers DA1 itself from its
-    /// local pane, and its output goes into SSH's buffers unpaced. tmux and screen pass a
-    /// wrapped question on to the terminal ([`LinkPath::question`]); zellij's link cannot be
-    /// measured in band.
-    Multiplexer(&'static str),
-    /// mosh: mosh-server is the terminal; it answers DA1 at once and sends the client only the
-    /// latest screen, paced to the link, so the program never sees the link. What it does see
-    /// of the picture still crosses the link: each screen it sends carries every cell changed
-    /// since the last one the client acknowledged.
-    Mosh,
-}
-
-impl LinkPath {
-    /// Reads the path from the environment (`var` looks a variable up) and the names of the
-    /// process's ancestors, nearest first (`/proc/PID/comm` on Linux; none elsewhere).
-    ///
-    /// mosh sets nothing of its own in the environment (only `TERM` and
-    /// `NCURSES_NO_UTF8_ACS`, and it removes `STY`), but `mosh-server` is the ancestor of every
-    /// program it runs. A multiplexer counts only over SSH (`SSH_CONNECTION`, `SSH_CLIENT` or
-    /// `SSH_TTY`, which tmux's default `update-environment` refreshes on every attach): on this
-    /// machine's own screen its answers come from a local terminal anyway.
-    pub fn detect<'a>(var: impl Fn(&str) -> Option<String>, ancestors: impl IntoIterator<Item = &'a str>) -> LinkPath {
-        let set = |name: &str| var(name).is_some_and(|v| !v.is_empty());
-        if ancestors.into_iter().any(|name| name.trim() == "mosh-server") {
-            return LinkPath::Mosh;
-        }
-        let remote = set("SSH_CONNECTION") || set("SSH_CLIENT") || set("SSH_TTY");
-        let multiplexer = [("TMUX", "tmux"), ("STY", "screen"), ("ZELLIJ", "zellij")]
-            .into_iter()
-            .find(|(variable, _)| set(variable))
-            .map(|(_, name)| name);
-        match multiplexer {
-            Some(name) if remote => LinkPath::Multiplexer(name),
-            _ => LinkPath::Direct,
-        }
-    }
-}
-
-impl LinkPath {
-    /// The link's question on this path: DA1, or inside tmux and screen a device status
-    /// report wrapped for their passthrough (answered by the terminal, not the multiplexer).
-    pub fn question(self) -> &'static [u8] {
-        match self {
-            LinkPath::Multiplexer("tmux") => TMUX_QUESTION,
-            LinkPath::Multiplexer("screen") => SCREEN_QUESTION,
-            _ => PROBE,
-        }
-    }
-
-    /// Whether the link's answers are device status reports (`ESC[0n`) rather than device
-    /// attributes: the wrapped question.
-    pub fn asks_status(self) -> bool {
-        self.question() != PROBE
-    }
-
-    /// Whether an answer to the link's question comes from the terminal at the far end.
-    fn answered_at_far_end(self) -> bool {
-        self == LinkPath::Direct || self.asks_status()
-    }
-}
-
-/// A question in flight, in the order asked.
-#[derive(Clone, Copy, Debug)]
-struct Question {
-    /// When it went out.
-    asked: Instant,
-    /// The bytes sent up to it (0 for a foreign one).
-    bytes: u64,
-    /// Asked by somebody else (the graphics probe): its answer is dropped.
-    foreign: bool,
-    /// Unanswered for longer than the loss timeout: counted as congestion once, its bytes
-    /// taken as delivered; it keeps its place for its late answer.
-    overdue: bool,
-    /// Every frame since the question before it left most of its budget unspent: the player,
-    /// not the link, set the pace, so its answer says little of the link (see
-    /// [`LinkControl::frame_sent`]).
-    app_limited: bool,
-}
-
-/// The questions in flight, oldest first (a fixed array: steady-state frames allocate nothing).
-#[derive(Clone, Debug)]
-struct Questions {
-    list: [Option<Question>; MAX_QUESTIONS],
-    len: usize,
-}
-
-impl Questions {
-    fn iter(&self) -> impl Iterator<Item = &Question> {
-        self.list[..self.len].iter().flatten()
-    }
-
-    fn push(&mut self, question: Question) -> bool {
-        if self.len == MAX_QUESTIONS {
-            return false;
-        }
-        self.list[self.len] = Some(question);
-        self.len += 1;
-        true
-    }
-
-    fn pop_oldest(&mut self) -> Option<Question> {
-        let oldest = self.list[..self.len].first().copied().flatten()?;
-        self.list.copy_within(1..self.len, 0);
-        self.len -= 1;
-        self.list[self.len] = None;
-        Some(oldest)
-    }
-
-    /// Takes the oldest of the link's own questions out, the foreign ones keeping their places
-    /// (a device status answer is never the probe's).
-    fn pop_oldest_own(&mut self) -> Option<Question> {
-        let i = self.list[..self.len].iter().position(|q| q.is_some_and(|q| !q.foreign))?;
-        let own = self.list[i];
-        self.list.copy_within(i + 1..self.len, i);
-        self.len -= 1;
-        self.list[self.len] = None;
-        own
-    }
-
-    /// Drops the questions `forget` says to, keeping the others in order.
-    fn forget(&mut self, mut forget: impl FnMut(&Question) -> bool) {
-        let mut kept = 0;
-        for i in 0..self.len {
-            if let Some(q) = self.list[i].filter(|q| !forget(q)) {
-                self.list[kept] = Some(q);
-                kept += 1;
-            }
-        }
-        self.list[kept..].fill(None);
-        self.len = kept;
-    }
 }
 
 /// The marks the queue is held between for a base round trip `base`: the high one is one
@@ -323,7 +199,7 @@ pub struct LinkControl {
     sample_count: usize,
     /// The queue the last answer showed (two answers in a row over the high mark make a fall,
     /// so one late read of an answer does not).
-    last_queue: Option<Duration>,
+    last_queue: Option<(Duration, bool)>,
     /// Whether any link question was ever answered.
     answered: bool,
     /// The terminal has not answered for [`SILENCE`]: [`SAFE_RATE`] and no window.
@@ -342,6 +218,16 @@ pub struct LinkControl {
     asked_up_to: u64,
     /// Every frame since the last question left most of its budget unspent.
     spare_since_question: bool,
+    /// The terminal's own answer times, which widen the queue's marks.
+    answer_time: AnswerTime,
+    /// When the next measurement of the terminal's own time is due (frames are held from
+    /// then until a bare question has gone out, at most [`answer_time::HOLD_MAX`]); `None`
+    /// until the first answer, and while a bare question waits for its answer.
+    clean_due: Option<Instant>,
+    /// The bytes sent, as the link would carry them at the capacity seen.
+    flight: Flight,
+    /// The bytes of the last frame sent.
+    last_frame: u64,
     /// Answers to foreign questions seen, and answers nobody asked for.
     foreign_answers: u64,
     stray_answers: u64,
@@ -384,6 +270,10 @@ impl LinkControl {
             acknowledged: 0,
             asked_up_to: 0,
             spare_since_question: true,
+            answer_time: AnswerTime::default(),
+            clean_due: None,
+            flight: Flight::default(),
+            last_frame: 0,
             foreign_answers: 0,
             stray_answers: 0,
         }
@@ -410,7 +300,21 @@ impl LinkControl {
     pub fn probed(&mut self, now: Instant, bytes_sent: u64) {
         self.asked_up_to = self.asked_up_to.max(bytes_sent);
         let app_limited = std::mem::replace(&mut self.spare_since_question, true);
-        self.questions.push(Question { asked: now, bytes: bytes_sent, foreign: false, overdue: false, app_limited });
+        let clean = self.holding(now) && bytes_sent.saturating_sub(self.acknowledged) <= answer_time::CLEAN_BYTES;
+        if clean {
+            // Frames may go again: they follow the question, so they cannot delay its answer.
+            self.clean_due = None;
+        }
+        let in_flight = self.flight.sent(now, bytes_sent, self.last_frame, self.capacity.unwrap_or(self.rate));
+        self.questions.push(Question {
+            asked: now,
+            bytes: bytes_sent,
+            foreign: false,
+            overdue: false,
+            app_limited,
+            clean,
+            in_flight,
+        });
     }
 
     /// A frame went out that spent `spent` of the `budget` it was given. A sender that leaves
@@ -421,6 +325,7 @@ impl LinkControl {
     /// seen to deliver (measured over SSH: kitty's pictures on their lowest rung, 5.4 kB/s
     /// read as the link on a 250 kB/s link, and `auto` left pixels for cells).
     pub fn frame_sent(&mut self, spent: usize, budget: usize) {
+        self.last_frame = spent as u64;
         if spent.saturating_mul(2) >= budget {
             self.spare_since_question = false;
         }
@@ -472,26 +377,70 @@ impl LinkControl {
             // bound of the link's rate, what the window starts from).
             None => Some((sent, bytes)),
         }
+        // Between two answers, at least DELIVERY_BYTES: a question that followed a few bytes
+        // (a frame with its window closed) and came late says how long the terminal took, not
+        // what the link carries (kitty 0.26 stalled 385 ms after 32 bytes, read as 78 B/s).
+        // A shorter interval is measured on with the next.
+        .filter(|&(_, b)| b > 0 && (self.last_answer.is_none() || b >= DELIVERY_BYTES))
         .map(|(since, b)| (now.saturating_duration_since(since).as_secs_f64(), b))
-        .filter(|&(dt, b)| dt > 0.0 && b > 0)
+        .filter(|&(dt, _)| dt > 0.0)
         .map(|(dt, b)| b as f64 / dt);
         if let Some(rate) = took.filter(|_| self.last_answer.is_some() && !app_limited) {
             self.delivered = Some(rate);
         }
-        self.last_answer = Some((now, bytes));
+        if took.is_some() || self.last_answer.is_none() {
+            self.last_answer = Some((now, bytes));
+        }
         let rtt = now.saturating_duration_since(sent);
         self.last_rtt = Some(rtt);
         self.samples[self.sample_count % BASE_SAMPLES] = rtt;
         self.sample_count += 1;
         let base = self.base().unwrap_or(rtt);
         let queue = rtt.saturating_sub(base);
-        let last_queue = self.last_queue.replace(queue);
+        self.flight.answered(now, bytes);
+        if question.clean {
+            // Nothing was in flight under it: its delay beyond the base is the terminal's own
+            // time, and it says nothing of what the link carries (no frames crossed).
+            self.answer_time.record(queue);
+            let gap = answer_time::next_gap(
+                self.answer_time.bare_count(),
+                self.answer_time.slow(),
+                queue_marks(base).0,
+                base,
+            );
+            self.clean_due = Some(now + gap);
+            return Change::Hold;
+        }
+        if first && self.path.answered_at_far_end() {
+            // The first measurement of the terminal's own time comes right after: holding the
+            // frames until the first answer is in also drains what the start rate queued, so
+            // the bare question's round trip is the link's own.
+            self.clean_due = Some(now);
+        }
         let (low, high) = queue_marks(base);
+        self.answer_time.infer(queue, question.in_flight, (low, high));
+        // The terminal's usual time to answer is not queue; its slow answers raise the high
+        // mark (a queue must stand beyond them to be the link's).
+        let (usual, slow) = (self.answer_time.usual(), self.answer_time.slow());
+        let link_queue = queue.saturating_sub(usual);
+        // Over the high mark, and either the bytes in flight explain it (a queue grows with
+        // them; the terminal's time does not) or it is beyond the terminal's slow answers too.
+        // Only a terminal the bare questions showed slow on its own is asked for that
+        // explanation: any other is late because it is still reading, a queue.
+        // (Until a few bare answers are in, it is taken for one: main's rules collapsed kitty
+        // 0.26 to 2 kB/s within the first second.)
+        let slow_terminal =
+            self.answer_time.is_slow(low, high) || self.answer_time.bare_count() < answer_time::FIRST_SAMPLES;
+        let explained = !slow_terminal || 2 * question.in_flight >= link_queue;
+        let over = link_queue > high && (explained || queue > high + slow);
+        let last_queue = self.last_queue.replace((link_queue, over));
+        let was_over = last_queue.is_some_and(|(_, was_over)| was_over);
         if let Some(took) = took {
             self.capacity = Some(match self.capacity {
-                // Only a standing queue says the link was the limit; a few late reads of an
-                // answer on a busy machine must not shrink the window to one frame's take.
-                Some(c) if queue <= high => c.max(took),
+                // A queue says the link was the limit; from a terminal slow on its own only a
+                // standing one (two answers over the mark in a row): its late answers must not
+                // shrink the window to one frame's take.
+                Some(c) if !(over && (was_over || !slow_terminal)) => c.max(took),
                 _ => took,
             });
         }
@@ -532,17 +481,24 @@ impl LinkControl {
         // A queue that is not draining, over the high mark twice in a row, or once when it
         // is beyond what a busy machine's late reads of an answer make (a long link then
         // falls a round trip sooner).
-        let not_draining = last_queue.is_none_or(|last| queue >= last);
-        let confirmed = last_queue.is_some_and(|last| last > high) || queue > 2 * QUEUE_HIGH_MIN;
+        let not_draining = last_queue.is_none_or(|(last, _)| link_queue >= last);
+        // One answer alone confirms a queue only when the bytes in flight explain it: a single
+        // late answer is the terminal's (kitty 0.26 under llvmpipe took up to a second now and
+        // then), never a collapse of the link.
+        let confirmed = was_over || (link_queue > 2 * QUEUE_HIGH_MIN && explained);
         // A sender that left its budget unspent cannot have built a queue of a few marks: only
         // a deep one lowers the rate then.
-        let caused = !app_limited || queue > 2 * high;
-        if queue > high && not_draining && confirmed && caused {
+        let caused = !app_limited || link_queue > 2 * high;
+        if over && not_draining && confirmed && caused {
             // A queue of several marks drains faster: at 15 % under the link, a second of
             // queue would take six to go.
-            self.fall(now, if queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE });
+            // A late answer the bytes in flight cannot explain (a terminal slow on its own, in
+            // a standing queue of its own making) never takes the rate under a quarter of the
+            // link seen: kitty 0.26 stalling under load fell to 4 kB/s on a 250 kB/s link.
+            let floor = if explained { MIN_RATE } else { self.capacity.map_or(SAFE_RATE, |c| c * 0.25).max(SAFE_RATE) };
+            self.fall(now, if link_queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE }, floor);
             Change::Down
-        } else if queue < low && self.rate < self.ceiling {
+        } else if link_queue < low && self.rate < self.ceiling {
             // Only a sender that used its budget learns that the link carries more: one that
             // left it unspent (cells of calm water) would grow the rate without evidence, to
             // "no limit" on a 250 kB/s link, and `auto` then switched to pixels that queued
@@ -556,7 +512,8 @@ impl LinkControl {
         }
     }
 
-    fn fall(&mut self, now: Instant, share: f64) {
+    /// Lowers the rate to under what the terminal was seen to take, never under `floor`.
+    fn fall(&mut self, now: Instant, share: f64, floor: f64) {
         let target = match self.delivered {
             // Under what the link was seen to carry (an estimate from two answers, so never
             // below a quarter of the rate in one fall: a rate far over the link comes down in
@@ -564,7 +521,7 @@ impl LinkControl {
             Some(delivered) => (delivered * share).max(self.rate * 0.25).min(self.rate * DRAIN_SHARE),
             None => self.rate * DECREASE,
         };
-        self.rate = target.max(MIN_RATE);
+        self.rate = target.max(floor.min(self.rate)).max(MIN_RATE);
         self.decided_at = Some(now);
         self.fell = true;
     }
@@ -574,45 +531,28 @@ impl LinkControl {
         self.silent || self.questions.iter().any(|q| !q.foreign && now.saturating_duration_since(q.asked) > SILENCE)
     }
 
-    /// How many more bytes may go out now, `bytes_sent` counting every byte written so far:
-    /// the window less what is still unanswered for ([`usize::MAX`] for a terminal that does
-    /// not answer).
-    pub fn window_left(&self, now: Instant, bytes_sent: u64) -> usize {
-        if self.is_silent(now) {
-            return usize::MAX;
-        }
-        let window = if self.answered {
-            // The bandwidth-delay product: one question at a time, so two round trips (each
-            // with the queue the window allows) and a frame; never below what the rate sends
-            // in that time, and the link's capacity as seen, not a rate still growing past it.
-            let taken = self.capacity.unwrap_or(self.rate).min(self.rate);
-            let base = self.base().unwrap_or(Duration::ZERO).min(WINDOW_RTT_MAX);
-            let time = 2.0 * (base + WINDOW_QUEUE).as_secs_f64() + FRAME_ALLOWANCE.as_secs_f64();
-            (taken * time).max(MIN_WINDOW as f64) as u64
-        } else {
-            let waited = self
-                .questions
-                .iter()
-                .find(|q| !q.foreign)
-                .map_or(Duration::ZERO, |q| now.saturating_duration_since(q.asked));
-            FIRST_WINDOW + (FIRST_TRICKLE * waited.as_secs_f64()) as u64
-        };
-        usize::try_from(window.saturating_sub(bytes_sent.saturating_sub(self.acknowledged))).unwrap_or(usize::MAX)
-    }
-
-    /// Whether bytes went out after the last question: with none in flight, a question must
-    /// follow them even without a frame, or a closed window would never open.
-    pub fn unasked(&self, bytes_sent: u64) -> bool {
-        bytes_sent > self.asked_up_to
-    }
-
     /// Looks at the clock: a question unanswered too long is congestion (once per question); a
     /// terminal silent for [`SILENCE`] gets [`SAFE_RATE`]; foreign answers overdue by
     /// [`FOREIGN_WAIT`] and questions older than [`GIVE_UP`] are forgotten.
     pub fn tick(&mut self, now: Instant) -> Change {
         let age = |q: &Question| now.saturating_duration_since(q.asked);
         self.questions.forget(|q| age(q) > GIVE_UP || (q.foreign && age(q) > FOREIGN_WAIT));
+        let base = self.base().unwrap_or(Duration::ZERO);
+        if let Some(due) = self.clean_due
+            && now >= answer_time::hold_end(due, base)
+        {
+            // The question in flight took too long: measure another time, frames go on.
+            let gap = answer_time::next_gap(0, Duration::ZERO, Duration::ZERO, base);
+            self.clean_due = Some(now + gap);
+        }
         let limit = self.base().map_or(PROBE_TIMEOUT, |b| (4 * b).max(PROBE_TIMEOUT));
+        // A terminal slow on its own (or not known yet) that stalls for a second with few
+        // bytes in flight is busy, not congested (kitty 0.26 under llvmpipe, setting up its
+        // first pictures): its lost question lowers the rate only when those bytes explain the
+        // wait, as for a late answer.
+        let (low, high) = queue_marks(base);
+        let slow_terminal =
+            self.answer_time.is_slow(low, high) || self.answer_time.bare_count() < answer_time::FIRST_SAMPLES;
         let mut lost = false;
         for q in self.questions.list[..self.questions.len].iter_mut().flatten() {
             // A terminal that has never answered is not congested: it is silent (below).
@@ -621,7 +561,7 @@ impl LinkControl {
                 // keeps its place, so its late answer is still paired with it.
                 self.acknowledged = self.acknowledged.max(q.bytes);
                 q.overdue = true;
-                lost = true;
+                lost |= !slow_terminal || 2 * q.in_flight >= age(q);
             }
         }
         if !self.silent && self.is_silent(now) {
@@ -635,97 +575,11 @@ impl LinkControl {
             return Change::Down;
         }
         if lost {
-            self.fall(now, DRAIN_SHARE);
+            self.fall(now, DRAIN_SHARE, MIN_RATE);
             Change::Down
         } else {
             Change::Hold
         }
-    }
-}
-
-/// What the Screen calls besides the loop above: the path, the status line's hint, the probe's
-/// answers, the answers to wait for at the end.
-impl LinkControl {
-    /// A few words for the status line when the link cannot be measured and the rate is a
-    /// guess ([`SAFE_RATE`]): how to set it. At most 67 characters: on a 160-column status
-    /// line they leave the rate and the stone size beside them.
-    pub fn hint(&self) -> Option<&'static str> {
-        match self.path {
-            // The wrapped question is answered (or has not waited long yet).
-            LinkPath::Multiplexer(_) if self.path.asks_status() && !self.silent => None,
-            LinkPath::Multiplexer("tmux") => {
-                Some("tmux: set -g allow-passthrough on, or --bandwidth (250k = 2 Mbit/s)")
-            }
-            LinkPath::Multiplexer("screen") => {
-                Some("screen: terminal not answering, set --bandwidth (250k = 2 Mbit/s)")
-            }
-            LinkPath::Multiplexer(_) => {
-                Some("multiplexer over SSH: link not measured, set --bandwidth (250k = 2 Mbit/s)")
-            }
-            LinkPath::Mosh => Some("mosh: link not measured, set --bandwidth (250k = 2 Mbit/s)"),
-            LinkPath::Direct if self.silent => Some("the terminal does not answer: set --bandwidth (250k = 2 Mbit/s)"),
-            LinkPath::Direct => None,
-        }
-    }
-
-    /// The link's question, to follow a frame ([`LinkPath::question`]).
-    pub fn question(&self) -> &'static [u8] {
-        self.path.question()
-    }
-
-    /// Whether the link's answers are device status reports ([`LinkControl::status_answered`])
-    /// rather than device attributes ([`LinkControl::answered`]).
-    pub fn asks_status(&self) -> bool {
-        self.path.asks_status()
-    }
-
-    /// The last round trip measured.
-    #[cfg(test)]
-    pub fn last_rtt(&self) -> Option<Duration> {
-        self.last_rtt
-    }
-
-    /// Answers counted as foreign ([`LinkControl::expect_foreign`]) and answers that came with
-    /// no question waiting, so far.
-    #[cfg(test)]
-    pub fn dropped_answers(&self) -> (u64, u64) {
-        (self.foreign_answers, self.stray_answers)
-    }
-
-    /// How many answers are still expected (link and foreign questions): at the end, wait a
-    /// little for them, or they reach the shell as typed text.
-    pub fn awaiting(&self) -> usize {
-        self.questions.len
-    }
-
-    /// `count` DA1 questions somebody else asked (the graphics probe) are still to be answered,
-    /// ahead of every link question asked from now on: their answers are counted and dropped.
-    /// Until they come, or [`FOREIGN_WAIT`] has passed, no link question is asked, so an answer
-    /// that never comes cannot shift the pairing.
-    pub fn expect_foreign(&mut self, now: Instant, count: usize) {
-        // (Called by the Screen when the probe's questions go out.)
-        for _ in 0..count {
-            if !self.questions.push(Question {
-                asked: now,
-                bytes: 0,
-                foreign: true,
-                overdue: false,
-                app_limited: false,
-            }) {
-                break;
-            }
-        }
-    }
-
-    /// Whether a question of the link's own is waiting for its answer.
-    pub fn asking(&self) -> bool {
-        self.questions.iter().any(|q| !q.foreign)
-    }
-
-    /// Whether an answer to somebody else's question is still due here (the Screen then gives
-    /// the next device-attributes answer to the probe and lets this queue drop its place).
-    pub fn foreign_due(&self) -> bool {
-        self.questions.iter().next().is_some_and(|q| q.foreign)
     }
 }
 

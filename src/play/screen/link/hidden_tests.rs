@@ -124,7 +124,7 @@ fn simulate(multiplexer: &'static str, path: Hidden, seconds: f64) -> Run {
             drained += Duration::from_secs_f64(size / path.capacity);
             redraw = None;
         }
-        if control.probe_due() && (bytes > 0.0 || control.unasked(sent)) {
+        if control.probe_due() && (bytes > 0.0 || control.question_wanted(now, sent)) {
             control.probed(now, sent);
             if path.passthrough {
                 answers.push_back(drained.max(now) + path.rtt);

@@ -33,7 +33,7 @@ mod profiles;
 mod shown;
 
 pub use canvas::Canvas;
-pub use profiles::{Edits, Placeholders, Profile, Sgr, Tcap};
+pub use profiles::{Edits, Placeholders, Profile, Sgr, Tcap, kitty_026_answer_time, status_rate};
 pub use shown::{Shown, Watch};
 
 /// kitty's chunked transmission in progress: the first chunk's keys, the payload so far.

@@ -1,0 +1,59 @@
+//! The window: how many bytes may be in flight, and the frames held while the terminal's own
+//! time is measured (the bare question, `answer_time`).
+
+use std::time::{Duration, Instant};
+
+use super::{
+    FIRST_TRICKLE, FIRST_WINDOW, FRAME_ALLOWANCE, LinkControl, MIN_WINDOW, WINDOW_QUEUE, WINDOW_RTT_MAX, answer_time,
+};
+
+impl LinkControl {
+    /// How many more bytes may go out now, `bytes_sent` counting every byte written so far:
+    /// the window less what is still unanswered for ([`usize::MAX`] for a terminal that does
+    /// not answer).
+    pub fn window_left(&self, now: Instant, bytes_sent: u64) -> usize {
+        if self.is_silent(now) {
+            return usize::MAX;
+        }
+        if self.holding(now) {
+            // The terminal's own time is being measured: nothing more until the bytes in
+            // flight are answered for and the bare question has gone out.
+            return 0;
+        }
+        let window = if self.answered {
+            // The bandwidth-delay product: one question at a time, so two round trips (each
+            // with the queue the window allows) and a frame; never below what the rate sends
+            // in that time, and the link's capacity as seen, not a rate still growing past it.
+            let taken = self.capacity.unwrap_or(self.rate).min(self.rate);
+            let base = self.base().unwrap_or(Duration::ZERO).min(WINDOW_RTT_MAX);
+            let time = 2.0 * (base + WINDOW_QUEUE).as_secs_f64() + FRAME_ALLOWANCE.as_secs_f64();
+            (taken * time).max(MIN_WINDOW as f64) as u64
+        } else {
+            let waited = self
+                .questions
+                .iter()
+                .find(|q| !q.foreign)
+                .map_or(Duration::ZERO, |q| now.saturating_duration_since(q.asked));
+            FIRST_WINDOW + (FIRST_TRICKLE * waited.as_secs_f64()) as u64
+        };
+        usize::try_from(window.saturating_sub(bytes_sent.saturating_sub(self.acknowledged))).unwrap_or(usize::MAX)
+    }
+
+    /// Whether a question should follow even a frame that wrote nothing, `bytes_sent`
+    /// counting every byte written so far: bytes went out after the last question (with none
+    /// in flight, or a closed window would never open), or the terminal's own time is being
+    /// measured and everything sent is answered for (the bare question, [`answer_time`]).
+    pub fn question_wanted(&self, now: Instant, bytes_sent: u64) -> bool {
+        bytes_sent > self.asked_up_to
+            || (self.holding(now) && bytes_sent.saturating_sub(self.acknowledged) <= answer_time::CLEAN_BYTES)
+    }
+
+    /// Whether frames are held for a measurement of the terminal's own time: it is due, for
+    /// at most [`answer_time::HOLD_MAX`] (a question in flight slow to be answered skips it).
+    pub(super) fn holding(&self, now: Instant) -> bool {
+        let base = self.base().unwrap_or(Duration::ZERO);
+        self.clean_due.is_some_and(|due| now >= due && now < answer_time::hold_end(due, base))
+            && !self.silent
+            && self.path.answered_at_far_end()
+    }
+}
