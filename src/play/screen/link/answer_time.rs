@@ -40,8 +40,10 @@ pub const CLEAN_EVERY: Duration = Duration::from_secs(5);
 pub const CLEAN_RARELY: Duration = Duration::from_secs(20);
 /// How often it is measured until then: the first seconds decide whether the rate collapses.
 pub const CLEAN_FIRST_EVERY: Duration = Duration::from_millis(300);
-/// Measurements taken at the faster pace.
-pub const FIRST_SAMPLES: usize = 4;
+/// Measurements taken at the faster pace, and before which every terminal is taken for one slow
+/// on its own: four were too few (kitty 0.26's answer times gave four bare answers of 0-8 ms
+/// in one fake run of 18, and main's rules then took its stalls for queue: 12-45 kB/s).
+pub const FIRST_SAMPLES: usize = CLEAN_SAMPLES;
 /// The least gap between two measurements, in base round trips.
 pub const CLEAN_RTTS: u32 = 40;
 /// The longest the link holds its frames for a measurement beyond the base round trip; past it

@@ -20,7 +20,14 @@ impl LinkControl {
             // flight are answered for and the bare question has gone out.
             return 0;
         }
-        let window = if self.answered {
+        let window = self.window(now);
+        usize::try_from(window.saturating_sub(bytes_sent.saturating_sub(self.acknowledged))).unwrap_or(usize::MAX)
+    }
+
+    /// The window: the bytes that may be unanswered for at `now` (holds and bytes in flight
+    /// aside).
+    pub(super) fn window(&self, now: Instant) -> u64 {
+        if self.answered {
             // The bandwidth-delay product: one question at a time, so two round trips (each
             // with the queue the window allows) and a frame; never below what the rate sends
             // in that time, and the link's capacity as seen, not a rate still growing past it.
@@ -35,8 +42,7 @@ impl LinkControl {
                 .find(|q| !q.foreign)
                 .map_or(Duration::ZERO, |q| now.saturating_duration_since(q.asked));
             FIRST_WINDOW + (FIRST_TRICKLE * waited.as_secs_f64()) as u64
-        };
-        usize::try_from(window.saturating_sub(bytes_sent.saturating_sub(self.acknowledged))).unwrap_or(usize::MAX)
+        }
     }
 
     /// Whether a question should follow even a frame that wrote nothing, `bytes_sent`
