@@ -57,7 +57,8 @@ for i in $(seq 0 $((edges - 1))); do
 done
 client_pids=()
 for i in $(seq 0 $((edges - 1))); do
-    CROWD_PORT=$((first_port + i)) CROWD_PLAYERS="$players" CROWD_SECONDS="$seconds" CROWD_WARM_UP="$warm" \
+    # The clients play 5 s past the window, so their processes' CPU can still be read at its end.
+    CROWD_PORT=$((first_port + i)) CROWD_PLAYERS="$players" CROWD_SECONDS=$((seconds + 5)) CROWD_WARM_UP="$warm" \
         CROWD_STONE_MS="$stone_ms" "$client" --ignored --exact crowd_client::crowd_client --nocapture \
         >"$work/client$i.log" 2>&1 &
     client_pids+=($!)
@@ -72,10 +73,12 @@ stat_cpu() { awk '{ print $14 + $15 }' "/proc/$1/stat"; }
 stat_rss() { awk '/VmRSS/ { print $2 }' "/proc/$1/status"; }
 varz() { curl -sf "http://127.0.0.1:$monitor/varz"; }
 t0=$(date +%s.%N)
+t0_us=$(date +%s%6N)
 v0=$(varz)
 cpu0=(); rss0=()
 for p in "${edge_pids[@]}"; do cpu0+=("$(stat_cpu "$p")"); rss0+=("$(stat_rss "$p")"); done
 ncpu0=$(stat_cpu "$nats")
+ccpu0=0; for p in "${client_pids[@]}"; do ccpu0=$((ccpu0 + $(stat_cpu "$p"))); done
 echo "window: $seconds s from $(date -u +%T), load average $(cut -d' ' -f1-3 /proc/loadavg)"
 # Memory every 30 s.
 samples=""
@@ -97,6 +100,8 @@ for i in $(seq 0 $((edges - 1))); do
     echo "edge e$i: CPU $cores cores ($(awk -v c="$cores" -v n="$players" 'BEGIN { printf "%.5f", c / n }') cores a player), memory ${rss0[$i]} kB at the start, $(stat_rss "$p") kB at the end"
 done
 echo "edges' memory (s: kB each): $samples"
+ccpu1=0; for p in "${client_pids[@]}"; do ccpu1=$((ccpu1 + $(stat_cpu "$p"))); done
+echo "the load clients' processes: CPU $(awk -v a="$ccpu0" -v b="$ccpu1" -v hz="$hz" -v w="$wall" 'BEGIN { printf "%.3f", (b - a) / hz / w }') cores together"
 ncores=$(awk -v a="$ncpu0" -v b="$(stat_cpu "$nats")" -v hz="$hz" -v w="$wall" 'BEGIN { printf "%.3f", (b - a) / hz / w }')
 python3 - "$wall" "$ncores" <<EOF
 import json, sys
@@ -109,9 +114,9 @@ for p in "${client_pids[@]}"; do wait "$p" || true; done
 grep -h '^crowd:.*players' "$work"/client*.log || true
 # A key's latency: `bus-trace sent EDGE N TIME` on one edge, `bus-trace taken EDGE N at STEP
 # for STAMP TIME BYTES` on the others (microseconds since the epoch).
-python3 - "$work" "$edges" "$fps" <<'EOF'
+python3 - "$work" "$edges" "$fps" "$t0_us" <<'EOF'
 import sys
-work, edges, fps = sys.argv[1], int(sys.argv[2]), float(sys.argv[3])
+work, edges, fps, t0_us = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4])
 sent, took = {}, []
 for i in range(edges):
     for line in open(f"{work}/edge{i}.log", errors="replace"):
@@ -123,13 +128,14 @@ for i in range(edges):
         w = line.split()
         if len(w) >= 10 and w[0] == "bus-trace" and w[1] == "taken" and w[2] != f"e{i}":
             t0 = sent.get((w[2], w[3]))
-            if t0 is not None:
+            # Keys sent in the window only (not while the crowd was connecting).
+            if t0 is not None and t0 >= t0_us:
                 step, stamp, t1 = float(w[5]), float(w[7]), float(w[8])
                 took.append(((t1 - t0) / 1000, (t1 - t0) / 1000 + max(stamp - step, 0) / 60 * 1000 + 1000 / fps / 2))
 if took:
     log = sorted(t[0] for t in took); screen = sorted(t[1] for t in took)
     p = lambda v, q: v[int((len(v) - 1) * q)]
-    print(f"a key from one edge's player to another edge: n {len(log)}, taken from the log median {p(log, .5):.1f} ms p95 {p(log, .95):.1f} ms; "
+    print(f"a key (sent in the window) from one edge's player to another edge: n {len(log)}, taken from the log median {p(log, .5):.1f} ms p95 {p(log, .95):.1f} ms; "
           f"ring on its screen (modelled: + the lead to the stamp + half a frame) median {p(screen, .5):.1f} ms p95 {p(screen, .95):.1f} ms")
 else:
     print("no key was traced across edges")

@@ -33,13 +33,13 @@ for i in 0 1; do
     for _ in $(seq 100); do grep -q "joined" "$work/edge$i.log" 2>/dev/null && break; sleep 0.2; done
     grep -q "joined" "$work/edge$i.log" || { echo "edge $i did not join: $(tail -3 "$work/edge$i.log")" >&2; exit 1; }
 done
-Xvfb "$display" -screen 0 1340x470x24 >/dev/null 2>&1 &
+Xvfb "$display" -screen 0 1180x400x24 >/dev/null 2>&1 &
 pids+=($!)
 sleep 1
 export DISPLAY=$display
 mkdir -p "$work/home"
 for i in 0 1; do
-    HOME="$work/home" xterm -xrm 'XTerm*allowSendEvents: true' -T "edge$i" -geometry "80x24+$((i * 670))+0" -fa Monospace -fs 10 -bg black \
+    HOME="$work/home" LANG=C.UTF-8 xterm -xrm 'XTerm*allowSendEvents: true' -T "edge$i" -geometry "80x24+$((i * 590))+0" -fa "DejaVu Sans Mono" -fs 8 -u8 -bg black \
         -e ssh -F /dev/null -p "$((2311 + i))" -o StrictHostKeyChecking=no -o UserKnownHostsFile=/dev/null \
         -o BatchMode=yes localhost &
     pids+=($!)
@@ -49,7 +49,7 @@ sleep 6
 for round in 1 2 3; do
     for i in 0 1; do
         win=$(xdotool search --name "edge$i" | head -1)
-        [ -n "$win" ] && xdotool type --window "$win" " "
+        [ -n "$win" ] && xdotool type --window "$win" " " 2>/dev/null
         sleep 0.4
     done
 done
