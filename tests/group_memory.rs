@@ -106,7 +106,7 @@ impl Crowd {
     fn step(&mut self, players: &mut [(Player, Membership)], playing: bool) -> Sources {
         self.frame += 1;
         let now = self.t0 + FRAME * self.frame;
-        if self.frame % 8 == 0 {
+        if self.frame.is_multiple_of(8) {
             self.host.apply(tidepool::play::Request::RandomStone { radius: 3 }, now);
         }
         self.host.advance(now);
