@@ -60,7 +60,7 @@ const CLASS_HYSTERESIS: f64 = 0.1;
 const GROUP_SHARE: f64 = 0.8;
 
 /// A range of link rates that share frames: a group encodes below its lower bound
-/// ([`GROUP_SHARE`]), so every member's link carries it with room to catch up.
+/// (`GROUP_SHARE`), so every member's link carries it with room to catch up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct LinkClass {
     /// The lower bound, bytes a second (a power of two times [`SLOWEST_CLASS`]).
@@ -88,7 +88,7 @@ impl LinkClass {
         }
     }
 
-    /// The class's lower bound, bytes a second (a group of it encodes at [`GROUP_SHARE`] of
+    /// The class's lower bound, bytes a second (a group of it encodes at `GROUP_SHARE` of
     /// it).
     pub fn rate(self) -> u64 {
         self.floor
