@@ -78,9 +78,10 @@ impl Screen {
         if self.auto() {
             self.link.frame_sent(report.bytes + sent, plan.budget);
         }
-        // Room for the largest frame at once, so the caller's buffers stop growing after the
-        // first frames: steady frames allocate nothing.
-        self.largest_frame = self.largest_frame.max(scratch.bytes.len());
+        // Room for the largest frame at once (rounded up as a growing buffer would be, so a
+        // frame a little larger than the last largest still fits), so the caller's buffers
+        // stop growing after the first frames: steady frames allocate nothing.
+        self.largest_frame = self.largest_frame.max(scratch.bytes.len().next_power_of_two());
         out.reserve(self.largest_frame);
         out.extend_from_slice(&scratch.bytes);
         scratch::give(scratch);
