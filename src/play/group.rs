@@ -52,9 +52,15 @@ const FASTEST_CLASS: f64 = 8_192_000.0;
 /// A member's rate may stray this far beyond its class's bounds before it changes class (so a
 /// rate near a bound does not flap between groups).
 const CLASS_HYSTERESIS: f64 = 0.1;
+/// The share of its class's lower bound a group encodes at. Below the hysteresis's 0.9, so the
+/// group's frames fit every member's link; and below it by enough that a member out of step
+/// catches up with the group's model: at the bound, encoding towards a model that moves as
+/// fast as its own link carries, a member on busy water never caught up (issue 31: 40 OpenSSH
+/// clients took 43 % of their frames from the group, each joining once, late).
+const GROUP_SHARE: f64 = 0.8;
 
-/// A range of link rates that share frames: a group encodes at its lower bound, so every
-/// member's link carries it.
+/// A range of link rates that share frames: a group encodes below its lower bound
+/// (`GROUP_SHARE`), so every member's link carries it with room to catch up.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct LinkClass {
     /// The lower bound, bytes a second (a power of two times [`SLOWEST_CLASS`]).
@@ -82,9 +88,15 @@ impl LinkClass {
         }
     }
 
-    /// The rate a group of this class encodes at, bytes a second.
+    /// The class's lower bound, bytes a second (a group of it encodes at `GROUP_SHARE` of
+    /// it).
     pub fn rate(self) -> u64 {
         self.floor
+    }
+
+    /// The rate a group of this class encodes at, bytes a second.
+    fn group_rate(self) -> u64 {
+        (self.floor as f64 * GROUP_SHARE) as u64
     }
 }
 
@@ -155,8 +167,8 @@ pub struct Group {
 impl Group {
     /// A group of screens of `key`, its clock starting at `now`.
     pub fn new(key: GroupKey, now: Instant) -> Group {
-        let rate = key.class.rate();
-        let bandwidth = if rate as f64 >= FASTEST_CLASS { Bandwidth::Unlimited } else { Bandwidth::Fixed(rate) };
+        let fastest = key.class.rate() as f64 >= FASTEST_CLASS;
+        let bandwidth = if fastest { Bandwidth::Unlimited } else { Bandwidth::Fixed(key.class.group_rate()) };
         let config = ScreenConfig {
             fps: key.fps,
             bandwidth,
@@ -182,7 +194,7 @@ impl Group {
     pub fn frame(&mut self, now: Instant, picture: &Pixmap, status: &SceneStatus) -> bool {
         self.screen.forget_pen();
         let (fps, bytes_per_second) = self.screen.figures();
-        let bandwidth = (self.screen.config().bandwidth != Bandwidth::Unlimited).then(|| self.key.class.rate());
+        let bandwidth = (self.screen.config().bandwidth != Bandwidth::Unlimited).then(|| self.key.class.group_rate());
         let figures = Figures { fps, bytes_per_second, bandwidth, pixels_elsewhere: false, note: None };
         let seat = SeatView { stone: DEFAULT_STONE_RADIUS, ..SeatView::default() };
         // The oldest frame's buffers are reused once no member holds it.

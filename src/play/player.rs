@@ -105,8 +105,9 @@ impl Player {
         self.seat.set_fit(self.screen.fit(scene));
     }
 
-    /// A message from the host for this person (a screenshot's name).
-    pub(crate) fn say(&mut self, message: String, now: Instant) {
+    /// A message for this person on their status line (a screenshot's name; a crowd's
+    /// greeting).
+    pub fn say(&mut self, message: String, now: Instant) {
         self.seat.say(message, now);
     }
 

@@ -18,11 +18,12 @@ pub(crate) mod link;
 mod picture;
 pub mod probe;
 mod routing;
+mod scratch;
 mod ui;
 
 use std::time::{Duration, Instant};
 
-use self::compose::{Figures, FrameBuilder, big_enough, half_block_picture};
+use self::compose::{Figures, big_enough, half_block_picture};
 pub use self::link::LinkPath;
 use self::link::{Change, LinkControl};
 use self::picture::Picture;
@@ -38,7 +39,6 @@ use crate::output::frame::Frame;
 use crate::output::graphics::GraphicsMode;
 use crate::output::graphics::stream::FileWrite;
 use crate::output::graphics::stream::crossover::AutoSwitch;
-use crate::output::rate::RateEncoder;
 use crate::play::clock::{FramePacer, Meter};
 
 /// How many bytes a second a screen may send.
@@ -151,14 +151,15 @@ pub struct Screen {
     pacer: FramePacer,
     bucket: ByteBucket,
     link: LinkControl,
-    encoder: RateEncoder,
+    /// What the terminal shows: the one model a screen keeps of its own (the encoder's, the
+    /// composed frame's and the bytes' buffers are borrowed per frame: `scratch`).
     shown: Shown,
-    builder: FrameBuilder,
     meter: Meter,
     /// Every byte handed out, for the link's delivery rate.
     bytes_sent: u64,
-    /// The frame's bytes before they are handed out (a reused buffer).
-    scratch: Vec<u8>,
+    /// The most bytes a frame of this screen took: the caller's buffer is given room for it
+    /// at once, so it stops growing after the first frames.
+    largest_frame: usize,
 }
 
 impl Screen {
@@ -202,11 +203,9 @@ impl Screen {
             colour_hint: false,
             bucket,
             link,
-            encoder: RateEncoder::new(),
             shown: Shown::UNKNOWN,
-            builder: FrameBuilder::default(),
             bytes_sent: 0,
-            scratch: Vec::new(),
+            largest_frame: 0,
         }
     }
 
@@ -407,14 +406,12 @@ impl Screen {
         (self.shown.cursor, self.shown.fg, self.shown.bg) = (Cursor::Unknown, None, None);
     }
 
-    /// Frees what only a screen that encodes needs (the model, the encoder's and the frame's
-    /// buffers): a group member in step takes its group's bytes instead. They come back, at
-    /// their cost, when it encodes again.
+    /// Frees what only a screen that encodes needs (its model of the terminal: the encoder's
+    /// buffers are the process's, borrowed per frame): a group member in step takes its
+    /// group's bytes instead. The model comes back, at its cost, when it encodes again.
     pub(crate) fn release(&mut self) {
         self.shown = Shown::UNKNOWN;
-        self.encoder = RateEncoder::new();
-        self.builder = FrameBuilder::default();
-        self.scratch = Vec::new();
+        self.largest_frame = 0;
     }
 
     /// A screen that writes to no terminal (a group's): no set-up bytes before its first frame.

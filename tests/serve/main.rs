@@ -9,6 +9,8 @@ mod bus;
 #[cfg(feature = "bus")]
 mod bus_load;
 mod common;
+/// A crowd of players in a process of its own (ignored: scripts/bus_scale.sh).
+mod crowd_client;
 /// Fake graphics terminals (shared with the integration tests).
 #[allow(dead_code)]
 #[path = "../integration/common/fake_terminal/mod.rs"]

@@ -183,3 +183,68 @@ fn on_still_water_a_member_back_in_step_draws_the_status_line_in_the_groups_colo
     assert!((30..100).filter(|&k| c.frames[k].1 == Source::Group && !c.frames[k].0.is_empty()).count() >= 2);
     assert!(same(&a.vt, &c.vt), "its terminal shows what the others' show");
 }
+
+/// Members whose links are at their class's lower bound (16 kB/s: what a terminal that answers
+/// nothing gets) on busy water: one that left the group's step for a message of its own
+/// catches up with the group's model and takes its frames again within a few seconds. With the
+/// group encoding at the bound itself, its model moved as fast as the member's link carried and
+/// the member never caught up (issue 31).
+#[test]
+fn a_member_at_its_class_bound_catches_up_on_busy_water() {
+    let t0 = Instant::now();
+    let term = (80, 24);
+    let config = ScreenConfig {
+        fps: 30,
+        bandwidth: Bandwidth::Fixed(16_000),
+        color: ColorMode::Palette256,
+        color_auto: false,
+        encode: EncodeOptions::default(),
+        graphics: GraphicsRequest::Force(GraphicsMode::Cells),
+        probe: None,
+        link_path: LinkPath::Direct,
+    };
+    let mut members: Vec<(Player, Membership)> = (0..2)
+        .map(|_| {
+            let screen = Screen::new(config.clone(), term, t0);
+            let picture = screen.picture_size();
+            (Player::new(screen, picture, None), Membership::new())
+        })
+        .collect();
+    let pool = PoolSettings { rain_rate: 1.0, breeze: 0.3, seed: 11, ..PoolSettings::default() };
+    let host_config = HostConfig { scenes: vec![SceneSpec::Pool(pool)], seed: 11, record: None, screenshots: false };
+    let size = members[0].0.screen.picture_size();
+    let mut host = Host::new(host_config, size, t0).unwrap();
+    let mut picture = Pixmap::new(size.0, size.1).unwrap();
+    let (player, membership) = &mut members[0];
+    let key = membership.key(&player.screen).unwrap();
+    let mut group = Group::new(key, t0);
+    // 20 s at 30 fps: the second member's message (4 s) from 8 s on; then busy water to 20 s.
+    let mut second = Vec::new();
+    for k in 0..600u32 {
+        let now = t0 + FRAME * k;
+        if k % 6 == 0 {
+            host.apply(Request::RandomStone { radius: 4 }, now);
+        }
+        if k == 240 {
+            members[1].0.seat.say("a message of its own", now);
+        }
+        host.advance(now);
+        host.render(&mut picture);
+        let status = host.status().clone();
+        group.frame(now, &picture, &status);
+        let feed = group.feed();
+        for (i, (player, membership)) in members.iter_mut().enumerate() {
+            let mut out = Vec::new();
+            let (_, source) = membership.frame(player, now, &picture, &status, Some(&feed), &mut out);
+            if i == 1 {
+                second.push(source);
+            }
+        }
+    }
+    let joined = |from: usize| (from..second.len()).find(|&k| second[k] == Source::Group);
+    let first = joined(0).expect("in step at the start");
+    assert!(first <= 240, "in step within its first 8 s (frame {first})");
+    assert!((250..360).all(|k| second[k] != Source::Group), "out of step while its message shows");
+    let back = joined(360).expect("back in step after its message, on busy water");
+    assert!(back <= 360 + 150, "back in step within 5 s of its message's end: frame {back}");
+}

@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 use tiny_skia::Pixmap;
 
 use super::compose::{Figures, big_enough};
+use super::scratch::{self, Scratch};
 use super::{APPROXIMATE_BELOW, CellSource, Screen, link, picture};
 use crate::output::color::ColorMode;
 use crate::output::cursor::Cursor;
@@ -68,19 +69,22 @@ impl Screen {
         self.follow_link(now, out);
         let plan = self.plan(now);
         let resized = self.shown.frame.is_none();
-        let mut bytes = std::mem::take(&mut self.scratch);
-        bytes.clear();
-        let report = self.encode_cells(picture, status, seat, cells, &plan, &mut bytes, out);
+        // Borrowed for this frame only (see `scratch`): a screen keeps no encoder of its own.
+        let mut scratch = scratch::take();
+        scratch.bytes.clear();
+        let report = self.encode_cells(picture, status, seat, cells, &plan, &mut scratch, out);
         self.bucket.spend(report.bytes);
-        let sent = self.add_picture(now, picture, seat, resized, &report, &plan, &mut bytes);
+        let sent = self.add_picture(now, picture, seat, resized, &report, &plan, &mut scratch.bytes);
         if self.auto() {
             self.link.frame_sent(report.bytes + sent, plan.budget);
         }
-        // Room for the largest frame at once (the scratch buffer has it), so the caller's
-        // buffers stop growing after the first frames: steady frames allocate nothing.
-        out.reserve(bytes.capacity());
-        out.extend_from_slice(&bytes);
-        self.scratch = bytes;
+        // Room for the largest frame at once (rounded up as a growing buffer would be, so a
+        // frame a little larger than the last largest still fits), so the caller's buffers
+        // stop growing after the first frames: steady frames allocate nothing.
+        self.largest_frame = self.largest_frame.max(scratch.bytes.len().next_power_of_two());
+        out.reserve(self.largest_frame);
+        out.extend_from_slice(&scratch.bytes);
+        scratch::give(scratch);
         let wanted = self.link.question_wanted(now, self.bytes_sent + (out.len() - start) as u64);
         if self.auto() && self.link.probe_due() && (out.len() > start || wanted) {
             // The question goes after the frame: its answer says the frame has arrived.
@@ -118,7 +122,7 @@ impl Screen {
         Plan { rate, figures, budget, overdraw, options }
     }
 
-    /// The frame's cells into `bytes` (a group's taken bytes straight into `out`).
+    /// The frame's cells into the scratch's bytes (a group's taken bytes straight into `out`).
     #[allow(clippy::too_many_arguments)]
     fn encode_cells(
         &mut self,
@@ -127,28 +131,27 @@ impl Screen {
         seat: &SeatView<'_>,
         cells: CellSource<'_>,
         plan: &Plan,
-        bytes: &mut Vec<u8>,
+        scratch: &mut Scratch,
         out: &mut Vec<u8>,
     ) -> Report {
+        let Scratch { encoder, builder, bytes } = scratch;
         match cells {
             CellSource::Own { figures: given } => {
                 let figures = given.unwrap_or(plan.figures);
-                let frame = self.builder.compose(self.term, picture, self.config.color, status, seat, &figures);
+                let frame = builder.compose(self.term, picture, self.config.color, status, seat, &figures);
                 let target = match self.config.color {
                     ColorMode::TrueColor => Target::new(frame),
                     mode => Target::with_truth(frame, picture, mode),
                 };
-                self.encoder.encode_into(&mut self.shown, target, plan.budget, plan.options, bytes)
+                encoder.encode_into(&mut self.shown, target, plan.budget, plan.options, bytes)
             }
             CellSource::Toward(model) => {
                 // Exactly (no colour threshold), so that the model becomes equal, not close.
                 let exact = RateOptions { threshold: 0, ..plan.options };
-                self.encoder.encode_into(&mut self.shown, Target::new(model), plan.budget, exact, bytes)
+                encoder.encode_into(&mut self.shown, Target::new(model), plan.budget, exact, bytes)
             }
             CellSource::Taken(taken) => {
-                // Straight to the caller: the group's bytes never pass through the scratch
-                // buffer, which a member in step has freed (it would grow back to a group
-                // frame's size, and the caller's buffer with it).
+                // Straight to the caller: the group's bytes need no copy in the scratch.
                 out.extend_from_slice(taken);
                 Report { bytes: taken.len(), drawn: 0, pending: 0 }
             }

@@ -56,8 +56,13 @@ pub(crate) struct ViewerCtx {
     pub slot: PlayerSlot,
 }
 
-/// The frame buffer a player in step with its group keeps at most, in bytes.
-const IN_STEP_BUFFER: usize = 64 * 1024;
+thread_local! {
+    /// The buffer frames are built in, one per thread of the runtime (a frame is built without
+    /// a pause, so no other player's task runs on the thread meanwhile): a player keeps only
+    /// its frame's bytes until they are written, at their own size (issue 31: a buffer per
+    /// player held room for its largest frame as long as it played).
+    static BUILD: std::cell::RefCell<Vec<u8>> = const { std::cell::RefCell::new(Vec::new()) };
+}
 
 /// How soon a new terminal size that had to wait is tried again.
 const RESIZE_RETRY: std::time::Duration = std::time::Duration::from_millis(100);
@@ -83,7 +88,7 @@ pub(crate) async fn run(ctx: ViewerCtx) {
         resize: None,
         deferred: false,
         last_input: now,
-        out: Vec::new(),
+        out: Bytes::new(),
         from_group: false,
         tally: Tally::default(),
         scene_name: frames.borrow().status.name,
@@ -116,8 +121,8 @@ struct Viewer {
     resize: Option<(u16, u16)>,
     deferred: bool,
     last_input: Instant,
-    /// The frame buffer, kept from frame to frame, and whether its bytes are the group's.
-    out: Vec<u8>,
+    /// The frame to write, and whether its bytes are the group's.
+    out: Bytes,
     from_group: bool,
     tally: Tally,
     scene_name: &'static str,
@@ -238,13 +243,17 @@ impl Viewer {
             return false;
         }
         self.driver.sent();
-        // The frame is built in a buffer kept from frame to frame (the screen reserves room
-        // for its largest frame in it) and copied out at its own size: handing the buffer
-        // itself to russh would hold that reservation per frame in flight.
-        self.out.clear();
+        // The frame is built in the thread's buffer (the screen reserves room for its largest
+        // frame in it) and copied out at its own size: handing the buffer itself to russh
+        // would hold that reservation per frame in flight.
         let feed = self.viewing.group.and_then(|key| shared.groups.get(&key));
         let player = self.driver.player_mut();
-        let (len, source) = self.membership.frame(player, now, &picture, &shared.status, feed, &mut self.out);
+        let (len, source) = BUILD.with_borrow_mut(|out| {
+            out.clear();
+            let made = self.membership.frame(player, now, &picture, &shared.status, feed, out);
+            self.out = if made.0 == 0 { Bytes::new() } else { Bytes::copy_from_slice(out) };
+            made
+        });
         if len == 0 {
             return false;
         }
@@ -253,24 +262,19 @@ impl Viewer {
         true
     }
 
-    /// Sends `self.out`. data_bytes waits for the client's SSH window and for room in russh's
-    /// queue: that wait is the backpressure (newer pictures replace older ones in the slot
-    /// meanwhile). `Some` when the player is cut.
+    /// Sends `self.out` (and lets it go). data_bytes waits for the client's SSH window and for
+    /// room in russh's queue: that wait is the backpressure (newer pictures replace older ones
+    /// in the slot meanwhile). `Some` when the player is cut.
     async fn send(&mut self, write: &ChannelWriteHalf<Msg>, kill: &CancellationToken) -> Option<Leave> {
         let (hub, len) = (&self.hub, self.out.len());
         tokio::select! {
             biased;
             _ = kill.cancelled() => Some(Leave::Cut),
             _ = hub.shutdown.cancelled() => Some(Leave::Shutdown),
-            done = write.data_bytes(Bytes::copy_from_slice(&self.out)) => {
+            done = write.data_bytes(std::mem::take(&mut self.out)) => {
                 if done.is_err() { return Some(Leave::Cut); }
                 self.tally.sent += 1;
                 self.tally.from_group += u64::from(self.from_group);
-                if self.membership.in_step() && self.out.capacity() > IN_STEP_BUFFER {
-                    // Room for a whole frame of its own is not needed while the group's
-                    // bytes come: give it back (it comes again if the player leaves).
-                    self.out = Vec::new();
-                }
                 self.tally.bytes += len as u64;
                 hub.stats.frames_sent.fetch_add(1, Ordering::Relaxed);
                 None

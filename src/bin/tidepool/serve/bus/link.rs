@@ -64,7 +64,8 @@ pub struct PoolLink {
 /// JetStream, or runs this pool with other settings.
 pub async fn open(options: &BusOptions, fingerprint: &str, state: Arc<BusState>) -> Result<PoolLink, String> {
     let names = Names::of(&options.pool).map_err(|e| e.0)?;
-    let url = &options.url;
+    let (user, address) = split_user(&options.url);
+    let url = &address;
     let mut connect = ConnectOptions::new()
         .name(format!("tidepool-{}", options.edge))
         .connection_timeout(CONNECT_TIMEOUT)
@@ -86,6 +87,10 @@ pub async fn open(options: &BusOptions, fingerprint: &str, state: Arc<BusState>)
                 }
             }
         });
+    if let Some((name, password)) = user {
+        // async-nats does not read a password in the URL itself.
+        connect = connect.user_and_password(name, password);
+    }
     if let Some(path) = &options.credentials {
         connect = connect
             .credentials_file(path)
@@ -95,7 +100,7 @@ pub async fn open(options: &BusOptions, fingerprint: &str, state: Arc<BusState>)
     if let Some(ca) = &options.ca {
         connect = connect.add_root_certificates(ca.clone()).require_tls(true);
     }
-    let client = tokio::time::timeout(CONNECT_TIMEOUT, connect.connect(url.as_str()))
+    let client = tokio::time::timeout(CONNECT_TIMEOUT, connect.connect(without_user(&options.url)))
         .await
         .map_err(|_| format!("no answer from the bus at {url} within {} s", CONNECT_TIMEOUT.as_secs()))?
         .map_err(|e| format!("cannot reach the bus at {url} ({e}); start `nats-server -js` there or fix --bus"))?;
@@ -302,5 +307,40 @@ pub async fn forward(
                 None => return,
             },
         }
+    }
+}
+
+/// The user and password a bus URL names (`tls://USER:PASSWORD@HOST:PORT`, as nats-server's
+/// accounts with passwords want), and the URL to show, its password hidden.
+fn split_user(url: &str) -> (Option<(String, String)>, String) {
+    let Some((scheme, rest)) = url.split_once("://") else { return (None, url.to_owned()) };
+    let Some((userinfo, host)) = rest.rsplit_once('@') else { return (None, url.to_owned()) };
+    let (name, password) = userinfo.split_once(':').unwrap_or((userinfo, ""));
+    (Some((name.to_owned(), password.to_owned())), format!("{scheme}://{name}:***@{host}"))
+}
+
+/// The URL without its user and password (what the connection is given).
+fn without_user(url: &str) -> String {
+    match url.split_once("://") {
+        Some((scheme, rest)) => match rest.rsplit_once('@') {
+            Some((_, host)) => format!("{scheme}://{host}"),
+            None => url.to_owned(),
+        },
+        None => url.to_owned(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_password_in_the_bus_url_is_used_and_never_shown() {
+        let (user, shown) = split_user("tls://edge1:s3cret@nats.example:4222");
+        assert_eq!(user, Some(("edge1".into(), "s3cret".into())));
+        assert_eq!(shown, "tls://edge1:***@nats.example:4222");
+        assert_eq!(without_user("tls://edge1:s3cret@nats.example:4222"), "tls://nats.example:4222");
+        assert_eq!(split_user("nats://127.0.0.1:4222"), (None, "nats://127.0.0.1:4222".into()));
+        assert_eq!(without_user("nats://127.0.0.1:4222"), "nats://127.0.0.1:4222");
     }
 }
