@@ -218,7 +218,9 @@ pub fn encode(shown: &Shown, target: Target<'_>, budget: usize, options: RateOpt
 }
 
 impl RateEncoder {
-    /// An encoder with empty scratch buffers.
+    /// An encoder with empty scratch buffers (the screens borrow theirs from the process's
+    /// pool, `play::screen::scratch`; this is for the tests and benches).
+    #[cfg(any(test, feature = "testing"))]
     pub fn new() -> RateEncoder {
         RateEncoder::default()
     }
