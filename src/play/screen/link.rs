@@ -429,8 +429,7 @@ impl LinkControl {
         // explanation: any other is late because it is still reading, a queue.
         // (Until a few bare answers are in, it is taken for one: main's rules collapsed kitty
         // 0.26 to 2 kB/s within the first second.)
-        let slow_terminal =
-            self.answer_time.is_slow(low, high) || self.answer_time.bare_count() < answer_time::FIRST_SAMPLES;
+        let slow_terminal = self.answer_time.treat_as_slow((low, high));
         let explained = !slow_terminal || 2 * question.in_flight >= link_queue;
         let over = link_queue > high && (explained || queue > high + slow);
         let last_queue = self.last_queue.replace((link_queue, over));
@@ -550,9 +549,7 @@ impl LinkControl {
         // bytes in flight is busy, not congested (kitty 0.26 under llvmpipe, setting up its
         // first pictures): its lost question lowers the rate only when those bytes explain the
         // wait, as for a late answer.
-        let (low, high) = queue_marks(base);
-        let slow_terminal =
-            self.answer_time.is_slow(low, high) || self.answer_time.bare_count() < answer_time::FIRST_SAMPLES;
+        let marks = queue_marks(base);
         let mut lost = false;
         for q in self.questions.list[..self.questions.len].iter_mut().flatten() {
             // A terminal that has never answered is not congested: it is silent (below).
@@ -561,7 +558,7 @@ impl LinkControl {
                 // keeps its place, so its late answer is still paired with it.
                 self.acknowledged = self.acknowledged.max(q.bytes);
                 q.overdue = true;
-                lost |= !slow_terminal || 2 * q.in_flight >= age(q);
+                lost |= 2 * q.in_flight >= age(q) || !self.answer_time.treat_as_slow(marks);
             }
         }
         if !self.silent && self.is_silent(now) {

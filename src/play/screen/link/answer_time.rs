@@ -119,6 +119,12 @@ impl AnswerTime {
         n > 0 && (clean[n - 1] > high || (n > 1 && clean[n - 2] > low))
     }
 
+    /// Whether the terminal is to be treated as slow on its own: shown so
+    /// ([`AnswerTime::is_slow`]), or not judged yet (fewer than [`FIRST_SAMPLES`] bare answers).
+    pub fn treat_as_slow(&self, (low, high): (Duration, Duration)) -> bool {
+        self.clean_count < FIRST_SAMPLES || self.is_slow(low, high)
+    }
+
     fn push(&mut self, excess: Duration) {
         self.samples[self.count % SAMPLES] = excess;
         self.count += 1;
