@@ -344,17 +344,38 @@ impl Lattice {
         // Filled in the lattice's order, row by row (no index needs a division, and the reads
         // run along rows: walking columns missed the cache at every point); the transform
         // transposes it in tiles.
+        // A point and its mirror -k need each other's coefficients: rows r and n - r are
+        // filled together, so each point's coefficients are computed once (row 0 and, for
+        // even n, row n/2 are their own mirrors). The same expressions as one point at a
+        // time, so the same bits.
         let mut buf = vec![Complex32::new(0.0, 0.0); n * n];
-        buf.par_chunks_mut(n).enumerate().for_each(|(r, row)| {
-            let r_mirror = if r == 0 { 0 } else { n - r };
+        let mirror_col = |c: usize| if c == 0 { 0 } else { n - c };
+        let spectrum = |(f, g): (Complex32, Complex32), (fm, gm): (Complex32, Complex32)| {
+            let sf = (f + fm.conj()) * 0.5;
+            let sg = (g + gm.conj()) * 0.5;
+            sf + Complex32::new(0.0, 1.0) * sg
+        };
+        let own_mirror = |r: usize, row: &mut [Complex32]| {
             for (c, out) in row.iter_mut().enumerate() {
-                let i = r * n + c;
-                let mirror = r_mirror * n + if c == 0 { 0 } else { n - c };
-                let (f, g) = coefficients(i, waves[i]);
-                let (fm, gm) = coefficients(mirror, waves[mirror]);
-                let sf = (f + fm.conj()) * 0.5;
-                let sg = (g + gm.conj()) * 0.5;
-                *out = sf + Complex32::new(0.0, 1.0) * sg;
+                let (i, mirror) = (r * n + c, r * n + mirror_col(c));
+                *out = spectrum(coefficients(i, waves[i]), coefficients(mirror, waves[mirror]));
+            }
+        };
+        let pairs = (n - 1) / 2;
+        let (row0, rest) = buf.split_at_mut(n);
+        let (top, rest) = rest.split_at_mut(pairs * n);
+        let (middle, bottom) = rest.split_at_mut(if n % 2 == 0 { n } else { 0 });
+        own_mirror(0, row0);
+        if n % 2 == 0 {
+            own_mirror(n / 2, middle);
+        }
+        top.par_chunks_mut(n).zip(bottom.par_chunks_mut(n).rev()).enumerate().for_each(|(k, (row, row_m))| {
+            let (r, r_m) = (k + 1, n - k - 1);
+            for c in 0..n {
+                let (i, mirror) = (r * n + c, r_m * n + mirror_col(c));
+                let (a, b) = (coefficients(i, waves[i]), coefficients(mirror, waves[mirror]));
+                row[c] = spectrum(a, b);
+                row_m[mirror_col(c)] = spectrum(b, a);
             }
         });
         self.ifft2(&mut buf, scratch);
