@@ -361,12 +361,12 @@ impl Lattice {
                 *out = spectrum(coefficients(i, waves[i]), coefficients(mirror, waves[mirror]));
             }
         };
-        let pairs = (n - 1) / 2;
+        let (pairs, even) = ((n - 1) / 2, n.is_multiple_of(2));
         let (row0, rest) = buf.split_at_mut(n);
         let (top, rest) = rest.split_at_mut(pairs * n);
-        let (middle, bottom) = rest.split_at_mut(if n % 2 == 0 { n } else { 0 });
+        let (middle, bottom) = rest.split_at_mut(if even { n } else { 0 });
         own_mirror(0, row0);
-        if n % 2 == 0 {
+        if even {
             own_mirror(n / 2, middle);
         }
         top.par_chunks_mut(n).zip(bottom.par_chunks_mut(n).rev()).enumerate().for_each(|(k, (row, row_m))| {
