@@ -7,14 +7,15 @@
 //! Beaufort 3, 6, 9 and 10 with the physical choppiness and foam, a wind sea with swell, a
 //! fetch-limited JONSWAP sea, a shallow TMA sea, the far crests of a 1920x1080 gale
 //! (cropped), the player's terminal frame (160x94, magnified), and a 2x2 tiling of a periodic
-//! map. (The presets' pictures are `render ocean --preset NAME`: `scripts/gallery.sh`.)
+//! map. Each is shaded as its command draws it: pictures flat (`render ocean`'s default for
+//! pictures), the player's frame smooth (`play`'s default). (The presets' pictures are `render ocean --preset NAME`: `scripts/gallery.sh`.)
 
 use std::path::{Path, PathBuf};
 
 use tiny_skia::{Pixmap, PixmapPaint, Transform};
 
 use tidepool::sea::{Depth, Jonswap, PatchSea, SpectrumChoice, Swell, Swells, beaufort_speed_m_s};
-use tidepool::{CameraPose, OceanScene, OceanSettings, OceanView, Scene, SeaParams};
+use tidepool::{CameraPose, OceanScene, OceanSettings, OceanView, Scene, SeaParams, SeaShading};
 
 struct Shot {
     name: &'static str,
@@ -22,12 +23,13 @@ struct Shot {
     sun: (f32, f32),
     size: (u32, u32),
     ssaa: u32,
+    shading: SeaShading,
     time_s: f64,
 }
 
 /// A gallery picture: 640x360, two samples a pixel, at time 0.
 fn gallery(name: &'static str, params: SeaParams, sun: (f32, f32)) -> Shot {
-    Shot { name, params, sun, size: (640, 360), ssaa: 2, time_s: 0.0 }
+    Shot { name, params, sun, size: (640, 360), ssaa: 2, shading: SeaShading::Flat, time_s: 0.0 }
 }
 
 fn render(shot: &Shot) -> Pixmap {
@@ -36,6 +38,7 @@ fn render(shot: &Shot) -> Pixmap {
         sun_azimuth_deg: shot.sun.0,
         sun_elevation_deg: shot.sun.1,
         ssaa: shot.ssaa,
+        shading: shot.shading,
         ..OceanView::default()
     };
     let settings = OceanSettings { sea: shot.params, view, start_time_s: shot.time_s, ..OceanSettings::default() };
@@ -107,23 +110,27 @@ fn main() {
     for shot in &shots {
         save(&dir, shot.name, &render(shot));
     }
-    // The far crests of a 1920x1080 gale (the default look: no choppiness), cropped.
+    // The far crests of a 1920x1080 gale (the default look: no choppiness, flat faces, two
+    // samples a pixel), cropped.
     let gale = Shot {
         name: "",
         params: SeaParams { wind_m_s: b(9), ..SeaParams::default() },
         sun: (200.0, 12.0),
         size: (1920, 1080),
         ssaa: 2,
+        shading: SeaShading::Flat,
         time_s: 0.0,
     };
     save(&dir, "far-crests-after.png", &crop(&render(&gale), 480, 180, 960, 300));
-    // The player's frame: 160x48 cells = 160x94 pixels at one sample per pixel, magnified.
+    // The player's frame: 160x48 cells = 160x94 pixels at one sample per pixel, smooth as
+    // `play` draws it, magnified.
     let term = Shot {
         name: "",
         params: SeaParams { wind_m_s: b(6), ..SeaParams::default() },
         sun: (15.0, 22.0),
         size: (160, 94),
         ssaa: 1,
+        shading: SeaShading::Smooth,
         time_s: 0.0,
     };
     save(&dir, "terminal-after.png", &magnify(&render(&term), 4));

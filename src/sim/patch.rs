@@ -43,7 +43,7 @@ mod foam;
 mod sampling;
 use super::ocean::{EULER_ITERATIONS, Sea, SeaParams, SeaTime, sizing_wavelength_m};
 use super::trig::fast_sincos;
-use sampling::{Bilinear, cubic, round_even, sincos_turns, transpose_square};
+use sampling::{Bilinear, cubic, round_even, sincos_turns, transpose_into};
 
 /// Smallest and largest lattice side.
 pub const PATCH_SIZE_RANGE: (usize, usize) = (8, 4096);
@@ -303,14 +303,15 @@ impl Lattice {
             .collect()
     }
 
-    /// The inverse 2-D FFT, in place, of a spectrum laid out transposed (`buf[kx·n + ky]`:
-    /// buffer row c is the lattice's column c): along ky on rows, one transpose, along kx on
-    /// rows, which leaves the field in row-major order (one transpose fewer than from the
-    /// natural layout). Rows in parallel: the same result on any number of cores.
-    fn ifft2_transposed(&self, buf: &mut [Complex32]) {
+    /// The inverse 2-D FFT, in place, of a spectrum in the lattice's order (`buf[r·n + c]`),
+    /// by way of `scratch` (n², any contents): transposed into `scratch`, along ky on its rows,
+    /// transposed back, along kx on the rows, which leaves the field in row-major order. Rows
+    /// and transposes in parallel: the same result on any number of cores.
+    fn ifft2(&self, buf: &mut [Complex32], scratch: &mut [Complex32]) {
         let n = self.n;
-        buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
-        transpose_square(buf, n);
+        transpose_into(buf, scratch, n);
+        scratch.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
+        transpose_into(scratch, buf, n);
         buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
     }
 
@@ -323,38 +324,61 @@ impl Lattice {
         &self,
         waves: &[Complex32],
         coefficients: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
+        scratch: &mut [Complex32],
     ) -> (Vec<f32>, Vec<f32>) {
-        let buf = self.real_fields_packed(waves, coefficients);
+        let buf = self.real_fields_packed(waves, coefficients, scratch);
         // Element by element, so in parallel with the same bits.
         (buf.par_iter().map(|c| c.re).collect(), buf.par_iter().map(|c| c.im).collect())
     }
 
     /// As [`Lattice::real_fields`], the two fields left packed as the transform gives them:
-    /// f in the real parts, g in the imaginary ones.
+    /// f in the real parts, g in the imaginary ones; `scratch` (n², any contents) is the
+    /// transform's working space, shared by a moment's transforms.
     fn real_fields_packed(
         &self,
         waves: &[Complex32],
         coefficients: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
+        scratch: &mut [Complex32],
     ) -> Vec<Complex32> {
         let n = self.n;
         // Filled in the lattice's order, row by row (no index needs a division, and the reads
-        // run along rows: walking columns missed the cache at every point), then transposed
-        // in blocks into the layout the transform wants.
+        // run along rows: walking columns missed the cache at every point); the transform
+        // transposes it in tiles.
+        // A point and its mirror -k need each other's coefficients: rows r and n - r are
+        // filled together, so each point's coefficients are computed once (row 0 and, for
+        // even n, row n/2 are their own mirrors). The same expressions as one point at a
+        // time, so the same bits.
         let mut buf = vec![Complex32::new(0.0, 0.0); n * n];
-        buf.par_chunks_mut(n).enumerate().for_each(|(r, row)| {
-            let r_mirror = if r == 0 { 0 } else { n - r };
+        let mirror_col = |c: usize| if c == 0 { 0 } else { n - c };
+        let spectrum = |(f, g): (Complex32, Complex32), (fm, gm): (Complex32, Complex32)| {
+            let sf = (f + fm.conj()) * 0.5;
+            let sg = (g + gm.conj()) * 0.5;
+            sf + Complex32::new(0.0, 1.0) * sg
+        };
+        let own_mirror = |r: usize, row: &mut [Complex32]| {
             for (c, out) in row.iter_mut().enumerate() {
-                let i = r * n + c;
-                let mirror = r_mirror * n + if c == 0 { 0 } else { n - c };
-                let (f, g) = coefficients(i, waves[i]);
-                let (fm, gm) = coefficients(mirror, waves[mirror]);
-                let sf = (f + fm.conj()) * 0.5;
-                let sg = (g + gm.conj()) * 0.5;
-                *out = sf + Complex32::new(0.0, 1.0) * sg;
+                let (i, mirror) = (r * n + c, r * n + mirror_col(c));
+                *out = spectrum(coefficients(i, waves[i]), coefficients(mirror, waves[mirror]));
+            }
+        };
+        let (pairs, even) = ((n - 1) / 2, n.is_multiple_of(2));
+        let (row0, rest) = buf.split_at_mut(n);
+        let (top, rest) = rest.split_at_mut(pairs * n);
+        let (middle, bottom) = rest.split_at_mut(if even { n } else { 0 });
+        own_mirror(0, row0);
+        if even {
+            own_mirror(n / 2, middle);
+        }
+        top.par_chunks_mut(n).zip(bottom.par_chunks_mut(n).rev()).enumerate().for_each(|(k, (row, row_m))| {
+            let (r, r_m) = (k + 1, n - k - 1);
+            for c in 0..n {
+                let (i, mirror) = (r * n + c, r_m * n + mirror_col(c));
+                let (a, b) = (coefficients(i, waves[i]), coefficients(mirror, waves[mirror]));
+                row[c] = spectrum(a, b);
+                row_m[mirror_col(c)] = spectrum(b, a);
             }
         });
-        transpose_square(&mut buf, n);
-        self.ifft2_transposed(&mut buf);
+        self.ifft2(&mut buf, scratch);
         buf
     }
 
@@ -367,8 +391,9 @@ impl Lattice {
             let (kx, ky, k) = (self.kx[i], self.ky[i], self.k[i]);
             (kx * kx / k, ky * ky / k, kx * ky / k)
         };
-        let (gxx, gyy) = self.real_fields(waves, |i, w| (w * coef(i).0, w * coef(i).1));
-        let (gxy, _) = self.real_fields(waves, |i, w| (w * coef(i).2, Complex32::new(0.0, 0.0)));
+        let mut scratch = vec![Complex32::new(0.0, 0.0); self.n * self.n];
+        let (gxx, gyy) = self.real_fields(waves, |i, w| (w * coef(i).0, w * coef(i).1), &mut scratch);
+        let (gxy, _) = self.real_fields(waves, |i, w| (w * coef(i).2, Complex32::new(0.0, 0.0)), &mut scratch);
         (gxx, gyy, gxy)
     }
 }
@@ -425,13 +450,16 @@ impl PatchSea {
         let i_unit = Complex32::new(0.0, 1.0);
         let unit = |i: usize| (l.kx[i] / l.k[i], l.ky[i] / l.k[i], l.k[i]);
         let waves = l.waves(time);
+        let mut scratch = vec![Complex32::new(0.0, 0.0); l.n * l.n];
         // The displacement per unit λ is -Σ a·û·sin θ = re Σ (i·û·w)·e^(ik·x); slopes re Σ (i·k·w)·e^(ik·x).
-        let h_dx = l.real_fields_packed(&waves, |i, w| (w, i_unit * w * unit(i).0));
-        let dy_hx = l.real_fields_packed(&waves, |i, w| (i_unit * w * unit(i).1, i_unit * w * l.kx[i]));
+        let h_dx = l.real_fields_packed(&waves, |i, w| (w, i_unit * w * unit(i).0), &mut scratch);
+        let dy_hx = l.real_fields_packed(&waves, |i, w| (i_unit * w * unit(i).1, i_unit * w * l.kx[i]), &mut scratch);
         // The displacement's gradient per unit λ, each times -1: g_ab = Σ a·(k_a·k_b/k)·cos θ.
         let (k, kx, ky) = (l.k.as_slice(), l.kx.as_slice(), l.ky.as_slice());
-        let hy_gxy = l.real_fields_packed(&waves, |i, w| (i_unit * w * ky[i], w * (kx[i] * ky[i] / k[i])));
-        let gxx_gyy = l.real_fields_packed(&waves, |i, w| (w * (kx[i] * kx[i] / k[i]), w * (ky[i] * ky[i] / k[i])));
+        let hy_gxy =
+            l.real_fields_packed(&waves, |i, w| (i_unit * w * ky[i], w * (kx[i] * ky[i] / k[i])), &mut scratch);
+        let gxx_gyy =
+            l.real_fields_packed(&waves, |i, w| (w * (kx[i] * kx[i] / k[i]), w * (ky[i] * ky[i] / k[i])), &mut scratch);
         // B = Σ a·√k·e^(iθ): the waves themselves, a complex field.
         let n = self.size;
         let mut b = vec![Complex32::new(0.0, 0.0); n * n];
@@ -443,8 +471,7 @@ impl PatchSea {
                 }
             }
         });
-        transpose_square(&mut b, n);
-        l.ifft2_transposed(&mut b);
+        l.ifft2(&mut b, &mut scratch);
         (Lagrangian { h_dx, dy_hx, hy_gxy, gxx_gyy }, b)
     }
 
