@@ -124,19 +124,23 @@ pub struct Role {
 }
 
 /// Starts this edge's part in the sequencer's role (watching the lease; sequencing while it
-/// holds it) on a thread of its own, with a runtime and a connection to the bus of its own.
+/// holds it) on a thread of its own with a runtime of its own, and opens the edge's
+/// connection to the bus there: the connection's own task (every message in and out) runs on
+/// that runtime too, and the edge's other tasks share it from theirs.
 ///
 /// Why a thread: the players' tasks (their frames' encoding) run on the server's runtime, and
 /// at load 8 to 12 on 2 cores a lease whose renewal shared their workers (and their
 /// connection's task) missed its second: the role moved six times in five minutes, keys waited
 /// seconds and 2 % of stones were refused (docs/serve/bus.md, round 2). Here only a dead or
-/// cut-off edge loses the role. Returns once the connection is open (its error otherwise).
+/// cut-off edge loses the role. One connection, not one for the role and one for the edge: the
+/// status line's `bus lost` then speaks for both. Returns the pool once the connection is
+/// open (its error otherwise).
 pub async fn start(
     options: &BusOptions,
     fingerprint: String,
     role: Role,
     stop: CancellationToken,
-) -> Result<(), String> {
+) -> Result<Arc<PoolLink>, String> {
     let (opened_tx, opened) = oneshot::channel();
     let options = options.clone();
     std::thread::Builder::new()
@@ -150,9 +154,10 @@ pub async fn start(
                 }
             };
             runtime.block_on(async move {
-                match link::open(&options, &fingerprint, None).await {
+                match link::open(&options, &fingerprint, role.state.clone()).await {
                     Ok(pool) => {
-                        let _ = opened_tx.send(Ok(()));
+                        let pool = Arc::new(pool);
+                        let _ = opened_tx.send(Ok(pool.clone()));
                         Leader { pool, role }.run(stop).await;
                     }
                     Err(e) => {
@@ -167,8 +172,8 @@ pub async fn start(
 
 /// An edge's part in the sequencer's role, on its own thread ([`start`]).
 struct Leader {
-    /// The pool, over the role's own connection.
-    pool: PoolLink,
+    /// The pool (its connection's task on the role's runtime).
+    pool: Arc<PoolLink>,
     /// The rest.
     role: Role,
 }

@@ -61,23 +61,19 @@ pub struct PoolLink {
 }
 
 /// Connects and opens the pool; fails with one line when the bus is not there, has no
-/// JetStream, or runs this pool with other settings. `state` is told when the connection
-/// comes and goes (the status line's `bus lost`): the edge's connection, not the sequencer's
-/// own (`lead::start`), whose connection shares its server and its fate.
-pub async fn open(options: &BusOptions, fingerprint: &str, state: Option<Arc<BusState>>) -> Result<PoolLink, String> {
+/// JetStream, or runs this pool with other settings.
+pub async fn open(options: &BusOptions, fingerprint: &str, state: Arc<BusState>) -> Result<PoolLink, String> {
     let names = Names::of(&options.pool).map_err(|e| e.0)?;
     let (user, address) = split_user(&options.url);
     let url = &address;
     let mut connect = ConnectOptions::new()
-        .name(format!("tidepool-{}{}", options.edge, if state.is_some() { "" } else { "-sequencer" }))
+        .name(format!("tidepool-{}", options.edge))
         .connection_timeout(CONNECT_TIMEOUT)
         .subscription_capacity(SUBSCRIPTION_CAPACITY)
         .max_reconnects(None)
         .event_callback(move |event| {
             let state = state.clone();
             async move {
-                // The sequencer's connection says nothing: the edge's says it for both.
-                let Some(state) = state else { return };
                 match event {
                     Event::Connected => {
                         eprintln!("bus: connected");

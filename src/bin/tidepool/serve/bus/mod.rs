@@ -3,8 +3,8 @@
 //!
 //! - every edge sends its players' requests to the pool's sequencer ([`protocol::Submit`]);
 //! - one edge at a time holds the sequencer's lease ([`lease`]) in the pool's JetStream
-//!   key-value bucket (on a thread, a runtime and a connection of its own: the players'
-//!   tasks cannot starve it); it checks every request (bounds, rates per player, per edge, per pool:
+//!   key-value bucket (on a thread and a runtime of its own, where the connection's task runs
+//!   too: the players' tasks cannot starve it); it checks every request (bounds, rates per player, per edge, per pool:
 //!   [`sequencer`]), and publishes ticks to the pool's JetStream stream: a step every edge may
 //!   run to and the events that apply at it;
 //! - every edge runs its own copy of the pool from that log ([`lockstep`]) and encodes for its
@@ -112,7 +112,6 @@ pub async fn start(
         .ok_or_else(|| format!("cannot make a {}x{} pool", spec.size.0, spec.size.1))?;
     let state = Arc::new(BusState::default());
     let fingerprint = spec.fingerprint();
-    let pool = link::open(&options, &fingerprint, Some(state.clone())).await?;
     let (incoming_tx, incoming_rx) = tokio::sync::mpsc::channel(QUEUE);
     let (outgoing_tx, outgoing_rx) = tokio::sync::mpsc::channel(QUEUE);
     let bus = EdgeLinks {
@@ -132,13 +131,12 @@ pub async fn start(
         snapshots: incoming_tx.clone(),
         state: state.clone(),
     };
-    lead::start(&options, fingerprint, role, stop.clone()).await?;
+    let pool = lead::start(&options, fingerprint, role, stop.clone()).await?;
     let fps = spec.fps;
     let game = std::thread::Builder::new()
         .name("tidepool-edge".into())
         .spawn(move || edge::run(scene, fps, links, bus))
         .map_err(|e| format!("cannot start the game thread ({e})"))?;
-    let pool = Arc::new(pool);
     tokio::spawn(link::follow(pool.clone(), incoming_tx, state.clone(), stop.clone()));
     tokio::spawn(link::forward(pool, outgoing_rx, options.edge.clone(), players, stop));
     Ok(game)
