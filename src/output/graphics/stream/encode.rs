@@ -32,9 +32,15 @@ impl PictureStream {
         if let Protocol::Sixel { .. } = self.protocol {
             let screen = self.layout.picture;
             let sixel = self.sixel.as_mut().expect("a sixel stream has its encoder");
+            // The palette fitted to the scene (once, and again when its colours drift): new
+            // registers, so what the terminal shows can no longer be compared with.
+            if sixel.fit_to(picture.data(), 4) {
+                self.shown = None;
+            }
             // Dithered straight from the pixmap (opaque: its bytes are straight RGB) when the
-            // rung is the picture's size; otherwise resampled to the rung first. Each rung
-            // pixel becomes a block of screen pixels.
+            // rung is the picture's size; otherwise resampled to the rung first (the top rung
+            // is the screen's size: the source enlarged smoothly). Each rung pixel becomes a
+            // block of screen pixels.
             // The top rung (a link that carries whole pictures) gets the fine pattern; the
             // others the flat blocks that cost fewer bytes.
             let fine = rung == 0;
