@@ -325,26 +325,27 @@ impl PictureStream {
     }
 
     /// The ladder for a `source`-sized picture: from the source within the layout's picture
-    /// (sixel: the layout's picture itself) down to a quarter of half-block resolution.
+    /// (sixel: the layout's picture above it) down to a quarter of half-block resolution.
     fn build_ladder(&mut self, source: (u32, u32)) {
         let area = self.layout.picture;
         let k = (f64::from(area.0) / f64::from(source.0.max(1)))
             .min(f64::from(area.1) / f64::from(source.1.max(1)))
             .min(1.0);
-        let top = match self.protocol {
-            // Sixel pixels are screen pixels (the terminal does not scale them): the top rung
-            // is the screen's size, the source enlarged by the resampler's tent filter, so a
-            // link that carries it shows the smooth picture kitty and iTerm2 show, not each
-            // source pixel repeated into a block.
-            Protocol::Sixel { .. } => area,
-            _ => (((f64::from(source.0) * k) as u32).max(1), ((f64::from(source.1) * k) as u32).max(1)),
-        };
+        let top = (((f64::from(source.0) * k) as u32).max(1), ((f64::from(source.1) * k) as u32).max(1));
         // A quarter of half-block resolution: below cells' own, but whole pictures there
         // score better than tiles of a finer rung (`benches/pictures.rs`: kitty at 250 kB/s,
         // SSIM 0.65 with whole 100x59 pictures against 0.62 with tiles of 160x94).
         let bottom = (u32::from(self.layout.cells.0) / 2, u32::from(self.layout.cells.1));
         self.source = source;
         self.rungs = ladder::rungs(top, bottom);
+        // Sixel pixels are screen pixels (the terminal does not scale them): above the source
+        // goes the screen's own size, the source enlarged by the resampler's tent filter, so
+        // a link that carries it shows the smooth picture kitty and iTerm2 show rather than
+        // each source pixel repeated into a block. The rungs below stay the source's, so a
+        // slow link keeps its fine steps near the bottom.
+        if matches!(self.protocol, Protocol::Sixel { .. }) && area != top {
+            self.rungs.insert(0, area);
+        }
         self.cost = vec![None; self.rungs.len()];
         self.rung = 0;
         self.shown = None;
