@@ -48,7 +48,8 @@
 //! send it in tiles, oldest first, each an edit of what is shown and each within the bytes
 //! available now; iTerm2 and kitty without frame edits send the bottom rung less often, when
 //! the bucket holds it. Without a rate every picture goes at the source's own size (no
-//! interpolated pixels), in the packing that costs least CPU.
+//! interpolated pixels; sixel: at the screen's, the source enlarged smoothly, since the
+//! terminal does not scale sixel), in the packing that costs least CPU.
 
 #[cfg(feature = "player")]
 pub mod crossover;
