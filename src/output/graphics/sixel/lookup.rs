@@ -52,7 +52,7 @@ pub const BAYER8: [[u8; 8]; 8] = [
 #[derive(Debug)]
 pub struct ColourMap {
     /// Each register's colour as shown, in OKLab (the drift measure) and in sRGB (the map).
-    labs: Vec<[f32; 3]>,
+    labs: Vec<oklab::Lab>,
     rgbs: Vec<[f32; 3]>,
     /// 64x64x64 registers (`EMPTY` until first used).
     table: Vec<u16>,
@@ -63,12 +63,7 @@ pub struct ColourMap {
 impl ColourMap {
     /// The map for `palette`: an empty table and offsets that span its typical step.
     pub fn new(palette: &SixelPalette) -> ColourMap {
-        let labs = (0..palette.len())
-            .map(|i| {
-                let lab = oklab::from_rgb(palette.rgb(i as u8));
-                [lab.l, lab.a, lab.b]
-            })
-            .collect();
+        let labs = (0..palette.len()).map(|i| oklab::from_rgb(palette.rgb(i as u8))).collect();
         let rgbs = (0..palette.len()).map(|i| palette.rgb(i as u8).map(f32::from)).collect();
         let spread = Self::spread(palette) * SPREAD_STEPS;
         let offsets = std::array::from_fn(|t| (((t as f32 + 0.5) / 64.0 - 0.5) * spread).round() as i16);
@@ -145,9 +140,7 @@ impl ColourMap {
         for i in (0..n).step_by(step) {
             let rgb = [pixels[i * bpp], pixels[i * bpp + 1], pixels[i * bpp + 2]];
             let reg = self.register(rgb, Self::MIDDLE);
-            let lab = oklab::from_rgb(rgb);
-            let p = self.labs[usize::from(reg)];
-            sum += ((lab.l - p[0]).powi(2) + (lab.a - p[1]).powi(2) + (lab.b - p[2]).powi(2)).sqrt();
+            sum += oklab::from_rgb(rgb).distance2(self.labs[usize::from(reg)]).sqrt();
             count += 1;
         }
         sum / count as f32
