@@ -102,7 +102,7 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
             GraphicsMode::Kitty => format!("{:?}", kitty_enc.encode(&rgb, w, h, out)?),
             GraphicsMode::Sixel => {
                 // The palette fitted to the scene (the first picture; again if its colours drift).
-                sixel_enc.fit_to(&rgb, 3);
+                sixel_enc.fit_to(&rgb, 3, 256);
                 format!("{:?}", sixel_enc.encode(&rgb, w, h, out))
             }
             GraphicsMode::Iterm2 => format!("{}", iterm2_enc.encode(picture, out)),

@@ -98,6 +98,8 @@ pub struct SixelEncoder {
     /// The fitted palette's own error on the picture it was fitted to (`None`: not fitted
     /// yet, the palette is the one given).
     fit_error: Option<f32>,
+    /// The registers the terminal offers (the palette given's): the most colours a fit uses.
+    registers_cap: u16,
     /// The picture's top-left cell (column, row), 0-based.
     origin: (u16, u16),
     /// The cell size in pixels, for changed rectangles; `None`: always whole pictures.
@@ -120,6 +122,7 @@ impl SixelEncoder {
         SixelEncoder {
             map: ColourMap::new(&palette),
             fit_error: None,
+            registers_cap: palette.registers(),
             definitions: definitions(&palette),
             palette,
             registers: Registers::PerImage,
@@ -142,17 +145,20 @@ impl SixelEncoder {
         &self.palette
     }
 
-    /// Fits the palette to the picture `pixels` (`bpp` bytes a pixel, RGB first) when none is
+    /// Fits a palette of at most `colours` (and the terminal's registers) to the picture
+    /// `pixels` (`bpp` bytes a pixel, RGB first) when none of that size is
     /// fitted yet or when the picture's colours have drifted from it by more than [`DRIFT`]
     /// (see the module documentation). Returns whether the registers changed: then every
     /// picture shown was drawn with other registers, and the next must be sent whole.
-    pub fn fit_to(&mut self, pixels: &[u8], bpp: usize) -> bool {
+    pub fn fit_to(&mut self, pixels: &[u8], bpp: usize, colours: u16) -> bool {
+        let colours = colours.clamp(MIN_REGISTERS, self.registers_cap);
         if let Some(fitted) = self.fit_error
+            && self.palette.registers() == colours
             && self.map.error(pixels, bpp) <= fitted + DRIFT
         {
             return false;
         }
-        self.set_palette(SixelPalette::fit(pixels, bpp, self.palette.registers()));
+        self.set_palette(SixelPalette::fit(pixels, bpp, colours));
         self.fit_error = Some(self.map.error(pixels, bpp));
         true
     }

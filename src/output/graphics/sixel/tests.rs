@@ -78,12 +78,12 @@ fn a_fitted_palette_is_close_to_the_picture() {
 fn the_palette_is_refitted_only_when_the_colours_drift() {
     let (w, h, rgb) = golden_pool();
     let mut enc = SixelEncoder::new(SixelPalette::for_registers(256), (0, 0), Some((8, 16)));
-    assert!(enc.fit_to(&rgb, 3), "the first picture fits the palette");
+    assert!(enc.fit_to(&rgb, 3, 256), "the first picture fits the palette");
     let fitted = enc.palette().clone();
-    assert!(!enc.fit_to(&rgb, 3), "the same picture: kept");
+    assert!(!enc.fit_to(&rgb, 3, 256), "the same picture: kept");
     // A little brighter everywhere (two levels): kept, the dither covers it.
     let brighter: Vec<u8> = rgb.iter().map(|&v| v.saturating_add(2)).collect();
-    assert!(!enc.fit_to(&brighter, 3), "a small change: kept");
+    assert!(!enc.fit_to(&brighter, 3, 256), "a small change: kept");
     // Half the picture turned red: refitted, and the next picture is sent whole.
     let mut out = Vec::new();
     enc.encode(&rgb, w, h, &mut out);
@@ -91,7 +91,7 @@ fn the_palette_is_refitted_only_when_the_colours_drift() {
     for p in red.chunks_exact_mut(3).take((w * h / 2) as usize) {
         p.copy_from_slice(&[220, 40, 30]);
     }
-    assert!(enc.fit_to(&red, 3), "new colours: refitted");
+    assert!(enc.fit_to(&red, 3, 256), "new colours: refitted");
     assert!(enc.palette() != &fitted);
     assert_eq!(enc.encode(&red, w, h, &mut out), Update::Full, "new registers: sent whole");
 }
