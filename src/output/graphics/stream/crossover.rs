@@ -28,8 +28,8 @@ pub fn crossover(mode: GraphicsMode) -> Option<f64> {
 /// crossover is at or below it; 50 kB/s is taken until lower rates are measured.
 const KITTY_CROSSOVER: f64 = 50_000.0;
 /// sixel has no crossover: in `cargo bench --bench pictures` it loses to cells at every rate,
-/// with the fitted palette too (SSIM 0.43 against 0.52 at 50 kB/s, 0.54/0.58 at 250 kB/s,
-/// 0.59/0.63 at 2 MB/s, unlimited 0.52/0.67 measured a frame after the 15-a-second picture
+/// with the fitted palette too (SSIM 0.47 against 0.52 at 50 kB/s, 0.54/0.58 at 250 kB/s,
+/// 0.58/0.63 at 2 MB/s, unlimited 0.52/0.67 measured a frame after the 15-a-second picture
 /// and 0.89 on its own frames; docs/pixels/sixel-palette.md): under a rate its bytes keep it
 /// on the bottom rung. A local terminal keeps it (no rate: the person asked for pixels by
 /// having them).
