@@ -8,13 +8,13 @@
 //! fitted palette a level or two. The palette is fitted once per scene
 //! ([`SixelEncoder::fit_to`]) and again only when the picture's colours drift from it: the
 //! mean OKLab distance from a subsample of the picture's pixels to their registers, measured
-//! every picture, has grown by [`DRIFT`] over what it was right after the fit. A refit changes
+//! every picture, has grown by `DRIFT` over what it was right after the fit. A refit changes
 //! the registers, so the next picture is sent whole; a palette refitted every frame would make
 //! the water shimmer and nothing could be skipped.
 //!
 //! **Ordered dithering, by position.** Each pixel is moved along the grey axis by an 8x8 Bayer
 //! offset of its screen position, spanning the palette's typical step, and then mapped to a
-//! register through a table filled once per fit ([`lookup`]). The register depends only on the
+//! register through a table filled once per fit (`lookup.rs`). The register depends only on the
 //! pixel's colour and position, so an unchanged block gives the same bytes every frame and
 //! still water sends nothing. (Error diffusion carries each pixel's error to its neighbours, so
 //! one changed pixel changes the rest of the picture.)
@@ -147,7 +147,7 @@ impl SixelEncoder {
 
     /// Fits a palette of at most `colours` (and the terminal's registers) to the picture
     /// `pixels` (`bpp` bytes a pixel, RGB first) when none of that size is
-    /// fitted yet or when the picture's colours have drifted from it by more than [`DRIFT`]
+    /// fitted yet or when the picture's colours have drifted from it by more than `DRIFT`
     /// (see the module documentation). Returns whether the registers changed: then every
     /// picture shown was drawn with other registers, and the next must be sent whole.
     pub fn fit_to(&mut self, pixels: &[u8], bpp: usize, colours: u16) -> bool {

@@ -1,7 +1,7 @@
 //! The sixel encoder's palette: the colours of its registers, as the percentages sixel defines
 //! them with. Either an evenly spaced RGB cube ([`SixelPalette::for_registers`]: what is used
 //! before a picture is seen) or colours fitted to a picture ([`SixelPalette::fit`]: median
-//! cut and k-means in OKLab, see [`super::fit`]).
+//! cut and k-means in OKLab, see `fit.rs`).
 
 use super::{MAX_REGISTERS, MIN_REGISTERS, fit};
 
@@ -50,7 +50,7 @@ impl SixelPalette {
     }
 
     /// At most `registers` (clamped to 8..=256) colours fitted to the picture `pixels` (`bpp`
-    /// bytes a pixel, RGB first): see [`super::fit`]. Colours that round to the same
+    /// bytes a pixel, RGB first): see `fit.rs`. Colours that round to the same
     /// percentages are kept once.
     pub fn fit(pixels: &[u8], bpp: usize, registers: u16) -> SixelPalette {
         let registers = registers.clamp(MIN_REGISTERS, MAX_REGISTERS);
