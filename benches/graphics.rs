@@ -77,7 +77,8 @@ fn graphics(c: &mut Criterion) {
     let (ka_rgb, kb_rgb) = (rgb(&ka), rgb(&kb));
 
     // Bytes per frame, printed once.
-    let palette = SixelPalette::for_registers(256);
+    // The palette fitted to the first frame, as the stream fits it to the scene.
+    let palette = SixelPalette::fit(&sa, 3, 256);
     let mut out = Vec::with_capacity(8 << 20);
     let mut enc = SixelEncoder::new(palette.clone(), (0, 0), Some(CELL_PX));
     enc.encode(&sa, sw, sh, &mut out);
@@ -137,7 +138,7 @@ fn graphics(c: &mut Criterion) {
         })
     });
     group.bench_function("sixel_dither_1280x750", |b| {
-        let enc = SixelEncoder::new(palette.clone(), (0, 0), Some(CELL_PX));
+        let mut enc = SixelEncoder::new(palette.clone(), (0, 0), Some(CELL_PX));
         let mut idx = Vec::new();
         b.iter(|| enc.dither_into(black_box(&sa), sw, sh, &mut idx))
     });

@@ -24,6 +24,7 @@
 //!     PICTURES=table cargo bench --bench pictures
 //!     PICTURES=table PICTURES_MODES=sixel,cells cargo bench --bench pictures   # some modes
 //!     PICTURES=cpu cargo bench --bench pictures
+//!     PICTURES=table PICTURES_PHASE=4 cargo bench --bench pictures   # SSIM on sixel's frames
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -199,7 +200,8 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
     let mut bucket = rate.map_or_else(ByteBucket::unlimited, ByteBucket::new);
     bucket.refill(t0);
     let mut row = Row { rung: "160x94 cells".into(), pictures: 0, bytes: 0, ssim: Vec::new(), times: Vec::new() };
-    let sample = |i: usize| i % SAMPLE_EVERY == SAMPLE_EVERY - 1;
+    let phase = phase();
+    let sample = |i: usize| i % SAMPLE_EVERY == phase;
     if mode == "cells" {
         let (cols, rows) = (usize::from(TERM.0), usize::from(TERM.1));
         let mut encoder = RateEncoder::new();
@@ -258,10 +260,10 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
         }
         if sample(n) {
             let truth = &truths[n];
-            // PICTURES_DEBUG: the mean luma error two seconds in (a misplaced or missing picture
+            // PICTURES_DEBUG: the mean luma error about two seconds in (a misplaced or missing picture
             // shows as tens of levels; sixel's dither alone is about 20, kitty's PNG 4).
             if std::env::var("PICTURES_DEBUG").is_ok()
-                && n == 59
+                && n / SAMPLE_EVERY == 9
                 && let Some(shown) = terminal.luma()
             {
                 let (w, h) = (shown.width().min(truth.width()), shown.height().min(truth.height()));
@@ -315,6 +317,17 @@ fn view_ssim(a: &Luma, b: &Luma) -> f64 {
     tidepool::testing::ssim(&shrink(a), &shrink(b))
 }
 
+/// The frame of each `SAMPLE_EVERY` that SSIM is measured on: the last unless `PICTURES_PHASE`
+/// says otherwise. Sixel pictures go at 15 a second, on even frames: on the default (odd)
+/// frames sixel always shows the frame before the truth, `PICTURES_PHASE=4` measures the
+/// frames it draws.
+fn phase() -> usize {
+    std::env::var("PICTURES_PHASE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .map_or(SAMPLE_EVERY - 1, |p: usize| p % SAMPLE_EVERY)
+}
+
 fn percentile(values: &[f64], p: f64) -> f64 {
     let mut sorted = values.to_vec();
     sorted.sort_by(f64::total_cmp);
@@ -328,7 +341,7 @@ fn table() {
         .iter()
         .enumerate()
         .map(|(n, p)| {
-            if n % SAMPLE_EVERY == SAMPLE_EVERY - 1 {
+            if n % SAMPLE_EVERY == phase() {
                 let mut rgb = Vec::new();
                 tidepool::testing::resample(p.data(), 4, SCENE, SCENE, &mut rgb);
                 luma_at(&rgb, SCENE, AREA, false)

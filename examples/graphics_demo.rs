@@ -100,7 +100,11 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
         let (w, h) = (picture.width(), picture.height());
         let what = match choice.mode {
             GraphicsMode::Kitty => format!("{:?}", kitty_enc.encode(&rgb, w, h, out)?),
-            GraphicsMode::Sixel => format!("{:?}", sixel_enc.encode(&rgb, w, h, out)),
+            GraphicsMode::Sixel => {
+                // The palette fitted to the scene (the first picture; again if its colours drift).
+                sixel_enc.fit_to(&rgb, 3, 256);
+                format!("{:?}", sixel_enc.encode(&rgb, w, h, out))
+            }
             GraphicsMode::Iterm2 => format!("{}", iterm2_enc.encode(picture, out)),
             GraphicsMode::Cells => {
                 let mut frame = tidepool::terminal::Frame::new(usize::from(cols), usize::from(rows) - 1);

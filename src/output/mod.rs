@@ -14,7 +14,6 @@ pub mod graphics;
 pub mod halfblock;
 pub mod heightmap;
 pub mod maps;
-#[cfg(any(test, feature = "player", feature = "testing"))]
 pub mod oklab;
 pub mod png;
 #[cfg(any(test, feature = "testing"))]

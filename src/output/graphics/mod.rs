@@ -4,8 +4,8 @@
 //! - [`kitty`]: one image id replaced in place, zlib-compressed RGB in base64 chunks (or a
 //!   temporary file when the terminal is on this machine), optional changed-rectangle updates,
 //!   Unicode placeholders for tmux; [`kitty_decode`] parses such a stream back into pixels.
-//! - [`sixel`]: a fixed palette with ordered dithering, so still water encodes to the same
-//!   bytes every frame.
+//! - [`sixel`]: a palette fitted to the scene with ordered dithering by position, so still
+//!   water encodes to the same bytes every frame.
 //! - [`iterm2`]: OSC 1337 inline PNG.
 //! - [`tmux`]: the passthrough wrapper every protocol needs inside tmux.
 //! - [`geometry`]: which resolution to render for each protocol, and which picture pixel a

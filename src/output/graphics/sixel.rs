@@ -1,22 +1,23 @@
-//! The sixel encoder: a fixed palette, ordered dithering, run-length encoding, one pixel per
-//! pixel.
+//! The sixel encoder: a palette fitted to the scene, a position-stable ordered dither,
+//! run-length encoding, one pixel per pixel.
 //!
-//! **Fixed palette.** The colour registers hold an evenly spaced RGB cube whose size the
-//! terminal's register count decides ([`SixelPalette::for_registers`]): with 256 registers it is
-//! 6 levels of red, 7 of green, 6 of blue (252 colours). Green gets the extra level because the
-//! eye is most sensitive to it (it carries ~60% of luminance). The remaining 4 registers are
-//! left unused rather than spent on greys: a grey ramp beside the cube would need a
-//! nearest-colour search per pixel, which costs the speed that dithering each channel on its
-//! own (three table look-ups a pixel) buys, and water has little pure grey; the cube's
-//! dither already averages to the right grey. A per-frame palette (what most sixel encoders
-//! make, by median cut or k-means) changes when the water moves, so every pixel's colour
-//! shifts with it: it shimmers and nothing can be skipped.
+//! **A palette fitted to the scene.** The colour registers hold colours fitted to the picture
+//! ([`SixelPalette::fit`]: median cut and k-means in OKLab over a subsample), as many as the
+//! terminal offers up to 256. Water uses a small part of the RGB cube: the fixed 6x7x6 cube
+//! used before left every pixel about 20 luma levels from its colour before dithering, a
+//! fitted palette a level or two. The palette is fitted once per scene
+//! ([`SixelEncoder::fit_to`]) and again only when the picture's colours drift from it: the
+//! mean OKLab distance from a subsample of the picture's pixels to their registers, measured
+//! every picture, has grown by `DRIFT` over what it was right after the fit. A refit changes
+//! the registers, so the next picture is sent whole; a palette refitted every frame would make
+//! the water shimmer and nothing could be skipped.
 //!
-//! **Ordered dithering.** Each channel is dithered between its two nearest levels with an 8x8
-//! Bayer threshold: the output depends only on the pixel's colour and position, so the same
-//! picture gives the same bytes every frame and still water sends nothing. (Error diffusion
-//! carries each pixel's error to its neighbours, so one changed pixel changes the rest of the
-//! picture.) The 64 thresholds average a level step exactly, so flat colours keep their mean.
+//! **Ordered dithering, by position.** Each pixel is moved along the grey axis by an 8x8 Bayer
+//! offset of its screen position, spanning the palette's typical step, and then mapped to a
+//! register through a table filled once per fit (`lookup.rs`). The register depends only on the
+//! pixel's colour and position, so an unchanged block gives the same bytes every frame and
+//! still water sends nothing. (Error diffusion carries each pixel's error to its neighbours, so
+//! one changed pixel changes the rest of the picture.)
 //!
 //! **Bytes.** Raster attributes `"1;1;W;H` ask for square pixels, one per screen pixel; `P2=1`
 //! leaves pixels no colour covers as they are. The picture is cut into bands of six rows; in
@@ -37,8 +38,11 @@
 //! match the whole picture exactly. Whole pictures should be a multiple of 6 rows tall for the
 //! same reason ([`crate::output::graphics::geometry`] picks such sizes).
 
+mod fit;
+mod lookup;
 mod palette;
 
+use self::lookup::{BAYER_SIDE, BAYER8, ColourMap};
 pub use self::palette::SixelPalette;
 pub use super::Update;
 
@@ -47,26 +51,16 @@ pub use super::Update;
 pub const MAX_REGISTERS: u16 = 256;
 /// The fewest registers a palette is built for (2 levels a channel).
 pub const MIN_REGISTERS: u16 = 8;
-/// The side of the Bayer matrix.
-const BAYER_SIDE: usize = 8;
+/// How far the picture's colours may drift from the palette before it is fitted again: the
+/// mean OKLab distance from the picture's pixels to their registers may grow this much over
+/// the fit's own (a quarter of a just-noticeable difference).
+pub const DRIFT: f32 = crate::output::oklab::JND / 4.0;
 /// The most bytes tmux (3.3 to 3.6) reads of one escape sequence: a longer sixel image is dropped.
 /// Kept a little under 1 MiB for the passthrough wrapper's doubled escapes and the cursor move.
 #[cfg(any(test, feature = "player", feature = "testing"))]
 pub const TMUX_MAX_IMAGE_BYTES: usize = (1 << 20) - 4096;
 /// A run of this many equal sixels or more is written `!n` (`!4x` is shorter than `xxxx`).
 const MIN_RUN: usize = 4;
-
-/// 8x8 Bayer thresholds, 0..64.
-const BAYER8: [[u8; 8]; 8] = [
-    [0, 32, 8, 40, 2, 34, 10, 42],
-    [48, 16, 56, 24, 50, 18, 58, 26],
-    [12, 44, 4, 36, 14, 46, 6, 38],
-    [60, 28, 52, 20, 62, 30, 54, 22],
-    [3, 35, 11, 43, 1, 33, 9, 41],
-    [51, 19, 59, 27, 49, 17, 57, 25],
-    [15, 47, 7, 39, 13, 45, 5, 37],
-    [63, 31, 55, 23, 61, 29, 53, 21],
-];
 
 /// When the colour registers are defined.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -99,7 +93,13 @@ pub struct SixelEncoder {
     band: Vec<u8>,
     /// The source column of every target column, for [`SixelEncoder::dither_scaled`].
     x_map: Vec<u32>,
-    tables: Vec<[[u8; 256]; 64]>,
+    /// From colour and dither threshold to register, for the palette.
+    map: ColourMap,
+    /// The fitted palette's own error on the picture it was fitted to (`None`: not fitted
+    /// yet, the palette is the one given).
+    fit_error: Option<f32>,
+    /// The registers the terminal offers (the palette given's): the most colours a fit uses.
+    registers_cap: u16,
     /// The picture's top-left cell (column, row), 0-based.
     origin: (u16, u16),
     /// The cell size in pixels, for changed rectangles; `None`: always whole pictures.
@@ -118,24 +118,19 @@ impl SixelEncoder {
     /// An encoder for `palette`, the picture's top-left at cell `origin`; changed rectangles
     /// are used when the cell size in pixels is known.
     pub fn new(palette: SixelPalette, origin: (u16, u16), cell_px: Option<(u16, u16)>) -> SixelEncoder {
-        let tables = palette.tables();
         let n = palette.len();
-        let definitions = (0..n)
-            .map(|i| {
-                let [r, g, b] = palette.percent_rgb(i as u8);
-                format!(";2;{r};{g};{b}").into_bytes()
-            })
-            .collect();
         SixelEncoder {
+            map: ColourMap::new(&palette),
+            fit_error: None,
+            registers_cap: palette.registers(),
+            definitions: definitions(&palette),
             palette,
-            definitions,
             registers: Registers::PerImage,
             defined: vec![false; n],
             max_image_bytes: None,
             tmux: false,
             band: Vec::new(),
             x_map: Vec::new(),
-            tables,
             origin,
             cell_px: cell_px.filter(|&(w, h)| w > 0 && h > 0),
             current: Vec::new(),
@@ -148,6 +143,36 @@ impl SixelEncoder {
     /// The palette.
     pub fn palette(&self) -> &SixelPalette {
         &self.palette
+    }
+
+    /// Fits a palette of at most `colours` (and the terminal's registers) to the picture
+    /// `pixels` (`bpp` bytes a pixel, RGB first) when none of that size is
+    /// fitted yet or when the picture's colours have drifted from it by more than `DRIFT`
+    /// (see the module documentation). Returns whether the registers changed: then every
+    /// picture shown was drawn with other registers, and the next must be sent whole.
+    pub fn fit_to(&mut self, pixels: &[u8], bpp: usize, colours: u16) -> bool {
+        let colours = colours.clamp(MIN_REGISTERS, self.registers_cap);
+        if let Some(fitted) = self.fit_error
+            && self.palette.registers() == colours
+            && self.map.error(pixels, bpp) <= fitted + DRIFT
+        {
+            return false;
+        }
+        self.set_palette(SixelPalette::fit(pixels, bpp, colours));
+        self.fit_error = Some(self.map.error(pixels, bpp));
+        true
+    }
+
+    /// Uses `palette` from now on: its registers are defined again where next used, and the
+    /// next picture is sent whole.
+    fn set_palette(&mut self, palette: SixelPalette) {
+        let n = palette.len();
+        self.map = ColourMap::new(&palette);
+        self.definitions = definitions(&palette);
+        self.defined = vec![false; n];
+        self.columns = vec![Vec::new(); n];
+        self.palette = palette;
+        self.shown = None;
     }
 
     /// Forgets what the terminal shows (a resize, a cleared screen): the next picture is sent
@@ -201,7 +226,7 @@ impl SixelEncoder {
         self.x_map.clear();
         self.x_map
             .extend((0..u64::from(tw)).map(|x| (x * u64::from(width) / u64::from(tw.max(1))) as u32 * bpp as u32));
-        let [tr, tg, tb] = [&self.tables[0], &self.tables[1], &self.tables[2]];
+        let map = &mut self.map;
         let stride = width as usize * bpp;
         // The threshold follows the source pixel, so a repeated pixel is one flat colour (runs
         // of equal sixels: a smaller picture costs fewer bytes); at scale 1 it is the target's.
@@ -212,7 +237,7 @@ impl SixelEncoder {
             for (x, &at) in self.x_map.iter().enumerate() {
                 let p = &row[at as usize..at as usize + 3];
                 let t = usize::from(thresholds[if fine { x } else { at as usize / bpp } % BAYER_SIDE]);
-                out.push(tr[t][usize::from(p[0])] + tg[t][usize::from(p[1])] + tb[t][usize::from(p[2])]);
+                out.push(map.register([p[0], p[1], p[2]], t));
             }
         }
     }
@@ -253,16 +278,15 @@ impl SixelEncoder {
     }
 
     /// The register of every pixel of `rgb` (`width x height`, 3 bytes a pixel), dithered.
-    pub fn dither_into(&self, rgb: &[u8], width: u32, height: u32, out: &mut Vec<u8>) {
+    pub fn dither_into(&mut self, rgb: &[u8], width: u32, height: u32, out: &mut Vec<u8>) {
         assert_eq!(rgb.len(), width as usize * height as usize * 3, "RGB buffer does not match {width}x{height}");
         out.clear();
         out.reserve(width as usize * height as usize);
-        let [tr, tg, tb] = [&self.tables[0], &self.tables[1], &self.tables[2]];
         for (y, row) in rgb.chunks_exact(width as usize * 3).enumerate() {
             let thresholds = &BAYER8[y % BAYER_SIDE];
             for (x, p) in row.chunks_exact(3).enumerate() {
                 let t = usize::from(thresholds[x % BAYER_SIDE]);
-                out.push(tr[t][usize::from(p[0])] + tg[t][usize::from(p[1])] + tb[t][usize::from(p[2])]);
+                out.push(self.map.register([p[0], p[1], p[2]], t));
             }
         }
     }
@@ -420,6 +444,16 @@ impl SixelEncoder {
     }
 }
 
+/// Each register's definition (`;2;r;g;b` after `#i`).
+fn definitions(palette: &SixelPalette) -> Vec<Vec<u8>> {
+    (0..palette.len())
+        .map(|i| {
+            let [r, g, b] = palette.percent_rgb(i as u8);
+            format!(";2;{r};{g};{b}").into_bytes()
+        })
+        .collect()
+}
+
 /// Appends an image's start: DCS with `P2=1` (uncovered pixels stay as they are) and raster
 /// attributes for square pixels of a `w x h` picture.
 fn push_header(out: &mut Vec<u8>, w: u32, h: u32) {
@@ -504,7 +538,7 @@ fn changed_cells(
 /// The picture the terminal shows for `rgb` after dithering with `palette` (each pixel its
 /// register's colour): what a decoded stream must equal.
 pub fn dithered_rgb(palette: &SixelPalette, rgb: &[u8], width: u32, height: u32) -> Vec<u8> {
-    let encoder = SixelEncoder::new(palette.clone(), (0, 0), None);
+    let mut encoder = SixelEncoder::new(palette.clone(), (0, 0), None);
     let mut indices = Vec::new();
     encoder.dither_into(rgb, width, height, &mut indices);
     indices.iter().flat_map(|&i| palette.rgb(i)).collect()

@@ -81,7 +81,7 @@ impl Inline {
             GraphicsMode::Sixel => {
                 push_rgb(picture, &mut rgb);
                 let registers = self.support.sixel_registers();
-                SixelEncoder::new(SixelPalette::for_registers(registers), (0, 0), None).encode(&rgb, w, h, &mut out);
+                SixelEncoder::new(SixelPalette::fit(&rgb, 3, registers), (0, 0), None).encode(&rgb, w, h, &mut out);
             }
             GraphicsMode::Iterm2 => {
                 Iterm2Encoder::new((0, 0), self.layout.cells, self.choice.tmux_wrap).encode(picture, &mut out);

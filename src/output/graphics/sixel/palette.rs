@@ -1,22 +1,25 @@
-//! The sixel encoder's fixed palette: an evenly spaced RGB cube of colour registers, and the
-//! tables that dither each channel between its two nearest levels (see the encoder's module
-//! documentation for why the palette is fixed and the dither ordered).
+//! The sixel encoder's palette: the colours of its registers, as the percentages sixel defines
+//! them with. Either an evenly spaced RGB cube ([`SixelPalette::for_registers`]: what is used
+//! before a picture is seen) or colours fitted to a picture ([`SixelPalette::fit`]: median
+//! cut and k-means in OKLab, see `fit.rs`).
 
-use super::{MAX_REGISTERS, MIN_REGISTERS};
+use super::{MAX_REGISTERS, MIN_REGISTERS, fit};
 
-/// An RGB cube of colour registers.
+/// The colours of the registers, in percent (what the stream defines), at most 256.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct SixelPalette {
-    /// Levels of red, green and blue.
-    levels: [u8; 3],
+    percent: Vec<[u8; 3]>,
+    /// The registers the terminal offers (clamped to 8..=256): what a refit may use.
+    registers: u16,
 }
 
 impl SixelPalette {
-    /// The largest cube that fits in `registers` (clamped to 8..=
-    /// 256): levels are added green, red, blue in turn while they fit, so 256
-    /// registers give 6x7x6, 64 give 4x4x4, 16 give 2x4x2.
+    /// The largest RGB cube that fits in `registers` (clamped to 8..=256): levels are added
+    /// green, red, blue in turn while they fit, so 256 registers give 6x7x6, 64 give 4x4x4,
+    /// 16 give 2x4x2. Blue varies fastest (register `r * lg * lb + g * lb + b`).
     pub fn for_registers(registers: u16) -> SixelPalette {
-        let n = u32::from(registers.clamp(MIN_REGISTERS, MAX_REGISTERS));
+        let registers = registers.clamp(MIN_REGISTERS, MAX_REGISTERS);
+        let n = u32::from(registers);
         let mut levels = [2u32; 3];
         loop {
             let mut grew = false;
@@ -32,75 +35,61 @@ impl SixelPalette {
                 break;
             }
         }
-        SixelPalette { levels: levels.map(|l| l as u8) }
+        // Level i of n levels in percent, rounded half up.
+        let level = |i: u32, n: u32| ((200 * i + n - 1) / (2 * (n - 1))) as u8;
+        let [lr, lg, lb] = levels;
+        let mut percent = Vec::with_capacity(n as usize);
+        for r in 0..lr {
+            for g in 0..lg {
+                for b in 0..lb {
+                    percent.push([level(r, lr), level(g, lg), level(b, lb)]);
+                }
+            }
+        }
+        SixelPalette { percent, registers }
     }
 
-    /// Levels of red, green and blue.
-    pub fn levels(&self) -> [u8; 3] {
-        self.levels
+    /// At most `registers` (clamped to 8..=256) colours fitted to the picture `pixels` (`bpp`
+    /// bytes a pixel, RGB first): see `fit.rs`. Colours that round to the same
+    /// percentages are kept once.
+    pub fn fit(pixels: &[u8], bpp: usize, registers: u16) -> SixelPalette {
+        let registers = registers.clamp(MIN_REGISTERS, MAX_REGISTERS);
+        let colours = fit::fit(&fit::subsample(pixels, bpp), usize::from(registers));
+        let mut percent: Vec<[u8; 3]> = Vec::with_capacity(colours.len());
+        for c in colours {
+            let p = c.map(|v| ((u32::from(v) * 100 + 127) / 255) as u8);
+            if !percent.contains(&p) {
+                percent.push(p);
+            }
+        }
+        if percent.is_empty() {
+            percent.push([0, 0, 0]);
+        }
+        SixelPalette { percent, registers }
+    }
+
+    /// The registers the palette was made for (what a refit may use).
+    pub fn registers(&self) -> u16 {
+        self.registers
     }
 
     /// Number of colours.
     pub fn len(&self) -> usize {
-        self.levels.iter().map(|&l| usize::from(l)).product()
+        self.percent.len()
     }
 
-    /// Whether the palette is empty (never: at least 2 levels a channel).
+    /// Whether the palette is empty (never: at least one colour).
     pub fn is_empty(&self) -> bool {
-        false
-    }
-
-    /// Level `i` of a channel with `levels` levels, in percent as sixel colour registers take it.
-    fn percent(i: u8, levels: u8) -> u8 {
-        ((200 * u32::from(i) + u32::from(levels) - 1) / (2 * (u32::from(levels) - 1))) as u8
-    }
-
-    /// The 0..=255 value a terminal makes of a percentage: `(p * 255 + 50) / 100`, as xterm.
-    fn value(percent: u8) -> u8 {
-        ((u32::from(percent) * 255 + 50) / 100) as u8
+        self.percent.is_empty()
     }
 
     /// The register's colour in percent (what the stream defines).
     pub fn percent_rgb(&self, index: u8) -> [u8; 3] {
-        let [lr, lg, lb] = self.levels;
-        let i = index as usize;
-        let (r, g, b) =
-            (i / (usize::from(lg) * usize::from(lb)), i / usize::from(lb) % usize::from(lg), i % usize::from(lb));
-        [Self::percent(r as u8, lr), Self::percent(g as u8, lg), Self::percent(b as u8, lb)]
+        self.percent[usize::from(index)]
     }
 
-    /// The register's colour as the terminal shows it.
+    /// The register's colour as the terminal shows it: `(p * 255 + 50) / 100`, as xterm.
     pub fn rgb(&self, index: u8) -> [u8; 3] {
-        self.percent_rgb(index).map(Self::value)
-    }
-
-    /// For each channel, Bayer threshold and value: the channel's share of the register index.
-    pub(super) fn tables(&self) -> Vec<[[u8; 256]; 64]> {
-        let [_, lg, lb] = self.levels.map(u16::from);
-        let strides = [lg * lb, lb, 1];
-        (0..3)
-            .map(|c| {
-                let levels = self.levels[c];
-                let values: Vec<u16> = (0..levels).map(|i| u16::from(Self::value(Self::percent(i, levels)))).collect();
-                let mut table = [[0u8; 256]; 64];
-                for (t, row) in table.iter_mut().enumerate() {
-                    for (v, entry) in row.iter_mut().enumerate() {
-                        let v = v as u16;
-                        // The level just below (or at) v, and whether v rounds up at threshold t:
-                        // up when the fraction of the step exceeds (t + 0.5) / 64.
-                        let lo = values.iter().rposition(|&l| l <= v).unwrap_or(0);
-                        let level = if lo + 1 < values.len() {
-                            let (a, b) = (values[lo], values[lo + 1]);
-                            let up = 128 * (v - a) > (2 * t as u16 + 1) * (b - a);
-                            lo + usize::from(up)
-                        } else {
-                            lo
-                        };
-                        *entry = (level as u16 * strides[c]) as u8;
-                    }
-                }
-                table
-            })
-            .collect()
+        self.percent_rgb(index).map(|p| ((u32::from(p) * 255 + 50) / 100) as u8)
     }
 }

@@ -27,11 +27,12 @@ pub fn crossover(mode: GraphicsMode) -> Option<f64> {
 /// measured, kitty already scored SSIM 0.583 against the cells' 0.519 (250 kB/s: 0.603), so the
 /// crossover is at or below it; 50 kB/s is taken until lower rates are measured.
 const KITTY_CROSSOVER: f64 = 50_000.0;
-/// sixel has no crossover: in `cargo bench --bench pictures` it lost to cells at every rate
-/// (SSIM 0.38 against 0.52 at 50 kB/s, 0.44/0.58 at 250 kB/s, 0.39/0.63 at 2 MB/s), and even
-/// unlimited (0.17/0.67): a fixed 6x7x6 cube's ordered dither moves each pixel by about half a
-/// level step (a mean luma error of 20 against kitty's 4), more than the water's own local
-/// contrast. A local terminal keeps it (no rate: the person asked for pixels by having them).
+/// sixel has no crossover: in `cargo bench --bench pictures` it loses to cells at every rate,
+/// with the fitted palette too (SSIM 0.47 against 0.52 at 50 kB/s, 0.54/0.58 at 250 kB/s,
+/// 0.58/0.63 at 2 MB/s, unlimited 0.52/0.67 measured a frame after the 15-a-second picture
+/// and 0.89 on its own frames; docs/pixels/sixel-palette.md): under a rate its bytes keep it
+/// on the bottom rung. A local terminal keeps it (no rate: the person asked for pixels by
+/// having them).
 const SIXEL_CROSSOVER: Option<f64> = None;
 /// iTerm2's crossover, bytes per second: JPEG won at 50 kB/s (0.604 against 0.519) and at
 /// 250 kB/s (0.664).

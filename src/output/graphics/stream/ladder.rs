@@ -1,7 +1,8 @@
 //! The resolution ladder and the resampler that puts any picture on a rung.
 //!
 //! The top rung is the source picture (the scene as rendered, within the layout's picture:
-//! a rung above it would only interpolate); the bottom rung is given (the stream takes a
+//! a rung above it would only interpolate, except for sixel, whose stream puts the screen's
+//! size above it because the terminal does not scale sixel pixels); the bottom rung is given (the stream takes a
 //! quarter of half-block resolution: a whole picture there moves truer than tiles of a finer
 //! one on a slow link). Between them the sides shrink by
 //! about a sixth a rung, so each rung has about 70% of the pixels of the one above and costs

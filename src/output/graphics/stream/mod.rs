@@ -48,7 +48,8 @@
 //! send it in tiles, oldest first, each an edit of what is shown and each within the bytes
 //! available now; iTerm2 and kitty without frame edits send the bottom rung less often, when
 //! the bucket holds it. Without a rate every picture goes at the source's own size (no
-//! interpolated pixels), in the packing that costs least CPU.
+//! interpolated pixels; sixel: at the screen's, the source enlarged smoothly, since the
+//! terminal does not scale sixel), in the packing that costs least CPU.
 
 #[cfg(feature = "player")]
 pub mod crossover;
@@ -324,8 +325,8 @@ impl PictureStream {
         self.next_due.is_none_or(|t| now >= t)
     }
 
-    /// The ladder for a `source`-sized picture: from the source within the layout's picture down
-    /// to a quarter of half-block resolution.
+    /// The ladder for a `source`-sized picture: from the source within the layout's picture
+    /// (sixel: the layout's picture above it) down to a quarter of half-block resolution.
     fn build_ladder(&mut self, source: (u32, u32)) {
         let area = self.layout.picture;
         let k = (f64::from(area.0) / f64::from(source.0.max(1)))
@@ -338,6 +339,14 @@ impl PictureStream {
         let bottom = (u32::from(self.layout.cells.0) / 2, u32::from(self.layout.cells.1));
         self.source = source;
         self.rungs = ladder::rungs(top, bottom);
+        // Sixel pixels are screen pixels (the terminal does not scale them): above the source
+        // goes the screen's own size, the source enlarged by the resampler's tent filter, so
+        // a link that carries it shows the smooth picture kitty and iTerm2 show rather than
+        // each source pixel repeated into a block. The rungs below stay the source's, so a
+        // slow link keeps its fine steps near the bottom.
+        if matches!(self.protocol, Protocol::Sixel { .. }) && area != top {
+            self.rungs.insert(0, area);
+        }
         self.cost = vec![None; self.rungs.len()];
         self.rung = 0;
         self.shown = None;
