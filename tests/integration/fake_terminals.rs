@@ -119,8 +119,8 @@ fn true_colour_is_found_by_asking_the_terminal_or_by_its_name() {
         // The manual override wins over the answers.
         (text(Tcap::Rgb, Sgr::TrueColor, "xterm-256color"), &["--color", "256"][..], false),
     ];
-    let runs: Vec<(&(Profile, &[&str], bool), bool)> =
-        cases.iter().flat_map(|case| [true, false].map(move |ssh| (case, ssh))).collect();
+    type Case<'a> = (Profile, &'a [&'a str], bool);
+    let runs: Vec<(&Case, bool)> = cases.iter().flat_map(|case| [true, false].map(move |ssh| (case, ssh))).collect();
     let failed = side_by_side(&runs, |&((profile, args, truecolor), ssh)| {
         let what = format!("{:?}/{:?} TERM={} {args:?} ssh {ssh}", profile.tcap, profile.sgr, profile.term);
         let (shown, fake) = match std::panic::catch_unwind(|| play(profile.clone(), args, ssh)) {
@@ -130,12 +130,12 @@ fn true_colour_is_found_by_asking_the_terminal_or_by_its_name() {
         let fake = fake.lock().unwrap();
         let (rgb, palette) = fake.colour_codes();
         let hint = fake.raw.windows(17).any(|w| w == b"--color truecolor");
+        let colours_right = if *truecolor { rgb > 100 && rgb > palette } else { palette > 100 && rgb == 0 };
         if !matches!(shown, Shown::Cells(_)) {
             Some(format!("{what}: {shown:?}"))
-        } else if *truecolor && !(rgb > 100 && rgb > palette) {
-            Some(format!("{what}: 24-bit colours expected ({rgb} 24-bit, {palette} palette)"))
-        } else if !truecolor && !(palette > 100 && rgb == 0) {
-            Some(format!("{what}: 256 colours expected ({rgb} 24-bit, {palette} palette)"))
+        } else if !colours_right {
+            let expected = if *truecolor { "24-bit" } else { "256" };
+            Some(format!("{what}: {expected} colours expected ({rgb} 24-bit, {palette} palette)"))
         } else if hint != (!truecolor && args.is_empty()) {
             Some(format!("{what}: the hint to use --color truecolor: {hint}"))
         } else {
