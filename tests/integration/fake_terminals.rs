@@ -3,7 +3,7 @@
 //! with a notice, never a blank screen.
 
 use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, PoisonError, RwLock};
 use std::time::{Duration, Instant};
 
 use crate::common::fake_terminal::{Edits, FakeTerminal, Profile, Shown, Watch};
@@ -212,6 +212,11 @@ fn every_graphics_terminal_gets_pictures_in_the_protocol_it_speaks_locally_and_o
 /// once keep two cores busy; the 78 runs above took 60 s one after another in CI.
 const RUNS_AT_ONCE: usize = 3;
 
+/// Held shared by each run of [`side_by_side`] and alone by a test that measures a rate: the
+/// extra players never take the CPU from the player it measures (a slow kitty's rate fell to
+/// 2.5 kB/s beside three of them on a loaded machine).
+static PLAYERS: RwLock<()> = RwLock::new(());
+
 /// `check` on every item, [`RUNS_AT_ONCE`] at a time; what it found wrong, in the items' order.
 fn side_by_side<T: Sync>(items: &[T], check: impl Fn(&T) -> Option<String> + Sync) -> Vec<String> {
     let next = AtomicUsize::new(0);
@@ -222,6 +227,7 @@ fn side_by_side<T: Sync>(items: &[T], check: impl Fn(&T) -> Option<String> + Syn
                 loop {
                     let i = next.fetch_add(1, Ordering::Relaxed);
                     let Some(item) = items.get(i) else { break };
+                    let _shared = PLAYERS.read().unwrap_or_else(PoisonError::into_inner);
                     if let Some(wrong) = check(item) {
                         found.lock().unwrap().push((i, wrong));
                     }
@@ -241,6 +247,7 @@ fn da1_questions(chunk: &[u8]) -> usize {
 
 #[test]
 fn a_kitty_slow_to_answer_keeps_its_rate_over_ssh() {
+    let _alone = PLAYERS.write().unwrap_or_else(PoisonError::into_inner);
     // Debian's kitty 0.26 under llvmpipe answers in its own time (median 18 ms, p90 98 ms); the
     // link control read that as the link's queue and the rate fell to the 2 kB/s floor within
     // 5 s: a black or half-painted picture, then cells in palette colours. Here the fake is
