@@ -74,8 +74,11 @@ pub mod serve {
 /// default; `tests/`, `benches/` and `examples/` turn it on through a dev-dependency): a terminal
 /// model that plays bytes back and the picture's quality as seen on it (SSIM, PSNR), an
 /// independent decoder of kitty's commands, and the knobs of the encoders the play session runs
-/// under a link's rate. Not part of the chosen API: they change when the tests need them to.
+/// under a link's rate. Not part of the chosen API: they change when the tests need them to,
+/// so the API's documentation leaves them out (their own doc comments stay, for the tests'
+/// authors: `cargo doc --document-hidden-items`).
 #[cfg(feature = "testing")]
+#[doc(hidden)]
 pub mod testing {
     pub use crate::output::diff::{SYNC_BEGIN, SYNC_END};
     pub use crate::output::graphics::kitty_decode::{Image as KittyImage, KittyState, decode as kitty_decode};

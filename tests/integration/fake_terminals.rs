@@ -2,7 +2,8 @@
 //! ([`crate::common::fake_terminal`]): each gets a picture in the protocol it speaks, or cells
 //! with a notice, never a blank screen.
 
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex, PoisonError, RwLock};
 use std::time::{Duration, Instant};
 
 use crate::common::fake_terminal::{Edits, FakeTerminal, Profile, Shown, Watch};
@@ -24,7 +25,9 @@ fn play(profile: Profile, args: &[&str], ssh: bool) -> (Shown, Arc<Mutex<FakeTer
         env.push(SSH);
     }
     let all: Vec<&str> = ["play", "--rain", "0.05"].iter().chain(args).copied().collect();
-    let name = format!("fake-{}", profile.name.replace(' ', "-"));
+    // Runs go on side by side (see `RUNS_AT_ONCE`): each has a folder of its own.
+    static RUN: AtomicUsize = AtomicUsize::new(0);
+    let name = format!("fake-{}-{}", profile.name.replace(' ', "-"), RUN.fetch_add(1, Ordering::Relaxed));
     let mut p = Player::spawn_fake(&temp_dir(&name), &all, &env, Arc::clone(&fake));
     let deadline = Instant::now() + HANG;
     let mut watch = Watch::new(fake.lock().unwrap().has_graphics());
@@ -72,21 +75,20 @@ fn play_or_blank(profile: Profile, args: &[&str], ssh: bool) -> Result<Shown, St
 
 #[test]
 fn a_kitty_terminal_refusing_or_ignoring_frame_edits_over_ssh_gets_pictures() {
-    let mut outcomes = Vec::new();
-    for edits in [Edits::Refuse, Edits::Ignore] {
-        for args in [&["--graphics", "kitty"][..], &[][..]] {
-            for run in 0..3 {
-                let shown = play_or_blank(Profile::kitty_minimal(edits), args, true);
-                outcomes.push((edits, args, run, shown));
-            }
-        }
-    }
-    let failed: Vec<String> = outcomes
-        .iter()
-        .filter(|(_, _, _, shown)| !matches!(shown, Ok(Shown::Kitty(..))))
-        .map(|(edits, args, run, shown)| format!("{edits:?} {args:?} run {run}: {shown:?}"))
+    let runs: Vec<(Edits, &[&str], usize)> = [Edits::Refuse, Edits::Ignore]
+        .into_iter()
+        .flat_map(|edits| {
+            [&["--graphics", "kitty"][..], &[][..]]
+                .into_iter()
+                .flat_map(move |args| (0..3).map(move |run| (edits, args, run)))
+        })
         .collect();
-    assert!(failed.is_empty(), "{} of {} runs without a picture:\n{}", failed.len(), outcomes.len(), failed.join("\n"));
+    let failed =
+        side_by_side(&runs, |&(edits, args, run)| match play_or_blank(Profile::kitty_minimal(edits), args, true) {
+            Ok(Shown::Kitty(..)) => None,
+            shown => Some(format!("{edits:?} {args:?} run {run}: {shown:?}")),
+        });
+    assert!(failed.is_empty(), "{} of {} runs without a picture:\n{}", failed.len(), runs.len(), failed.join("\n"));
 }
 
 #[test]
@@ -117,25 +119,30 @@ fn true_colour_is_found_by_asking_the_terminal_or_by_its_name() {
         // The manual override wins over the answers.
         (text(Tcap::Rgb, Sgr::TrueColor, "xterm-256color"), &["--color", "256"][..], false),
     ];
-    for (profile, args, truecolor) in cases {
-        for ssh in [true, false] {
-            let what = format!("{:?}/{:?} TERM={} {args:?} ssh {ssh}", profile.tcap, profile.sgr, profile.term);
-            let (shown, fake) = play(profile.clone(), args, ssh);
-            assert!(matches!(shown, Shown::Cells(_)), "{what}: {shown:?}");
-            let (rgb, palette) = fake.lock().unwrap().colour_codes();
-            if truecolor {
-                assert!(
-                    rgb > 100 && rgb > palette,
-                    "{what}: 24-bit colours expected ({rgb} 24-bit, {palette} palette)"
-                );
-            } else {
-                assert!(palette > 100 && rgb == 0, "{what}: 256 colours expected ({rgb} 24-bit, {palette} palette)");
-            }
-            let raw = fake.lock().unwrap().raw.clone();
-            let hint = raw.windows(17).any(|w| w == b"--color truecolor");
-            assert_eq!(hint, !truecolor && args.is_empty(), "{what}: the hint to use --color truecolor");
+    type Case<'a> = (Profile, &'a [&'a str], bool);
+    let runs: Vec<(&Case, bool)> = cases.iter().flat_map(|case| [true, false].map(move |ssh| (case, ssh))).collect();
+    let failed = side_by_side(&runs, |&((profile, args, truecolor), ssh)| {
+        let what = format!("{:?}/{:?} TERM={} {args:?} ssh {ssh}", profile.tcap, profile.sgr, profile.term);
+        let (shown, fake) = match std::panic::catch_unwind(|| play(profile.clone(), args, ssh)) {
+            Ok(outcome) => outcome,
+            Err(e) => return Some(format!("{what}: {}", e.downcast_ref::<String>().cloned().unwrap_or_default())),
+        };
+        let fake = fake.lock().unwrap();
+        let (rgb, palette) = fake.colour_codes();
+        let hint = fake.raw.windows(17).any(|w| w == b"--color truecolor");
+        let colours_right = if *truecolor { rgb > 100 && rgb > palette } else { palette > 100 && rgb == 0 };
+        if !matches!(shown, Shown::Cells(_)) {
+            Some(format!("{what}: {shown:?}"))
+        } else if !colours_right {
+            let expected = if *truecolor { "24-bit" } else { "256" };
+            Some(format!("{what}: {expected} colours expected ({rgb} 24-bit, {palette} palette)"))
+        } else if hint != (!truecolor && args.is_empty()) {
+            Some(format!("{what}: the hint to use --color truecolor: {hint}"))
+        } else {
+            None
         }
-    }
+    });
+    assert!(failed.is_empty(), "{} of {} runs wrong:\n{}", failed.len(), runs.len(), failed.join("\n"));
 }
 
 /// How many times each scenario runs (`TIDEPOOL_FAKE_RUNS`, default 3): a flaky outcome is a
@@ -175,30 +182,62 @@ fn every_graphics_terminal_gets_pictures_in_the_protocol_it_speaks_locally_and_o
         }),
         (Profile::xterm_vt340(), &["--graphics", "sixel"], |s, _| matches!(s, Shown::Sixel)),
     ];
-    let mut failed = Vec::new();
-    let mut seen = 0;
-    for (profile, args, expected) in &scenarios {
-        for ssh in [false, true] {
-            for run in 0..runs() {
-                seen += 1;
-                let what = format!("{} {args:?} ssh {ssh} run {run}", profile.name);
-                match std::panic::catch_unwind(|| play(profile.clone(), args, ssh)) {
-                    Ok((shown, fake)) => {
-                        let (rgb, _) = fake.lock().unwrap().colour_codes();
-                        if !expected(&shown, ssh) {
-                            failed.push(format!("{what}: {shown:?}"));
-                        } else if true_colour(profile) != (rgb > 0) {
-                            failed.push(format!("{what}: true colour {} but {rgb} 24-bit codes", true_colour(profile)));
-                        }
-                    }
-                    Err(e) => {
-                        failed.push(format!("{what}: {}", e.downcast_ref::<String>().cloned().unwrap_or_default()))
-                    }
+    let runs: Vec<(&Scenario, bool, usize)> = scenarios
+        .iter()
+        .flat_map(|scenario| {
+            [false, true].into_iter().flat_map(move |ssh| (0..runs()).map(move |run| (scenario, ssh, run)))
+        })
+        .collect();
+    let failed = side_by_side(&runs, |&((profile, args, expected), ssh, run)| {
+        let what = format!("{} {args:?} ssh {ssh} run {run}", profile.name);
+        match std::panic::catch_unwind(|| play(profile.clone(), args, ssh)) {
+            Ok((shown, fake)) => {
+                let (rgb, _) = fake.lock().unwrap().colour_codes();
+                if !expected(&shown, ssh) {
+                    Some(format!("{what}: {shown:?}"))
+                } else if true_colour(profile) != (rgb > 0) {
+                    Some(format!("{what}: true colour {} but {rgb} 24-bit codes", true_colour(profile)))
+                } else {
+                    None
                 }
             }
+            Err(e) => Some(format!("{what}: {}", e.downcast_ref::<String>().cloned().unwrap_or_default())),
         }
-    }
-    assert!(failed.is_empty(), "{} of {seen} runs wrong:\n{}", failed.len(), failed.join("\n"));
+    });
+    assert!(failed.is_empty(), "{} of {} runs wrong:\n{}", failed.len(), runs.len(), failed.join("\n"));
+}
+
+/// How many players [`side_by_side`] runs at once. A run mostly waits (for the terminal's
+/// answers and the link control's first seconds: about 0.6 s of CPU in 1.7 s), so three at
+/// once keep two cores busy; the 78 runs above took 60 s one after another in CI.
+const RUNS_AT_ONCE: usize = 3;
+
+/// Held shared by each run of [`side_by_side`] and alone by a test that measures a rate: the
+/// extra players never take the CPU from the player it measures (a slow kitty's rate fell to
+/// 2.5 kB/s beside three of them on a loaded machine).
+static PLAYERS: RwLock<()> = RwLock::new(());
+
+/// `check` on every item, [`RUNS_AT_ONCE`] at a time; what it found wrong, in the items' order.
+fn side_by_side<T: Sync>(items: &[T], check: impl Fn(&T) -> Option<String> + Sync) -> Vec<String> {
+    let next = AtomicUsize::new(0);
+    let found = Mutex::new(Vec::new());
+    std::thread::scope(|scope| {
+        for _ in 0..RUNS_AT_ONCE {
+            scope.spawn(|| {
+                loop {
+                    let i = next.fetch_add(1, Ordering::Relaxed);
+                    let Some(item) = items.get(i) else { break };
+                    let _shared = PLAYERS.read().unwrap_or_else(PoisonError::into_inner);
+                    if let Some(wrong) = check(item) {
+                        found.lock().unwrap().push((i, wrong));
+                    }
+                }
+            });
+        }
+    });
+    let mut found = found.into_inner().unwrap();
+    found.sort();
+    found.into_iter().map(|(_, wrong)| wrong).collect()
 }
 
 /// The DA1 questions in `chunk` (the probe's and the link's).
@@ -208,6 +247,7 @@ fn da1_questions(chunk: &[u8]) -> usize {
 
 #[test]
 fn a_kitty_slow_to_answer_keeps_its_rate_over_ssh() {
+    let _alone = PLAYERS.write().unwrap_or_else(PoisonError::into_inner);
     // Debian's kitty 0.26 under llvmpipe answers in its own time (median 18 ms, p90 98 ms); the
     // link control read that as the link's queue and the rate fell to the 2 kB/s floor within
     // 5 s: a black or half-painted picture, then cells in palette colours. Here the fake is

@@ -13,6 +13,10 @@ use crate::fake_terminal::{Edits, FakeTerminal, Profile, Sgr, Shown, Tcap, Watch
 const COLS: u32 = 160;
 const ROWS: u32 = 48;
 
+/// Held shared by the runs that go side by side and alone by a test that measures a rate, so
+/// that the extra servers never take the CPU it measures.
+static SERVERS: tokio::sync::RwLock<()> = tokio::sync::RwLock::const_new(());
+
 /// Plays `profile` on a fresh server until it shows something; the outcome and the terminal.
 async fn serve_to(profile: Profile) -> (Shown, FakeTerminal) {
     let server = Server::start(TEST_FLAGS);
@@ -84,20 +88,30 @@ async fn every_graphics_terminal_gets_pictures_or_cells_with_a_notice_over_ssh()
         // (xterm's TERM is xterm-256color: 256 colours through serve, as for WezTerm.)
         (Profile::xterm_vt340(), |s| matches!(s, Shown::Cells(status) if status.contains("sixel over a link")), false),
     ];
-    let mut failed = Vec::new();
-    let mut seen = 0;
-    for (profile, expected, true_colour) in &scenarios {
+    // Two servers at a time: a run mostly waits for its picture to grow with the link
+    // control's first seconds, and the 24 runs took 40 s one after another.
+    let gate = std::sync::Arc::new(tokio::sync::Semaphore::new(2));
+    let mut set = tokio::task::JoinSet::new();
+    for (profile, expected, true_colour) in scenarios {
         for run in 0..runs() {
-            seen += 1;
-            let (shown, fake) = serve_to(profile.clone()).await;
-            let (rgb, _) = fake.colour_codes();
-            if !expected(&shown) {
-                failed.push(format!("{} run {run}: {shown:?}", profile.name));
-            } else if *true_colour != (rgb > 0) {
-                failed.push(format!("{} run {run}: true colour {true_colour} but {rgb} 24-bit codes", profile.name));
-            }
+            let (profile, gate) = (profile.clone(), std::sync::Arc::clone(&gate));
+            set.spawn(async move {
+                let _turn = gate.acquire_owned().await.expect("the gate stays open");
+                let _shared = SERVERS.read().await;
+                let (shown, fake) = serve_to(profile.clone()).await;
+                let (rgb, _) = fake.colour_codes();
+                if !expected(&shown) {
+                    Some(format!("{} run {run}: {shown:?}", profile.name))
+                } else if true_colour != (rgb > 0) {
+                    Some(format!("{} run {run}: true colour {true_colour} but {rgb} 24-bit codes", profile.name))
+                } else {
+                    None
+                }
+            });
         }
     }
+    let seen = set.len();
+    let failed: Vec<String> = set.join_all().await.into_iter().flatten().collect();
     assert!(failed.is_empty(), "{} of {seen} runs wrong:\n{}", failed.len(), failed.join("\n"));
 }
 
@@ -126,6 +140,7 @@ async fn serve_finds_true_colour_by_asking_the_terminal() {
 
 #[tokio::test]
 async fn a_kitty_slow_to_answer_keeps_its_rate_through_serve() {
+    let _alone = SERVERS.write().await;
     // kitty 0.26 under llvmpipe, busy for its own answer time at each device-attributes
     // question (median 18 ms, p90 98 ms; reading nothing meanwhile): through serve the rate fell
     // to the 2 kB/s floor within 5 s (round 3, real kitty over the shaped link).
