@@ -64,18 +64,17 @@ impl ColourMap {
     /// The map for `palette`: an empty table and offsets that span its typical step.
     pub fn new(palette: &SixelPalette) -> ColourMap {
         let labs = (0..palette.len()).map(|i| oklab::from_rgb(palette.rgb(i as u8))).collect();
-        let rgbs = (0..palette.len()).map(|i| palette.rgb(i as u8).map(f32::from)).collect();
-        let spread = Self::spread(palette) * SPREAD_STEPS;
+        let rgbs: Vec<[f32; 3]> = (0..palette.len()).map(|i| palette.rgb(i as u8).map(f32::from)).collect();
+        let spread = Self::spread(&rgbs) * SPREAD_STEPS;
         let offsets = std::array::from_fn(|t| (((t as f32 + 0.5) / 64.0 - 0.5) * spread).round() as i16);
         ColourMap { labs, rgbs, table: vec![EMPTY; 1 << (3 * BITS)], offsets }
     }
 
     /// The palette's typical step: the median distance (luma-weighted, in 8-bit levels: a
-    /// move of `d` along the grey axis is a distance of `d`) from a colour to its nearest
-    /// neighbour. 17 for the 6x7x6 cube (its blue step); a few levels for a palette fitted to
-    /// water.
-    pub fn spread(palette: &SixelPalette) -> f32 {
-        let colours: Vec<[f32; 3]> = (0..palette.len()).map(|i| palette.rgb(i as u8).map(f32::from)).collect();
+    /// move of `d` along the grey axis is a distance of `d`) from a colour (`colours`, its
+    /// registers as shown) to its nearest neighbour. 17 for the 6x7x6 cube (its blue step); a
+    /// few levels for a palette fitted to water.
+    fn spread(colours: &[[f32; 3]]) -> f32 {
         let mut steps: Vec<f32> = colours
             .iter()
             .enumerate()
