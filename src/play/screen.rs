@@ -64,6 +64,11 @@ pub struct ScreenConfig {
     /// `color` is a guess from the environment (`--color auto`): the terminal's answers to the
     /// probe raise it to true colour, and otherwise the status line says how to get it.
     pub color_auto: bool,
+    /// Under `color_auto`, the status line says how to get true colour (`--color truecolor`)
+    /// when the terminal's answers did not give it. Only where the person passes the flags:
+    /// `tidepool serve`'s are the server's, and its players would be told of a flag they cannot
+    /// pass (while the hint covered the status line's count of players).
+    pub colour_hint: bool,
     /// Encoder options (colour threshold, synchronized output).
     pub encode: EncodeOptions,
     /// How the picture is drawn (`--graphics`).

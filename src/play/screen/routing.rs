@@ -167,7 +167,7 @@ impl Screen {
             self.shown = Shown::UNKNOWN;
             self.colour_hint = false;
         } else {
-            self.colour_hint = true;
+            self.colour_hint = self.config.colour_hint;
         }
     }
 
