@@ -61,6 +61,7 @@ fn player(t0: Instant) -> Player {
         bandwidth: Bandwidth::Fixed(8_000_000),
         color: ColorMode::Palette256,
         color_auto: false,
+        colour_hint: false,
         encode: EncodeOptions::default(),
         graphics: GraphicsRequest::Force(tidepool::graphics::GraphicsMode::Cells),
         probe: None,

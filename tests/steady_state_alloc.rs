@@ -137,6 +137,7 @@ fn player_frames(scene: SceneSpec) -> usize {
             bandwidth: Bandwidth::Unlimited,
             color: ColorMode::TrueColor,
             color_auto: false,
+            colour_hint: false,
             encode: EncodeOptions { threshold: 0, sync: true },
             graphics: GraphicsRequest::Auto,
             probe: None,

@@ -174,6 +174,7 @@ impl Group {
             bandwidth,
             color: key.color,
             color_auto: false,
+            colour_hint: false,
             encode: key.encode,
             graphics: GraphicsRequest::Force(GraphicsMode::Cells),
             probe: None,

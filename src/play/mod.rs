@@ -41,6 +41,7 @@
 //!     bandwidth: Bandwidth::Unlimited,
 //!     color: Default::default(),
 //!     color_auto: false,
+//!     colour_hint: false,
 //!     encode: Default::default(),
 //!     graphics: Default::default(),
 //!     probe: None,

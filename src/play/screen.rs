@@ -19,6 +19,7 @@ mod picture;
 pub mod probe;
 mod routing;
 mod scratch;
+mod switch;
 mod ui;
 
 use std::time::{Duration, Instant};
@@ -64,6 +65,11 @@ pub struct ScreenConfig {
     /// `color` is a guess from the environment (`--color auto`): the terminal's answers to the
     /// probe raise it to true colour, and otherwise the status line says how to get it.
     pub color_auto: bool,
+    /// Under `color_auto`, the status line says how to get true colour (`--color truecolor`)
+    /// when the terminal's answers did not give it. Only where the person passes the flags:
+    /// `tidepool serve`'s are the server's, and its players would be told of a flag they cannot
+    /// pass (while the hint covered the status line's count of players).
+    pub colour_hint: bool,
     /// Encoder options (colour threshold, synchronized output).
     pub encode: EncodeOptions,
     /// How the picture is drawn (`--graphics`).
@@ -151,6 +157,9 @@ pub struct Screen {
     pacer: FramePacer,
     bucket: ByteBucket,
     link: LinkControl,
+    /// `auto`'s switch between pixels and cells under way (the old picture stays until the
+    /// new one covers it).
+    switch: Option<switch::Switch>,
     /// What the terminal shows: the one model a screen keeps of its own (the encoder's, the
     /// composed frame's and the bytes' buffers are borrowed per frame: `scratch`).
     shown: Shown,
@@ -203,6 +212,7 @@ impl Screen {
             colour_hint: false,
             bucket,
             link,
+            switch: None,
             shown: Shown::UNKNOWN,
             bytes_sent: 0,
             largest_frame: 0,
@@ -429,7 +439,12 @@ impl Screen {
     /// What must be undone before [`Screen::RESTORE`] when the session ends: kitty's image
     /// deleted, pixel mouse reports off. A door writes it on every way out (a signal too).
     pub(crate) fn restore_prefix(&self) -> Vec<u8> {
-        picture::restore_bytes(&self.choice, self.mouse_pixels)
+        let mut out = picture::restore_bytes(&self.choice, self.mouse_pixels);
+        if let Some(switch::Switch::ToCells { delete }) = &self.switch {
+            // The picture a switch to cells has not taken away yet.
+            out.extend_from_slice(delete);
+        }
+        out
     }
 
     /// The bytes that hand the terminal back: what the picture needs undone (kitty's image

@@ -16,6 +16,7 @@ pub(crate) fn screen_config() -> ScreenConfig {
         bandwidth: Bandwidth::Fixed(60_000),
         color: Default::default(),
         color_auto: false,
+        colour_hint: false,
         encode: Default::default(),
         graphics: GraphicsRequest::Auto,
         probe: None,

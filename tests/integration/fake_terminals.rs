@@ -215,7 +215,7 @@ const RUNS_AT_ONCE: usize = 3;
 /// Held shared by each run of [`side_by_side`] and alone by a test that measures a rate: the
 /// extra players never take the CPU from the player it measures (a slow kitty's rate fell to
 /// 2.5 kB/s beside three of them on a loaded machine).
-static PLAYERS: RwLock<()> = RwLock::new(());
+pub(crate) static PLAYERS: RwLock<()> = RwLock::new(());
 
 /// `check` on every item, [`RUNS_AT_ONCE`] at a time; what it found wrong, in the items' order.
 fn side_by_side<T: Sync>(items: &[T], check: impl Fn(&T) -> Option<String> + Sync) -> Vec<String> {

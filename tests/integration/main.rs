@@ -10,6 +10,7 @@ mod cli;
 mod coherence;
 mod common;
 mod docs;
+mod fake_switch;
 mod fake_terminals;
 mod goldens;
 mod graphics;

@@ -59,6 +59,16 @@ impl Default for FrameBuilder {
 }
 
 impl FrameBuilder {
+    /// The frame composed last, to change before it is encoded (a switch keeps cells).
+    pub fn last_mut(&mut self) -> &mut Frame {
+        &mut self.frame
+    }
+
+    /// The frame composed last.
+    pub fn last(&self) -> &Frame {
+        &self.frame
+    }
+
     /// The frame for a `term` (columns, rows) terminal: `picture` (the cells' pixel size: one
     /// pixel a column, two a row, above the status line) with the seat's marker, help and
     /// message, and the status line of `status` with the screen's `figures`.

@@ -7,9 +7,12 @@ use tiny_skia::Pixmap;
 
 use super::compose::{Figures, big_enough};
 use super::scratch::{self, Scratch};
+use super::switch::{self, Switch};
 use super::{APPROXIMATE_BELOW, CellSource, Screen, link, picture};
 use crate::output::color::ColorMode;
 use crate::output::cursor::Cursor;
+use crate::output::diff::Shown;
+use crate::output::frame::Frame;
 use crate::output::graphics::stream::Budget;
 use crate::output::rate::{RateOptions, Report, Target, budget_after};
 use crate::play::host::SceneStatus;
@@ -67,14 +70,17 @@ impl Screen {
         }
         self.bucket.refill(now);
         self.follow_link(now, out);
+        self.switch_before_cells(out);
         let plan = self.plan(now);
         let resized = self.shown.frame.is_none();
         // Borrowed for this frame only (see `scratch`): a screen keeps no encoder of its own.
         let mut scratch = scratch::take();
         scratch.bytes.clear();
-        let report = self.encode_cells(picture, status, seat, cells, &plan, &mut scratch, out);
+        let (report, covered) = self.encode_cells(picture, status, seat, cells, &plan, &mut scratch, out);
         self.bucket.spend(report.bytes);
+        self.switch_after_cells(covered, &mut scratch.bytes);
         let sent = self.add_picture(now, picture, seat, resized, &report, &plan, &mut scratch.bytes);
+        self.switch_after_picture(sent);
         if self.auto() {
             self.link.frame_sent(report.bytes + sent, plan.budget);
         }
@@ -122,7 +128,9 @@ impl Screen {
         Plan { rate, figures, budget, overdraw, options }
     }
 
-    /// The frame's cells into the scratch's bytes (a group's taken bytes straight into `out`).
+    /// The frame's cells into the scratch's bytes (a group's taken bytes straight into `out`),
+    /// and whether they cover the picture area when a switch to cells waits for that (`None`:
+    /// a group's cells, whole).
     #[allow(clippy::too_many_arguments)]
     fn encode_cells(
         &mut self,
@@ -133,27 +141,39 @@ impl Screen {
         plan: &Plan,
         scratch: &mut Scratch,
         out: &mut Vec<u8>,
-    ) -> Report {
+    ) -> (Report, Option<bool>) {
         let Scratch { encoder, builder, bytes } = scratch;
+        let waits = matches!(self.switch, Some(Switch::ToCells { .. }));
+        let covered = |shown: &Shown, wanted: &Frame| {
+            waits.then(|| shown.frame.as_ref().is_some_and(|s| switch::covered(s, wanted)))
+        };
         match cells {
             CellSource::Own { figures: given } => {
                 let figures = given.unwrap_or(plan.figures);
-                let frame = builder.compose(self.term, picture, self.config.color, status, seat, &figures);
+                builder.compose(self.term, picture, self.config.color, status, seat, &figures);
+                if self.keeps_cells()
+                    && let Some(shown) = &self.shown.frame
+                {
+                    switch::keep_picture_rows(builder.last_mut(), shown);
+                }
+                let frame = builder.last();
                 let target = match self.config.color {
                     ColorMode::TrueColor => Target::new(frame),
                     mode => Target::with_truth(frame, picture, mode),
                 };
-                encoder.encode_into(&mut self.shown, target, plan.budget, plan.options, bytes)
+                let report = encoder.encode_into(&mut self.shown, target, plan.budget, plan.options, bytes);
+                (report, covered(&self.shown, frame))
             }
             CellSource::Toward(model) => {
                 // Exactly (no colour threshold), so that the model becomes equal, not close.
                 let exact = RateOptions { threshold: 0, ..plan.options };
-                encoder.encode_into(&mut self.shown, Target::new(model), plan.budget, exact, bytes)
+                let report = encoder.encode_into(&mut self.shown, Target::new(model), plan.budget, exact, bytes);
+                (report, covered(&self.shown, model))
             }
             CellSource::Taken(taken) => {
                 // Straight to the caller: the group's bytes need no copy in the scratch.
                 out.extend_from_slice(taken);
-                Report { bytes: taken.len(), drawn: 0, pending: 0 }
+                (Report { bytes: taken.len(), drawn: 0, pending: 0 }, None)
             }
         }
     }

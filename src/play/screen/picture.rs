@@ -117,6 +117,12 @@ impl Picture {
     fn text_erases_pixels(&self) -> bool {
         self.choice.mode != GraphicsMode::Kitty
     }
+
+    /// Whether drawing the picture replaces the cells it covers (sixel and iTerm2 pixels,
+    /// kitty's placeholder cells); a kitty placement lies under them instead.
+    pub fn replaces_cells(&self) -> bool {
+        self.text_erases_pixels() || self.choice.kitty_placeholders
+    }
 }
 
 /// What the player's frame is like, for [`Picture::add_to_frame`].
@@ -168,6 +174,12 @@ impl Picture {
         self.stream.commit();
         bytes.len() - before
     }
+}
+
+/// Appends `extra` (a picture's delete) inside the frame's synchronized update, as a picture
+/// goes (see [`splice_picture`]).
+pub fn append_in_frame(frame: &mut Vec<u8>, extra: &[u8], sync: bool) {
+    splice_picture(frame, extra, sync);
 }
 
 /// Puts a picture's bytes into the frame's synchronized update (before its end marker), so the

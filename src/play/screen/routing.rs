@@ -146,6 +146,9 @@ impl Screen {
         }
         let late = if first { "" } else { " (the terminal answered late)" };
         self.draw_with(drawn, notice, late);
+        // A new protocol from the probe's answers: the screen is repainted whole.
+        self.shown = Shown::UNKNOWN;
+        self.switch = None;
     }
 
     /// Whether the terminal is on this machine: not over SSH (the probe's environment), and
@@ -167,13 +170,13 @@ impl Screen {
             self.shown = Shown::UNKNOWN;
             self.colour_hint = false;
         } else {
-            self.colour_hint = true;
+            self.colour_hint = self.config.colour_hint;
         }
     }
 
     /// `auto` between pixels and cells as the link's rate crosses the protocol's crossover
-    /// (with the switch's hysteresis); a switch is said on the status line. Leaving kitty deletes
-    /// its image (in `out`, before the frame).
+    /// (with the switch's hysteresis); a switch is said on the status line. The old picture
+    /// stays until the new one covers it (see `switch`); pixel mouse reports end in `out`.
     pub(super) fn follow_link(&mut self, now: Instant, out: &mut Vec<u8>) {
         let rate = self.bucket.rate();
         let Some((switch, pixels)) = &mut self.auto_pixels else { return };
@@ -187,13 +190,22 @@ impl Screen {
             pixels.clone()
         };
         let notice = picture::switch_notice(pixels.mode, mode, rate);
-        out.extend_from_slice(&picture::restore_bytes(&self.choice, self.mouse_pixels));
+        // The old picture stays until the new one covers it (`switch`): only the pixel mouse
+        // reports go now.
+        if self.mouse_pixels {
+            out.extend_from_slice(picture::PIXEL_MOUSE_OFF);
+        }
+        self.switch = Some(if mode == GraphicsMode::Cells {
+            switch::Switch::ToCells { delete: picture::restore_bytes(&self.choice, false) }
+        } else {
+            switch::Switch::ToPixels
+        });
         self.mouse_pixels = false;
         self.draw_with(choice, vec![notice], "");
     }
 
-    /// Draws with `choice` from the next frame on (a repaint), telling `notice` and which
-    /// protocol draws.
+    /// Draws with `choice` from the next frame on, telling `notice` and which protocol draws.
+    /// The terminal's cells stay known (a switch paints over them; see `switch`).
     pub(super) fn draw_with(&mut self, choice: GraphicsChoice, mut notice: Vec<String>, late: &str) {
         self.picture = Picture::new(&choice, &self.support, self.term, super::files_dir(&self.config));
         let mouse_pixels = picture::pixel_mouse(&choice, &self.support);
@@ -207,7 +219,6 @@ impl Screen {
             self.notice = Some(notice.join("; "));
         }
         self.choice = choice;
-        self.shown = Shown::UNKNOWN;
         self.layout_changed = true;
     }
 }

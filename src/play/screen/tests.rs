@@ -16,6 +16,7 @@ fn config(bandwidth: Bandwidth, probe: bool) -> ScreenConfig {
         bandwidth,
         color: ColorMode::TrueColor,
         color_auto: false,
+        colour_hint: false,
         encode: EncodeOptions::default(),
         graphics: GraphicsRequest::Auto,
         probe: probe.then(|| ProbeOptions {
@@ -243,7 +244,7 @@ fn a_late_answer_without_kitty_turns_a_forced_kitty_into_cells() {
 /// A screen with `--color auto` guessed `guess` from the environment, asking the terminal.
 fn colour_screen(guess: ColorMode, t0: Instant) -> Screen {
     let mut config = config(Bandwidth::Unlimited, true);
-    (config.color, config.color_auto) = (guess, true);
+    (config.color, config.color_auto, config.colour_hint) = (guess, true, true);
     let mut screen = Screen::new(config, (40, 12), t0);
     let mut asked = Vec::new();
     screen.start(t0, &mut asked);

@@ -166,6 +166,7 @@ fn player_rows(
             bandwidth: Bandwidth::Unlimited,
             color: ColorMode::TrueColor,
             color_auto: false,
+            colour_hint: false,
             encode: EncodeOptions::default(),
             graphics: GraphicsRequest::Force(tidepool::graphics::GraphicsMode::Cells),
             probe: None,

@@ -63,6 +63,7 @@ pub fn run(command: PlayCommand) -> Result<()> {
         bandwidth: command.max_bps.map_or(command.bandwidth, Bandwidth::Fixed),
         color,
         color_auto: command.color == ColorChoice::Auto,
+        colour_hint: command.color == ColorChoice::Auto,
         encode: EncodeOptions { threshold, sync: !command.no_sync },
         graphics: command.graphics.into(),
         // The door asks the terminal itself when both ends are terminals, and finds what sits

@@ -319,12 +319,12 @@ impl russh::server::Handler for ClientHandler {
             bandwidth: self.hub.limits.client_bandwidth,
             // COLORTERM arrives only where the client sends it and this server accepts it
             // (OpenSSH sends it only with SendEnv); the TERM of a terminal known to draw 24-bit
-            // colour (xterm-kitty, xterm-ghostty, wezterm, foot, ...) says it. The colour
-            // questions the terminal door asks are not asked here yet: with them, three serve
-            // tests' players stopped getting frames (tests/serve: a silent terminal never
-            // painted, a reader's status line never updated), a cause not found this round.
+            // colour (xterm-kitty, xterm-ghostty, wezterm, foot, ...) says it; otherwise the
+            // probe asks the terminal (XTGETTCAP, DECRQSS). No hint of `--color truecolor`:
+            // that flag is the server's, not the player's.
             color: ColorMode::detect(self.colorterm.as_deref(), self.term.as_deref()),
-            color_auto: false,
+            color_auto: true,
+            colour_hint: false,
             encode: EncodeOptions { threshold: COLOR_THRESHOLD, sync: true },
             graphics: GraphicsRequest::Auto,
             // A remote terminal: no file medium; its TMUX is not ours to see.

@@ -35,6 +35,7 @@ fn config(bandwidth: Bandwidth, graphics: GraphicsRequest) -> ScreenConfig {
         bandwidth,
         color: ColorMode::TrueColor,
         color_auto: false,
+        colour_hint: false,
         encode: EncodeOptions::default(),
         graphics,
         probe: Some(ProbeOptions {

@@ -333,6 +333,7 @@ mod through_the_screen {
             bandwidth: Bandwidth::Unlimited,
             color: ColorMode::TrueColor,
             color_auto: false,
+            colour_hint: false,
             encode: EncodeOptions::default(),
             graphics: GraphicsRequest::Auto,
             probe: Some(ProbeOptions {
