@@ -283,12 +283,21 @@ impl SixelEncoder {
         out.clear();
         out.reserve(width as usize * height as usize);
         for (y, row) in rgb.chunks_exact(width as usize * 3).enumerate() {
-            let thresholds = &BAYER8[y % BAYER_SIDE];
-            for (x, p) in row.chunks_exact(3).enumerate() {
-                let t = usize::from(thresholds[x % BAYER_SIDE]);
-                out.push(self.map.register([p[0], p[1], p[2]], t));
-            }
+            self.dither_row(row, y, out);
         }
+    }
+
+    /// Appends the registers of row `y` of a picture one pixel a screen pixel (`rgb`, 3 bytes a
+    /// pixel), dithered by position: what [`SixelEncoder::dither_into`] does for each row, for a
+    /// caller that makes the picture a row at a time (the stream's enlargement to the screen).
+    pub fn dither_row(&mut self, rgb: &[u8], y: usize, out: &mut Vec<u8>) {
+        let thresholds = &BAYER8[y % BAYER_SIDE];
+        let map = &mut self.map;
+        out.extend(
+            rgb.chunks_exact(3)
+                .zip(thresholds.iter().cycle())
+                .map(|(p, &t)| map.register([p[0], p[1], p[2]], usize::from(t))),
+        );
     }
 
     /// Appends the bytes that make the terminal show `rgb` (`width x height`, 3 bytes a pixel)
@@ -399,26 +408,24 @@ impl SixelEncoder {
             let start = (y + dy) * stride + x0;
             *line = &pixels[start..start + w];
         }
-        let lines = &lines[..rows];
         for x in 0..w {
-            // The (at most six) registers of this column and their sixel bits.
-            let (mut regs, mut bits, mut n) = ([0u8; 6], [0u8; 6], 0);
-            for (dy, line) in lines.iter().enumerate() {
-                let c = line[x];
-                match regs[..n].iter().position(|&r| r == c) {
-                    Some(k) => bits[k] |= 1 << dy,
-                    None => {
-                        (regs[n], bits[n]) = (c, 1 << dy);
-                        n += 1;
-                    }
-                }
+            // The column's six registers (a short band's missing rows never read), then each
+            // register with the bits of the rows it covers, in the order of their first rows.
+            let mut px = [0u8; 6];
+            for (p, line) in px.iter_mut().zip(&lines[..rows]) {
+                *p = line[x];
             }
-            for k in 0..n {
-                let cols = &mut self.columns[usize::from(regs[k])];
+            let mut left = (1u8 << rows) - 1;
+            while left != 0 {
+                let c = px[left.trailing_zeros() as usize];
+                let same = px.iter().enumerate().fold(0u8, |m, (dy, &p)| m | u8::from(p == c) << dy);
+                let bits = same & left;
+                left &= !bits;
+                let cols = &mut self.columns[usize::from(c)];
                 if cols.is_empty() {
-                    self.used.push(regs[k]);
+                    self.used.push(c);
                 }
-                cols.push((x as u32) << 8 | u32::from(bits[k]));
+                cols.push((x as u32) << 8 | u32::from(bits));
             }
         }
         self.used.sort_unstable();
@@ -500,6 +507,15 @@ fn push_run(out: &mut Vec<u8>, ch: u8, n: usize) {
 }
 
 fn push_decimal(out: &mut Vec<u8>, v: usize) {
+    // Run lengths and registers are mostly one or two digits.
+    if v < 10 {
+        out.push(b'0' + v as u8);
+        return;
+    }
+    if v < 100 {
+        out.extend_from_slice(&[b'0' + (v / 10) as u8, b'0' + (v % 10) as u8]);
+        return;
+    }
     let mut digits = [0u8; 20];
     let mut n = v;
     let mut i = digits.len();
