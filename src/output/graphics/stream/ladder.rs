@@ -150,11 +150,16 @@ impl Resampler {
         for (y, &(lo, n)) in self.rows.spans.iter().enumerate() {
             let (w, rest) = weights.split_at(n as usize);
             weights = rest;
-            self.acc.clear();
+            // The first tap sets the sums (`0 + w * s`, as a zeroed sum plus it: no memset of
+            // the row), the others add to them.
             self.acc.resize(tw * 3, 0.0);
             for (k, &w) in w.iter().enumerate() {
                 let src = &self.rows_buf[(lo as usize + k) * tw * 3..][..tw * 3];
-                self.acc.iter_mut().zip(src).for_each(|(a, &s)| *a += w * s);
+                if k == 0 {
+                    self.acc.iter_mut().zip(src).for_each(|(a, &s)| *a = 0.0 + w * s);
+                } else {
+                    self.acc.iter_mut().zip(src).for_each(|(a, &s)| *a += w * s);
+                }
             }
             self.line.clear();
             self.line.extend(self.acc.iter().map(|&a| (a + 0.5).clamp(0.0, 255.0) as u8));
