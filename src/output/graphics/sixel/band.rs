@@ -20,7 +20,14 @@ pub struct Band {
     entries: Vec<u64>,
     /// The same entries by register, then column: `column << 8 | bits`.
     sorted: Vec<u32>,
+    /// The bytes that skip `n` columns (`?` to `???`, then `!n?`), eight bytes and the
+    /// length used, for every `n` up to the widest band seen: written as eight bytes and cut,
+    /// with no branch on the length.
+    skips: Vec<([u8; 8], u8)>,
 }
+
+/// The most columns a skip in the table may cover (`!999999?` is eight bytes).
+const MAX_SKIP: usize = 999_999;
 
 /// What the band's registers need from the image: each register's definition (`;2;r;g;b`)
 /// and whether it is defined already (in this image, or in this session).
@@ -46,8 +53,24 @@ impl Band {
             let start = (y + dy) * stride + x0;
             *line = &pixels[start..start + w];
         }
+        // A short band's missing rows repeat its last (never used: the mask of rows leaves
+        // them out), so every column reads six.
+        let rows = rows.clamp(1, 6);
+        for dy in rows..6 {
+            lines[dy] = lines[rows - 1];
+        }
+        let n = self.collect(&lines, rows, w);
         let mut counts = [0u32; 256];
-        self.collect(&lines, rows.min(6), w, &mut counts);
+        for &e in &self.entries[..n] {
+            counts[(e >> 32) as usize] += 1;
+        }
+        while self.skips.len() <= w.min(MAX_SKIP) {
+            let mut code = Vec::with_capacity(8);
+            push_run(&mut code, b'?', self.skips.len());
+            let mut bytes = [0u8; 8];
+            bytes[..code.len()].copy_from_slice(&code);
+            self.skips.push((bytes, code.len() as u8));
+        }
         // Where each register's entries start, in register order.
         let mut starts = [0u32; 256];
         let mut sum = 0;
@@ -55,9 +78,9 @@ impl Band {
             *start = sum;
             sum += n;
         }
-        self.sorted.resize(self.entries.len(), 0);
+        self.sorted.resize(n, 0);
         let mut at = starts;
-        for &e in &self.entries {
+        for &e in &self.entries[..n] {
             let r = (e >> 32) as usize;
             self.sorted[at[r] as usize] = e as u32;
             at[r] += 1;
@@ -78,48 +101,62 @@ impl Band {
                 push_decimal(out, c);
                 registers.defined[c] = true;
             }
-            push_colour_pass(out, &self.sorted[start as usize..(start + n) as usize]);
+            push_colour_pass(out, &self.sorted[start as usize..(start + n) as usize], &self.skips);
         }
         out.push(b'-');
     }
 
-    /// Fills `entries` with the band's (register, column, bits), columns ascending and within a
-    /// column in the order of each register's first row, and counts them by register.
-    fn collect(&mut self, lines: &[&[u8]; 6], rows: usize, w: usize, counts: &mut [u32; 256]) {
-        self.entries.clear();
+    /// Writes the band's (register, column, bits) to `entries` and says how many: columns
+    /// ascending, within a column in the order of each register's first row. Without branches
+    /// on the pixels: each of a column's six rows is compared with all six, and its entry is
+    /// written always and kept (the count moved on) only when its row is the first of its
+    /// register (a loop over the column's registers mispredicted about once a column).
+    fn collect(&mut self, lines: &[&[u8]; 6], rows: usize, w: usize) -> usize {
+        if self.entries.len() < 6 * w {
+            self.entries.resize(6 * w, 0);
+        }
+        let valid = (1u8 << rows) - 1;
+        let mut n = 0;
         for x in 0..w {
-            // The column's registers (a short band's missing rows are never read: `left`
-            // holds only the rows it has).
-            let mut px = [0u8; 6];
-            for (p, line) in px.iter_mut().zip(&lines[..rows]) {
-                *p = line[x];
-            }
-            let mut left = (1u8 << rows) - 1;
-            while left != 0 {
-                let c = px[left.trailing_zeros() as usize];
-                let same = px.iter().enumerate().fold(0u8, |m, (dy, &p)| m | u8::from(p == c) << dy);
-                let bits = same & left;
-                left &= !bits;
-                counts[usize::from(c)] += 1;
-                self.entries.push(u64::from(c) << 32 | (x as u64) << 8 | u64::from(bits));
+            let px: [u8; 6] = std::array::from_fn(|dy| lines[dy][x]);
+            for (dy, &c) in px.iter().enumerate() {
+                let same = px.iter().enumerate().fold(0u8, |m, (k, &p)| m | u8::from(p == c) << k) & valid;
+                let first = (same & ((1u8 << dy) - 1) == 0) & (valid >> dy & 1 == 1);
+                self.entries[n] = u64::from(c) << 32 | (x as u64) << 8 | u64::from(same);
+                n += usize::from(first);
             }
         }
+        n
     }
 }
 
 /// Appends one colour's pass over a band from its covered columns (`column << 8 | sixel bits`,
 /// ascending): empty sixels (`?`) up to each covered column, runs of equal sixels as `!n`.
-fn push_colour_pass(out: &mut Vec<u8>, cols: &[u32]) {
+/// `skips`: the bytes of each skip (see [`Band`]).
+fn push_colour_pass(out: &mut Vec<u8>, cols: &[u32], skips: &[([u8; 8], u8)]) {
     let mut next = 0usize; // the column the pass has reached
     let mut i = 0;
     while i < cols.len() {
         let (x, sixel) = ((cols[i] >> 8) as usize, cols[i] as u8);
-        push_run(out, b'?', x - next);
+        match skips.get(x - next) {
+            Some((bytes, len)) => {
+                let at = out.len();
+                out.extend_from_slice(bytes);
+                out.truncate(at + usize::from(*len));
+            }
+            None => push_run(out, b'?', x - next),
+        }
         let mut run = 1;
         while i + run < cols.len() && cols[i + run] == cols[i] + ((run as u32) << 8) {
             run += 1;
         }
-        push_run(out, 63 + sixel, run);
+        if run < MIN_RUN {
+            let at = out.len();
+            out.extend_from_slice(&[63 + sixel; MIN_RUN]);
+            out.truncate(at + run);
+        } else {
+            push_run(out, 63 + sixel, run);
+        }
         next = x + run;
         i += run;
     }
