@@ -58,6 +58,11 @@ struct Axis {
     spans: Vec<(u32, u32)>,
     /// The weights of every span, one after another.
     weights: Vec<f32>,
+    /// When every span has one or two pixels (an enlargement): each as two, the first
+    /// source pixel, the second (the first again at the edge) and their weights (0 for a
+    /// span of one: `s + 0 * p` is `s` for the non-negative sums here, so the sums are the
+    /// spans' to the bit).
+    pairs: Option<Vec<(u32, u32, f32, f32)>>,
 }
 
 impl Axis {
@@ -83,6 +88,18 @@ impl Axis {
                 axis.weights[start] = 1.0;
             }
             axis.spans.push((lo, hi - lo + 1));
+        }
+        if axis.spans.iter().all(|&(_, n)| n <= 2) {
+            let mut weights = &axis.weights[..];
+            let pairs = axis.spans.iter().map(|&(lo, n)| {
+                let (w, rest) = weights.split_at(n as usize);
+                weights = rest;
+                match *w {
+                    [a, b] => (lo, lo + 1, a, b),
+                    _ => (lo, lo, w[0], 0.0),
+                }
+            });
+            axis.pairs = Some(pairs.collect());
         }
         axis
     }
@@ -132,6 +149,15 @@ impl Resampler {
         // a picture).
         self.rows_buf.resize(from.1 as usize * tw * 3, 0.0);
         for (line, dst) in source.chunks_exact(sw * bpp).zip(self.rows_buf.chunks_exact_mut(tw * 3)) {
+            if let Some(pairs) = &self.columns.pairs {
+                for (&(a, b, wa, wb), d) in pairs.iter().zip(dst.chunks_exact_mut(3)) {
+                    let (p, q) = (&line[a as usize * bpp..][..3], &line[b as usize * bpp..][..3]);
+                    for c in 0..3 {
+                        d[c] = 0.0 + wa * f32::from(p[c]) + wb * f32::from(q[c]);
+                    }
+                }
+                continue;
+            }
             let mut weights = &self.columns.weights[..];
             for (&(lo, n), d) in self.columns.spans.iter().zip(dst.chunks_exact_mut(3)) {
                 let (w, rest) = weights.split_at(n as usize);
@@ -162,7 +188,8 @@ impl Resampler {
                 }
             }
             self.line.clear();
-            self.line.extend(self.acc.iter().map(|&a| (a + 0.5).clamp(0.0, 255.0) as u8));
+            // Clamped first, so the truncation through i32 (which vectorizes) is `as u8`'s.
+            self.line.extend(self.acc.iter().map(|&a| (a + 0.5).clamp(0.0, 255.0) as i32 as u8));
             row(y, &self.line);
         }
     }
