@@ -256,7 +256,13 @@ impl SixelEncoder {
         image.clear();
         let _ = std::io::Write::write_fmt(&mut image, format_args!("\x1b[{};{}H", row + 1, col + 1));
         self.push_image(&mut image, pixels, width, (x, y, w, h), (origin, (cw, ch)), out);
-        self.flush(out, &image);
+        if out.is_empty() && !self.tmux {
+            // The image is all there is to send: handed over, not copied (a megabyte at the
+            // screen's size).
+            std::mem::swap(out, &mut image);
+        } else {
+            self.flush(out, &image);
+        }
         self.band = image;
     }
 

@@ -188,8 +188,9 @@ impl Resampler {
                 }
             }
             self.line.clear();
-            // Clamped first, so the truncation through i32 (which vectorizes) is `as u8`'s.
-            self.line.extend(self.acc.iter().map(|&a| (a + 0.5).clamp(0.0, 255.0) as i32 as u8));
+            // `(a + 0.5).clamp(0.0, 255.0) as u8` for every f32 (NaN too: 0), but clamped as
+            // an integer: the float clamp's NaN handling kept the loop scalar.
+            self.line.extend(self.acc.iter().map(|&a| ((a + 0.5) as i32).clamp(0, 255) as u8));
             row(y, &self.line);
         }
     }
