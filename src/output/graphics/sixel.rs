@@ -25,10 +25,9 @@
 //! column, `$` back to the band's start), runs of four or more equal sixels are `!n`. A register
 //! is defined where an image first uses it and then selected again (`#n;2;r;g;b#n`): xterm's
 //! definition does not select, and without the second `#n` the band was drawn in the register
-//! selected before (a VT340 default: green). Colours
-//! and columns are collected per band in one pass over the band's pixels (each column's at most
-//! six registers and their bits, appended to each register's list), so the cost grows with the
-//! pixels, not with pixels x colours, and nothing of palette x width size is touched.
+//! selected before (a VT340 default: green). The bands are written by `band.rs`: one pass
+//! over a band's pixels collects every column's registers and bits, a counting sort lays them
+//! out register by register, so the cost grows with the pixels, not with pixels x colours.
 //!
 //! **Changed rectangles.** Only the text rows and columns whose dithered pixels changed are sent,
 //! as a smaller sixel image placed at the top-left cell of that block (a sixel image is drawn

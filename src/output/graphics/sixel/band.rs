@@ -111,6 +111,7 @@ impl Band {
     /// on the pixels: each of a column's six rows is compared with all six, and its entry is
     /// written always and kept (the count moved on) only when its row is the first of its
     /// register (a loop over the column's registers mispredicted about once a column).
+    #[allow(clippy::needless_range_loop, reason = "a column is read across the six rows")]
     fn collect(&mut self, lines: &[&[u8]; 6], rows: usize, w: usize) -> usize {
         if self.entries.len() < 6 * w {
             self.entries.resize(6 * w, 0);

@@ -59,7 +59,8 @@ impl PictureStream {
                 // The source enlarged to the screen and dithered a row at a time.
                 self.candidate.clear();
                 let candidate = &mut self.candidate;
-                self.resampler.resample_rows(picture.data(), 4, from, size, |y, row| sixel.dither_row(row, y, candidate));
+                self.resampler
+                    .resample_rows(picture.data(), 4, from, size, |y, row| sixel.dither_row(row, y, candidate));
             } else {
                 self.resampler.resample(picture.data(), 4, from, size, &mut self.rgb);
                 sixel.dither_scaled(&self.rgb, 3, size, screen, fine, &mut self.candidate);

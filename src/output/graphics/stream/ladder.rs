@@ -200,6 +200,7 @@ impl Resampler {
 /// `v` rounded to the nearest integer (ties to even) in its low mantissa bits; one is taken
 /// off when that rounded up, which gives the truncation `as` does.
 #[inline]
+#[allow(clippy::manual_clamp, reason = "max and min map NaN to 0 as the cast does; clamp keeps NaN")]
 fn to_byte(a: f32) -> u8 {
     const SHIFT: f32 = 8_388_608.0; // 2^23
     let v = (a + 0.5).max(0.0).min(255.0); // max(NaN, 0) is 0, as the clamp's NaN cast to u8
