@@ -25,10 +25,9 @@
 //! column, `$` back to the band's start), runs of four or more equal sixels are `!n`. A register
 //! is defined where an image first uses it and then selected again (`#n;2;r;g;b#n`): xterm's
 //! definition does not select, and without the second `#n` the band was drawn in the register
-//! selected before (a VT340 default: green). Colours
-//! and columns are collected per band in one pass over the band's pixels (each column's at most
-//! six registers and their bits, appended to each register's list), so the cost grows with the
-//! pixels, not with pixels x colours, and nothing of palette x width size is touched.
+//! selected before (a VT340 default: green). The bands are written by `band.rs`: one pass
+//! over a band's pixels collects every column's registers and bits, a counting sort lays them
+//! out register by register, so the cost grows with the pixels, not with pixels x colours.
 //!
 //! **Changed rectangles.** Only the text rows and columns whose dithered pixels changed are sent,
 //! as a smaller sixel image placed at the top-left cell of that block (a sixel image is drawn
@@ -38,10 +37,12 @@
 //! match the whole picture exactly. Whole pictures should be a multiple of 6 rows tall for the
 //! same reason ([`crate::output::graphics::geometry`] picks such sizes).
 
+mod band;
 mod fit;
 mod lookup;
 mod palette;
 
+use self::band::{Band, push_decimal};
 use self::lookup::{BAYER_SIDE, BAYER8, ColourMap};
 pub use self::palette::SixelPalette;
 pub use super::Update;
@@ -59,8 +60,6 @@ pub const DRIFT: f32 = crate::output::oklab::JND / 4.0;
 /// Kept a little under 1 MiB for the passthrough wrapper's doubled escapes and the cursor move.
 #[cfg(any(test, feature = "player", feature = "testing"))]
 pub const TMUX_MAX_IMAGE_BYTES: usize = (1 << 20) - 4096;
-/// A run of this many equal sixels or more is written `!n` (`!4x` is shorter than `xxxx`).
-const MIN_RUN: usize = 4;
 
 /// When the colour registers are defined.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -108,10 +107,8 @@ pub struct SixelEncoder {
     /// register per pixel).
     current: Vec<u8>,
     shown: Option<(u32, u32, Vec<u8>)>,
-    /// Per band: for each register, the columns it covers (ascending) with their sixel bits,
-    /// as `column << 8 | bits`; and the registers used.
-    columns: Vec<Vec<u32>>,
-    used: Vec<u8>,
+    /// The band writer's scratch.
+    bands: Band,
 }
 
 impl SixelEncoder {
@@ -135,8 +132,7 @@ impl SixelEncoder {
             cell_px: cell_px.filter(|&(w, h)| w > 0 && h > 0),
             current: Vec::new(),
             shown: None,
-            columns: vec![Vec::new(); n],
-            used: Vec::new(),
+            bands: Band::default(),
         }
     }
 
@@ -170,7 +166,6 @@ impl SixelEncoder {
         self.map = ColourMap::new(&palette);
         self.definitions = definitions(&palette);
         self.defined = vec![false; n];
-        self.columns = vec![Vec::new(); n];
         self.palette = palette;
         self.shown = None;
     }
@@ -260,7 +255,13 @@ impl SixelEncoder {
         image.clear();
         let _ = std::io::Write::write_fmt(&mut image, format_args!("\x1b[{};{}H", row + 1, col + 1));
         self.push_image(&mut image, pixels, width, (x, y, w, h), (origin, (cw, ch)), out);
-        self.flush(out, &image);
+        if out.is_empty() && !self.tmux {
+            // The image is all there is to send: handed over, not copied (a megabyte at the
+            // screen's size).
+            std::mem::swap(out, &mut image);
+        } else {
+            self.flush(out, &image);
+        }
         self.band = image;
     }
 
@@ -283,10 +284,21 @@ impl SixelEncoder {
         out.clear();
         out.reserve(width as usize * height as usize);
         for (y, row) in rgb.chunks_exact(width as usize * 3).enumerate() {
-            let thresholds = &BAYER8[y % BAYER_SIDE];
-            for (x, p) in row.chunks_exact(3).enumerate() {
-                let t = usize::from(thresholds[x % BAYER_SIDE]);
-                out.push(self.map.register([p[0], p[1], p[2]], t));
+            self.dither_row(row, y, out);
+        }
+    }
+
+    /// Appends the registers of row `y` of a picture one pixel a screen pixel (`rgb`, 3 bytes a
+    /// pixel), dithered by position: what [`SixelEncoder::dither_into`] does for each row, for a
+    /// caller that makes the picture a row at a time (the stream's enlargement to the screen).
+    pub fn dither_row(&mut self, rgb: &[u8], y: usize, out: &mut Vec<u8>) {
+        let thresholds = &BAYER8[y % BAYER_SIDE];
+        let start = out.len();
+        out.resize(start + rgb.len() / 3, 0);
+        // Eight pixels at a time, one row of the Bayer matrix.
+        for (o, p) in out[start..].chunks_mut(BAYER_SIDE).zip(rgb.chunks(3 * BAYER_SIDE)) {
+            for ((o, p), &t) in o.iter_mut().zip(p.chunks_exact(3)).zip(thresholds) {
+                *o = self.map.register([p[0], p[1], p[2]], usize::from(t));
             }
         }
     }
@@ -355,7 +367,9 @@ impl SixelEncoder {
             if starts_row && band > piece_top {
                 mark = Some((band, image.len()));
             }
-            self.push_band(image, pixels, stride, (x0 as usize, y0 as usize + band, w_px, 6.min(h as usize - band)));
+            let registers = band::Definitions { definitions: &self.definitions, defined: &mut self.defined };
+            let rows = 6.min(h as usize - band);
+            self.bands.push(image, pixels, stride, (x0 as usize, y0 as usize + band, w_px, rows), registers);
             band += 6;
             let too_big = self.max_image_bytes.is_some_and(|max| image.len() + 2 > max);
             if let (true, Some((cut, at))) = (too_big, mark) {
@@ -383,65 +397,6 @@ impl SixelEncoder {
         }
         image.extend_from_slice(b"\x1b\\");
     }
-
-    /// Appends one band: `(x0, y, w, rows)` of `pixels`, every register used getting one pass
-    /// (defined where it is first used when it is not defined yet).
-    fn push_band(
-        &mut self,
-        out: &mut Vec<u8>,
-        pixels: &[u8],
-        stride: usize,
-        (x0, y, w, rows): (usize, usize, usize, usize),
-    ) {
-        self.used.clear();
-        let mut lines: [&[u8]; 6] = [&[]; 6];
-        for (dy, line) in lines.iter_mut().enumerate().take(rows) {
-            let start = (y + dy) * stride + x0;
-            *line = &pixels[start..start + w];
-        }
-        let lines = &lines[..rows];
-        for x in 0..w {
-            // The (at most six) registers of this column and their sixel bits.
-            let (mut regs, mut bits, mut n) = ([0u8; 6], [0u8; 6], 0);
-            for (dy, line) in lines.iter().enumerate() {
-                let c = line[x];
-                match regs[..n].iter().position(|&r| r == c) {
-                    Some(k) => bits[k] |= 1 << dy,
-                    None => {
-                        (regs[n], bits[n]) = (c, 1 << dy);
-                        n += 1;
-                    }
-                }
-            }
-            for k in 0..n {
-                let cols = &mut self.columns[usize::from(regs[k])];
-                if cols.is_empty() {
-                    self.used.push(regs[k]);
-                }
-                cols.push((x as u32) << 8 | u32::from(bits[k]));
-            }
-        }
-        self.used.sort_unstable();
-        for (n, &c) in self.used.iter().enumerate() {
-            if n > 0 {
-                out.push(b'$');
-            }
-            out.push(b'#');
-            push_decimal(out, usize::from(c));
-            if !self.defined[usize::from(c)] {
-                // Defined, then selected: xterm's `#Pc;2;...` only defines (DEC's selects
-                // too), and the band would be drawn in the register selected before.
-                out.extend_from_slice(&self.definitions[usize::from(c)]);
-                out.push(b'#');
-                push_decimal(out, usize::from(c));
-                self.defined[usize::from(c)] = true;
-            }
-            let cols = &mut self.columns[usize::from(c)];
-            push_colour_pass(out, cols);
-            cols.clear();
-        }
-        out.push(b'-');
-    }
 }
 
 /// Each register's definition (`;2;r;g;b` after `#i`).
@@ -467,51 +422,6 @@ fn push_header(out: &mut Vec<u8>, w: u32, h: u32) {
 fn header_len(bytes: &[u8]) -> usize {
     let fixed = b"\x1bP0;1;0q\"1;1;".len();
     fixed + bytes[fixed..].iter().position(|b| !(b.is_ascii_digit() || *b == b';')).unwrap_or(bytes.len() - fixed)
-}
-
-/// Appends one colour's pass over a band from its covered columns (`column << 8 | sixel bits`,
-/// ascending): empty sixels (`?`) up to each covered column, runs of equal sixels as `!n`.
-fn push_colour_pass(out: &mut Vec<u8>, cols: &[u32]) {
-    let mut next = 0usize; // the column the pass has reached
-    let mut i = 0;
-    while i < cols.len() {
-        let (x, sixel) = ((cols[i] >> 8) as usize, cols[i] as u8);
-        push_run(out, b'?', x - next);
-        let mut run = 1;
-        while i + run < cols.len() && cols[i + run] == cols[i] + ((run as u32) << 8) {
-            run += 1;
-        }
-        push_run(out, 63 + sixel, run);
-        next = x + run;
-        i += run;
-    }
-}
-
-/// Appends `n` copies of the sixel character `ch`.
-#[inline]
-fn push_run(out: &mut Vec<u8>, ch: u8, n: usize) {
-    if n >= MIN_RUN {
-        out.push(b'!');
-        push_decimal(out, n);
-        out.push(ch);
-    } else {
-        out.extend(std::iter::repeat_n(ch, n));
-    }
-}
-
-fn push_decimal(out: &mut Vec<u8>, v: usize) {
-    let mut digits = [0u8; 20];
-    let mut n = v;
-    let mut i = digits.len();
-    loop {
-        i -= 1;
-        digits[i] = b'0' + (n % 10) as u8;
-        n /= 10;
-        if n == 0 {
-            break;
-        }
-    }
-    out.extend_from_slice(&digits[i..]);
 }
 
 /// The block of whole cells (x, y, width, height in pixels, clipped to the picture) that holds

@@ -55,6 +55,12 @@ impl PictureStream {
             let fine = rung == 0;
             if size == from {
                 sixel.dither_scaled(picture.data(), 4, from, screen, fine, &mut self.candidate);
+            } else if size == screen {
+                // The source enlarged to the screen and dithered a row at a time.
+                self.candidate.clear();
+                let candidate = &mut self.candidate;
+                self.resampler
+                    .resample_rows(picture.data(), 4, from, size, |y, row| sixel.dither_row(row, y, candidate));
             } else {
                 self.resampler.resample(picture.data(), 4, from, size, &mut self.rgb);
                 sixel.dither_scaled(&self.rgb, 3, size, screen, fine, &mut self.candidate);

@@ -47,6 +47,9 @@ pub struct Resampler {
     rows: Axis,
     /// One horizontally resampled row per source row, 3 floats a pixel.
     rows_buf: Vec<f32>,
+    /// One target row: its sums (3 floats a pixel) and its RGB.
+    acc: Vec<f32>,
+    line: Vec<u8>,
 }
 
 #[derive(Debug, Default)]
@@ -55,6 +58,11 @@ struct Axis {
     spans: Vec<(u32, u32)>,
     /// The weights of every span, one after another.
     weights: Vec<f32>,
+    /// When every span has one or two pixels (an enlargement): each as two, the first
+    /// source pixel, the second (the first again at the edge) and their weights (0 for a
+    /// span of one: `s + 0 * p` is `s` for the non-negative sums here, so the sums are the
+    /// spans' to the bit).
+    pairs: Option<Vec<(u32, u32, f32, f32)>>,
 }
 
 impl Axis {
@@ -81,6 +89,18 @@ impl Axis {
             }
             axis.spans.push((lo, hi - lo + 1));
         }
+        if axis.spans.iter().all(|&(_, n)| n <= 2) {
+            let mut weights = &axis.weights[..];
+            let pairs = axis.spans.iter().map(|&(lo, n)| {
+                let (w, rest) = weights.split_at(n as usize);
+                weights = rest;
+                match *w {
+                    [a, b] => (lo, lo + 1, a, b),
+                    _ => (lo, lo, w[0], 0.0),
+                }
+            });
+            axis.pairs = Some(pairs.collect());
+        }
         axis
     }
 }
@@ -89,12 +109,34 @@ impl Resampler {
     /// Writes `source` (`from` pixels of `bpp` bytes, 3 or 4; the first three are taken as RGB)
     /// resampled to `to` as RGB into `out` (cleared first). Equal sizes copy the pixels.
     pub fn resample(&mut self, source: &[u8], bpp: usize, from: (u32, u32), to: (u32, u32), out: &mut Vec<u8>) {
-        assert_eq!(source.len(), from.0 as usize * from.1 as usize * bpp, "source does not match {from:?}");
         out.clear();
+        out.reserve(to.0 as usize * to.1 as usize * 3);
+        self.resample_rows(source, bpp, from, to, |_, row| out.extend_from_slice(row));
+    }
+
+    /// Resamples as [`Resampler::resample`], handing each target row (RGB, top to bottom) to
+    /// `row` with its index instead of keeping the picture: a caller that maps pixels on (the
+    /// sixel dither) reads each row while it is in the cache, and no picture-sized buffer is
+    /// written and read again.
+    ///
+    /// The arithmetic is the same, in the same order, as one pixel at a time (each target
+    /// value is `0 + w0 * s0 + w1 * s1 + ...` in f32, IEEE basic operations): only the loops
+    /// are turned so the vertical pass runs along a row, which the compiler vectorizes.
+    pub fn resample_rows(
+        &mut self,
+        source: &[u8],
+        bpp: usize,
+        from: (u32, u32),
+        to: (u32, u32),
+        mut row: impl FnMut(usize, &[u8]),
+    ) {
+        assert_eq!(source.len(), from.0 as usize * from.1 as usize * bpp, "source does not match {from:?}");
+        let (tw, sw) = (to.0 as usize, from.0 as usize);
         if from == to {
-            out.reserve(source.len() / bpp * 3);
-            for p in source.chunks_exact(bpp) {
-                out.extend_from_slice(&p[..3]);
+            for (y, line) in source.chunks_exact(sw * bpp).enumerate() {
+                self.line.clear();
+                line.chunks_exact(bpp).for_each(|p| self.line.extend_from_slice(&p[..3]));
+                row(y, &self.line);
             }
             return;
         }
@@ -103,40 +145,67 @@ impl Resampler {
             self.rows = Axis::new(from.1, to.1);
             self.sizes = Some((from, to));
         }
-        let (tw, sw) = (to.0 as usize, from.0 as usize);
-        self.rows_buf.clear();
+        // Every value is written below: only a new size fills (a clear here was a 4 MB memset
+        // a picture).
         self.rows_buf.resize(from.1 as usize * tw * 3, 0.0);
-        for (y, row) in source.chunks_exact(sw * bpp).enumerate() {
-            let dst = &mut self.rows_buf[y * tw * 3..(y + 1) * tw * 3];
-            let mut w_at = 0;
-            for (x, &(lo, n)) in self.columns.spans.iter().enumerate() {
+        for (line, dst) in source.chunks_exact(sw * bpp).zip(self.rows_buf.chunks_exact_mut(tw * 3)) {
+            if let Some(pairs) = &self.columns.pairs {
+                for (&(a, b, wa, wb), d) in pairs.iter().zip(dst.chunks_exact_mut(3)) {
+                    let (p, q) = (&line[a as usize * bpp..][..3], &line[b as usize * bpp..][..3]);
+                    for c in 0..3 {
+                        d[c] = 0.0 + wa * f32::from(p[c]) + wb * f32::from(q[c]);
+                    }
+                }
+                continue;
+            }
+            let mut weights = &self.columns.weights[..];
+            for (&(lo, n), d) in self.columns.spans.iter().zip(dst.chunks_exact_mut(3)) {
+                let (w, rest) = weights.split_at(n as usize);
+                weights = rest;
+                let pixels = &line[lo as usize * bpp..(lo + n) as usize * bpp];
                 let mut acc = [0f32; 3];
-                for k in 0..n as usize {
-                    let w = self.columns.weights[w_at + k];
-                    let p = &row[(lo as usize + k) * bpp..];
+                for (&w, p) in w.iter().zip(pixels.chunks_exact(bpp)) {
                     acc[0] += w * f32::from(p[0]);
                     acc[1] += w * f32::from(p[1]);
                     acc[2] += w * f32::from(p[2]);
                 }
-                w_at += n as usize;
-                dst[x * 3..x * 3 + 3].copy_from_slice(&acc);
+                d.copy_from_slice(&acc);
             }
         }
-        out.resize(tw * to.1 as usize * 3, 0);
-        let mut w_at = 0;
+        let mut weights = &self.rows.weights[..];
         for (y, &(lo, n)) in self.rows.spans.iter().enumerate() {
-            let dst = &mut out[y * tw * 3..(y + 1) * tw * 3];
-            let weights = &self.rows.weights[w_at..w_at + n as usize];
-            w_at += n as usize;
-            for (i, d) in dst.iter_mut().enumerate() {
-                let mut acc = 0f32;
-                for (k, &w) in weights.iter().enumerate() {
-                    acc += w * self.rows_buf[(lo as usize + k) * tw * 3 + i];
+            let (w, rest) = weights.split_at(n as usize);
+            weights = rest;
+            // The first tap sets the sums (`0 + w * s`, as a zeroed sum plus it: no memset of
+            // the row), the others add to them.
+            self.acc.resize(tw * 3, 0.0);
+            for (k, &w) in w.iter().enumerate() {
+                let src = &self.rows_buf[(lo as usize + k) * tw * 3..][..tw * 3];
+                if k == 0 {
+                    self.acc.iter_mut().zip(src).for_each(|(a, &s)| *a = 0.0 + w * s);
+                } else {
+                    self.acc.iter_mut().zip(src).for_each(|(a, &s)| *a += w * s);
                 }
-                *d = (acc + 0.5).clamp(0.0, 255.0) as u8;
             }
+            self.line.clear();
+            self.line.extend(self.acc.iter().map(|&a| to_byte(a)));
+            row(y, &self.line);
         }
     }
+}
+
+/// `(a + 0.5).clamp(0.0, 255.0) as u8`, the same byte for every f32 (NaN: 0), in operations
+/// the compiler vectorizes: the float clamp's NaN test and the saturating `as` were scalar code
+/// a value, about a tenth of the sixel player's CPU at the screen's size. `v + 2^23` holds
+/// `v` rounded to the nearest integer (ties to even) in its low mantissa bits; one is taken
+/// off when that rounded up, which gives the truncation `as` does.
+#[inline]
+#[allow(clippy::manual_clamp, reason = "max and min map NaN to 0 as the cast does; clamp keeps NaN")]
+fn to_byte(a: f32) -> u8 {
+    const SHIFT: f32 = 8_388_608.0; // 2^23
+    let v = (a + 0.5).max(0.0).min(255.0); // max(NaN, 0) is 0, as the clamp's NaN cast to u8
+    let big = v + SHIFT;
+    (big.to_bits() - u32::from(big - SHIFT > v)) as u8
 }
 
 #[cfg(any(test, feature = "testing"))]
@@ -148,6 +217,25 @@ pub fn resample(source: &[u8], bpp: usize, from: (u32, u32), to: (u32, u32), out
 
 #[cfg(test)]
 mod tests {
+    #[test]
+    fn bytes_are_the_clamped_truncation_of_every_float() {
+        let cast = |a: f32| (a + 0.5).clamp(0.0, 255.0) as u8;
+        let mut specials = vec![f32::NAN, f32::INFINITY, f32::NEG_INFINITY, -0.0, 0.0, -0.5, 254.5, 255.0, 1e30];
+        // Every integer and half from -2 to 258 and the floats either side of them.
+        for k in -4..=516 {
+            let x = k as f32 / 2.0;
+            specials.extend([x, f32::from_bits(x.to_bits() + 1), f32::from_bits(x.to_bits().saturating_sub(1))]);
+        }
+        for a in specials {
+            assert_eq!(super::to_byte(a), cast(a), "{a} ({:#x})", a.to_bits());
+        }
+        // And a spread of every magnitude.
+        for bits in (0..u32::MAX).step_by(65_537) {
+            let a = f32::from_bits(bits);
+            assert_eq!(super::to_byte(a), cast(a), "{a} ({bits:#x})");
+        }
+    }
+
     use super::*;
 
     #[test]

@@ -185,3 +185,41 @@ fn sixel_tiles_and_blocks_end_where_their_cells_end() {
     }
     assert!(parts > 0, "30 kB/s sends tiles of the 1400x966 picture");
 }
+
+/// FNV-1a, 64 bits: a stable hash of bytes (std's hashers may change between releases).
+fn fnv1a(hash: u64, bytes: &[u8]) -> u64 {
+    bytes.iter().fold(hash, |h, &b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3))
+}
+
+#[test]
+fn sixel_streams_write_the_same_bytes_as_before() {
+    // The encoder's speed-ups (the enlargement fused with the dither, the bands' colour passes)
+    // must not change a byte: a hash of every offer over moving water at every rate class
+    // (the screen-size rung, the lower rungs and their tiles, changed blocks), taken from the
+    // encoder before them (4099f6b). A change meant to alter the picture updates it after
+    // looking at the picture (docs/pixels/cpu.md, "Round 3").
+    let t0 = Instant::now();
+    let mut hash = 0xcbf2_9ce4_8422_2325u64;
+    for (rate, frames) in [(None, 6u32), (Some(2e6), 12), (Some(250e3), 12)] {
+        let mut stream = sixel_stream();
+        let mut bucket = rate.map_or_else(ByteBucket::unlimited, ByteBucket::new);
+        for n in 1..=frames {
+            let now = t0 + FRAME * (4 * n);
+            bucket.refill(now);
+            let budget = Budget::new(bucket.budget(), rate, FRAME);
+            // Moving water, then a still picture with a small changed block.
+            let mut picture = moving(n.min(frames - 2));
+            if n == frames {
+                for px in picture.pixels_mut()[100 * 640 + 200..100 * 640 + 260].iter_mut() {
+                    *px = tiny_skia::ColorU8::from_rgba(250, 240, 10, 255).premultiply();
+                }
+            }
+            let Some(offer) = stream.prepare(&picture, budget, now) else { continue };
+            hash = fnv1a(hash, format!("{:?}", offer.state.part).as_bytes());
+            hash = fnv1a(hash, offer.bytes);
+            bucket.spend(offer.bytes.len());
+            stream.commit();
+        }
+    }
+    assert_eq!(hash, 10844920514458207448, "the sixel bytes changed");
+}

@@ -1,0 +1,205 @@
+//! One six-row band of a sixel image: every register the band uses gets one colour pass
+//! (`#n`, its sixels from its first to its last column, `$` back to the band's start), in
+//! register order, runs of [`MIN_RUN`] or more equal sixels written `!n`.
+//!
+//! **One pass over the pixels.** Each column's (at most six) registers and the bits of the
+//! rows each covers are found by comparing the column's six registers with each other (no
+//! search per pixel), and every (register, column, bits) entry goes to one flat list in column
+//! order, counted by register; a counting sort then lays the entries out register by register,
+//! each register's columns still ascending. The colour passes read that list in order. The
+//! cost grows with the pixels and the entries, never with pixels x colours, and no list per
+//! register is touched (256 of them, one push each per entry, was a fifth of the encoder).
+
+/// A run of this many equal sixels or more is written `!n` (`!4x` is shorter than `xxxx`).
+const MIN_RUN: usize = 4;
+
+/// The band writer's scratch, kept between bands and pictures.
+#[derive(Debug, Default)]
+pub struct Band {
+    /// The band's entries in column order: `register << 32 | column << 8 | bits`.
+    entries: Vec<u64>,
+    /// The same entries by register, then column: `column << 8 | bits`.
+    sorted: Vec<u32>,
+    /// The bytes that skip `n` columns (`?` to `???`, then `!n?`), eight bytes and the
+    /// length used, for every `n` up to the widest band seen: written as eight bytes and cut,
+    /// with no branch on the length.
+    skips: Vec<([u8; 8], u8)>,
+}
+
+/// The most columns a skip in the table may cover (`!999999?` is eight bytes).
+const MAX_SKIP: usize = 999_999;
+
+/// What the band's registers need from the image: each register's definition (`;2;r;g;b`)
+/// and whether it is defined already (in this image, or in this session).
+pub struct Definitions<'a> {
+    pub definitions: &'a [Vec<u8>],
+    pub defined: &'a mut [bool],
+}
+
+impl Band {
+    /// Appends the band `(x0, y, w, rows)` (at most six rows) of `pixels` (`stride` registers
+    /// a row), each register defined where first used when it is not defined yet, then the
+    /// band's end (`-`).
+    pub fn push(
+        &mut self,
+        out: &mut Vec<u8>,
+        pixels: &[u8],
+        stride: usize,
+        (x0, y, w, rows): (usize, usize, usize, usize),
+        registers: Definitions<'_>,
+    ) {
+        let mut lines: [&[u8]; 6] = [&[]; 6];
+        for (dy, line) in lines.iter_mut().enumerate().take(rows.min(6)) {
+            let start = (y + dy) * stride + x0;
+            *line = &pixels[start..start + w];
+        }
+        // A short band's missing rows repeat its last (never used: the mask of rows leaves
+        // them out), so every column reads six.
+        let rows = rows.clamp(1, 6);
+        for dy in rows..6 {
+            lines[dy] = lines[rows - 1];
+        }
+        let n = self.collect(&lines, rows, w);
+        let mut counts = [0u32; 256];
+        for &e in &self.entries[..n] {
+            counts[(e >> 32) as usize] += 1;
+        }
+        while self.skips.len() <= w.min(MAX_SKIP) {
+            let mut code = Vec::with_capacity(8);
+            push_run(&mut code, b'?', self.skips.len());
+            let mut bytes = [0u8; 8];
+            bytes[..code.len()].copy_from_slice(&code);
+            self.skips.push((bytes, code.len() as u8));
+        }
+        // Where each register's entries start, in register order.
+        let mut starts = [0u32; 256];
+        let mut sum = 0;
+        for (start, &n) in starts.iter_mut().zip(&counts) {
+            *start = sum;
+            sum += n;
+        }
+        self.sorted.resize(n, 0);
+        let mut at = starts;
+        for &e in &self.entries[..n] {
+            let r = (e >> 32) as usize;
+            self.sorted[at[r] as usize] = e as u32;
+            at[r] += 1;
+        }
+        let mut first = true;
+        for (c, (&start, &n)) in starts.iter().zip(&counts).enumerate().filter(|(_, (_, n))| **n > 0) {
+            if !first {
+                out.push(b'$');
+            }
+            first = false;
+            out.push(b'#');
+            push_decimal(out, c);
+            if !registers.defined[c] {
+                // Defined, then selected: xterm's `#Pc;2;...` only defines (DEC's selects
+                // too), and the band would be drawn in the register selected before.
+                out.extend_from_slice(&registers.definitions[c]);
+                out.push(b'#');
+                push_decimal(out, c);
+                registers.defined[c] = true;
+            }
+            push_colour_pass(out, &self.sorted[start as usize..(start + n) as usize], &self.skips);
+        }
+        out.push(b'-');
+    }
+
+    /// Writes the band's (register, column, bits) to `entries` and says how many: columns
+    /// ascending, within a column in the order of each register's first row. Without branches
+    /// on the pixels: each of a column's six rows is compared with all six, and its entry is
+    /// written always and kept (the count moved on) only when its row is the first of its
+    /// register (a loop over the column's registers mispredicted about once a column).
+    #[allow(clippy::needless_range_loop, reason = "a column is read across the six rows")]
+    fn collect(&mut self, lines: &[&[u8]; 6], rows: usize, w: usize) -> usize {
+        if self.entries.len() < 6 * w {
+            self.entries.resize(6 * w, 0);
+        }
+        let valid = (1u8 << rows) - 1;
+        let mut n = 0;
+        for x in 0..w {
+            let px: [u8; 6] = std::array::from_fn(|dy| lines[dy][x]);
+            for (dy, &c) in px.iter().enumerate() {
+                let same = px.iter().enumerate().fold(0u8, |m, (k, &p)| m | u8::from(p == c) << k) & valid;
+                let first = (same & ((1u8 << dy) - 1) == 0) & (valid >> dy & 1 == 1);
+                self.entries[n] = u64::from(c) << 32 | (x as u64) << 8 | u64::from(same);
+                n += usize::from(first);
+            }
+        }
+        n
+    }
+}
+
+/// Appends one colour's pass over a band from its covered columns (`column << 8 | sixel bits`,
+/// ascending): empty sixels (`?`) up to each covered column, runs of equal sixels as `!n`.
+/// `skips`: the bytes of each skip (see [`Band`]).
+fn push_colour_pass(out: &mut Vec<u8>, cols: &[u32], skips: &[([u8; 8], u8)]) {
+    let mut next = 0usize; // the column the pass has reached
+    let mut i = 0;
+    while i < cols.len() {
+        let (x, sixel) = ((cols[i] >> 8) as usize, cols[i] as u8);
+        match skips.get(x - next) {
+            Some((bytes, len)) => {
+                let at = out.len();
+                out.extend_from_slice(bytes);
+                out.truncate(at + usize::from(*len));
+            }
+            None => push_run(out, b'?', x - next),
+        }
+        let mut run = 1;
+        while i + run < cols.len() && cols[i + run] == cols[i] + ((run as u32) << 8) {
+            run += 1;
+        }
+        if run < MIN_RUN {
+            let at = out.len();
+            out.extend_from_slice(&[63 + sixel; MIN_RUN]);
+            out.truncate(at + run);
+        } else {
+            push_run(out, 63 + sixel, run);
+        }
+        next = x + run;
+        i += run;
+    }
+}
+
+/// Appends `n` copies of the sixel character `ch`.
+#[inline]
+fn push_run(out: &mut Vec<u8>, ch: u8, n: usize) {
+    if n >= MIN_RUN {
+        out.push(b'!');
+        push_decimal(out, n);
+        out.push(ch);
+    } else {
+        // Byte by byte: a slice of variable length is a call to memcpy.
+        for _ in 0..n {
+            out.push(ch);
+        }
+    }
+}
+
+/// Appends `v` in decimal.
+pub fn push_decimal(out: &mut Vec<u8>, v: usize) {
+    // Run lengths and registers are mostly one or two digits.
+    if v < 10 {
+        out.push(b'0' + v as u8);
+        return;
+    }
+    if v < 100 {
+        out.push(b'0' + (v / 10) as u8);
+        out.push(b'0' + (v % 10) as u8);
+        return;
+    }
+    let mut digits = [0u8; 20];
+    let mut n = v;
+    let mut i = digits.len();
+    loop {
+        i -= 1;
+        digits[i] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
+            break;
+        }
+    }
+    out.extend_from_slice(&digits[i..]);
+}
