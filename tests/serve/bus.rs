@@ -20,8 +20,16 @@ use tokio::sync::mpsc;
 
 use crate::common::*;
 
-/// The test's ports, within the range this project's bus tests use.
-const PORTS: std::ops::Range<u16> = 42000..42999;
+/// The tests' ports: `TIDEPOOL_BUS_TEST_PORTS` (`FIRST-LAST`), the bus tests' 42000-42999 when
+/// unset (the binary's own bus test reads the same).
+fn ports() -> std::ops::Range<u16> {
+    let range = std::env::var("TIDEPOOL_BUS_TEST_PORTS").unwrap_or_else(|_| "42000-42999".into());
+    let (first, last) = range
+        .split_once('-')
+        .and_then(|(a, b)| Some((a.parse::<u16>().ok()?, b.parse::<u16>().ok()?)))
+        .expect("TIDEPOOL_BUS_TEST_PORTS is FIRST-LAST, e.g. 42000-42999");
+    first..last
+}
 static NEXT_PORT: AtomicU16 = AtomicU16::new(0);
 /// Water that moves by itself (rain, gusts): a step's picture depends on every step before.
 const WATER: &[&str] = &[
@@ -37,18 +45,19 @@ const WATER: &[&str] = &[
     "1000",
 ];
 
-/// A free loopback port in [`PORTS`], never the same twice in this process.
+/// A free loopback port in [`ports`], never the same twice in this process.
 pub fn free_port() -> u16 {
-    let span = PORTS.end - PORTS.start;
+    let range = ports();
+    let span = range.end - range.start;
     let offset = (std::process::id() % u32::from(span)) as u16;
     for _ in 0..span {
         let i = NEXT_PORT.fetch_add(1, Ordering::Relaxed);
-        let port = PORTS.start + (offset + i) % span;
+        let port = range.start + (offset + i) % span;
         if TcpListener::bind(("127.0.0.1", port)).is_ok() {
             return port;
         }
     }
-    panic!("no free port in {PORTS:?}");
+    panic!("no free port in {range:?}");
 }
 
 /// Waits (bounded) until `ok` holds.

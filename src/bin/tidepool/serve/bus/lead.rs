@@ -9,15 +9,17 @@ use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
 use async_nats::jetstream::context::PublishErrorKind;
-use async_nats::jetstream::kv::Operation;
+use async_nats::jetstream::kv::{self, Operation};
 use async_nats::jetstream::message::PublishMessage;
 use futures_util::StreamExt;
 use tokio::sync::{mpsc, oneshot};
+use tokio::time::MissedTickBehavior;
 use tokio_util::sync::CancellationToken;
 
+use super::BusOptions;
 use super::edge::{BusState, Incoming};
 use super::lease::{self, Lease, LeaseStep};
-use super::link::{PoolLink, SNAPSHOT_OBJECT};
+use super::link::{self, PoolLink, SNAPSHOT_OBJECT};
 use super::lockstep::MAX_SNAPSHOT_BYTES;
 use super::protocol::{self, Tick};
 use super::sequencer::{Sequencer, SequencerLimits, TICK_PERIOD};
@@ -65,10 +67,46 @@ impl Refusals {
     }
 }
 
-/// An edge's part in the sequencer's role.
-pub struct Leader {
-    /// The pool.
-    pub pool: Arc<PoolLink>,
+/// Renews the lease every [`lease::REFRESH`] until `give_up`; cancels `lost` and ends when it
+/// could not for [`lease::EXPIRY`] (a standby may have taken it). Returns the lease as it
+/// left it.
+async fn keep(
+    kv: kv::Store,
+    me: String,
+    mut lease: Lease,
+    lost: CancellationToken,
+    give_up: CancellationToken,
+) -> Lease {
+    let mut refresh = tokio::time::interval(lease::REFRESH);
+    refresh.set_missed_tick_behavior(MissedTickBehavior::Delay);
+    loop {
+        tokio::select! {
+            _ = give_up.cancelled() => return lease,
+            _ = refresh.tick() => {}
+        }
+        let Some(revision) = lease.held() else {
+            lost.cancel();
+            return lease;
+        };
+        let wrote = tokio::select! {
+            _ = give_up.cancelled() => return lease,
+            wrote = kv.update(LEASE_KEY, me.clone().into(), revision) => wrote,
+        };
+        match wrote {
+            Ok(r) => lease.wrote(r, Instant::now()),
+            Err(e) if lease.expired(Instant::now()) => {
+                eprintln!("bus: cannot renew the lease ({e})");
+                lease.refused();
+                lost.cancel();
+                return lease;
+            }
+            Err(_) => {}
+        }
+    }
+}
+
+/// What the sequencer's role needs besides its connection to the bus.
+pub struct Role {
     /// This edge's name.
     pub me: String,
     /// The scene's size.
@@ -85,6 +123,61 @@ pub struct Leader {
     pub state: Arc<BusState>,
 }
 
+/// Starts this edge's part in the sequencer's role (watching the lease; sequencing while it
+/// holds it) on a thread of its own with a runtime of its own, and opens the edge's
+/// connection to the bus there: the connection's own task (every message in and out) runs on
+/// that runtime too, and the edge's other tasks share it from theirs.
+///
+/// Why a thread: the players' tasks (their frames' encoding) run on the server's runtime, and
+/// at load 8 to 12 on 2 cores a lease whose renewal shared their workers (and their
+/// connection's task) missed its second: the role moved six times in five minutes, keys waited
+/// seconds and 2 % of stones were refused (docs/serve/bus.md, round 2). Here only a dead or
+/// cut-off edge loses the role. One connection, not one for the role and one for the edge: the
+/// status line's `bus lost` then speaks for both. Returns the pool once the connection is
+/// open (its error otherwise).
+pub async fn start(
+    options: &BusOptions,
+    fingerprint: String,
+    role: Role,
+    stop: CancellationToken,
+) -> Result<Arc<PoolLink>, String> {
+    let (opened_tx, opened) = oneshot::channel();
+    let options = options.clone();
+    std::thread::Builder::new()
+        .name("tidepool-sequencer".into())
+        .spawn(move || {
+            let runtime = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
+                Ok(runtime) => runtime,
+                Err(e) => {
+                    let _ = opened_tx.send(Err(format!("cannot start the sequencer's runtime ({e})")));
+                    return;
+                }
+            };
+            runtime.block_on(async move {
+                match link::open(&options, &fingerprint, role.state.clone()).await {
+                    Ok(pool) => {
+                        let pool = Arc::new(pool);
+                        let _ = opened_tx.send(Ok(pool.clone()));
+                        Leader { pool, role }.run(stop).await;
+                    }
+                    Err(e) => {
+                        let _ = opened_tx.send(Err(e));
+                    }
+                }
+            });
+        })
+        .map_err(|e| format!("cannot start the sequencer's thread ({e})"))?;
+    opened.await.map_err(|_| "the sequencer's thread ended while starting".to_owned())?
+}
+
+/// An edge's part in the sequencer's role, on its own thread ([`start`]).
+struct Leader {
+    /// The pool (its connection's task on the role's runtime).
+    pool: Arc<PoolLink>,
+    /// The rest.
+    role: Role,
+}
+
 /// Why a sequencer stopped.
 enum Ended {
     Stopped,
@@ -94,7 +187,7 @@ enum Ended {
 impl Leader {
     /// Watches the lease until `stop`; sequences while it holds it.
     pub async fn run(self, stop: CancellationToken) {
-        let mut lease = Lease::new(&self.me);
+        let mut lease = Lease::new(&self.role.me);
         while !stop.is_cancelled() {
             let entry = match self.pool.kv.entry(LEASE_KEY).await {
                 Ok(entry) => entry.filter(|e| e.operation == Operation::Put),
@@ -106,8 +199,8 @@ impl Leader {
             let holder = entry.as_ref().map(|e| (String::from_utf8_lossy(&e.value).into_owned(), e.revision));
             let wrote = match lease.observe(holder.as_ref().map(|(h, r)| (h.as_str(), *r)), now) {
                 LeaseStep::Wait => None,
-                LeaseStep::Create => Some(self.pool.kv.create(LEASE_KEY, self.me.clone().into()).await.ok()),
-                LeaseStep::Update(r) => Some(self.pool.kv.update(LEASE_KEY, self.me.clone().into(), r).await.ok()),
+                LeaseStep::Create => Some(self.pool.kv.create(LEASE_KEY, self.role.me.clone().into()).await.ok()),
+                LeaseStep::Update(r) => Some(self.pool.kv.update(LEASE_KEY, self.role.me.clone().into(), r).await.ok()),
             };
             match wrote {
                 Some(Some(revision)) => lease.wrote(revision, Instant::now()),
@@ -115,12 +208,12 @@ impl Leader {
                 None => {}
             }
             if lease.held().is_some() {
-                if let Some(previous) = holder.filter(|(h, _)| *h != self.me) {
+                if let Some(previous) = holder.filter(|(h, _)| *h != self.role.me) {
                     eprintln!("bus: took the sequencer's role over from {}", previous.0);
                 }
-                self.state.leading.store(true, Ordering::Relaxed);
+                self.role.state.leading.store(true, Ordering::Relaxed);
                 let ended = self.sequence(&mut lease, &stop).await;
-                self.state.leading.store(false, Ordering::Relaxed);
+                self.role.state.leading.store(false, Ordering::Relaxed);
                 match ended {
                     Ended::Stopped => return,
                     Ended::LostLease => eprintln!("bus: this edge is no longer the sequencer"),
@@ -141,12 +234,12 @@ impl Leader {
             Err(e) => return Err(e.to_string()),
         };
         let end = last.sequence;
-        if let Ok(tick) = protocol::read_tick(&last.payload, self.size) {
+        if let Ok(tick) = protocol::read_tick(&last.payload, self.role.size) {
             return Ok((end, Some(tick)));
         }
         for seq in (end.saturating_sub(LOOK_BACK)..end).rev().filter(|&s| s > 0) {
             if let Ok(message) = self.pool.stream.get_raw_message(seq).await
-                && let Ok(tick) = protocol::read_tick(&message.payload, self.size)
+                && let Ok(tick) = protocol::read_tick(&message.payload, self.role.size)
             {
                 return Ok((end, Some(tick)));
             }
@@ -157,7 +250,7 @@ impl Leader {
     /// Sequences while the lease holds.
     async fn sequence(&self, lease: &mut Lease, stop: &CancellationToken) -> Ended {
         let Some(term) = lease.held() else { return Ended::LostLease };
-        let (mut last_seq, last) = match self.last_tick().await {
+        let (last_seq, last) = match self.last_tick().await {
             Ok(x) => x,
             Err(e) => {
                 eprintln!("bus: cannot read the log's end ({e}); giving the role up");
@@ -165,9 +258,39 @@ impl Leader {
             }
         };
         let now = Instant::now();
-        let mut seq =
-            Sequencer::new(self.size, self.steps_per_second, self.limits, self.seed, last.as_ref(), term, now);
+        let seq = Sequencer::new(
+            self.role.size,
+            self.role.steps_per_second,
+            self.role.limits,
+            self.role.seed,
+            last.as_ref(),
+            term,
+            now,
+        );
         eprintln!("bus: this edge is the sequencer (term {term}), after log entry {last_seq}");
+        // The lease is renewed by a task of its own: a tick's publish waiting for its
+        // acknowledgement (up to a second when nats-server is slow) must not delay it.
+        let (lost, give_up) = (CancellationToken::new(), CancellationToken::new());
+        let held = std::mem::replace(lease, Lease::new(&self.role.me));
+        let keeper =
+            tokio::spawn(keep(self.pool.kv.clone(), self.role.me.clone(), held, lost.clone(), give_up.clone()));
+        let ended = self.sequence_held(seq, last_seq, &lost, stop).await;
+        give_up.cancel();
+        if let Ok(back) = keeper.await {
+            *lease = back;
+        }
+        ended
+    }
+
+    /// The sequencer's loop: requests in, a tick out every [`TICK_PERIOD`], a snapshot every
+    /// [`SNAPSHOT_PERIOD`], until `lost` (the lease's keeper gave up) or `stop`.
+    async fn sequence_held(
+        &self,
+        mut seq: Sequencer,
+        mut last_seq: u64,
+        lost: &CancellationToken,
+        stop: &CancellationToken,
+    ) -> Ended {
         let (Ok(mut submits), Ok(mut presence)) = (
             self.pool.client.subscribe(self.pool.names.submit.clone()).await,
             self.pool.client.subscribe(self.pool.names.presence.clone()).await,
@@ -175,7 +298,6 @@ impl Leader {
             return Ended::LostLease;
         };
         let mut ticks = tokio::time::interval(TICK_PERIOD);
-        let mut refresh = tokio::time::interval(lease::REFRESH);
         let mut snapshot = tokio::time::interval(SNAPSHOT_PERIOD);
         let mut refusals = Refusals::default();
         loop {
@@ -206,18 +328,7 @@ impl Leader {
                         }
                     }
                 }
-                _ = refresh.tick() => {
-                    let Some(revision) = lease.held() else { return Ended::LostLease };
-                    match self.pool.kv.update(LEASE_KEY, self.me.clone().into(), revision).await {
-                        Ok(r) => lease.wrote(r, Instant::now()),
-                        Err(e) if lease.expired(Instant::now()) => {
-                            eprintln!("bus: cannot renew the lease ({e})");
-                            lease.refused();
-                            return Ended::LostLease;
-                        }
-                        Err(_) => {}
-                    }
-                }
+                _ = lost.cancelled() => return Ended::LostLease,
                 _ = snapshot.tick() => self.store_snapshot().await,
             }
         }
@@ -240,11 +351,11 @@ impl Leader {
     /// Asks the game thread for its state and stores it as the latest snapshot.
     async fn store_snapshot(&self) {
         // An edge still joining has nothing to offer: it would replace a good snapshot.
-        if !self.state.joined.load(Ordering::Relaxed) {
+        if !self.role.state.joined.load(Ordering::Relaxed) {
             return;
         }
         let (reply, answer) = oneshot::channel();
-        if self.snapshots.send(Incoming::Snapshot(reply)).await.is_err() {
+        if self.role.snapshots.send(Incoming::Snapshot(reply)).await.is_err() {
             return;
         }
         let Ok(bytes) = answer.await else { return };
@@ -257,3 +368,7 @@ impl Leader {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "lead_tests.rs"]
+mod tests;
