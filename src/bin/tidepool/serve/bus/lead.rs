@@ -8,7 +8,6 @@ use std::sync::Arc;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-use async_nats::jetstream::context::PublishErrorKind;
 use async_nats::jetstream::kv::{self, Operation};
 use async_nats::jetstream::message::PublishMessage;
 use futures_util::StreamExt;
@@ -67,9 +66,18 @@ impl Refusals {
     }
 }
 
-/// Renews the lease every [`lease::REFRESH`] until `give_up`; cancels `lost` and ends when it
-/// could not for [`lease::EXPIRY`] (a standby may have taken it). Returns the lease as it
-/// left it.
+/// Renews the lease every [`lease::REFRESH`] until `give_up`; cancels `lost` and ends only
+/// when the compare-and-set says another edge holds it. Returns the lease as it left it.
+///
+/// A renewal that fails otherwise (the bus away, a timeout) is tried again at the next
+/// refresh, however long that takes: the clock alone never gives the role up. That is safe
+/// because nothing rests on it: a standby takes the key only with a compare-and-set on the
+/// revision this edge last wrote (so this edge learns of it on its next try), and a tick this
+/// edge publishes meanwhile is refused by the log's expected-last-sequence check. Giving up by
+/// the clock made a restart of nats-server move the role for nothing: the holder gave up
+/// while the bus was away, and requests sent once it was back found no sequencer
+/// (docs/serve/bus.md, round 4). Each try waits at most a refresh, so a try lost with the
+/// old connection does not hold the next one back once the bus returns.
 async fn keep(
     kv: kv::Store,
     me: String,
@@ -79,6 +87,7 @@ async fn keep(
 ) -> Lease {
     let mut refresh = tokio::time::interval(lease::REFRESH);
     refresh.set_missed_tick_behavior(MissedTickBehavior::Delay);
+    let mut failing = false;
     loop {
         tokio::select! {
             _ = give_up.cancelled() => return lease,
@@ -90,19 +99,47 @@ async fn keep(
         };
         let wrote = tokio::select! {
             _ = give_up.cancelled() => return lease,
-            wrote = kv.update(LEASE_KEY, me.clone().into(), revision) => wrote,
+            wrote = tokio::time::timeout(lease::REFRESH, kv.update(LEASE_KEY, me.clone().into(), revision)) => wrote,
         };
         match wrote {
-            Ok(r) => lease.wrote(r, Instant::now()),
-            Err(e) if lease.expired(Instant::now()) => {
-                eprintln!("bus: cannot renew the lease ({e})");
-                lease.refused();
-                lost.cancel();
-                return lease;
+            Ok(Ok(r)) => {
+                if std::mem::take(&mut failing) {
+                    eprintln!("bus: the lease renewed again (revision {r})");
+                }
+                lease.wrote(r, Instant::now());
             }
-            Err(_) => {}
+            Ok(Err(e)) if e.kind() == kv::UpdateErrorKind::WrongLastRevision => {
+                match ours(&kv, &me).await {
+                    // A renewal that seemed to fail landed after all (sent when the bus came
+                    // back): the key still names this edge, and no other wrote since.
+                    Some(Some(r)) => lease.wrote(r, Instant::now()),
+                    Some(None) => {
+                        eprintln!("bus: cannot renew the lease ({e}): another edge holds it");
+                        lease.refused();
+                        lost.cancel();
+                        return lease;
+                    }
+                    None => failing = true,
+                }
+            }
+            failed => {
+                let why = match failed {
+                    Ok(Err(e)) => e.to_string(),
+                    _ => "timed out".to_owned(),
+                };
+                if !std::mem::replace(&mut failing, true) {
+                    eprintln!("bus: cannot renew the lease ({why}); trying again, still the sequencer");
+                }
+            }
         }
     }
+}
+
+/// The lease key's revision if it names `me` (`Some(None)`: another edge, or no key; `None`:
+/// it could not be read).
+async fn ours(kv: &kv::Store, me: &str) -> Option<Option<u64>> {
+    let entry = tokio::time::timeout(lease::REFRESH, kv.entry(LEASE_KEY)).await.ok()?.ok()?;
+    Some(entry.filter(|e| e.operation == Operation::Put && e.value.as_ref() == me.as_bytes()).map(|e| e.revision))
 }
 
 /// What the sequencer's role needs besides its connection to the bus.
@@ -189,11 +226,14 @@ impl Leader {
     pub async fn run(self, stop: CancellationToken) {
         let mut lease = Lease::new(&self.role.me);
         while !stop.is_cancelled() {
-            let entry = match self.pool.kv.entry(LEASE_KEY).await {
-                Ok(entry) => entry.filter(|e| e.operation == Operation::Put),
-                Err(_) => {
-                    tokio::select! { _ = stop.cancelled() => return, _ = tokio::time::sleep(lease::POLL) => continue }
-                }
+            let read = match self.role.state.connected.load(Ordering::Relaxed) {
+                true => self.pool.kv.entry(LEASE_KEY).await.ok(),
+                false => None,
+            };
+            let Some(entry) = read.map(|entry| entry.filter(|e| e.operation == Operation::Put)) else {
+                // Blind for a while: the holder's silence meanwhile proves nothing.
+                lease.lost_sight();
+                tokio::select! { _ = stop.cancelled() => return, _ = tokio::time::sleep(lease::POLL) => continue }
             };
             let now = Instant::now();
             let holder = entry.as_ref().map(|e| (String::from_utf8_lossy(&e.value).into_owned(), e.revision));
@@ -274,7 +314,7 @@ impl Leader {
         let held = std::mem::replace(lease, Lease::new(&self.role.me));
         let keeper =
             tokio::spawn(keep(self.pool.kv.clone(), self.role.me.clone(), held, lost.clone(), give_up.clone()));
-        let ended = self.sequence_held(seq, last_seq, &lost, stop).await;
+        let ended = self.sequence_held(seq, (term, last_seq), &lost, stop).await;
         give_up.cancel();
         if let Ok(back) = keeper.await {
             *lease = back;
@@ -287,7 +327,7 @@ impl Leader {
     async fn sequence_held(
         &self,
         mut seq: Sequencer,
-        mut last_seq: u64,
+        (term, mut last_seq): (u64, u64),
         lost: &CancellationToken,
         stop: &CancellationToken,
     ) -> Ended {
@@ -315,17 +355,18 @@ impl Leader {
                     let tick = seq.tick(Instant::now());
                     match self.publish(&tick, last_seq).await {
                         Ok(s) => last_seq = s,
-                        Err(Some(why)) => {
-                            eprintln!("bus: {why}; giving the sequencer's role up");
-                            return Ended::LostLease;
-                        }
-                        // The bus is away: this tick's events are lost (never acknowledged);
-                        // the next tick carries on, after the log's end as it then stands.
-                        Err(None) => {
-                            if let Ok((s, _)) = self.last_tick().await {
-                                last_seq = s;
+                        // Not acknowledged (the bus away, or the log's fence): carry on after
+                        // the log's end only if this term wrote it.
+                        Err(()) => match self.end_of_term(term, last_seq).await {
+                            Some(Some(s)) => last_seq = s,
+                            Some(None) => {
+                                eprintln!("bus: the log moved on after entry {last_seq} without this sequencer; giving the sequencer's role up");
+                                return Ended::LostLease;
                             }
-                        }
+                            // Unreadable: this tick's events are lost (never acknowledged);
+                            // the next tick tries again after the same entry.
+                            None => {}
+                        },
                     }
                 }
                 _ = lost.cancelled() => return Ended::LostLease,
@@ -334,18 +375,32 @@ impl Leader {
         }
     }
 
-    /// Publishes a tick after log entry `after`; its sequence, or why it failed: `Some` when
-    /// another sequencer wrote since (this one lost the role), `None` when the bus is away.
-    async fn publish(&self, tick: &Tick, after: u64) -> Result<u64, Option<String>> {
+    /// Publishes a tick after log entry `after`; its sequence, or `Err` when it was not
+    /// acknowledged (refused by the log's fence, or the bus away: it may have been written).
+    async fn publish(&self, tick: &Tick, after: u64) -> Result<u64, ()> {
         let message = PublishMessage::build().payload(protocol::bytes_of(tick).into()).expected_last_sequence(after);
-        let ack = self.pool.js.send_publish(self.pool.names.log.clone(), message).await.map_err(|_| None)?;
-        match ack.await {
-            Ok(ack) => Ok(ack.sequence),
-            Err(e) if e.kind() == PublishErrorKind::WrongLastSequence => {
-                Err(Some(format!("the log moved on after entry {after} without this sequencer")))
+        let ack = self.pool.js.send_publish(self.pool.names.log.clone(), message).await.map_err(|_| ())?;
+        ack.await.map(|ack| ack.sequence).map_err(|_| ())
+    }
+
+    /// After a tick of `term` that was not acknowledged: the log's last entry if this term
+    /// wrote it or the log is still at `after` (`Some(None)`: something else wrote it, another
+    /// sequencer or a stray writer; `None`: the log could not be read). A publish whose
+    /// acknowledgement was lost with the connection may have been written (a request queued
+    /// while the bus was away is sent when it is back); a later tick would then be fenced out
+    /// after it, and the role would move for nothing. Reading the end and carrying on after
+    /// it whoever wrote it would instead open the fence to a sequencer that lost the role.
+    async fn end_of_term(&self, term: u64, after: u64) -> Option<Option<u64>> {
+        let last = match self.pool.stream.get_last_raw_message_by_subject(&self.pool.names.log).await {
+            Ok(message) => message,
+            Err(e) if after == 0 && (e.to_string().contains("no message") || e.to_string().contains("not found")) => {
+                return Some(Some(0));
             }
-            Err(_) => Err(None),
-        }
+            Err(_) => return None,
+        };
+        let mine = last.sequence == after
+            || protocol::read_tick(&last.payload, self.role.size).is_ok_and(|tick| tick.term == term);
+        Some(mine.then_some(last.sequence))
     }
 
     /// Asks the game thread for its state and stores it as the latest snapshot.
