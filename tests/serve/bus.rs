@@ -511,3 +511,38 @@ async fn the_bus_restarted_or_an_edge_cut_off_players_stay_told_why_and_resume_i
     assert!(after > step);
     assert_same(after, &pictures, "after the bus's restart");
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+#[ignore = "needs nats-server: scripts/bus_tests.sh installs it and runs these (.ci/run does)"]
+async fn the_sequencers_edge_cut_off_another_takes_over_and_it_stands_down_when_back() {
+    let nats = Nats::start();
+    let pool = pool_name("cutlead");
+    let relay = Relay::start(nats.port);
+    let a = Edge::first(&relay.url(), &pool);
+    let b = Edge::start(&nats.url(), &pool, "b");
+    let (pa, pb) = (Player::join(&a).await, Player::join(&b).await);
+    pa.wait_status("2 playing", |s| s.contains("2 playing")).await;
+    pb.send(&click(20, 6));
+    let (step, pictures) = shoot(&pb, &[&a, &b]).await;
+    assert_same(step, &pictures, "before the cut");
+
+    // The sequencer's edge cut off: its player is told; b takes the role over, and orders
+    // b's stones meanwhile.
+    relay.cut();
+    pa.wait_status("bus lost", |s| s.contains("bus lost")).await;
+    b.wait_log("this edge is the sequencer");
+    pb.send(&click(40, 10));
+    // Back: a learns that b holds the role (its lease's compare-and-set, or its tick fenced
+    // out of the log) and stands down; it does not write after b, and follows b's log.
+    relay.mend();
+    a.wait_log("no longer the sequencer");
+    pa.wait_status("the bus back", |s| !s.contains("bus lost")).await;
+    pa.send(&click(30, 9));
+    let (after, pictures) = shoot(&pa, &[&a, &b]).await;
+    assert!(after > step);
+    assert_same(after, &pictures, "after a came back");
+    // Exactly one sequencer after the cut: b, once; a never took the role back.
+    assert_eq!(b.count_log("this edge is the sequencer"), 1, "{:?}", b.log());
+    assert_eq!(a.count_log("this edge is the sequencer"), 1, "{:?}", a.log());
+    assert_eq!(a.count_log("skipped"), 0, "{:?}", a.log());
+}
