@@ -340,6 +340,8 @@ impl Leader {
         let mut ticks = tokio::time::interval(TICK_PERIOD);
         let mut snapshot = tokio::time::interval(SNAPSHOT_PERIOD);
         let mut refusals = Refusals::default();
+        // Ticks not acknowledged in a row (said once when it starts and once when it ends).
+        let mut unacked = 0u32;
         loop {
             tokio::select! {
                 _ = stop.cancelled() => return Ended::Stopped,
@@ -354,19 +356,30 @@ impl Leader {
                     refusals.summarize(Instant::now());
                     let tick = seq.tick(Instant::now());
                     match self.publish(&tick, last_seq).await {
-                        Ok(s) => last_seq = s,
+                        Ok(s) => {
+                            if unacked > 0 {
+                                eprintln!("bus: ticks acknowledged again (entry {s}) after {unacked} that were not");
+                            }
+                            (last_seq, unacked) = (s, 0);
+                        }
                         // Not acknowledged (the bus away, or the log's fence): carry on after
                         // the log's end only if this term wrote it.
-                        Err(()) => match self.end_of_term(term, last_seq).await {
-                            Some(Some(s)) => last_seq = s,
-                            Some(None) => {
-                                eprintln!("bus: the log moved on after entry {last_seq} without this sequencer; giving the sequencer's role up");
-                                return Ended::LostLease;
+                        Err(why) => {
+                            if unacked == 0 {
+                                eprintln!("bus: a tick after log entry {last_seq} not acknowledged ({why}); trying again");
                             }
-                            // Unreadable: this tick's events are lost (never acknowledged);
-                            // the next tick tries again after the same entry.
-                            None => {}
-                        },
+                            unacked += 1;
+                            match self.end_of_term(term, last_seq).await {
+                                Some(Some(s)) => last_seq = s,
+                                Some(None) => {
+                                    eprintln!("bus: the log moved on after entry {last_seq} without this sequencer; giving the sequencer's role up");
+                                    return Ended::LostLease;
+                                }
+                                // Unreadable: this tick's events are lost (never acknowledged);
+                                // the next tick tries again after the same entry.
+                                None => {}
+                            }
+                        }
                     }
                 }
                 _ = lost.cancelled() => return Ended::LostLease,
@@ -375,12 +388,12 @@ impl Leader {
         }
     }
 
-    /// Publishes a tick after log entry `after`; its sequence, or `Err` when it was not
-    /// acknowledged (refused by the log's fence, or the bus away: it may have been written).
-    async fn publish(&self, tick: &Tick, after: u64) -> Result<u64, ()> {
+    /// Publishes a tick after log entry `after`; its sequence, or why it was not acknowledged
+    /// (refused by the log's fence, or the bus away: it may have been written).
+    async fn publish(&self, tick: &Tick, after: u64) -> Result<u64, String> {
         let message = PublishMessage::build().payload(protocol::bytes_of(tick).into()).expected_last_sequence(after);
-        let ack = self.pool.js.send_publish(self.pool.names.log.clone(), message).await.map_err(|_| ())?;
-        ack.await.map(|ack| ack.sequence).map_err(|_| ())
+        let ack = self.pool.js.send_publish(self.pool.names.log.clone(), message).await.map_err(|e| e.to_string())?;
+        ack.await.map(|ack| ack.sequence).map_err(|e| e.to_string())
     }
 
     /// After a tick of `term` that was not acknowledged: the log's last entry if this term
