@@ -141,3 +141,19 @@ else:
     print("no key was traced across edges")
 EOF
 grep -h "refused\|lost" "$work"/edge*.log | head -5 || true
+# The sequencer's role over the whole run (warm-up included): how often an edge took it, and
+# the requests its holders refused (each logged, or summed up once a second).
+python3 - "$work" "$edges" <<'EOF'
+import re, sys
+work, edges = sys.argv[1], int(sys.argv[2])
+took, refused = 0, 0
+for i in range(edges):
+    for line in open(f"{work}/edge{i}.log", errors="replace"):
+        if "this edge is the sequencer (term" in line:
+            took += 1
+        elif line.startswith("bus: refused a request"):
+            refused += 1
+        elif (m := re.match(r"bus: refused (\d+) more requests", line)):
+            refused += int(m.group(1))
+print(f"the sequencer's role: taken {took} times (moved {max(took - 1, 0)} times); requests refused: {refused}")
+EOF

@@ -111,7 +111,7 @@ impl Crowd {
         self.host.advance(now);
         self.host.render(&mut self.picture);
         let status = self.host.status().clone();
-        self.groups.keep([self.key, self.key], now);
+        self.groups.keep([(self.key, None), (self.key, None)], now);
         let pictures = [(self.picture.width(), self.picture.height())]
             .into_iter()
             .map(|size| (size, std::sync::Arc::new(self.picture.clone())))

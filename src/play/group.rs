@@ -100,6 +100,20 @@ impl LinkClass {
     }
 }
 
+/// A passing message on a status line (a hash of its text): players who show the same one
+/// share a group too. A crowd that joins together is greeted alike for its first seconds; with
+/// the message outside the key, each of them encoded its own frames all that time (issue 31:
+/// 29 % of the frames of 40 OpenSSH clients' 40 s sessions).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Note(u64);
+
+impl Note {
+    /// The note of `text` (FNV-1a: stable from run to run).
+    fn of(text: &str) -> Note {
+        Note(text.bytes().fold(0xcbf2_9ce4_8422_2325u64, |h, b| (h ^ u64::from(b)).wrapping_mul(0x100_0000_01b3)))
+    }
+}
+
 /// What screens must share to share frames.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct GroupKey {
@@ -113,9 +127,16 @@ pub struct GroupKey {
     pub fps: u32,
     /// The link's class.
     pub(crate) class: LinkClass,
+    /// The passing message its status line shows, if any.
+    pub(crate) note: Option<Note>,
 }
 
 impl GroupKey {
+    /// The key of a member whose status line shows `message` (a passing message, or none).
+    pub fn with_note(self, message: Option<&str>) -> GroupKey {
+        GroupKey { note: message.map(Note::of), ..self }
+    }
+
     /// The picture a group of this key draws, in pixels (as its members' screens take it).
     pub fn picture_size(&self) -> (u32, u32) {
         half_block_picture(self.term)
@@ -162,6 +183,8 @@ pub struct Group {
     screen: Screen,
     frames: VecDeque<Arc<GroupFrame>>,
     number: u64,
+    /// The text of its key's note, shown on its status line.
+    note: Option<Arc<str>>,
 }
 
 impl Group {
@@ -181,7 +204,13 @@ impl Group {
             link_path: LinkPath::Direct,
         };
         let screen = Screen::new(config, key.term, now).without_enter();
-        Group { key, screen, frames: VecDeque::with_capacity(FEED_FRAMES), number: 0 }
+        Group { key, screen, frames: VecDeque::with_capacity(FEED_FRAMES), number: 0, note: None }
+    }
+
+    /// The group whose status line shows `text` (its key's note: ignored when it is not).
+    pub fn noted(mut self, text: Option<Arc<str>>) -> Group {
+        self.note = text.filter(|t| self.key.note == Some(Note::of(t)));
+        self
     }
 
     /// What its members share.
@@ -190,14 +219,14 @@ impl Group {
     }
 
     /// Encodes the frame for now: `picture` (of [`GroupKey::picture_size`]) under the status
-    /// line of `status`, with no one's overlay. Returns whether the frame changed anything (a
+    /// line of `status`, with no one's overlay but the group's note. Returns whether the frame changed anything (a
     /// frame that sends nothing is no new group frame).
     pub fn frame(&mut self, now: Instant, picture: &Pixmap, status: &SceneStatus) -> bool {
         self.screen.forget_pen();
         let (fps, bytes_per_second) = self.screen.figures();
         let bandwidth = (self.screen.config().bandwidth != Bandwidth::Unlimited).then(|| self.key.class.group_rate());
         let figures = Figures { fps, bytes_per_second, bandwidth, pixels_elsewhere: false, note: None };
-        let seat = SeatView { stone: DEFAULT_STONE_RADIUS, ..SeatView::default() };
+        let seat = SeatView { stone: DEFAULT_STONE_RADIUS, message: self.note.as_deref(), ..SeatView::default() };
         // The oldest frame's buffers are reused once no member holds it.
         let recycled = if self.frames.len() >= FEED_FRAMES { self.frames.pop_front() } else { None };
         let (mut bytes, mut after) = match recycled.map(Arc::try_unwrap) {
@@ -236,13 +265,22 @@ impl Groups {
     /// Players a key needs for a group: one player alone encodes for itself.
     pub const MIN_MEMBERS: usize = 2;
 
-    /// Keeps a group for every key of `keys` (one a player) that enough players have, new
-    /// ones starting at `now`; drops the rest.
-    pub fn keep(&mut self, keys: impl IntoIterator<Item = GroupKey>, now: Instant) {
-        let mut members: HashMap<GroupKey, usize> = HashMap::new();
-        for key in keys {
-            *members.entry(key).or_default() += 1;
+    /// Keeps a group for every key of `keys` (one a player, with the text of its note) that
+    /// enough players have, new ones starting at `now`; drops the rest.
+    pub fn keep(&mut self, keys: impl IntoIterator<Item = (GroupKey, Option<Arc<str>>)>, now: Instant) {
+        let mut members: HashMap<GroupKey, (usize, Option<Arc<str>>)> = HashMap::new();
+        for (key, note) in keys {
+            let entry = members.entry(key).or_insert((0, note));
+            entry.0 += 1;
         }
+        let mut notes: HashMap<GroupKey, Option<Arc<str>>> = HashMap::new();
+        let members: HashMap<GroupKey, usize> = members
+            .into_iter()
+            .map(|(key, (n, note))| {
+                notes.insert(key, note);
+                (key, n)
+            })
+            .collect();
         let mut keys: Vec<(usize, GroupKey)> =
             members.into_iter().filter(|&(_, n)| n >= Self::MIN_MEMBERS).map(|(k, n)| (n, k)).collect();
         if keys.len() > Self::MAX {
@@ -252,7 +290,8 @@ impl Groups {
         }
         self.groups.retain(|key, _| keys.iter().any(|(_, k)| k == key));
         for (_, key) in keys {
-            self.groups.entry(key).or_insert_with(|| Group::new(key, now));
+            let note = notes.remove(&key).flatten();
+            self.groups.entry(key).or_insert_with(|| Group::new(key, now).noted(note));
         }
     }
 
@@ -339,7 +378,14 @@ impl Membership {
         };
         self.class = Some(class);
         let config = screen.config();
-        Some(GroupKey { term: screen.term(), color: config.color, encode: config.encode, fps: config.fps, class })
+        Some(GroupKey {
+            term: screen.term(),
+            color: config.color,
+            encode: config.encode,
+            fps: config.fps,
+            class,
+            note: None,
+        })
     }
 
     /// Whether the player's terminal shows its group's frames now.
@@ -373,10 +419,10 @@ impl Membership {
         feed: Option<&GroupFeed>,
         out: &mut Vec<u8>,
     ) -> (usize, Source) {
-        let key = self.key(&player.screen);
-        let feed = feed.filter(|f| Some(f.key) == key && !f.frames.is_empty());
         let Player { seat, screen, .. } = player;
         let view = seat.view(now, status);
+        let key = self.key(screen).map(|k| k.with_note(view.message));
+        let feed = feed.filter(|f| Some(f.key) == key && !f.frames.is_empty());
         let plain = plain(&view, status);
         if let Some(pinned) = self.pinned.clone() {
             let why = match feed {
@@ -492,13 +538,11 @@ fn looks_alike(a: &Shown, b: &Shown) -> bool {
     }
 }
 
-/// Whether a seat shows nothing of its own over the group's frame (no aim, help or message, and
-/// the stone size every seat starts with, where the status line shows it).
+/// Whether a seat shows nothing of its own over the group's frame (no aim or help, and the
+/// stone size every seat starts with, where the status line shows it; its passing message is
+/// its key's note, which the group shows).
 fn plain(view: &SeatView<'_>, status: &SceneStatus) -> bool {
-    view.aim.is_none()
-        && view.help.is_none()
-        && view.message.is_none()
-        && (view.stone == DEFAULT_STONE_RADIUS || !status.takes_stones)
+    view.aim.is_none() && view.help.is_none() && (view.stone == DEFAULT_STONE_RADIUS || !status.takes_stones)
 }
 
 #[cfg(test)]

@@ -51,6 +51,14 @@ impl Player {
         self.seat.fit()
     }
 
+    /// The passing message on their status line at `now` (the greeting, a notice), if any:
+    /// players who show the same one share a group's frames ([`GroupKey::with_note`]).
+    ///
+    /// [`GroupKey::with_note`]: crate::play::group::GroupKey::with_note
+    pub fn message(&self, now: Instant) -> Option<&str> {
+        self.seat.message(now)
+    }
+
     /// A player whose `s` key says screenshots are off instead of asking the host (a shared
     /// scene saves no files on a player's behalf).
     pub fn without_screenshots(mut self) -> Player {

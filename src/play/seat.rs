@@ -166,9 +166,14 @@ impl Seat {
         SeatView {
             aim: self.aim_until.is_some_and(|t| now < t).then(|| self.fit.cell_of(self.aim.0, self.aim.1)),
             help: self.help.as_ref().map(|(_, lines)| lines.as_slice()),
-            message: self.message.as_ref().filter(|(_, until)| now < *until).map(|(m, _)| m.as_str()),
+            message: self.message(now),
             stone: self.radius,
         }
+    }
+
+    /// The passing message on the status line at `now`, if any.
+    pub(crate) fn message(&self, now: Instant) -> Option<&str> {
+        self.message.as_ref().filter(|(_, until)| now < *until).map(|(m, _)| m.as_str())
     }
 
     /// Whether the help overlay is open.

@@ -20,8 +20,16 @@ use tokio::sync::mpsc;
 
 use crate::common::*;
 
-/// The test's ports, within the range this project's bus tests use.
-const PORTS: std::ops::Range<u16> = 42000..42999;
+/// The tests' ports: `TIDEPOOL_BUS_TEST_PORTS` (`FIRST-LAST`), the bus tests' 42000-42999 when
+/// unset (the binary's own bus test reads the same).
+fn ports() -> std::ops::Range<u16> {
+    let range = std::env::var("TIDEPOOL_BUS_TEST_PORTS").unwrap_or_else(|_| "42000-42999".into());
+    let (first, last) = range
+        .split_once('-')
+        .and_then(|(a, b)| Some((a.parse::<u16>().ok()?, b.parse::<u16>().ok()?)))
+        .expect("TIDEPOOL_BUS_TEST_PORTS is FIRST-LAST, e.g. 42000-42999");
+    first..last
+}
 static NEXT_PORT: AtomicU16 = AtomicU16::new(0);
 /// Water that moves by itself (rain, gusts): a step's picture depends on every step before.
 const WATER: &[&str] = &[
@@ -37,18 +45,19 @@ const WATER: &[&str] = &[
     "1000",
 ];
 
-/// A free loopback port in [`PORTS`], never the same twice in this process.
+/// A free loopback port in [`ports`], never the same twice in this process.
 pub fn free_port() -> u16 {
-    let span = PORTS.end - PORTS.start;
+    let range = ports();
+    let span = range.end - range.start;
     let offset = (std::process::id() % u32::from(span)) as u16;
     for _ in 0..span {
         let i = NEXT_PORT.fetch_add(1, Ordering::Relaxed);
-        let port = PORTS.start + (offset + i) % span;
+        let port = range.start + (offset + i) % span;
         if TcpListener::bind(("127.0.0.1", port)).is_ok() {
             return port;
         }
     }
-    panic!("no free port in {PORTS:?}");
+    panic!("no free port in {range:?}");
 }
 
 /// Waits (bounded) until `ok` holds.
@@ -91,12 +100,17 @@ impl Nats {
         format!("nats://127.0.0.1:{}", self.port)
     }
 
-    /// Stops the server (SIGTERM, as a service manager does), waits `down`, starts it again
-    /// on the same port with the same data.
-    pub fn restart(&mut self, down: Duration) {
+    /// Stops the server (SIGTERM, as a service manager does); returns when it has exited.
+    pub fn stop(&mut self) -> Instant {
         let _ = Command::new("kill").arg(self.child.id().to_string()).status();
         let _ = self.child.wait();
-        std::thread::sleep(down);
+        Instant::now()
+    }
+
+    /// Starts it again on the same port with the same data, once it has been down `down`
+    /// since `stopped`.
+    pub fn start_again(&mut self, stopped: Instant, down: Duration) {
+        std::thread::sleep(down.saturating_sub(stopped.elapsed()));
         // The old one's drop kills and reaps nothing more: it has exited.
         *self = Nats::start_at(self.port, self.dir.clone());
     }
@@ -485,12 +499,50 @@ async fn the_bus_restarted_or_an_edge_cut_off_players_stay_told_why_and_resume_i
     assert!(b.log_has("disconnected"), "{:?}", b.log());
 
     // nats-server restarted: both edges keep their players, say so, and resume in step.
-    nats.restart(Duration::from_millis(1500));
+    // (Told while it is down: an edge may be back a moment after the server.)
+    let stopped = nats.stop();
     pa.wait_status("bus lost", |s| s.contains("bus lost")).await;
+    pb.wait_status("bus lost", |s| s.contains("bus lost")).await;
+    nats.start_again(stopped, Duration::from_millis(1500));
     pa.wait_status("the bus back", |s| !s.contains("bus lost")).await;
     pb.wait_status("the bus back", |s| !s.contains("bus lost")).await;
     pa.send(&click(45, 11));
     let (after, pictures) = shoot(&pb, &[&a, &b]).await;
     assert!(after > step);
     assert_same(after, &pictures, "after the bus's restart");
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+#[ignore = "needs nats-server: scripts/bus_tests.sh installs it and runs these (.ci/run does)"]
+async fn the_sequencers_edge_cut_off_another_takes_over_and_it_stands_down_when_back() {
+    let nats = Nats::start();
+    let pool = pool_name("cutlead");
+    let relay = Relay::start(nats.port);
+    let a = Edge::first(&relay.url(), &pool);
+    let b = Edge::start(&nats.url(), &pool, "b");
+    let (pa, pb) = (Player::join(&a).await, Player::join(&b).await);
+    pa.wait_status("2 playing", |s| s.contains("2 playing")).await;
+    pb.send(&click(20, 6));
+    let (step, pictures) = shoot(&pb, &[&a, &b]).await;
+    assert_same(step, &pictures, "before the cut");
+
+    // The sequencer's edge cut off: its player is told; b takes the role over, and orders
+    // b's stones meanwhile.
+    relay.cut();
+    pa.wait_status("bus lost", |s| s.contains("bus lost")).await;
+    b.wait_log("this edge is the sequencer");
+    pb.send(&click(40, 10));
+    // Back: a learns that b holds the role (its lease's compare-and-set, or its tick fenced
+    // out of the log) and stands down; it does not write after b, and follows b's log.
+    relay.mend();
+    a.wait_log("no longer the sequencer");
+    pa.wait_status("the bus back", |s| !s.contains("bus lost")).await;
+    pa.send(&click(30, 9));
+    let (after, pictures) = shoot(&pa, &[&a, &b]).await;
+    assert!(after > step);
+    assert_same(after, &pictures, "after a came back");
+    // Exactly one sequencer after the cut: b, once; a never took the role back.
+    assert_eq!(b.count_log("this edge is the sequencer"), 1, "{:?}", b.log());
+    assert_eq!(a.count_log("this edge is the sequencer"), 1, "{:?}", a.log());
+    assert_eq!(a.count_log("skipped"), 0, "{:?}", a.log());
 }

@@ -15,6 +15,11 @@ const FRAME: Duration = Duration::from_nanos(1_000_000_000 / 30);
 const TERM: (u16, u16) = (60, 16);
 
 fn player(t0: Instant) -> Player {
+    greeted(t0, None)
+}
+
+/// A player greeted with `greeting` (shown for its first seconds).
+fn greeted(t0: Instant, greeting: Option<&str>) -> Player {
     let config = ScreenConfig {
         fps: 30,
         bandwidth: Bandwidth::Unlimited,
@@ -28,7 +33,7 @@ fn player(t0: Instant) -> Player {
     };
     let screen = Screen::new(config, TERM, t0);
     let picture = screen.picture_size();
-    Player::new(screen, picture, None)
+    Player::new(screen, picture, greeting.map(String::from))
 }
 
 /// One member: its player, its place in the group, its terminal, and what each frame was.
@@ -249,4 +254,69 @@ fn a_member_at_its_class_bound_catches_up_on_busy_water() {
     assert!((250..360).all(|k| second[k] != Source::Group), "out of step while its message shows");
     let back = joined(360).expect("back in step after its message, on busy water");
     assert!(back <= 360 + 150, "back in step within 5 s of its message's end: frame {back}");
+}
+
+#[test]
+fn players_greeted_alike_share_a_group_that_shows_the_greeting_then_the_plain_one() {
+    const GREETING: &str = "a shared greeting";
+    let t0 = Instant::now();
+    // Three players greeted alike (as a crowd that joins together is); the greeting shows for
+    // their first 10 s (300 frames at 30 fps).
+    let mut members: Vec<(Player, Membership, Vt, Vec<Source>)> = (0..3)
+        .map(|_| {
+            (greeted(t0, Some(GREETING)), Membership::new(), Vt::new(TERM.0 as usize, TERM.1 as usize), Vec::new())
+        })
+        .collect();
+    let pool = PoolSettings { rain_rate: 0.5, seed: 7, ..PoolSettings::default() };
+    let config = HostConfig { scenes: vec![SceneSpec::Pool(pool)], seed: 7, record: None, screenshots: false };
+    let size = members[0].0.screen.picture_size();
+    let mut host = Host::new(config, size, t0).unwrap();
+    let mut picture = Pixmap::new(size.0, size.1).unwrap();
+    let mut groups = Groups::default();
+    let mut requests = Vec::new();
+    let status_row = |vt: &Vt| (0..vt.cols()).map(|x| vt.cell(x, vt.rows() - 1).ch).collect::<String>();
+    let mut shown_at_150 = String::new();
+    for k in 0..360u32 {
+        let now = t0 + FRAME * k;
+        if k % 10 == 0 {
+            host.apply(Request::RandomStone { radius: 3 }, now);
+        }
+        host.advance(now);
+        host.render(&mut picture);
+        let status = host.status().clone();
+        // The keys as the server takes them: each with its note's text.
+        let keys: Vec<(GroupKey, Option<Arc<str>>)> = members
+            .iter_mut()
+            .map(|(p, m, _, _)| {
+                p.turn(now, &status, &mut requests);
+                let message = p.message(now);
+                (m.key(&p.screen).expect("a group").with_note(message), message.map(Arc::from))
+            })
+            .collect();
+        groups.keep(keys.clone(), now);
+        let pictures = HashMap::from([(size, Arc::new(picture.clone()))]);
+        groups.encode(&pictures, &status, now);
+        let feeds = groups.feeds();
+        for ((p, m, vt, sources), (key, _)) in members.iter_mut().zip(&keys) {
+            let mut out = Vec::new();
+            let (_, source) = m.frame(p, now, &picture, &status, feeds.get(key), &mut out);
+            vt.feed(&out);
+            sources.push(source);
+        }
+        if k == 150 {
+            shown_at_150 = status_row(&members[0].2);
+        }
+    }
+    // While greeted, they take the greeted group's frames, and their terminals show the
+    // greeting (drawn by the group).
+    for (_, m, vt, sources) in &members {
+        let shared = (30..290).filter(|&k| sources[k] == Source::Group).count();
+        assert!(shared >= 230, "frames from the greeted group while greeted: {shared} of 260");
+        // After it, the plain group's (a status row apart: in step again within a second).
+        let back = (300..360).find(|&k| sources[k] == Source::Group).expect("in the plain group's step after");
+        assert!(back <= 330, "back in step at frame {back}");
+        assert!(m.in_step());
+        assert!(!status_row(vt).contains(GREETING), "the greeting is gone: {:?}", status_row(vt));
+    }
+    assert!(shown_at_150.contains(GREETING), "the greeting shows while greeted: {shown_at_150:?}");
 }

@@ -44,12 +44,14 @@ pub struct SharedFrame {
 }
 
 /// How a player's screen wants the scene.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct Viewing {
     /// How the scene fits its picture (one picture per distinct size).
     pub fit: Fit,
     /// The group it belongs in, if any.
     pub group: Option<GroupKey>,
+    /// The text of its group's note (the passing message its status line shows), if any.
+    pub note: Option<Arc<str>>,
 }
 
 /// Every player's [`Viewing`], by player id.
@@ -98,7 +100,7 @@ impl Publisher {
     /// Publishes `scene` (just rendered) with `status` to every player of `links`.
     pub fn publish(&mut self, scene: &Pixmap, status: SceneStatus, links: &GameLinks, now: Instant) {
         self.number += 1;
-        let viewing: Vec<Viewing> = links.fits.lock().unwrap_or_else(|p| p.into_inner()).values().copied().collect();
+        let viewing: Vec<Viewing> = links.fits.lock().unwrap_or_else(|p| p.into_inner()).values().cloned().collect();
         let mut drawn = HashMap::with_capacity(viewing.len());
         for fit in viewing.iter().map(|v| v.fit) {
             if drawn.contains_key(&fit.target()) {
@@ -111,7 +113,7 @@ impl Publisher {
                 links.stats.pictures.fetch_add(1, Ordering::Relaxed);
             }
         }
-        self.groups.keep(viewing.iter().filter_map(|v| v.group), now);
+        self.groups.keep(viewing.iter().filter_map(|v| Some((v.group?, v.note.clone()))), now);
         let encoded = self.groups.encode(&drawn, &status, now);
         links.stats.group_frames.fetch_add(encoded, Ordering::Relaxed);
         let feeds = self.groups.feeds();

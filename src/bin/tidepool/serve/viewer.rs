@@ -76,8 +76,8 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     if !hub.screenshots {
         player = player.without_screenshots();
     }
-    let viewing = Viewing { fit: *player.fit(), group: None };
-    hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing);
+    let viewing = Viewing { fit: *player.fit(), group: None, note: None };
+    hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing.clone());
     let mut frames = hub.frames.clone();
     let mut v = Viewer {
         driver: Driver::new(player, Pacing::Pictures),
@@ -217,11 +217,14 @@ impl Viewer {
                 }
             }
         }
-        let screen = &self.driver.player().screen;
-        let now_viewing = Viewing { fit: *self.driver.player().fit(), group: self.membership.key(screen) };
-        if (now_viewing.fit, now_viewing.group) != (self.viewing.fit, self.viewing.group) {
-            self.viewing = now_viewing;
-            self.hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(self.id, self.viewing);
+        let player = self.driver.player();
+        let message = player.message(now);
+        let (fit, group) = (*player.fit(), self.membership.key(&player.screen).map(|k| k.with_note(message)));
+        if (fit, group) != (self.viewing.fit, self.viewing.group) {
+            // The note's text travels with the key, to the group that shows it.
+            let note = message.filter(|_| group.is_some()).map(Arc::from);
+            self.viewing = Viewing { fit, group, note };
+            self.hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(self.id, self.viewing.clone());
         }
         None
     }

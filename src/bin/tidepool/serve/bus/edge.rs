@@ -12,7 +12,7 @@ use std::time::{Duration, Instant, SystemTime};
 use tidepool::play::SceneStatus;
 use tidepool::{Controls, PoolScene};
 use tiny_skia::Pixmap;
-use tokio::sync::{mpsc, oneshot};
+use tokio::sync::{Notify, mpsc, oneshot};
 
 use super::lockstep::{Lockstep, Missed};
 use super::protocol::{self, Submit};
@@ -53,6 +53,8 @@ pub enum Outgoing {
 pub struct BusState {
     /// Connected to the NATS server.
     pub connected: AtomicBool,
+    /// The connection was lost at least once (a `Connected` after it is a return).
+    pub lost_once: AtomicBool,
     /// This edge holds the sequencer's lease.
     pub leading: AtomicBool,
     /// The edge has its copy of the pool (from a snapshot or the log's start).
@@ -61,6 +63,10 @@ pub struct BusState {
     pub dropped: AtomicU64,
     /// Log entries skipped as malformed.
     pub bad_entries: AtomicU64,
+    /// Told when the connection is back after it was lost: the log's reader starts again at
+    /// once (nats-server forgot its consumer; async-nats's own reader noticed only after its
+    /// 15 s heartbeat, and the water stood still that long).
+    pub back: Notify,
 }
 
 impl BusState {

@@ -8,16 +8,17 @@ use std::sync::Arc;
 use std::sync::atomic::Ordering;
 use std::time::{Duration, Instant};
 
-use async_nats::jetstream::context::PublishErrorKind;
-use async_nats::jetstream::kv::Operation;
+use async_nats::jetstream::kv::{self, Operation};
 use async_nats::jetstream::message::PublishMessage;
 use futures_util::StreamExt;
 use tokio::sync::{mpsc, oneshot};
+use tokio::time::MissedTickBehavior;
 use tokio_util::sync::CancellationToken;
 
+use super::BusOptions;
 use super::edge::{BusState, Incoming};
 use super::lease::{self, Lease, LeaseStep};
-use super::link::{PoolLink, SNAPSHOT_OBJECT};
+use super::link::{self, PoolLink, SNAPSHOT_OBJECT};
 use super::lockstep::MAX_SNAPSHOT_BYTES;
 use super::protocol::{self, Tick};
 use super::sequencer::{Sequencer, SequencerLimits, TICK_PERIOD};
@@ -65,10 +66,84 @@ impl Refusals {
     }
 }
 
-/// An edge's part in the sequencer's role.
-pub struct Leader {
-    /// The pool.
-    pub pool: Arc<PoolLink>,
+/// Renews the lease every [`lease::REFRESH`] until `give_up`; cancels `lost` and ends only
+/// when the compare-and-set says another edge holds it. Returns the lease as it left it.
+///
+/// A renewal that fails otherwise (the bus away, a timeout) is tried again at the next
+/// refresh, however long that takes: the clock alone never gives the role up. That is safe
+/// because nothing rests on it: a standby takes the key only with a compare-and-set on the
+/// revision this edge last wrote (so this edge learns of it on its next try), and a tick this
+/// edge publishes meanwhile is refused by the log's expected-last-sequence check. Giving up by
+/// the clock made a restart of nats-server move the role for nothing: the holder gave up
+/// while the bus was away, and requests sent once it was back found no sequencer
+/// (docs/serve/bus.md, round 4). Each try waits at most a refresh, so a try lost with the
+/// old connection does not hold the next one back once the bus returns.
+async fn keep(
+    kv: kv::Store,
+    me: String,
+    mut lease: Lease,
+    lost: CancellationToken,
+    give_up: CancellationToken,
+) -> Lease {
+    let mut refresh = tokio::time::interval(lease::REFRESH);
+    refresh.set_missed_tick_behavior(MissedTickBehavior::Delay);
+    let mut failing = false;
+    loop {
+        tokio::select! {
+            _ = give_up.cancelled() => return lease,
+            _ = refresh.tick() => {}
+        }
+        let Some(revision) = lease.held() else {
+            lost.cancel();
+            return lease;
+        };
+        let wrote = tokio::select! {
+            _ = give_up.cancelled() => return lease,
+            wrote = tokio::time::timeout(lease::REFRESH, kv.update(LEASE_KEY, me.clone().into(), revision)) => wrote,
+        };
+        match wrote {
+            Ok(Ok(r)) => {
+                if std::mem::take(&mut failing) {
+                    eprintln!("bus: the lease renewed again (revision {r})");
+                }
+                lease.wrote(r, Instant::now());
+            }
+            Ok(Err(e)) if e.kind() == kv::UpdateErrorKind::WrongLastRevision => {
+                match ours(&kv, &me).await {
+                    // A renewal that seemed to fail landed after all (sent when the bus came
+                    // back): the key still names this edge, and no other wrote since.
+                    Some(Some(r)) => lease.wrote(r, Instant::now()),
+                    Some(None) => {
+                        eprintln!("bus: cannot renew the lease ({e}): another edge holds it");
+                        lease.refused();
+                        lost.cancel();
+                        return lease;
+                    }
+                    None => failing = true,
+                }
+            }
+            failed => {
+                let why = match failed {
+                    Ok(Err(e)) => e.to_string(),
+                    _ => "timed out".to_owned(),
+                };
+                if !std::mem::replace(&mut failing, true) {
+                    eprintln!("bus: cannot renew the lease ({why}); trying again, still the sequencer");
+                }
+            }
+        }
+    }
+}
+
+/// The lease key's revision if it names `me` (`Some(None)`: another edge, or no key; `None`:
+/// it could not be read).
+async fn ours(kv: &kv::Store, me: &str) -> Option<Option<u64>> {
+    let entry = tokio::time::timeout(lease::REFRESH, kv.entry(LEASE_KEY)).await.ok()?.ok()?;
+    Some(entry.filter(|e| e.operation == Operation::Put && e.value.as_ref() == me.as_bytes()).map(|e| e.revision))
+}
+
+/// What the sequencer's role needs besides its connection to the bus.
+pub struct Role {
     /// This edge's name.
     pub me: String,
     /// The scene's size.
@@ -85,6 +160,61 @@ pub struct Leader {
     pub state: Arc<BusState>,
 }
 
+/// Starts this edge's part in the sequencer's role (watching the lease; sequencing while it
+/// holds it) on a thread of its own with a runtime of its own, and opens the edge's
+/// connection to the bus there: the connection's own task (every message in and out) runs on
+/// that runtime too, and the edge's other tasks share it from theirs.
+///
+/// Why a thread: the players' tasks (their frames' encoding) run on the server's runtime, and
+/// at load 8 to 12 on 2 cores a lease whose renewal shared their workers (and their
+/// connection's task) missed its second: the role moved six times in five minutes, keys waited
+/// seconds and 2 % of stones were refused (docs/serve/bus.md, round 2). Here only a dead or
+/// cut-off edge loses the role. One connection, not one for the role and one for the edge: the
+/// status line's `bus lost` then speaks for both. Returns the pool once the connection is
+/// open (its error otherwise).
+pub async fn start(
+    options: &BusOptions,
+    fingerprint: String,
+    role: Role,
+    stop: CancellationToken,
+) -> Result<Arc<PoolLink>, String> {
+    let (opened_tx, opened) = oneshot::channel();
+    let options = options.clone();
+    std::thread::Builder::new()
+        .name("tidepool-sequencer".into())
+        .spawn(move || {
+            let runtime = match tokio::runtime::Builder::new_current_thread().enable_all().build() {
+                Ok(runtime) => runtime,
+                Err(e) => {
+                    let _ = opened_tx.send(Err(format!("cannot start the sequencer's runtime ({e})")));
+                    return;
+                }
+            };
+            runtime.block_on(async move {
+                match link::open(&options, &fingerprint, role.state.clone()).await {
+                    Ok(pool) => {
+                        let pool = Arc::new(pool);
+                        let _ = opened_tx.send(Ok(pool.clone()));
+                        Leader { pool, role }.run(stop).await;
+                    }
+                    Err(e) => {
+                        let _ = opened_tx.send(Err(e));
+                    }
+                }
+            });
+        })
+        .map_err(|e| format!("cannot start the sequencer's thread ({e})"))?;
+    opened.await.map_err(|_| "the sequencer's thread ended while starting".to_owned())?
+}
+
+/// An edge's part in the sequencer's role, on its own thread ([`start`]).
+struct Leader {
+    /// The pool (its connection's task on the role's runtime).
+    pool: Arc<PoolLink>,
+    /// The rest.
+    role: Role,
+}
+
 /// Why a sequencer stopped.
 enum Ended {
     Stopped,
@@ -94,20 +224,23 @@ enum Ended {
 impl Leader {
     /// Watches the lease until `stop`; sequences while it holds it.
     pub async fn run(self, stop: CancellationToken) {
-        let mut lease = Lease::new(&self.me);
+        let mut lease = Lease::new(&self.role.me);
         while !stop.is_cancelled() {
-            let entry = match self.pool.kv.entry(LEASE_KEY).await {
-                Ok(entry) => entry.filter(|e| e.operation == Operation::Put),
-                Err(_) => {
-                    tokio::select! { _ = stop.cancelled() => return, _ = tokio::time::sleep(lease::POLL) => continue }
-                }
+            let read = match self.role.state.connected.load(Ordering::Relaxed) {
+                true => self.pool.kv.entry(LEASE_KEY).await.ok(),
+                false => None,
+            };
+            let Some(entry) = read.map(|entry| entry.filter(|e| e.operation == Operation::Put)) else {
+                // Blind for a while: the holder's silence meanwhile proves nothing.
+                lease.lost_sight();
+                tokio::select! { _ = stop.cancelled() => return, _ = tokio::time::sleep(lease::POLL) => continue }
             };
             let now = Instant::now();
             let holder = entry.as_ref().map(|e| (String::from_utf8_lossy(&e.value).into_owned(), e.revision));
             let wrote = match lease.observe(holder.as_ref().map(|(h, r)| (h.as_str(), *r)), now) {
                 LeaseStep::Wait => None,
-                LeaseStep::Create => Some(self.pool.kv.create(LEASE_KEY, self.me.clone().into()).await.ok()),
-                LeaseStep::Update(r) => Some(self.pool.kv.update(LEASE_KEY, self.me.clone().into(), r).await.ok()),
+                LeaseStep::Create => Some(self.pool.kv.create(LEASE_KEY, self.role.me.clone().into()).await.ok()),
+                LeaseStep::Update(r) => Some(self.pool.kv.update(LEASE_KEY, self.role.me.clone().into(), r).await.ok()),
             };
             match wrote {
                 Some(Some(revision)) => lease.wrote(revision, Instant::now()),
@@ -115,12 +248,12 @@ impl Leader {
                 None => {}
             }
             if lease.held().is_some() {
-                if let Some(previous) = holder.filter(|(h, _)| *h != self.me) {
+                if let Some(previous) = holder.filter(|(h, _)| *h != self.role.me) {
                     eprintln!("bus: took the sequencer's role over from {}", previous.0);
                 }
-                self.state.leading.store(true, Ordering::Relaxed);
+                self.role.state.leading.store(true, Ordering::Relaxed);
                 let ended = self.sequence(&mut lease, &stop).await;
-                self.state.leading.store(false, Ordering::Relaxed);
+                self.role.state.leading.store(false, Ordering::Relaxed);
                 match ended {
                     Ended::Stopped => return,
                     Ended::LostLease => eprintln!("bus: this edge is no longer the sequencer"),
@@ -141,12 +274,12 @@ impl Leader {
             Err(e) => return Err(e.to_string()),
         };
         let end = last.sequence;
-        if let Ok(tick) = protocol::read_tick(&last.payload, self.size) {
+        if let Ok(tick) = protocol::read_tick(&last.payload, self.role.size) {
             return Ok((end, Some(tick)));
         }
         for seq in (end.saturating_sub(LOOK_BACK)..end).rev().filter(|&s| s > 0) {
             if let Ok(message) = self.pool.stream.get_raw_message(seq).await
-                && let Ok(tick) = protocol::read_tick(&message.payload, self.size)
+                && let Ok(tick) = protocol::read_tick(&message.payload, self.role.size)
             {
                 return Ok((end, Some(tick)));
             }
@@ -157,7 +290,7 @@ impl Leader {
     /// Sequences while the lease holds.
     async fn sequence(&self, lease: &mut Lease, stop: &CancellationToken) -> Ended {
         let Some(term) = lease.held() else { return Ended::LostLease };
-        let (mut last_seq, last) = match self.last_tick().await {
+        let (last_seq, last) = match self.last_tick().await {
             Ok(x) => x,
             Err(e) => {
                 eprintln!("bus: cannot read the log's end ({e}); giving the role up");
@@ -165,9 +298,39 @@ impl Leader {
             }
         };
         let now = Instant::now();
-        let mut seq =
-            Sequencer::new(self.size, self.steps_per_second, self.limits, self.seed, last.as_ref(), term, now);
+        let seq = Sequencer::new(
+            self.role.size,
+            self.role.steps_per_second,
+            self.role.limits,
+            self.role.seed,
+            last.as_ref(),
+            term,
+            now,
+        );
         eprintln!("bus: this edge is the sequencer (term {term}), after log entry {last_seq}");
+        // The lease is renewed by a task of its own: a tick's publish waiting for its
+        // acknowledgement (up to a second when nats-server is slow) must not delay it.
+        let (lost, give_up) = (CancellationToken::new(), CancellationToken::new());
+        let held = std::mem::replace(lease, Lease::new(&self.role.me));
+        let keeper =
+            tokio::spawn(keep(self.pool.kv.clone(), self.role.me.clone(), held, lost.clone(), give_up.clone()));
+        let ended = self.sequence_held(seq, (term, last_seq), &lost, stop).await;
+        give_up.cancel();
+        if let Ok(back) = keeper.await {
+            *lease = back;
+        }
+        ended
+    }
+
+    /// The sequencer's loop: requests in, a tick out every [`TICK_PERIOD`], a snapshot every
+    /// [`SNAPSHOT_PERIOD`], until `lost` (the lease's keeper gave up) or `stop`.
+    async fn sequence_held(
+        &self,
+        mut seq: Sequencer,
+        (term, mut last_seq): (u64, u64),
+        lost: &CancellationToken,
+        stop: &CancellationToken,
+    ) -> Ended {
         let (Ok(mut submits), Ok(mut presence)) = (
             self.pool.client.subscribe(self.pool.names.submit.clone()).await,
             self.pool.client.subscribe(self.pool.names.presence.clone()).await,
@@ -175,9 +338,10 @@ impl Leader {
             return Ended::LostLease;
         };
         let mut ticks = tokio::time::interval(TICK_PERIOD);
-        let mut refresh = tokio::time::interval(lease::REFRESH);
         let mut snapshot = tokio::time::interval(SNAPSHOT_PERIOD);
         let mut refusals = Refusals::default();
+        // Ticks not acknowledged in a row (said once when it starts and once when it ends).
+        let mut unacked = 0u32;
         loop {
             tokio::select! {
                 _ = stop.cancelled() => return Ended::Stopped,
@@ -192,59 +356,74 @@ impl Leader {
                     refusals.summarize(Instant::now());
                     let tick = seq.tick(Instant::now());
                     match self.publish(&tick, last_seq).await {
-                        Ok(s) => last_seq = s,
-                        Err(Some(why)) => {
-                            eprintln!("bus: {why}; giving the sequencer's role up");
-                            return Ended::LostLease;
+                        Ok(s) => {
+                            if unacked > 0 {
+                                eprintln!("bus: ticks acknowledged again (entry {s}) after {unacked} that were not");
+                            }
+                            (last_seq, unacked) = (s, 0);
                         }
-                        // The bus is away: this tick's events are lost (never acknowledged);
-                        // the next tick carries on, after the log's end as it then stands.
-                        Err(None) => {
-                            if let Ok((s, _)) = self.last_tick().await {
-                                last_seq = s;
+                        // Not acknowledged (the bus away, or the log's fence): carry on after
+                        // the log's end only if this term wrote it.
+                        Err(why) => {
+                            if unacked == 0 {
+                                eprintln!("bus: a tick after log entry {last_seq} not acknowledged ({why}); trying again");
+                            }
+                            unacked += 1;
+                            match self.end_of_term(term, last_seq).await {
+                                Some(Some(s)) => last_seq = s,
+                                Some(None) => {
+                                    eprintln!("bus: the log moved on after entry {last_seq} without this sequencer; giving the sequencer's role up");
+                                    return Ended::LostLease;
+                                }
+                                // Unreadable: this tick's events are lost (never acknowledged);
+                                // the next tick tries again after the same entry.
+                                None => {}
                             }
                         }
                     }
                 }
-                _ = refresh.tick() => {
-                    let Some(revision) = lease.held() else { return Ended::LostLease };
-                    match self.pool.kv.update(LEASE_KEY, self.me.clone().into(), revision).await {
-                        Ok(r) => lease.wrote(r, Instant::now()),
-                        Err(e) if lease.expired(Instant::now()) => {
-                            eprintln!("bus: cannot renew the lease ({e})");
-                            lease.refused();
-                            return Ended::LostLease;
-                        }
-                        Err(_) => {}
-                    }
-                }
+                _ = lost.cancelled() => return Ended::LostLease,
                 _ = snapshot.tick() => self.store_snapshot().await,
             }
         }
     }
 
-    /// Publishes a tick after log entry `after`; its sequence, or why it failed: `Some` when
-    /// another sequencer wrote since (this one lost the role), `None` when the bus is away.
-    async fn publish(&self, tick: &Tick, after: u64) -> Result<u64, Option<String>> {
+    /// Publishes a tick after log entry `after`; its sequence, or why it was not acknowledged
+    /// (refused by the log's fence, or the bus away: it may have been written).
+    async fn publish(&self, tick: &Tick, after: u64) -> Result<u64, String> {
         let message = PublishMessage::build().payload(protocol::bytes_of(tick).into()).expected_last_sequence(after);
-        let ack = self.pool.js.send_publish(self.pool.names.log.clone(), message).await.map_err(|_| None)?;
-        match ack.await {
-            Ok(ack) => Ok(ack.sequence),
-            Err(e) if e.kind() == PublishErrorKind::WrongLastSequence => {
-                Err(Some(format!("the log moved on after entry {after} without this sequencer")))
+        let ack = self.pool.js.send_publish(self.pool.names.log.clone(), message).await.map_err(|e| e.to_string())?;
+        ack.await.map(|ack| ack.sequence).map_err(|e| e.to_string())
+    }
+
+    /// After a tick of `term` that was not acknowledged: the log's last entry if this term
+    /// wrote it or the log is still at `after` (`Some(None)`: something else wrote it, another
+    /// sequencer or a stray writer; `None`: the log could not be read). A publish whose
+    /// acknowledgement was lost with the connection may have been written (a request queued
+    /// while the bus was away is sent when it is back); a later tick would then be fenced out
+    /// after it, and the role would move for nothing. Reading the end and carrying on after
+    /// it whoever wrote it would instead open the fence to a sequencer that lost the role.
+    async fn end_of_term(&self, term: u64, after: u64) -> Option<Option<u64>> {
+        let last = match self.pool.stream.get_last_raw_message_by_subject(&self.pool.names.log).await {
+            Ok(message) => message,
+            Err(e) if after == 0 && (e.to_string().contains("no message") || e.to_string().contains("not found")) => {
+                return Some(Some(0));
             }
-            Err(_) => Err(None),
-        }
+            Err(_) => return None,
+        };
+        let mine = last.sequence == after
+            || protocol::read_tick(&last.payload, self.role.size).is_ok_and(|tick| tick.term == term);
+        Some(mine.then_some(last.sequence))
     }
 
     /// Asks the game thread for its state and stores it as the latest snapshot.
     async fn store_snapshot(&self) {
         // An edge still joining has nothing to offer: it would replace a good snapshot.
-        if !self.state.joined.load(Ordering::Relaxed) {
+        if !self.role.state.joined.load(Ordering::Relaxed) {
             return;
         }
         let (reply, answer) = oneshot::channel();
-        if self.snapshots.send(Incoming::Snapshot(reply)).await.is_err() {
+        if self.role.snapshots.send(Incoming::Snapshot(reply)).await.is_err() {
             return;
         }
         let Ok(bytes) = answer.await else { return };
@@ -257,3 +436,7 @@ impl Leader {
         }
     }
 }
+
+#[cfg(test)]
+#[path = "lead_tests.rs"]
+mod tests;

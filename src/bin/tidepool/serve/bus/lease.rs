@@ -5,6 +5,13 @@
 //! compare-and-set fails has lost the lease and stops sequencing at once; the log's
 //! expected-last-sequence check fences out any tick it still had in flight.
 //!
+//! Only what an edge saw counts: a standby that could not read the key (the bus away, or its
+//! own link cut) starts its count again when it reads it next ([`Lease::lost_sight`]), and a
+//! holder never gives the lease up by its clock alone, only when the compare-and-set says
+//! another edge wrote. After nats-server restarts, every edge has been blind alike: without
+//! the first rule a standby would take the key the moment it could read it, though its
+//! holder is back and renewing (docs/serve/bus.md, round 4).
+//!
 //! Sans-IO: what the key holds and `now` in, what to write out.
 
 use std::time::{Duration, Instant};
@@ -84,10 +91,10 @@ impl Lease {
         self.held = None;
     }
 
-    /// Whether a holder that last wrote at `wrote` must consider the lease lost by `now` (it
-    /// could not refresh within the expiry: a standby may have taken it).
-    pub fn expired(&self, now: Instant) -> bool {
-        self.held.is_some() && self.wrote.is_some_and(|w| now.saturating_duration_since(w) >= EXPIRY)
+    /// The key could not be read (the bus away, or this edge cut off from it): how long it
+    /// stood unchanged is unknown, so a standby counts [`EXPIRY`] again from its next read.
+    pub fn lost_sight(&mut self) {
+        self.seen = None;
     }
 }
 
@@ -126,8 +133,26 @@ mod tests {
         a.wrote(1, t0);
         assert_eq!(a.observe(Some(("b", 2)), t0 + REFRESH), LeaseStep::Wait);
         assert_eq!(a.held(), None);
-        a.wrote(3, t0);
-        assert!(!a.expired(t0 + REFRESH));
-        assert!(a.expired(t0 + EXPIRY));
+    }
+
+    #[test]
+    fn a_standby_that_lost_sight_of_the_lease_waits_a_whole_expiry_after_it_sees_it_again() {
+        // The holder wrote revision 6, then nats-server went away for 1.5 s: the standby saw
+        // revision 6 long ago, but not while the bus was down.
+        let t0 = Instant::now();
+        let mut b = Lease::new("b");
+        assert_eq!(b.observe(Some(("a", 6)), t0), LeaseStep::Wait);
+        b.lost_sight();
+        let back = t0 + EXPIRY + EXPIRY / 2;
+        assert_eq!(b.observe(Some(("a", 6)), back), LeaseStep::Wait, "taken the moment the bus came back");
+        assert_eq!(b.observe(Some(("a", 6)), back + EXPIRY / 2), LeaseStep::Wait);
+        // The holder did not renew within a whole expiry of the standby's sight: it is gone.
+        assert_eq!(b.observe(Some(("a", 6)), back + EXPIRY), LeaseStep::Update(6));
+        // A holder that lost sight keeps its revision: only a compare-and-set takes it away.
+        let mut a = Lease::new("a");
+        a.wrote(6, t0);
+        a.lost_sight();
+        assert_eq!(a.held(), Some(6));
+        assert_eq!(a.observe(Some(("a", 6)), back), LeaseStep::Update(6));
     }
 }

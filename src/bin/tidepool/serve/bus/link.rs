@@ -38,6 +38,11 @@ pub const REQUEST_TIMEOUT: Duration = Duration::from_secs(1);
 const PRESENCE_PERIOD: Duration = Duration::from_secs(1);
 /// Pause before trying again after the bus failed a request.
 const RETRY: Duration = Duration::from_millis(500);
+/// The longest wait between two tries to reach the bus again (async-nats's own grows to 4 s).
+/// Every edge is back within this of nats-server's return, so the holder of the sequencer's
+/// lease renews it before a standby has read it unchanged for the lease's expiry (a second):
+/// a restart does not move the role (docs/serve/bus.md, round 4).
+const RECONNECT_DELAY_MAX: Duration = Duration::from_millis(250);
 /// Messages a subscription buffers before the client drops them (bounds the sequencer's
 /// intake from a flood).
 const SUBSCRIPTION_CAPACITY: usize = 4096;
@@ -71,6 +76,7 @@ pub async fn open(options: &BusOptions, fingerprint: &str, state: Arc<BusState>)
         .connection_timeout(CONNECT_TIMEOUT)
         .subscription_capacity(SUBSCRIPTION_CAPACITY)
         .max_reconnects(None)
+        .reconnect_delay_callback(|attempts| Duration::from_millis(1u64 << attempts.min(16)).min(RECONNECT_DELAY_MAX))
         .event_callback(move |event| {
             let state = state.clone();
             async move {
@@ -78,10 +84,14 @@ pub async fn open(options: &BusOptions, fingerprint: &str, state: Arc<BusState>)
                     Event::Connected => {
                         eprintln!("bus: connected");
                         state.connected.store(true, Ordering::Relaxed);
+                        if state.lost_once.load(Ordering::Relaxed) {
+                            state.back.notify_one();
+                        }
                     }
                     Event::Disconnected => {
                         eprintln!("bus: disconnected; players stay, stones wait for the bus");
                         state.connected.store(false, Ordering::Relaxed);
+                        state.lost_once.store(true, Ordering::Relaxed);
                     }
                     other => eprintln!("bus: {other}"),
                 }
@@ -259,6 +269,10 @@ pub async fn follow(pool: Arc<PoolLink>, tx: mpsc::Sender<Incoming>, state: Arc<
             tokio::select! {
                 _ = stop.cancelled() => return,
                 _ = pool.rejoin.notified() => { next = None; break; }
+                _ = state.back.notified() => {
+                    eprintln!("bus: back; reading the log again from entry {}", next.unwrap_or(0));
+                    break;
+                }
                 m = messages.next() => match m {
                     Some(Ok(message)) => {
                         let Ok(info) = message.info() else { continue };

@@ -3,7 +3,8 @@
 //!
 //! - every edge sends its players' requests to the pool's sequencer ([`protocol::Submit`]);
 //! - one edge at a time holds the sequencer's lease ([`lease`]) in the pool's JetStream
-//!   key-value bucket; it checks every request (bounds, rates per player, per edge, per pool:
+//!   key-value bucket (on a thread and a runtime of its own, where the connection's task runs
+//!   too: the players' tasks cannot starve it); it checks every request (bounds, rates per player, per edge, per pool:
 //!   [`sequencer`]), and publishes ticks to the pool's JetStream stream: a step every edge may
 //!   run to and the events that apply at it;
 //! - every edge runs its own copy of the pool from that log ([`lockstep`]) and encodes for its
@@ -110,7 +111,7 @@ pub async fn start(
     let scene = PoolScene::new(spec.size.0, spec.size.1, spec.settings.clone())
         .ok_or_else(|| format!("cannot make a {}x{} pool", spec.size.0, spec.size.1))?;
     let state = Arc::new(BusState::default());
-    let pool = link::open(&options, &spec.fingerprint(), state.clone()).await?;
+    let fingerprint = spec.fingerprint();
     let (incoming_tx, incoming_rx) = tokio::sync::mpsc::channel(QUEUE);
     let (outgoing_tx, outgoing_rx) = tokio::sync::mpsc::channel(QUEUE);
     let bus = EdgeLinks {
@@ -121,25 +122,22 @@ pub async fn start(
         shots: options.shots.clone(),
         trace: std::env::var_os("TIDEPOOL_BUS_TRACE").is_some_and(|v| v == "1"),
     };
-    let fps = spec.fps;
-    let game = std::thread::Builder::new()
-        .name("tidepool-edge".into())
-        .spawn(move || edge::run(scene, fps, links, bus))
-        .map_err(|e| format!("cannot start the game thread ({e})"))?;
-    let pool = Arc::new(pool);
-    let steps_per_second = f64::from(spec.settings.steps_per_second);
-    let lead = lead::Leader {
-        pool: pool.clone(),
+    let role = lead::Role {
         me: options.edge.clone(),
         size: spec.size,
-        steps_per_second,
+        steps_per_second: f64::from(spec.settings.steps_per_second),
         seed: spec.seed,
         limits: options.limits,
         snapshots: incoming_tx.clone(),
         state: state.clone(),
     };
+    let pool = lead::start(&options, fingerprint, role, stop.clone()).await?;
+    let fps = spec.fps;
+    let game = std::thread::Builder::new()
+        .name("tidepool-edge".into())
+        .spawn(move || edge::run(scene, fps, links, bus))
+        .map_err(|e| format!("cannot start the game thread ({e})"))?;
     tokio::spawn(link::follow(pool.clone(), incoming_tx, state.clone(), stop.clone()));
-    tokio::spawn(link::forward(pool.clone(), outgoing_rx, options.edge.clone(), players, stop.clone()));
-    tokio::spawn(lead.run(stop));
+    tokio::spawn(link::forward(pool, outgoing_rx, options.edge.clone(), players, stop));
     Ok(game)
 }
