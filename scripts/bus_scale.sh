@@ -27,7 +27,9 @@ first_port=${EDGE_PORT:-2301}
 bin=${BIN:-target/release/tidepool}
 command -v nats-server >/dev/null || { echo "bus_scale.sh: nats-server not found (scripts/bus_tests.sh --install)" >&2; exit 2; }
 [ -x "$bin" ] || { echo "bus_scale.sh: $bin not found (cargo build --release --features bus)" >&2; exit 2; }
-client=$(cargo test --release --features serve --test serve --no-run 2>&1 | grep -o 'target/release/deps/serve-[0-9a-f]*' | tail -1)
+# The load client is built with the edges' features: a build with fewer would relink
+# target/release/tidepool without `--bus` (cargo builds the binary for the test target).
+client=$(cargo test --release --features bus --test serve --no-run 2>&1 | grep -o 'target/release/deps/serve-[0-9a-f]*' | tail -1)
 [ -x "$client" ] || { echo "bus_scale.sh: the load client did not build" >&2; exit 1; }
 work=$(mktemp -d /tmp/bus-scale.XXXXXX)
 pids=()
@@ -67,6 +69,7 @@ done
 # The window starts when every client says so.
 until [ "$(cat "$work"/client*.log 2>/dev/null | grep -c 'window starts')" -ge "$edges" ]; do
     for p in "${client_pids[@]}"; do kill -0 "$p" 2>/dev/null || { echo "a client ended early:"; tail -5 "$work"/client*.log; exit 1; }; done
+    for i in "${!edge_pids[@]}"; do kill -0 "${edge_pids[$i]}" 2>/dev/null || { echo "edge e$i ended early:"; tail -5 "$work/edge$i.log"; exit 1; }; done
     sleep 1
 done
 stat_cpu() { awk '{ print $14 + $15 }' "/proc/$1/stat"; }
