@@ -176,15 +176,10 @@ impl Picture {
     }
 }
 
-/// Appends `extra` (a picture's delete) inside the frame's synchronized update, as a picture
-/// goes (see [`splice_picture`]).
-pub fn append_in_frame(frame: &mut Vec<u8>, extra: &[u8], sync: bool) {
-    splice_picture(frame, extra, sync);
-}
-
 /// Puts a picture's bytes into the frame's synchronized update (before its end marker), so the
-/// picture and the status line change together; a frame without markers gets them.
-fn splice_picture(frame: &mut Vec<u8>, picture: &[u8], sync: bool) {
+/// picture and the status line change together; a frame without markers gets them. (A
+/// switch's delete of the old picture goes the same way.)
+pub(super) fn splice_picture(frame: &mut Vec<u8>, picture: &[u8], sync: bool) {
     if !sync {
         frame.extend_from_slice(picture);
     } else if frame.ends_with(SYNC_END) {

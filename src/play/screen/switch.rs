@@ -62,9 +62,6 @@ impl Screen {
         {
             out.extend_from_slice(&delete);
         }
-        if self.shown.frame.is_none() {
-            self.switch = None;
-        }
     }
 
     /// Whether the frame's cells above the status line are to stay as they are (cells to
@@ -79,7 +76,7 @@ impl Screen {
     pub(super) fn switch_after_cells(&mut self, covered: Option<bool>, bytes: &mut Vec<u8>) {
         let done = covered.unwrap_or(true) || !big_enough(self.term);
         if done && let Some(Switch::ToCells { delete }) = self.switch.take_if(|s| matches!(s, Switch::ToCells { .. })) {
-            super::picture::append_in_frame(bytes, &delete, self.config.encode.sync);
+            super::picture::splice_picture(bytes, &delete, self.config.encode.sync);
         }
     }
 

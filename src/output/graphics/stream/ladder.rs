@@ -173,12 +173,12 @@ impl Resampler {
             }
         }
         let mut weights = &self.rows.weights[..];
+        self.acc.resize(tw * 3, 0.0);
         for (y, &(lo, n)) in self.rows.spans.iter().enumerate() {
             let (w, rest) = weights.split_at(n as usize);
             weights = rest;
             // The first tap sets the sums (`0 + w * s`, as a zeroed sum plus it: no memset of
             // the row), the others add to them.
-            self.acc.resize(tw * 3, 0.0);
             for (k, &w) in w.iter().enumerate() {
                 let src = &self.rows_buf[(lo as usize + k) * tw * 3..][..tw * 3];
                 if k == 0 {
@@ -217,6 +217,8 @@ pub fn resample(source: &[u8], bpp: usize, from: (u32, u32), to: (u32, u32), out
 
 #[cfg(test)]
 mod tests {
+    use super::*;
+
     #[test]
     fn bytes_are_the_clamped_truncation_of_every_float() {
         let cast = |a: f32| (a + 0.5).clamp(0.0, 255.0) as u8;
@@ -227,16 +229,14 @@ mod tests {
             specials.extend([x, f32::from_bits(x.to_bits() + 1), f32::from_bits(x.to_bits().saturating_sub(1))]);
         }
         for a in specials {
-            assert_eq!(super::to_byte(a), cast(a), "{a} ({:#x})", a.to_bits());
+            assert_eq!(to_byte(a), cast(a), "{a} ({:#x})", a.to_bits());
         }
         // And a spread of every magnitude.
         for bits in (0..u32::MAX).step_by(65_537) {
             let a = f32::from_bits(bits);
-            assert_eq!(super::to_byte(a), cast(a), "{a} ({bits:#x})");
+            assert_eq!(to_byte(a), cast(a), "{a} ({bits:#x})");
         }
     }
-
-    use super::*;
 
     #[test]
     fn the_ladder_runs_from_the_area_to_half_blocks() {
