@@ -1,7 +1,6 @@
 //! `auto`'s switch from kitty pictures to half-block cells, as a user over a link meets it: the
 //! fake kitty's link slows down (the pty's bytes are taken at 30 kB/s), `play` leaves its
-//! pictures for cells, and the link recovers (`auto` usually comes back to pictures within the
-//! test's 8 s; that way is watched too). Between the first picture and `q`, no moment
+//! pictures for cells, and the link recovers: `auto` comes back to pictures. Between the first picture and `q`, no moment
 //! outside a synchronized update may leave the picture area blank: neither kitty's image placed
 //! nor the cells painted (a switch used to delete the image and clear the screen first: about a
 //! second of black).
@@ -55,9 +54,15 @@ fn image_shown(fake: &FakeTerminal) -> bool {
 fn wait_for(seen: &Mutex<Seen>, fake: &Mutex<FakeTerminal>, done: impl Fn(&Seen, &FakeTerminal) -> bool) -> bool {
     let until = Instant::now() + PHASE;
     while Instant::now() < until {
-        // In the responder's order (the fake, then what was seen): no deadlock.
-        let f = fake.lock().unwrap();
-        if done(&seen.lock().unwrap(), &f) {
+        // In the responder's order (the fake, then what was seen): no deadlock. Both are let
+        // go before the sleep: held through it (as they were), they kept the responder from
+        // the pty's bytes for most of each 50 ms (a mutex is not fair), so the fake read at a
+        // few kB/s, its answers came seconds late, and the switch took 20 to 60 s.
+        let finished = {
+            let f = fake.lock().unwrap();
+            done(&seen.lock().unwrap(), &f)
+        };
+        if finished {
             return true;
         }
         std::thread::sleep(Duration::from_millis(50));
@@ -112,27 +117,27 @@ fn auto_leaving_kitty_pictures_for_cells_and_coming_back_never_shows_a_blank_pic
     rate.store(SLOW, Ordering::Relaxed);
     let to_cells = pictured && wait_for(&seen, &fake, |s, _| s.in_cells);
     let at_cells = start.elapsed().as_secs_f64();
-    // It recovers. The way back to pictures is watched for blank moments too, but not
-    // required: after the slow phase the link control stays at its floor for longer than a
-    // test can wait (the fake's pty buffer made its questions overdue: "the terminal does not
-    // answer"; docs/terminals/right-pictures.md, Round 6).
+    // It recovers: auto comes back to pictures once the rate has held over the crossover (and
+    // at least `AutoSwitch::MIN_BETWEEN` after the last switch), and the way back is watched
+    // for blank moments too, for two seconds after it.
     rate.store(0, Ordering::Relaxed);
-    std::thread::sleep(Duration::from_secs(8));
-    let to_pixels = seen.lock().unwrap().in_pixels;
+    let to_pixels = to_cells && wait_for(&seen, &fake, |s, _| s.in_pixels);
+    let at_pixels = start.elapsed().as_secs_f64();
+    std::thread::sleep(Duration::from_secs(2));
     let status = fake.lock().unwrap().status().trim_end().to_string();
     seen.lock().unwrap().quitting = true;
     p.send(b"q");
     let _ = p.wait_exit(PHASE);
     let s = seen.lock().unwrap();
     println!(
-        "switch: pictured {pictured}, cells {to_cells} at {at_cells:.1} s, pixels again {to_pixels}, \
+        "switch: pictured {pictured}, cells {to_cells} at {at_cells:.1} s, pixels again {to_pixels} at {at_pixels:.1} s, \
          blank moments {}, status {status:?}\nnotices: {:?}",
         s.blank.len(),
         s.notices
     );
     assert!(
-        pictured && to_cells,
-        "the switch did not happen: pictured {pictured}, cells {to_cells}; status {status:?}"
+        pictured && to_cells && to_pixels,
+        "the switches did not happen: pictured {pictured}, cells {to_cells}, pixels again {to_pixels}; status {status:?}"
     );
     assert!(
         s.blank.is_empty(),
