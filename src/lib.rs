@@ -40,6 +40,10 @@ mod storage;
 #[cfg(feature = "player")]
 mod term;
 
+/// The `tidepool` command line (feature `cli`), as the `tidepool` binary runs it.
+#[cfg(feature = "cli")]
+pub mod cli;
+
 pub mod encode;
 pub mod graphics;
 #[cfg(feature = "player")]
