@@ -48,8 +48,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
-use tidepool::serve::ByteBucket;
 use tidepool::terminal::{Color, ColorMode, EncodeOptions, Frame, Shown};
+use tidepool::testing::ByteBucket;
 use tidepool::testing::{
     self as quality, Luma, RateEncoder, RateOptions, SsimReference, Strategy, Target, TerminalModel, UNLIMITED,
 };

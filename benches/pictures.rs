@@ -34,8 +34,8 @@ use criterion::Criterion;
 use tidepool::graphics::kitty::KittyOptions;
 use tidepool::graphics::sixel::{Registers, SixelPalette};
 use tidepool::graphics::{GraphicsMode, Layout, layout};
-use tidepool::serve::ByteBucket;
 use tidepool::terminal::{Color, ColorMode, Frame, Shown};
+use tidepool::testing::ByteBucket;
 use tidepool::testing::{
     Budget, KittyState, Luma, PictureStream, Protocol, RateEncoder, RateOptions, Target, TerminalModel,
 };

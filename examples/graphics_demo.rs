@@ -9,7 +9,7 @@
 //! which mode), waits half of `SECONDS` (default 4), paints a red square into the picture and
 //! sends only that change (a kitty frame edit or a sixel cell block where the terminal allows),
 //! writes the picture the terminal should show to `REPORT.png` (for sixel the dithered one), waits the other half and restores the
-//! terminal (kitty's image deleted). The terminal is asked with `tidepool::tty::probe_for_picture`,
+//! terminal (kitty's image deleted). The terminal is asked with `tidepool::testing::probe_for_picture`,
 //! as `render --out -` asks it.
 
 use std::io::{self, Write};
@@ -51,7 +51,7 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
     // The same question and the same rules as `tidepool render --out -` (at most
     // 150 ms; the file medium is not offered).
     let started = Instant::now();
-    let (choice, support) = tidepool::tty::probe_for_picture(request);
+    let (choice, support) = tidepool::testing::probe_for_picture(request);
     let took = started.elapsed();
     let support = &support;
     let mut text = format!("probe took {took:?}\n{support:#?}\n{choice:#?}\n");

@@ -9,5 +9,3 @@ pub use crate::output::apng::ApngWriter;
 pub use crate::output::gif::{GifPalette, GifWriter};
 pub use crate::output::halfblock::encode as halfblock;
 pub use crate::output::png::encode as png;
-pub use crate::output::units::human_bytes;
-pub use crate::render::background::decode as decode_image;

@@ -36,6 +36,7 @@ mod scene;
 mod sim;
 mod simd;
 mod size;
+#[cfg(feature = "player")]
 mod storage;
 #[cfg(feature = "player")]
 mod term;
@@ -54,26 +55,6 @@ pub mod terminal;
 #[cfg(feature = "ratatui")]
 pub mod widget;
 
-/// This process's own terminal (feature `player`): the door that puts a play session on a
-/// terminal. It lives beside [`play`], not inside it, because the session imports no door
-/// (`scripts/import_cycles.py` checks it).
-#[cfg(feature = "player")]
-pub mod tty {
-    pub use crate::term::door::{PlayConfig, TerminalInput, run};
-    pub use crate::term::tty::{play, probe_for_picture, restore};
-}
-
-/// What `tidepool serve` (the binary's SSH door, feature `serve`) needs beyond one person's
-/// [`play`] session: players whose screens are alike share frames, encoded once per group, and
-/// each player's requests, resizes and bytes are rationed by token buckets. Only serve uses
-/// these; they are here because serve lives in the binary and the groups encode with the
-/// screen's crate-private parts.
-#[cfg(feature = "player")]
-pub mod serve {
-    pub use crate::output::bucket::ByteBucket;
-    pub use crate::play::group::{GroupFeed, GroupKey, Groups, Membership, MembershipStats, Source};
-}
-
 /// The tools tidepool's own tests and benchmarks check pictures with (feature `testing`, off by
 /// default; `tests/`, `benches/` and `examples/` turn it on through a dev-dependency): a terminal
 /// model that plays bytes back and the picture's quality as seen on it (SSIM, PSNR), an
@@ -84,6 +65,7 @@ pub mod serve {
 #[cfg(feature = "testing")]
 #[doc(hidden)]
 pub mod testing {
+    pub use crate::output::bucket::ByteBucket;
     pub use crate::output::diff::{SYNC_BEGIN, SYNC_END};
     pub use crate::output::graphics::kitty_decode::{Image as KittyImage, KittyState, decode as kitty_decode};
     pub use crate::output::graphics::pack::Packing;
@@ -94,12 +76,22 @@ pub mod testing {
     pub use crate::output::rate::{RateEncoder, RateOptions, Report, Strategy, Target, UNLIMITED};
     pub use crate::output::ssim::{Luma, SsimReference, ssim};
     pub use crate::output::vt::{ModelCell, TerminalModel};
+    pub use crate::play::fit::Fit;
+    pub use crate::play::group::{GroupFeed, GroupKey, Groups, Membership, MembershipStats, Source};
+    pub use crate::play::host::{Host, SceneStatus};
+    pub use crate::play::player::Player;
+    pub use crate::play::request::Request;
+    pub use crate::play::screen::Screen;
+    pub use crate::play::screen::probe::{GraphicsChoice, GraphicsSupport, SixelSupport};
+    pub use crate::render::background::{decode as decode_image, load as load_image};
     pub use crate::render::plot::spectrum_plot;
     pub use crate::sim::spectrum::PiersonMoskowitz;
+    pub use crate::storage::Storage;
+    pub use crate::term::door::{PlayConfig, TerminalInput, run};
+    pub use crate::term::tty::probe_for_picture;
 }
 
 pub use error::{Error, Result, ValueError};
-pub use render::background::load as load_image;
 pub use render::camera::CameraPose;
 pub use render::caustics::CausticsLook;
 pub use render::ocean::{OceanView, SeaShading};
@@ -117,7 +109,6 @@ pub use sim::ocean::SeaParams;
 pub use sim::ripple::{Damping, RipplePool, Stone};
 pub use simd::Simd;
 pub use size::Size;
-pub use storage::Storage;
 
 /// The rust code of the README and the guide, compiled and run as doctests, so that what a
 /// newcomer copies from them builds.

@@ -20,7 +20,7 @@
 
 pub use crate::sim::looping::LoopPeriod;
 pub use crate::sim::patch::{PatchMaps, PatchSea};
-pub use crate::sim::sea_state::{beaufort_number, beaufort_speed_m_s, wmo_sea_state, wmo_sea_state_name};
+pub use crate::sim::sea_state::beaufort_speed_m_s;
 pub use crate::sim::spectra::swell::{Swell, Swells};
 pub use crate::sim::spectra::{
     Depth, Jonswap, SeaSpectrum, SpectrumChoice, SpectrumChoiceError, SpectrumKind, Spreading,

@@ -50,7 +50,7 @@ pub fn check_writable(path: &Path) -> std::result::Result<(), String> {
 /// removed if a signal arrives mid-write.
 pub struct AtomicStorage;
 
-impl crate::Storage for AtomicStorage {
+impl crate::storage::Storage for AtomicStorage {
     fn save(&self, path: &Path, bytes: &[u8]) -> crate::Result<()> {
         write_file(path, bytes).map_err(|e| match e {
             Error::Lib(e) => e,

@@ -84,7 +84,7 @@ impl StopOnSignal {
             while !finished.load(Ordering::SeqCst) && std::time::Instant::now() < deadline {
                 std::thread::sleep(std::time::Duration::from_millis(5));
             }
-            crate::tty::restore();
+            crate::term::tty::restore();
         });
         StopOnSignal { key, done }
     }

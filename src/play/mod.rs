@@ -65,6 +65,8 @@
 pub(crate) mod clock;
 pub(crate) mod driver;
 pub(crate) mod fit;
+// Only `tidepool serve` shares frames between screens (and the tests, through `testing`).
+#[cfg(any(feature = "serve", feature = "testing", test))]
 pub(crate) mod group;
 pub(crate) mod host;
 pub(crate) mod input;
@@ -76,16 +78,25 @@ pub(crate) mod seat;
 pub(crate) mod session;
 
 pub use crate::output::graphics::stream::FileWrite;
-pub use driver::{Driver, DriverEvent, Pacing, Transmit};
-pub use fit::Fit;
-pub use host::{Effect, Host, HostConfig, Recording, SceneStatus};
-pub use player::Player;
-pub use request::Request;
-pub use screen::probe::{
-    EnvHints, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, SixelSupport, WinSize,
-};
-pub use screen::{Bandwidth, LinkPath, Screen, ScreenConfig};
+pub use driver::Transmit;
+pub use host::{Effect, HostConfig, Recording};
+pub use screen::probe::{EnvHints, GraphicsRequest, ProbeOptions, WinSize};
+pub use screen::{Bandwidth, LinkPath, ScreenConfig};
 pub use session::{Session, SessionEvent};
+
+// The pieces the doors (the terminal door, `tidepool serve`) assemble a session from: the
+// crate's, not the API's (a library user drives a [`Session`]).
+#[cfg(any(feature = "serve", feature = "testing"))]
+pub(crate) use driver::{Driver, DriverEvent, Pacing};
+#[cfg(any(feature = "serve", feature = "testing"))]
+pub(crate) use fit::Fit;
+pub(crate) use host::Host;
+#[cfg(any(feature = "serve", feature = "testing"))]
+pub(crate) use host::SceneStatus;
+pub(crate) use player::Player;
+pub(crate) use request::Request;
+pub(crate) use screen::Screen;
+pub(crate) use screen::probe::{GraphicsChoice, GraphicsSupport};
 
 #[cfg(test)]
 pub(crate) mod tests;

@@ -5,7 +5,7 @@
 use std::time::Duration;
 
 use crate::common::pty::{Player, cooked, find, rfind, temp_dir};
-use tidepool::play::Screen;
+use tidepool::testing::Screen;
 
 const ENTER: &[u8] = Screen::ENTER;
 const RESTORE: &[u8] = Screen::RESTORE;

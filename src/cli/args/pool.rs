@@ -139,7 +139,7 @@ impl PoolArgs {
     /// The pool floor: `--background` decoded, or the built-in tiles.
     pub fn floor(&self) -> crate::cli::error::Result<tiny_skia::Pixmap> {
         match &self.background {
-            Some(path) => crate::load_image(path).map_err(crate::cli::error::Error::flag("--background")),
+            Some(path) => crate::render::background::load(path).map_err(crate::cli::error::Error::flag("--background")),
             None => Ok(crate::PoolSettings::default_floor()),
         }
     }

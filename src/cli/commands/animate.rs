@@ -14,7 +14,8 @@ use std::time::Instant;
 
 use tiny_skia::Pixmap;
 
-use crate::encode::{ApngWriter, GifPalette, GifWriter, human_bytes};
+use crate::encode::{ApngWriter, GifPalette, GifWriter};
+use crate::output::units::human_bytes;
 use crate::{Event, SceneSpec, Script, Size};
 
 use super::output::size_error;

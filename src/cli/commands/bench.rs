@@ -222,7 +222,7 @@ fn text_row(budget: Duration, (cols, rows_cells): (u16, u16)) -> Result<Option<R
         stage: "half-block text, a whole frame".into(),
         size: format!("{w}x{h}"),
         median: text_median,
-        rate: crate::encode::human_bytes(halfblock(&frame).len() as u64),
+        rate: crate::output::units::human_bytes(halfblock(&frame).len() as u64),
     }))
 }
 
@@ -251,7 +251,7 @@ fn picture_rows(budget: Duration, rows: &mut Vec<Row>) {
                 stage: "PNG encode".into(),
                 size: "1920x1080".into(),
                 median: png_median,
-                rate: crate::encode::human_bytes(png(&picture).len() as u64),
+                rate: crate::output::units::human_bytes(png(&picture).len() as u64),
             });
         }
     }

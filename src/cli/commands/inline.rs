@@ -30,9 +30,9 @@ pub struct Inline {
 }
 
 impl Inline {
-    /// Asks the terminal (see `crate::tty::probe_for_picture`); `None` for cells.
+    /// Asks the terminal (see `crate::term::tty::probe_for_picture`); `None` for cells.
     pub fn probe(request: Request) -> Option<Inline> {
-        let (choice, support) = crate::tty::probe_for_picture(request.into());
+        let (choice, support) = crate::term::tty::probe_for_picture(request.into());
         if choice.mode == GraphicsMode::Cells {
             return None;
         }

@@ -8,7 +8,7 @@ use std::path::Path;
 use std::time::Instant;
 
 use crate::SeaParams;
-use crate::encode::human_bytes;
+use crate::output::units::human_bytes;
 use crate::sea::{PatchMaps, PatchSea};
 
 use super::stats::Stats;

@@ -29,9 +29,10 @@ fn sea_params(args: &RenderOcean) -> Result<SeaParams> {
 fn settings(args: &RenderOcean, format: Format) -> Result<OceanSettings> {
     let sea = sea_params(args)?;
     let texture = match &args.texture {
-        Some(path) => {
-            SeaTexture::from_pixmap(&crate::load_image(path).map_err(Error::flag("--texture"))?, SeaTexture::TILE_M)
-        }
+        Some(path) => SeaTexture::from_pixmap(
+            &crate::render::background::load(path).map_err(Error::flag("--texture"))?,
+            SeaTexture::TILE_M,
+        ),
         None => SeaTexture::builtin(),
     };
     Ok(OceanSettings {

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use crate::{Heightmap, Size};
+
 use tiny_skia::Pixmap;
 
 use super::stats::Stats;
@@ -135,7 +136,7 @@ impl OutputPlan {
             (Format::Ansi, Some(inline)) => inline.name(),
             (Format::Ansi, None) => "half-block text",
         };
-        stats.record("encode", started, format!("{format}, {}", crate::encode::human_bytes(bytes.len() as u64)));
+        stats.record("encode", started, format!("{format}, {}", crate::output::units::human_bytes(bytes.len() as u64)));
         let started = Instant::now();
         let target = match &self.target {
             Destination::Stdout => {
@@ -155,7 +156,7 @@ impl OutputPlan {
                 HeightmapKind::Png16 => map.to_png16(),
             };
             files::write_file(path, &bytes)?;
-            let size = crate::encode::human_bytes(bytes.len() as u64);
+            let size = crate::output::units::human_bytes(bytes.len() as u64);
             stats.record("heightmap", started, format!("{}, {size}", path.display()));
         }
         Ok(())

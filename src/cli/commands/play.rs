@@ -8,8 +8,8 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use crate::play::{Bandwidth, HostConfig, Recording, ScreenConfig};
+use crate::term::door::PlayConfig;
 use crate::terminal::{ColorMode, EncodeOptions};
-use crate::tty::PlayConfig;
 
 use crate::cli::args::{ColorChoice, PlayCommand};
 use crate::cli::error::{Error, Result};
@@ -71,10 +71,10 @@ pub fn run(command: PlayCommand) -> Result<()> {
         probe: None,
         link_path: crate::play::LinkPath::Direct,
     };
-    let storage: Arc<dyn crate::Storage> = Arc::new(crate::cli::files::AtomicStorage);
+    let storage: Arc<dyn crate::storage::Storage> = Arc::new(crate::cli::files::AtomicStorage);
     let config = PlayConfig { host, screen, greeting: None, storage: Some(storage), quit: Arc::clone(&quit) };
     let _stop_on_signal = crate::cli::signals::StopOnSignal::new(quit);
-    crate::tty::play(config).map_err(|e| match e {
+    crate::term::tty::play(config).map_err(|e| match e {
         crate::Error::TooLarge { what, width, height } => {
             Error::Usage(format!("cannot allocate a {width}x{height} {what}; use a smaller terminal"))
         }

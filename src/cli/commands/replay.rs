@@ -55,7 +55,7 @@ pub fn render(args: &RenderPool, path: &Path) -> Result<()> {
 /// The scene at the replay's start: its options, with its background decoded.
 fn spec(replay: &Replay) -> Result<SceneSpec> {
     let floor = match &replay.header.options.background {
-        Some(file) => crate::load_image(file).map_err(Error::flag("--replay (its background)"))?,
+        Some(file) => crate::render::background::load(file).map_err(Error::flag("--replay (its background)"))?,
         None => crate::PoolSettings::default_floor(),
     };
     Ok(replay.spec(floor))

@@ -7,7 +7,8 @@
 //! significant height and the sea state are the whole sea's.
 
 use crate::SeaParams;
-use crate::sea::{SpectrumChoice, beaufort_number, wmo_sea_state, wmo_sea_state_name};
+use crate::sea::SpectrumChoice;
+use crate::sim::sea_state::{beaufort_number, wmo_sea_state, wmo_sea_state_name};
 
 use crate::cli::args::ocean::{SpectrumCommand, wind_of};
 use crate::cli::error::{Error, Result};

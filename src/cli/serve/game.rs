@@ -18,8 +18,8 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
+use crate::play::group::{GroupFeed, GroupKey, Groups};
 use crate::play::{Fit, Host, Request, SceneStatus};
-use crate::serve::{GroupFeed, GroupKey, Groups};
 use tiny_skia::Pixmap;
 use tokio::sync::{mpsc, watch};
 

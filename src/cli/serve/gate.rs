@@ -7,8 +7,8 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 use crate::Action;
+use crate::output::bucket::ByteBucket;
 use crate::play::Request;
-use crate::serve::ByteBucket;
 
 use super::hub::Hub;
 use super::limits::Limits;

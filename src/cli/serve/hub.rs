@@ -12,8 +12,8 @@ use tokio_util::sync::CancellationToken;
 use tokio_util::task::TaskTracker;
 
 use super::authorized_keys::AllowList;
+use crate::output::bucket::ByteBucket;
 use crate::play::Request;
-use crate::serve::ByteBucket;
 
 use super::game::{Fits, GameStats, SharedFrame};
 use super::limits::{ConnTracker, Limits, PlayerSlots};

@@ -7,8 +7,8 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
+use crate::output::bucket::ByteBucket;
 use crate::play::Bandwidth;
-use crate::serve::ByteBucket;
 
 /// Default players in the pool at once (`--max-clients`).
 pub const DEFAULT_MAX_CLIENTS: usize = 64;

@@ -2,7 +2,7 @@
 
 use std::net::SocketAddr;
 
-use crate::serve::Membership;
+use crate::play::group::Membership;
 
 use super::game::SharedFrame;
 use super::gate::Gated;

@@ -15,9 +15,9 @@ use std::sync::Arc;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
+use crate::output::bucket::ByteBucket;
+use crate::play::group::{Membership, Source};
 use crate::play::{Driver, DriverEvent, Pacing, Player, Screen, ScreenConfig};
-use crate::serve::ByteBucket;
-use crate::serve::{Membership, Source};
 use bytes::Bytes;
 use russh::ChannelWriteHalf;
 use russh::server::Msg;

@@ -8,7 +8,7 @@
 use std::collections::HashMap;
 use std::time::{Duration, Instant};
 
-use crate::serve::ByteBucket;
+use crate::output::bucket::ByteBucket;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
