@@ -16,7 +16,7 @@
 //!
 //! Each clip is encoded at 25, 50, 100, 250 and 500 kB/s and unlimited, in truecolor and in
 //! 256 colours, by three strategies in the same run: the shipped rate-controlled encoder
-//! ([`tidepool::terminal::RateEncoder`]), changed cells in scan order until the budget runs out
+//! ([`tidepool::testing::RateEncoder`]), changed cells in scan order until the budget runs out
 //! (the same encoder with [`Strategy::ScanOrder`]), and whole exact frames as often as the link
 //! allows (best of colour quantization steps 1, 8, 16 and 32: colours rounded to multiples of
 //! the step before the frame is drawn, so fewer cells change and more colour codes repeat). The
@@ -48,11 +48,12 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
-use tidepool::terminal::{Color, ColorMode, EncodeOptions, Frame, Shown};
+use tidepool::play::{ColorMode, EncodeOptions};
 use tidepool::testing::ByteBucket;
 use tidepool::testing::{
     self as quality, Luma, RateEncoder, RateOptions, SsimReference, Strategy, Target, TerminalModel, UNLIMITED,
 };
+use tidepool::testing::{Color, Frame, Shown};
 use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneSpec, Script};
 use tiny_skia::Pixmap;
 
@@ -311,7 +312,7 @@ fn run(clip: &Clip, frames: &[Frame], mode: ColorMode, rate: Option<f64>, sender
 /// The bytes that show `frame` exactly after `shown`: today's diff encoder, which sends the
 /// changed cells (a whole screen the first time).
 fn quality_exact(shown: &mut Shown, frame: &Frame, out: &mut Vec<u8>) {
-    tidepool::terminal::encode_into(shown, frame, EncodeOptions::default(), out);
+    tidepool::testing::encode_into(shown, frame, EncodeOptions::default(), out);
 }
 
 fn percentile(values: &[f64], p: f64) -> f64 {
@@ -525,7 +526,7 @@ fn cpu(c: &mut Criterion) {
             let frame = &frames[n % frames.len()];
             n += 1;
             out.clear();
-            tidepool::terminal::encode_into(&mut shown, black_box(frame), EncodeOptions::default(), &mut out);
+            tidepool::testing::encode_into(&mut shown, black_box(frame), EncodeOptions::default(), &mut out);
             out.len()
         })
     });
@@ -543,7 +544,7 @@ fn stale() {
             let mut screen = TerminalModel::new(COLS, ROWS);
             screen.lf_returns = false;
             let frame = clip.frame(i - k, ColorMode::TrueColor, 1);
-            let (bytes, _) = tidepool::terminal::encode(&Shown::UNKNOWN, &frame, EncodeOptions::default());
+            let (bytes, _) = tidepool::testing::encode(&Shown::UNKNOWN, &frame, EncodeOptions::default());
             screen.feed(&bytes);
             psnr += quality::measure(&screen, &clip.pictures[i]).psnr();
             ssim += clip.references[i].ssim(&quality::screen_luma(&screen, w, h));

@@ -31,14 +31,16 @@ use std::time::{Duration, Instant};
 
 use base64::Engine;
 use criterion::Criterion;
-use tidepool::graphics::kitty::KittyOptions;
-use tidepool::graphics::sixel::{Registers, SixelPalette};
-use tidepool::graphics::{GraphicsMode, Layout, layout};
-use tidepool::terminal::{Color, ColorMode, Frame, Shown};
+use tidepool::play::ColorMode;
+use tidepool::play::GraphicsMode;
 use tidepool::testing::ByteBucket;
+use tidepool::testing::KittyOptions;
 use tidepool::testing::{
     Budget, KittyState, Luma, PictureStream, Protocol, RateEncoder, RateOptions, Target, TerminalModel,
 };
+use tidepool::testing::{Color, Frame, Shown};
+use tidepool::testing::{Layout, layout};
+use tidepool::testing::{Registers, SixelPalette};
 use tidepool::{Event, Script, Stone};
 use tiny_skia::Pixmap;
 

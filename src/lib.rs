@@ -46,12 +46,10 @@ mod term;
 pub mod cli;
 
 pub mod encode;
-pub mod graphics;
 #[cfg(feature = "player")]
 pub mod play;
 pub mod replay;
 pub mod sea;
-pub mod terminal;
 #[cfg(feature = "ratatui")]
 pub mod widget;
 
@@ -66,12 +64,20 @@ pub mod widget;
 #[doc(hidden)]
 pub mod testing {
     pub use crate::output::bucket::ByteBucket;
+    pub use crate::output::color::Color;
     pub use crate::output::diff::{SYNC_BEGIN, SYNC_END};
+    pub use crate::output::diff::{Shown, encode, encode_into};
+    pub use crate::output::frame::{Cell, Frame};
+    pub use crate::output::graphics::geometry::{Layout, layout};
+    pub use crate::output::graphics::iterm2::Iterm2Encoder;
+    pub use crate::output::graphics::kitty::{KittyEncoder, KittyOptions, Medium, temp_dir as kitty_temp_dir};
     pub use crate::output::graphics::kitty_decode::{Image as KittyImage, KittyState, decode as kitty_decode};
     pub use crate::output::graphics::pack::Packing;
     pub use crate::output::graphics::sixel::dithered_rgb;
+    pub use crate::output::graphics::sixel::{Registers, SixelEncoder, SixelPalette};
     pub use crate::output::graphics::stream::ladder::resample;
     pub use crate::output::graphics::stream::{Budget, Offer, Part, PictureStream, Protocol, State};
+    pub use crate::output::graphics::{Update, push_rgb};
     pub use crate::output::quality::{Quality, measure, screen_luma};
     pub use crate::output::rate::{RateEncoder, RateOptions, Report, Strategy, Target, UNLIMITED};
     pub use crate::output::ssim::{Luma, SsimReference, ssim};

@@ -16,7 +16,7 @@ use std::sync::atomic::{AtomicIsize, Ordering};
 use std::time::{Duration, Instant};
 
 use tidepool::play::{Bandwidth, GraphicsRequest, HostConfig, LinkPath, ScreenConfig};
-use tidepool::terminal::{ColorMode, EncodeOptions};
+use tidepool::play::{ColorMode, EncodeOptions};
 use tidepool::testing::{GroupKey, Groups, Host, Membership, Player, Screen, Source};
 use tidepool::{PoolSettings, SceneSpec};
 use tiny_skia::Pixmap;
@@ -63,7 +63,7 @@ fn player(t0: Instant) -> Player {
         color_auto: false,
         colour_hint: false,
         encode: EncodeOptions::default(),
-        graphics: GraphicsRequest::Force(tidepool::graphics::GraphicsMode::Cells),
+        graphics: GraphicsRequest::Force(tidepool::play::GraphicsMode::Cells),
         probe: None,
         link_path: LinkPath::Direct,
     };

@@ -17,7 +17,7 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use tidepool::play::{Bandwidth, GraphicsRequest, HostConfig, ScreenConfig};
-use tidepool::terminal::{ColorMode, EncodeOptions};
+use tidepool::play::{ColorMode, EncodeOptions};
 use tidepool::testing::{PlayConfig, TerminalInput};
 use tidepool::{LakeSettings, OceanSettings, PoolScene, PoolSettings, Scene, SceneSpec, Stone};
 

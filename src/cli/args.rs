@@ -222,7 +222,7 @@ pub(crate) enum GraphicsFlag {
 
 impl From<GraphicsFlag> for crate::play::GraphicsRequest {
     fn from(choice: GraphicsFlag) -> Self {
-        use crate::graphics::GraphicsMode;
+        use crate::play::GraphicsMode;
         use crate::play::GraphicsRequest::{Auto, Force};
         match choice {
             GraphicsFlag::Auto => Auto,

@@ -77,6 +77,9 @@ pub(crate) mod screen;
 pub(crate) mod seat;
 pub(crate) mod session;
 
+pub use crate::output::color::ColorMode;
+pub use crate::output::diff::EncodeOptions;
+pub use crate::output::graphics::GraphicsMode;
 pub use crate::output::graphics::stream::FileWrite;
 pub use driver::Transmit;
 pub use host::{Effect, HostConfig, Recording};

@@ -7,7 +7,7 @@
 use std::time::Duration;
 
 use crate::common::pty::{DA1_ANSWER, Player, cooked, find, rfind, temp_dir};
-use tidepool::graphics::kitty::KittyOptions;
+use tidepool::testing::KittyOptions;
 use tidepool::testing::Screen;
 use tidepool::testing::kitty_decode;
 

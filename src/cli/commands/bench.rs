@@ -12,9 +12,10 @@ use std::time::{Duration, Instant};
 
 use crate::Action;
 use crate::encode::{halfblock, png};
-use crate::graphics::{GraphicsMode, Layout, layout};
+use crate::output::graphics::geometry::{Layout, layout};
+use crate::play::GraphicsMode;
 use crate::play::{Bandwidth, GraphicsRequest, Host, HostConfig, Player, Request, Screen, ScreenConfig};
-use crate::terminal::{ColorMode, EncodeOptions};
+use crate::play::{ColorMode, EncodeOptions};
 use crate::{Damping, LakeSettings, OceanSettings, OceanView, PoolSettings, RipplePool, SceneSpec, Simd, Stone};
 use tiny_skia::Pixmap;
 
@@ -168,7 +169,7 @@ fn player_rows(
             color_auto: false,
             colour_hint: false,
             encode: EncodeOptions::default(),
-            graphics: GraphicsRequest::Force(crate::graphics::GraphicsMode::Cells),
+            graphics: GraphicsRequest::Force(crate::play::GraphicsMode::Cells),
             probe: None,
             link_path: crate::play::LinkPath::Direct,
         };

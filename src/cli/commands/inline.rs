@@ -9,11 +9,12 @@
 //! deleted: it is the output).
 
 use crate::Size;
-use crate::graphics::iterm2::Iterm2Encoder;
-use crate::graphics::kitty::{KittyEncoder, KittyOptions};
-use crate::graphics::sixel::{SixelEncoder, SixelPalette};
-use crate::graphics::{GraphicsMode, push_rgb};
-use crate::graphics::{Layout, layout};
+use crate::output::graphics::geometry::{Layout, layout};
+use crate::output::graphics::iterm2::Iterm2Encoder;
+use crate::output::graphics::kitty::{KittyEncoder, KittyOptions};
+use crate::output::graphics::push_rgb;
+use crate::output::graphics::sixel::{SixelEncoder, SixelPalette};
+use crate::play::GraphicsMode;
 use crate::play::{GraphicsChoice, GraphicsSupport};
 use tiny_skia::Pixmap;
 

@@ -8,8 +8,8 @@ use std::sync::Arc;
 use std::sync::atomic::AtomicBool;
 
 use crate::play::{Bandwidth, HostConfig, Recording, ScreenConfig};
+use crate::play::{ColorMode, EncodeOptions};
 use crate::term::door::PlayConfig;
-use crate::terminal::{ColorMode, EncodeOptions};
 
 use crate::cli::args::{ColorChoice, PlayCommand};
 use crate::cli::error::{Error, Result};

@@ -17,8 +17,8 @@ use russh::{Channel, ChannelId, ChannelOpenFailure, ChannelWriteHalf, Pty};
 use tokio::sync::watch;
 use tokio_util::sync::CancellationToken;
 
+use crate::play::{ColorMode, EncodeOptions};
 use crate::play::{EnvHints, GraphicsRequest, ProbeOptions, ScreenConfig, WinSize};
-use crate::terminal::{ColorMode, EncodeOptions};
 use tokio::sync::mpsc;
 
 use super::authorized_keys::Refused;
