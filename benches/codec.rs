@@ -149,7 +149,7 @@ fn quantized(picture: &Pixmap, step: u8) -> Pixmap {
 fn pool_clip(name: &'static str, file: &str) -> Clip {
     let replay =
         tidepool::replay::Replay::read(std::path::Path::new(&fixture(file))).expect("a committed fixture replay");
-    assert_eq!(replay.header.size, [PICTURE.0, PICTURE.1], "a 160x48-cell recording");
+    assert_eq!(replay.size(), [PICTURE.0, PICTURE.1], "a 160x48-cell recording");
     let mut scene =
         replay.spec(tidepool::PoolSettings::default_floor()).build(PICTURE.0, PICTURE.1).expect("a valid size");
     let events = replay.script();
@@ -492,7 +492,7 @@ fn cpu(c: &mut Criterion) {
     // rain, a stone a second), the picture, the cells and the encoder at 250 kB/s.
     let replay =
         tidepool::replay::Replay::read(std::path::Path::new(&fixture("pool-160x48.jsonl"))).expect("the fixture");
-    let [w, h] = replay.header.size;
+    let [w, h] = replay.size();
     let mut scene = replay.spec(tidepool::PoolSettings::default_floor()).build(w, h).expect("a valid size");
     let steps_per_frame = (scene.steps_per_second() / f64::from(FPS)).round().max(1.0) as u64;
     let mut picture = Pixmap::new(w, h).expect("a valid size");

@@ -61,7 +61,7 @@ const MODES: [&str; 4] = ["kitty", "sixel", "iterm2", "cells"];
 /// The fixture at the pixel modes' scene size: one picture per frame.
 fn pictures() -> Vec<Pixmap> {
     let replay = tidepool::replay::Replay::read(std::path::Path::new(FIXTURE)).expect("the committed fixture replay");
-    let [w0, _] = replay.header.size;
+    let [w0, _] = replay.size();
     let scale = f64::from(SCENE.0) / f64::from(w0);
     let mut scene = replay.spec(tidepool::PoolSettings::default_floor()).build(SCENE.0, SCENE.1).expect("a valid size");
     let events: Vec<(u64, Event)> = replay

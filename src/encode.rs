@@ -9,3 +9,4 @@ pub use crate::output::apng::ApngWriter;
 pub use crate::output::gif::{GifPalette, GifWriter};
 pub use crate::output::halfblock::encode as halfblock;
 pub use crate::output::png::encode as png;
+pub use crate::render::background::decode as decode_image;

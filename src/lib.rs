@@ -2,8 +2,9 @@
 //!
 //! Three scenes — a ripple pool, a wind-driven sea and a lake mirroring its shore — behind one
 //! contract, [`Scene`]: advance it, apply [`Event`]s, render it into a `tiny_skia::Pixmap`.
-//! Data flows one way: **simulation -> renderer -> pixels -> output** ([`encode`],
-//! [`terminal`]); nothing flows back except user input, which becomes events.
+//! Data flows one way: **simulation -> renderer -> pixels -> output** ([`encode`], and a
+//! terminal's frames through `play`); nothing flows back except user input, which becomes
+//! events.
 //!
 //! ```
 //! use tidepool::{PoolScene, PoolSettings, Scene, Stone};
@@ -19,11 +20,12 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Features: `cli` (default: the `tidepool` binary), `player` (the play session, [`play`], the
-//! interactive terminal player, [`tty`], and what `tidepool serve` shares between players,
-//! [`serve`]), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
-//! that draws any scene, `widget`), `testing` (the tools the tests and benchmarks check
-//! pictures with, `testing`; not part of the chosen API).
+//! Features: `cli` (default: the `tidepool` command line, `cli`, which the binary runs),
+//! `serve` (its SSH server), `player` (the play session, [`play`]: a sans-IO [`play::Session`]
+//! any byte stream drives), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui`
+//! (a widget that draws any scene, `widget`), `testing` (the tools the tests and benchmarks
+//! check pictures with, and the pieces the doors assemble a session from, `testing`; not part
+//! of the chosen API).
 #![warn(missing_docs)]
 #![warn(unnameable_types)]
 
@@ -89,9 +91,11 @@ pub mod testing {
     pub use crate::play::request::Request;
     pub use crate::play::screen::Screen;
     pub use crate::play::screen::probe::{GraphicsChoice, GraphicsSupport, SixelSupport};
-    pub use crate::render::background::{decode as decode_image, load as load_image};
+    pub use crate::render::background::load as load_image;
     pub use crate::render::plot::spectrum_plot;
+    pub use crate::sim::ripple::RipplePool;
     pub use crate::sim::spectrum::PiersonMoskowitz;
+    pub use crate::simd::Simd;
     pub use crate::storage::Storage;
     pub use crate::term::door::{PlayConfig, TerminalInput, run};
     pub use crate::term::tty::probe_for_picture;
@@ -112,8 +116,7 @@ pub use sim::breeze::BreezeStyle;
 pub use sim::lake::LakeParams;
 pub use sim::noise::NoiseKind;
 pub use sim::ocean::SeaParams;
-pub use sim::ripple::{Damping, RipplePool, Stone};
-pub use simd::Simd;
+pub use sim::ripple::{Damping, Stone};
 pub use size::Size;
 
 /// The rust code of the README and the guide, compiled and run as doctests, so that what a

@@ -66,7 +66,7 @@ fn a_pool_on_a_user_background() {
     });
     let mut png = Vec::new();
     stripes.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png).unwrap();
-    let floor = tidepool::testing::decode_image(&png).unwrap();
+    let floor = tidepool::encode::decode_image(&png).unwrap();
     let look = PoolLook { refraction: Refraction::fixed(1.0).unwrap(), ..PoolLook::default() };
     let spec = SceneSpec::Pool(PoolSettings { look, floor, ..PoolSettings::default() });
     let p = picture(&spec, 240, 160, &stones(&[(120, 80, 6, 160)]), 45);

@@ -16,7 +16,9 @@ use crate::output::graphics::geometry::{Layout, layout};
 use crate::play::GraphicsMode;
 use crate::play::{Bandwidth, GraphicsRequest, Host, HostConfig, Player, Request, Screen, ScreenConfig};
 use crate::play::{ColorMode, EncodeOptions};
-use crate::{Damping, LakeSettings, OceanSettings, OceanView, PoolSettings, RipplePool, SceneSpec, Simd, Stone};
+use crate::sim::ripple::RipplePool;
+use crate::simd::Simd;
+use crate::{Damping, LakeSettings, OceanSettings, OceanView, PoolSettings, SceneSpec, Stone};
 use tiny_skia::Pixmap;
 
 use crate::cli::args::BenchArgs;
