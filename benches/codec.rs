@@ -50,11 +50,12 @@ use std::time::{Duration, Instant};
 use criterion::Criterion;
 use tidepool::play::{ColorMode, EncodeOptions};
 use tidepool::testing::ByteBucket;
+use tidepool::testing::Script;
 use tidepool::testing::{
     self as quality, Luma, RateEncoder, RateOptions, SsimReference, Strategy, Target, TerminalModel, UNLIMITED,
 };
 use tidepool::testing::{Color, Frame, Shown};
-use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneSpec, Script};
+use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneSpec};
 use tiny_skia::Pixmap;
 
 const COLS: usize = 160;

@@ -35,13 +35,14 @@ use tidepool::play::ColorMode;
 use tidepool::play::GraphicsMode;
 use tidepool::testing::ByteBucket;
 use tidepool::testing::KittyOptions;
+use tidepool::testing::Script;
 use tidepool::testing::{
     Budget, KittyState, Luma, PictureStream, Protocol, RateEncoder, RateOptions, Target, TerminalModel,
 };
 use tidepool::testing::{Color, Frame, Shown};
 use tidepool::testing::{Layout, layout};
 use tidepool::testing::{Registers, SixelPalette};
-use tidepool::{Event, Script, Stone};
+use tidepool::{Event, Stone};
 use tiny_skia::Pixmap;
 
 const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/alive-160x48.jsonl");

@@ -1,5 +1,5 @@
 //! Pixels to bytes: PNG and half-block text (a `Heightmap` writes itself, the sea's maps are
-//! `sea::PatchMaps::files`), and with the `animation`
+//! `tidepool maps`), and with the `animation`
 //! feature animated GIF and PNG. Every encoder returns bytes (or writes to any `Write`); where
 //! the bytes go is the caller's choice.
 

@@ -93,9 +93,13 @@ pub mod testing {
     pub use crate::play::screen::probe::{GraphicsChoice, GraphicsSupport, SixelSupport};
     pub use crate::render::background::load as load_image;
     pub use crate::render::plot::spectrum_plot;
+    pub use crate::scene::Script;
+    pub use crate::sim::patch::{PatchMaps, PatchSea};
     pub use crate::sim::ripple::RipplePool;
+    pub use crate::sim::spectra::SeaSpectrum;
     pub use crate::sim::spectrum::PiersonMoskowitz;
     pub use crate::simd::Simd;
+    pub use crate::size::Size;
     pub use crate::storage::Storage;
     pub use crate::term::door::{PlayConfig, TerminalInput, run};
     pub use crate::term::tty::probe_for_picture;
@@ -111,13 +115,12 @@ pub use render::texture::SeaTexture;
 pub use scene::lake::{LakeScene, LakeSettings};
 pub use scene::ocean::{OceanScene, OceanSettings};
 pub use scene::pool::{PoolScene, PoolSettings};
-pub use scene::{Action, Controls, Event, Heightmap, Playable, Scene, SceneKind, SceneSpec, Script};
+pub use scene::{Action, Controls, Event, Heightmap, Playable, Scene, SceneKind, SceneSpec};
 pub use sim::breeze::BreezeStyle;
 pub use sim::lake::LakeParams;
 pub use sim::noise::NoiseKind;
 pub use sim::ocean::SeaParams;
 pub use sim::ripple::{Damping, Stone};
-pub use size::Size;
 
 /// The rust code of the README and the guide, compiled and run as doctests, so that what a
 /// newcomer copies from them builds.

@@ -9,7 +9,9 @@
 use std::path::PathBuf;
 use std::str::FromStr;
 
-use crate::{BreezeStyle, CausticsLook, Damping, Refraction, SceneKind, Size, Stone, Sun, ValueError};
+use crate::scene::SceneKind;
+use crate::size::Size;
+use crate::{BreezeStyle, CausticsLook, Damping, Refraction, Stone, Sun, ValueError};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 
 pub mod lake;

@@ -19,6 +19,7 @@ pub mod gif;
 pub mod graphics;
 pub mod halfblock;
 pub mod heightmap;
+#[cfg(any(feature = "cli", feature = "testing", test))]
 pub mod maps;
 #[cfg(any(test, feature = "player"))]
 pub mod oklab;

@@ -4,7 +4,7 @@
 
 use std::path::PathBuf;
 
-use crate::Size;
+use crate::size::Size;
 use clap::Args;
 
 use super::{PlayScene, parse_size};

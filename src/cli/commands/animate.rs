@@ -16,7 +16,9 @@ use tiny_skia::Pixmap;
 
 use crate::encode::{ApngWriter, GifPalette, GifWriter};
 use crate::output::units::human_bytes;
-use crate::{Event, SceneSpec, Script, Size};
+use crate::scene::Script;
+use crate::size::Size;
+use crate::{Event, SceneSpec};
 
 use super::output::size_error;
 use super::stats::Stats;

@@ -8,7 +8,6 @@
 //! cursor is left on the last row for the shell's prompt. The image stays on screen (nothing is
 //! deleted: it is the output).
 
-use crate::Size;
 use crate::output::graphics::geometry::{Layout, layout};
 use crate::output::graphics::iterm2::Iterm2Encoder;
 use crate::output::graphics::kitty::{KittyEncoder, KittyOptions};
@@ -16,6 +15,7 @@ use crate::output::graphics::push_rgb;
 use crate::output::graphics::sixel::{SixelEncoder, SixelPalette};
 use crate::play::GraphicsMode;
 use crate::play::{GraphicsChoice, GraphicsSupport};
+use crate::size::Size;
 use tiny_skia::Pixmap;
 
 use crate::cli::args::GraphicsFlag as Request;

@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use crate::SeaParams;
 use crate::output::units::human_bytes;
-use crate::sea::{PatchMaps, PatchSea};
+use crate::sim::patch::{PatchMaps, PatchSea};
 
 use super::stats::Stats;
 use crate::cli::args::ocean::{MapFormat, RenderOcean};

@@ -5,7 +5,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-use crate::{Heightmap, Size};
+use crate::Heightmap;
+use crate::size::Size;
 
 use tiny_skia::Pixmap;
 

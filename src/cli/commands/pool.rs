@@ -3,7 +3,8 @@
 
 use std::io::IsTerminal;
 
-use crate::{Event, SceneSpec, Size};
+use crate::size::Size;
+use crate::{Event, SceneSpec};
 
 use super::animate::{Animation, AnimationTarget, animate};
 use super::output::{DEFAULT_PNG_SIZE, OutputPlan, terminal_pixels};

@@ -8,8 +8,9 @@ use std::io::IsTerminal;
 use std::path::Path;
 use std::time::Instant;
 
+use crate::SceneSpec;
 use crate::replay::Replay;
-use crate::{SceneSpec, Size};
+use crate::size::Size;
 
 use super::animate::{Animation, AnimationTarget, animate};
 use super::output::{OutputPlan, terminal_pixels};

@@ -1,7 +1,8 @@
 //! The scenes a live session cycles through with `tab`, built from the scene flags that
 //! `play` and `serve` share, so both start the same water from the same flags.
 
-use crate::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneKind, SceneSpec, SeaParams};
+use crate::scene::SceneKind;
+use crate::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneSpec, SeaParams};
 
 use crate::cli::args::{LiveSceneArgs, PlayScene};
 use crate::cli::error::Result;

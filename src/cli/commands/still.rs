@@ -3,7 +3,9 @@
 
 use std::time::Instant;
 
-use crate::{Event, SceneKind, SceneSpec, Script};
+use crate::scene::SceneKind;
+use crate::scene::Script;
+use crate::{Event, SceneSpec};
 
 use super::output::{OutputPlan, size_error};
 use super::stats::Stats;
