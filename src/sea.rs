@@ -10,7 +10,7 @@
 //! // A JONSWAP sea (a fetch of 50 km) under a 12 m/s wind.
 //! let choice = SpectrumChoice::new(SpectrumKind::Jonswap, None, Some(50.0), None)?;
 //! let sea = SeaParams { wind_m_s: 12.0, spectrum: choice, choppiness: 1.0, ..SeaParams::default() };
-//! let mut scene = OceanScene::new(OceanSettings { sea, ..OceanSettings::default() }, 64, 36)?;
+//! let mut scene = OceanScene::new(OceanSettings { sea, ..OceanSettings::default() }, 64, 36).expect("a small sea");
 //! let picture = scene.snapshot()?;
 //! assert_eq!((picture.width(), picture.height()), (64, 36));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
