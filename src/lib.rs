@@ -38,9 +38,11 @@ mod scene;
 mod sim;
 mod simd;
 mod size;
-#[cfg(feature = "player")]
+// The terminal door (this process's terminal) is the command line's (`tidepool play`) and the
+// tests'; a library user with feature `player` drives a `play::Session` on a stream of theirs.
+#[cfg(any(feature = "cli", feature = "testing"))]
 mod storage;
-#[cfg(feature = "player")]
+#[cfg(any(feature = "cli", feature = "testing"))]
 mod term;
 
 /// The `tidepool` command line (feature `cli`), as the `tidepool` binary runs it.

@@ -134,7 +134,7 @@ impl ByteBucket {
         }
     }
 
-    #[cfg(any(feature = "serve", feature = "testing", test))]
+    #[cfg(any(feature = "testing", test))]
     /// Whether the bucket is in debt (see [`ByteBucket::owe`]).
     pub fn in_debt(&self) -> bool {
         self.rate.is_some() && self.level < 0.0

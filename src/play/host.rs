@@ -19,7 +19,7 @@ use super::clock::SimClock;
 use super::request::Request;
 use crate::error::{Result, ValueError};
 use crate::replay::{FORMAT, Header, PoolOptions, Recorder};
-#[cfg(any(feature = "serve", feature = "testing", test))]
+#[cfg(any(feature = "testing", test))]
 use crate::scene::SceneKind;
 use crate::scene::{Action, Event, Playable, SceneSpec};
 
@@ -171,13 +171,13 @@ impl Host {
         self.scene.size()
     }
 
-    #[cfg(any(feature = "serve", feature = "testing", test))]
+    #[cfg(any(feature = "testing", test))]
     /// Which scene is shown.
     pub fn kind(&self) -> SceneKind {
         self.scene.kind()
     }
 
-    #[cfg(any(feature = "serve", feature = "testing", test))]
+    #[cfg(any(feature = "testing", test))]
     /// Simulation steps run so far.
     pub fn step(&self) -> u64 {
         self.step

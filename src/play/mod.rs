@@ -84,12 +84,17 @@ pub use session::{Session, SessionEvent};
 pub(crate) use driver::{Driver, DriverEvent, Pacing};
 #[cfg(any(feature = "serve", feature = "testing"))]
 pub(crate) use fit::Fit;
+#[cfg(any(feature = "cli", feature = "testing"))]
 pub(crate) use host::Host;
 #[cfg(any(feature = "serve", feature = "testing"))]
 pub(crate) use host::SceneStatus;
+#[cfg(any(feature = "cli", feature = "testing"))]
 pub(crate) use player::Player;
+#[cfg(any(feature = "cli", feature = "testing"))]
 pub(crate) use request::Request;
+#[cfg(any(feature = "cli", feature = "testing"))]
 pub(crate) use screen::Screen;
+#[cfg(any(feature = "cli", feature = "testing"))]
 pub(crate) use screen::probe::{GraphicsChoice, GraphicsSupport};
 
 #[cfg(test)]

@@ -180,6 +180,7 @@ impl Screen {
     /// (buttons and drags only, mode 1002, not every motion; SGR coordinates, mode 1006),
     /// screen cleared.
     pub const ENTER: &'static [u8] = b"\x1b[?1049h\x1b[?25l\x1b[?1000h\x1b[?1002h\x1b[?1006h\x1b[0m\x1b[2J";
+    #[cfg(any(test, feature = "cli", feature = "testing"))]
     /// Sent when the session ends (after the restore prefix, see [`Screen::farewell`]): abort any cut sequence,
     /// end synchronized output, reset colours, mouse off, cursor on, back to the normal screen.
     pub const RESTORE: &'static [u8] = b"\x18\x1b[?2026l\x1b[0m\x1b[?1006l\x1b[?1002l\x1b[?1000l\x1b[?25h\x1b[?1049l";

@@ -220,6 +220,7 @@ impl Session {
         self.driver.player().screen.awaiting_answers()
     }
 
+    #[cfg(any(test, feature = "cli", feature = "testing"))]
     /// The host, once the probe is over.
     pub(crate) fn host(&self) -> Option<&Host> {
         self.host.as_ref()

@@ -361,9 +361,12 @@ pub fn changed_rect(old: &[u8], new: &[u8], width: u32, height: u32) -> Option<(
 }
 
 mod files;
-#[cfg(feature = "player")]
+pub use files::write_temp_file;
+// The door's (the command line's terminal door) and the tests'.
+#[cfg(any(test, feature = "cli", feature = "testing"))]
+pub use files::temp_dir;
+#[cfg(any(feature = "cli", feature = "testing"))]
 pub use files::write_new_file;
-pub use files::{temp_dir, write_temp_file};
 
 #[cfg(test)]
 mod tests;
