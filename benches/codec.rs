@@ -16,7 +16,7 @@
 //!
 //! Each clip is encoded at 25, 50, 100, 250 and 500 kB/s and unlimited, in truecolor and in
 //! 256 colours, by three strategies in the same run: the shipped rate-controlled encoder
-//! ([`tidepool::terminal::RateEncoder`]), changed cells in scan order until the budget runs out
+//! ([`tidepool::testing::RateEncoder`]), changed cells in scan order until the budget runs out
 //! (the same encoder with [`Strategy::ScanOrder`]), and whole exact frames as often as the link
 //! allows (best of colour quantization steps 1, 8, 16 and 32: colours rounded to multiples of
 //! the step before the frame is drawn, so fewer cells change and more colour codes repeat). The
@@ -48,12 +48,14 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use criterion::Criterion;
-use tidepool::serve::ByteBucket;
-use tidepool::terminal::{Color, ColorMode, EncodeOptions, Frame, Shown};
+use tidepool::play::{ColorMode, EncodeOptions};
+use tidepool::testing::ByteBucket;
+use tidepool::testing::Script;
 use tidepool::testing::{
     self as quality, Luma, RateEncoder, RateOptions, SsimReference, Strategy, Target, TerminalModel, UNLIMITED,
 };
-use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneSpec, Script};
+use tidepool::testing::{Color, Frame, Shown};
+use tidepool::{LakeParams, LakeSettings, OceanSettings, OceanView, SceneSpec};
 use tiny_skia::Pixmap;
 
 const COLS: usize = 160;
@@ -148,7 +150,7 @@ fn quantized(picture: &Pixmap, step: u8) -> Pixmap {
 fn pool_clip(name: &'static str, file: &str) -> Clip {
     let replay =
         tidepool::replay::Replay::read(std::path::Path::new(&fixture(file))).expect("a committed fixture replay");
-    assert_eq!(replay.header.size, [PICTURE.0, PICTURE.1], "a 160x48-cell recording");
+    assert_eq!(replay.size(), [PICTURE.0, PICTURE.1], "a 160x48-cell recording");
     let mut scene =
         replay.spec(tidepool::PoolSettings::default_floor()).build(PICTURE.0, PICTURE.1).expect("a valid size");
     let events = replay.script();
@@ -311,7 +313,7 @@ fn run(clip: &Clip, frames: &[Frame], mode: ColorMode, rate: Option<f64>, sender
 /// The bytes that show `frame` exactly after `shown`: today's diff encoder, which sends the
 /// changed cells (a whole screen the first time).
 fn quality_exact(shown: &mut Shown, frame: &Frame, out: &mut Vec<u8>) {
-    tidepool::terminal::encode_into(shown, frame, EncodeOptions::default(), out);
+    tidepool::testing::encode_into(shown, frame, EncodeOptions::default(), out);
 }
 
 fn percentile(values: &[f64], p: f64) -> f64 {
@@ -491,7 +493,7 @@ fn cpu(c: &mut Criterion) {
     // rain, a stone a second), the picture, the cells and the encoder at 250 kB/s.
     let replay =
         tidepool::replay::Replay::read(std::path::Path::new(&fixture("pool-160x48.jsonl"))).expect("the fixture");
-    let [w, h] = replay.header.size;
+    let [w, h] = replay.size();
     let mut scene = replay.spec(tidepool::PoolSettings::default_floor()).build(w, h).expect("a valid size");
     let steps_per_frame = (scene.steps_per_second() / f64::from(FPS)).round().max(1.0) as u64;
     let mut picture = Pixmap::new(w, h).expect("a valid size");
@@ -525,7 +527,7 @@ fn cpu(c: &mut Criterion) {
             let frame = &frames[n % frames.len()];
             n += 1;
             out.clear();
-            tidepool::terminal::encode_into(&mut shown, black_box(frame), EncodeOptions::default(), &mut out);
+            tidepool::testing::encode_into(&mut shown, black_box(frame), EncodeOptions::default(), &mut out);
             out.len()
         })
     });
@@ -543,7 +545,7 @@ fn stale() {
             let mut screen = TerminalModel::new(COLS, ROWS);
             screen.lf_returns = false;
             let frame = clip.frame(i - k, ColorMode::TrueColor, 1);
-            let (bytes, _) = tidepool::terminal::encode(&Shown::UNKNOWN, &frame, EncodeOptions::default());
+            let (bytes, _) = tidepool::testing::encode(&Shown::UNKNOWN, &frame, EncodeOptions::default());
             screen.feed(&bytes);
             psnr += quality::measure(&screen, &clip.pictures[i]).psnr();
             ssim += clip.references[i].ssim(&quality::screen_luma(&screen, w, h));

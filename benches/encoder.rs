@@ -12,7 +12,8 @@
 use std::hint::black_box;
 
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
-use tidepool::terminal::{Color, ColorMode, EncodeOptions, Frame, Shown, encode_into};
+use tidepool::play::{ColorMode, EncodeOptions};
+use tidepool::testing::{Color, Frame, Shown, encode_into};
 use tidepool::{Damping, PoolScene, PoolSettings, Scene, Stone};
 use tiny_skia::Pixmap;
 

@@ -25,11 +25,12 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use tidepool::graphics::iterm2::Iterm2Encoder;
-use tidepool::graphics::kitty::{KittyEncoder, KittyOptions, Medium, temp_dir};
-use tidepool::graphics::sixel::{SixelEncoder, SixelPalette};
-use tidepool::graphics::{GraphicsMode, push_rgb};
-use tidepool::graphics::{Layout, layout};
+use tidepool::play::GraphicsMode;
+use tidepool::testing::Iterm2Encoder;
+use tidepool::testing::push_rgb;
+use tidepool::testing::{KittyEncoder, KittyOptions, Medium, kitty_temp_dir as temp_dir};
+use tidepool::testing::{Layout, layout};
+use tidepool::testing::{SixelEncoder, SixelPalette};
 use tidepool::{Damping, PoolScene, PoolSettings, Scene, Stone};
 use tiny_skia::Pixmap;
 

@@ -14,7 +14,8 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use tiny_skia::Pixmap;
 
-use tidepool::sea::{PatchSea, beaufort_speed_m_s};
+use tidepool::sea::beaufort_speed_m_s;
+use tidepool::testing::PatchSea;
 use tidepool::{OceanScene, OceanSettings, OceanView, Scene, SeaParams};
 
 fn scene(width: u32, height: u32, ssaa: u32, sea: SeaParams) -> OceanScene {

@@ -31,15 +31,18 @@ use std::time::{Duration, Instant};
 
 use base64::Engine;
 use criterion::Criterion;
-use tidepool::graphics::kitty::KittyOptions;
-use tidepool::graphics::sixel::{Registers, SixelPalette};
-use tidepool::graphics::{GraphicsMode, Layout, layout};
-use tidepool::serve::ByteBucket;
-use tidepool::terminal::{Color, ColorMode, Frame, Shown};
+use tidepool::play::ColorMode;
+use tidepool::play::GraphicsMode;
+use tidepool::testing::ByteBucket;
+use tidepool::testing::KittyOptions;
+use tidepool::testing::Script;
 use tidepool::testing::{
     Budget, KittyState, Luma, PictureStream, Protocol, RateEncoder, RateOptions, Target, TerminalModel,
 };
-use tidepool::{Event, Script, Stone};
+use tidepool::testing::{Color, Frame, Shown};
+use tidepool::testing::{Layout, layout};
+use tidepool::testing::{Registers, SixelPalette};
+use tidepool::{Event, Stone};
 use tiny_skia::Pixmap;
 
 const FIXTURE: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/fixtures/alive-160x48.jsonl");
@@ -59,7 +62,7 @@ const MODES: [&str; 4] = ["kitty", "sixel", "iterm2", "cells"];
 /// The fixture at the pixel modes' scene size: one picture per frame.
 fn pictures() -> Vec<Pixmap> {
     let replay = tidepool::replay::Replay::read(std::path::Path::new(FIXTURE)).expect("the committed fixture replay");
-    let [w0, _] = replay.header.size;
+    let [w0, _] = replay.size();
     let scale = f64::from(SCENE.0) / f64::from(w0);
     let mut scene = replay.spec(tidepool::PoolSettings::default_floor()).build(SCENE.0, SCENE.1).expect("a valid size");
     let events: Vec<(u64, Event)> = replay

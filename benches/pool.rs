@@ -14,7 +14,8 @@
 
 use criterion::measurement::{Measurement, ValueFormatter, WallTime};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group};
-use tidepool::{BreezeStyle, Damping, Event, PoolLook, PoolScene, PoolSettings, RipplePool, Scene, Stone};
+use tidepool::testing::RipplePool;
+use tidepool::{BreezeStyle, Damping, Event, PoolLook, PoolScene, PoolSettings, Scene, Stone};
 use tiny_skia::Pixmap;
 
 /// The papers' loop, transliterated: index arithmetic, an i32 sum, shifts, store, swap.

@@ -11,7 +11,8 @@
 
 use std::path::PathBuf;
 
-use tidepool::{Damping, PoolScene, PoolSettings, Scene, Size, Stone};
+use tidepool::testing::Size;
+use tidepool::{Damping, PoolScene, PoolSettings, Scene, Stone};
 use tiny_skia::{Pixmap, PixmapPaint, Transform};
 
 /// The player's simulation rate.

@@ -9,19 +9,20 @@
 //! which mode), waits half of `SECONDS` (default 4), paints a red square into the picture and
 //! sends only that change (a kitty frame edit or a sixel cell block where the terminal allows),
 //! writes the picture the terminal should show to `REPORT.png` (for sixel the dithered one), waits the other half and restores the
-//! terminal (kitty's image deleted). The terminal is asked with `tidepool::tty::probe_for_picture`,
+//! terminal (kitty's image deleted). The terminal is asked with `tidepool::testing::probe_for_picture`,
 //! as `render --out -` asks it.
 
 use std::io::{self, Write};
 use std::time::{Duration, Instant};
 
-use tidepool::graphics::iterm2::Iterm2Encoder;
-use tidepool::graphics::kitty::{self, KittyEncoder, KittyOptions, Medium};
-use tidepool::graphics::sixel::{SixelEncoder, SixelPalette};
-use tidepool::graphics::{GraphicsMode, push_rgb};
-use tidepool::graphics::{Layout, layout};
+use tidepool::play::GraphicsMode;
 use tidepool::play::GraphicsRequest;
+use tidepool::testing::Iterm2Encoder;
 use tidepool::testing::dithered_rgb;
+use tidepool::testing::push_rgb;
+use tidepool::testing::{KittyEncoder, KittyOptions, Medium, kitty_temp_dir};
+use tidepool::testing::{Layout, layout};
+use tidepool::testing::{SixelEncoder, SixelPalette};
 use tiny_skia::{Color, FilterQuality, Pixmap, PixmapPaint, Rect, Transform};
 
 const GOLDEN: &[u8] = include_bytes!("../tests/golden/pool_default.png");
@@ -51,7 +52,7 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
     // The same question and the same rules as `tidepool render --out -` (at most
     // 150 ms; the file medium is not offered).
     let started = Instant::now();
-    let (choice, support) = tidepool::tty::probe_for_picture(request);
+    let (choice, support) = tidepool::testing::probe_for_picture(request);
     let took = started.elapsed();
     let support = &support;
     let mut text = format!("probe took {took:?}\n{support:#?}\n{choice:#?}\n");
@@ -86,7 +87,7 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
         tmux: choice.tmux_wrap,
         placeholders: choice.kitty_placeholders,
         frame_edits: support.kitty_frame_edits,
-        medium: if support.kitty_temp_file { Medium::TempFile(kitty::temp_dir()) } else { Medium::Direct },
+        medium: if support.kitty_temp_file { Medium::TempFile(kitty_temp_dir()) } else { Medium::Direct },
         // Under text glyphs, as the player places it (src/term/picture.rs).
         z_index: -1,
         ..KittyOptions::new(l.cells)
@@ -107,10 +108,10 @@ fn run(request: GraphicsRequest, report: &str, seconds: f64) -> io::Result<()> {
             }
             GraphicsMode::Iterm2 => format!("{}", iterm2_enc.encode(picture, out)),
             GraphicsMode::Cells => {
-                let mut frame = tidepool::terminal::Frame::new(usize::from(cols), usize::from(rows) - 1);
-                frame.draw_pixels(picture, tidepool::terminal::ColorMode::TrueColor);
-                let mut shown = tidepool::terminal::Shown::UNKNOWN;
-                tidepool::terminal::encode_into(&mut shown, &frame, Default::default(), out);
+                let mut frame = tidepool::testing::Frame::new(usize::from(cols), usize::from(rows) - 1);
+                frame.draw_pixels(picture, tidepool::play::ColorMode::TrueColor);
+                let mut shown = tidepool::testing::Shown::UNKNOWN;
+                tidepool::testing::encode_into(&mut shown, &frame, Default::default(), out);
                 "cells".into()
             }
         };

@@ -14,7 +14,8 @@ use std::path::{Path, PathBuf};
 
 use tiny_skia::{Pixmap, PixmapPaint, Transform};
 
-use tidepool::sea::{Depth, Jonswap, PatchSea, SpectrumChoice, Swell, Swells, beaufort_speed_m_s};
+use tidepool::sea::{Depth, Jonswap, SpectrumChoice, Swell, Swells, beaufort_speed_m_s};
+use tidepool::testing::PatchSea;
 use tidepool::{CameraPose, OceanScene, OceanSettings, OceanView, Scene, SeaParams, SeaShading};
 
 struct Shot {

@@ -24,8 +24,8 @@ if [ "${1:-}" = load ]; then
     TIDEPOOL_BUS_TRACE=1 exec cargo test --release --features bus --test serve bus_load:: -- --ignored --nocapture
 fi
 # Every feature, as the README's test command builds: .ci/run runs this after that command,
-# and the same features reuse its build. First the binary's own (the sequencer's role on its
-# thread: src/bin/tidepool/serve/bus/lead_tests.rs), then the edges as processes. Ports:
+# and the same features reuse its build. First the library's own (the sequencer's role on its
+# thread: src/cli/serve/bus/lead_tests.rs), then the edges as processes. Ports:
 # TIDEPOOL_BUS_TEST_PORTS=FIRST-LAST (default 42000-42999).
-cargo test --all-features --bin tidepool serve::bus:: -- --ignored "$@"
+cargo test --all-features --lib cli::serve::bus:: -- --ignored "$@"
 exec cargo test --all-features --test serve bus:: -- --ignored "$@"

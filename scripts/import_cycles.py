@@ -6,19 +6,24 @@
 2. The layers (ARCHITECTURE.md, "The layers"), by top-level folder of src/: a folder never
    imports the folders LAYERS lists for it (any file in it, any depth, `crate::x` or
    `crate::{x, ..}`). The rule that matters most: the play session (src/play/) imports no door
-   (src/term/; the SSH door lives in the binary and cannot be named). Test files (`tests.rs`,
+   (src/term/, and the command line src/cli/ with the SSH door src/cli/serve/). The command
+   line is the top: no folder but src/cli/ itself imports it (the binary, src/bin/, only calls
+   `tidepool::cli::main`). Test files (`tests.rs`,
    `*_tests.rs`, anything under a `tests/` folder) are the harness and may use any layer.
 3. The sans-IO core (ARCHITECTURE.md, "The play session"): no file of src/play/ or src/output/
    (the encoders the session calls) names the file system, the environment, /proc, threads,
    sockets, the clock or sleep outside its tests; NO_IO_EXCEPTIONS lists the files that may,
    each with its reason.
 
-Usage: scripts/import_cycles.py src src/bin/tidepool   (prints each problem; exit 1 if any)"""
+Usage: scripts/import_cycles.py src   (prints each problem; exit 1 if any)"""
 import os,re,sys
 
 # folder -> the folders it must never import. Lower layers know nothing of the ones above them:
-# simulation < rendering < scenes < output encoders < the play session < the terminal door.
-DOORS = {"term", "tty"}
+# simulation < rendering < scenes < output encoders < the play session < the doors (the
+# terminal door, the command line and its SSH door, src/cli/serve/).
+DOORS = {"term", "tty", "cli"}
+# The top of the crate: only itself (and the binary, through the public `cli::main`) uses it.
+TOP = "cli"
 LAYERS = {
     "sim": {"render", "scene", "output", "play"} | DOORS,
     "render": {"scene", "output", "play"} | DOORS,
@@ -93,7 +98,7 @@ def layer_problems(root):
             if is_test_file(path): continue
             top=os.path.relpath(path,root).split(os.sep)[0]
             top=top[:-3] if top.endswith('.rs') else top
-            forbidden=LAYERS.get(top,set())
+            forbidden=LAYERS.get(top,set()) | ({TOP} if top not in (TOP, "bin") else set())
             for name,line in crate_roots(code_of(path)):
                 if name in forbidden: problems.append((path,line,top,name))
     return problems

@@ -3,7 +3,7 @@
 //! replay reader calls the same checks through the modules that own them. Each refusal names
 //! the value and a good one; the caller adds where the value came from (a flag, a replay line).
 //! (Values with a type of their own check themselves: [`crate::Stone::new`],
-//! `Damping::from_str`, [`crate::Size`], [`crate::Refraction`], [`crate::Sun`].)
+//! `Damping::from_str`, `Size`, [`crate::Refraction`], [`crate::Sun`].)
 
 use crate::error::ValueError;
 use crate::{LakeSettings, OceanSettings, PoolSettings};

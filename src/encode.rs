@@ -1,5 +1,5 @@
 //! Pixels to bytes: PNG and half-block text (a `Heightmap` writes itself, the sea's maps are
-//! `sea::PatchMaps::files`), and with the `animation`
+//! `tidepool maps`), and with the `animation`
 //! feature animated GIF and PNG. Every encoder returns bytes (or writes to any `Write`); where
 //! the bytes go is the caller's choice.
 
@@ -9,5 +9,4 @@ pub use crate::output::apng::ApngWriter;
 pub use crate::output::gif::{GifPalette, GifWriter};
 pub use crate::output::halfblock::encode as halfblock;
 pub use crate::output::png::encode as png;
-pub use crate::output::units::human_bytes;
 pub use crate::render::background::decode as decode_image;

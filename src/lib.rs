@@ -2,8 +2,9 @@
 //!
 //! Three scenes — a ripple pool, a wind-driven sea and a lake mirroring its shore — behind one
 //! contract, [`Scene`]: advance it, apply [`Event`]s, render it into a `tiny_skia::Pixmap`.
-//! Data flows one way: **simulation -> renderer -> pixels -> output** ([`encode`],
-//! [`terminal`]); nothing flows back except user input, which becomes events.
+//! Data flows one way: **simulation -> renderer -> pixels -> output** ([`encode`], and a
+//! terminal's frames through `play`); nothing flows back except user input, which becomes
+//! events.
 //!
 //! ```
 //! use tidepool::{PoolScene, PoolSettings, Scene, Stone};
@@ -19,11 +20,12 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 //!
-//! Features: `cli` (default: the `tidepool` binary), `player` (the play session, [`play`], the
-//! interactive terminal player, [`tty`], and what `tidepool serve` shares between players,
-//! [`serve`]), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui` (a widget
-//! that draws any scene, `widget`), `testing` (the tools the tests and benchmarks check
-//! pictures with, `testing`; not part of the chosen API).
+//! Features: `cli` (default: the `tidepool` command line, `cli`, which the binary runs),
+//! `serve` (its SSH server), `player` (the play session, [`play`]: a sans-IO [`play::Session`]
+//! any byte stream drives), `animation` (GIF and animated PNG writers in [`encode`]), `ratatui`
+//! (a widget that draws any scene, `widget`), `testing` (the tools the tests and benchmarks
+//! check pictures with, and the pieces the doors assemble a session from, `testing`; not part
+//! of the chosen API).
 #![warn(missing_docs)]
 #![warn(unnameable_types)]
 
@@ -36,39 +38,24 @@ mod scene;
 mod sim;
 mod simd;
 mod size;
+// The terminal door (this process's terminal) is the command line's (`tidepool play`) and the
+// tests'; a library user with feature `player` drives a `play::Session` on a stream of theirs.
+#[cfg(any(feature = "cli", feature = "testing"))]
 mod storage;
-#[cfg(feature = "player")]
+#[cfg(any(feature = "cli", feature = "testing"))]
 mod term;
 
+/// The `tidepool` command line (feature `cli`), as the `tidepool` binary runs it.
+#[cfg(feature = "cli")]
+pub mod cli;
+
 pub mod encode;
-pub mod graphics;
 #[cfg(feature = "player")]
 pub mod play;
 pub mod replay;
 pub mod sea;
-pub mod terminal;
 #[cfg(feature = "ratatui")]
 pub mod widget;
-
-/// This process's own terminal (feature `player`): the door that puts a play session on a
-/// terminal. It lives beside [`play`], not inside it, because the session imports no door
-/// (`scripts/import_cycles.py` checks it).
-#[cfg(feature = "player")]
-pub mod tty {
-    pub use crate::term::door::{PlayConfig, TerminalInput, run};
-    pub use crate::term::tty::{play, probe_for_picture, restore};
-}
-
-/// What `tidepool serve` (the binary's SSH door, feature `serve`) needs beyond one person's
-/// [`play`] session: players whose screens are alike share frames, encoded once per group, and
-/// each player's requests, resizes and bytes are rationed by token buckets. Only serve uses
-/// these; they are here because serve lives in the binary and the groups encode with the
-/// screen's crate-private parts.
-#[cfg(feature = "player")]
-pub mod serve {
-    pub use crate::output::bucket::ByteBucket;
-    pub use crate::play::group::{GroupFeed, GroupKey, Groups, Membership, MembershipStats, Source};
-}
 
 /// The tools tidepool's own tests and benchmarks check pictures with (feature `testing`, off by
 /// default; `tests/`, `benches/` and `examples/` turn it on through a dev-dependency): a terminal
@@ -80,22 +67,47 @@ pub mod serve {
 #[cfg(feature = "testing")]
 #[doc(hidden)]
 pub mod testing {
+    pub use crate::output::bucket::ByteBucket;
+    pub use crate::output::color::Color;
     pub use crate::output::diff::{SYNC_BEGIN, SYNC_END};
+    pub use crate::output::diff::{Shown, encode, encode_into};
+    pub use crate::output::frame::{Cell, Frame};
+    pub use crate::output::graphics::geometry::{Layout, layout};
+    pub use crate::output::graphics::iterm2::Iterm2Encoder;
+    pub use crate::output::graphics::kitty::{KittyEncoder, KittyOptions, Medium, temp_dir as kitty_temp_dir};
     pub use crate::output::graphics::kitty_decode::{Image as KittyImage, KittyState, decode as kitty_decode};
     pub use crate::output::graphics::pack::Packing;
     pub use crate::output::graphics::sixel::dithered_rgb;
+    pub use crate::output::graphics::sixel::{Registers, SixelEncoder, SixelPalette};
     pub use crate::output::graphics::stream::ladder::resample;
     pub use crate::output::graphics::stream::{Budget, Offer, Part, PictureStream, Protocol, State};
+    pub use crate::output::graphics::{Update, push_rgb};
     pub use crate::output::quality::{Quality, measure, screen_luma};
     pub use crate::output::rate::{RateEncoder, RateOptions, Report, Strategy, Target, UNLIMITED};
     pub use crate::output::ssim::{Luma, SsimReference, ssim};
     pub use crate::output::vt::{ModelCell, TerminalModel};
+    pub use crate::play::fit::Fit;
+    pub use crate::play::group::{GroupFeed, GroupKey, Groups, Membership, MembershipStats, Source};
+    pub use crate::play::host::{Host, SceneStatus};
+    pub use crate::play::player::Player;
+    pub use crate::play::request::Request;
+    pub use crate::play::screen::Screen;
+    pub use crate::play::screen::probe::{GraphicsChoice, GraphicsSupport, SixelSupport};
+    pub use crate::render::background::load as load_image;
     pub use crate::render::plot::spectrum_plot;
+    pub use crate::scene::Script;
+    pub use crate::sim::patch::{PatchMaps, PatchSea};
+    pub use crate::sim::ripple::RipplePool;
+    pub use crate::sim::spectra::SeaSpectrum;
     pub use crate::sim::spectrum::PiersonMoskowitz;
+    pub use crate::simd::Simd;
+    pub use crate::size::Size;
+    pub use crate::storage::Storage;
+    pub use crate::term::door::{PlayConfig, TerminalInput, run};
+    pub use crate::term::tty::probe_for_picture;
 }
 
 pub use error::{Error, Result, ValueError};
-pub use render::background::load as load_image;
 pub use render::camera::CameraPose;
 pub use render::caustics::CausticsLook;
 pub use render::ocean::{OceanView, SeaShading};
@@ -105,15 +117,12 @@ pub use render::texture::SeaTexture;
 pub use scene::lake::{LakeScene, LakeSettings};
 pub use scene::ocean::{OceanScene, OceanSettings};
 pub use scene::pool::{PoolScene, PoolSettings};
-pub use scene::{Action, Controls, Event, Heightmap, Playable, Scene, SceneKind, SceneSpec, Script};
+pub use scene::{Action, Controls, Event, Heightmap, Playable, Scene, SceneKind, SceneSpec};
 pub use sim::breeze::BreezeStyle;
 pub use sim::lake::LakeParams;
 pub use sim::noise::NoiseKind;
 pub use sim::ocean::SeaParams;
-pub use sim::ripple::{Damping, RipplePool, Stone};
-pub use simd::Simd;
-pub use size::Size;
-pub use storage::Storage;
+pub use sim::ripple::{Damping, Stone};
 
 /// The rust code of the README and the guide, compiled and run as doctests, so that what a
 /// newcomer copies from them builds.

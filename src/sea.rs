@@ -4,24 +4,19 @@
 //! the spectrum.
 //!
 //! ```
-//! use tidepool::sea::{PatchSea, SeaSpectrum, SpectrumChoice, SpectrumKind};
-//! use tidepool::SeaParams;
+//! use tidepool::sea::{SpectrumChoice, SpectrumKind};
+//! use tidepool::{OceanScene, OceanSettings, Scene, SeaParams};
 //!
+//! // A JONSWAP sea (a fetch of 50 km) under a 12 m/s wind.
 //! let choice = SpectrumChoice::new(SpectrumKind::Jonswap, None, Some(50.0), None)?;
-//! let spectrum = SeaSpectrum::new(12.0, choice);
-//! assert!(spectrum.significant_height_m() > 1.0);
-//! let params = SeaParams { wind_m_s: 12.0, spectrum: choice, choppiness: 1.0, ..SeaParams::default() };
-//! let maps = PatchSea::new(params, 64, 300.0)?.maps(0.0);
-//! assert_eq!(maps.height.len(), 64 * 64);
-//! let files = maps.files(None);
-//! assert_eq!(files[0].0, "height.npy");
+//! let sea = SeaParams { wind_m_s: 12.0, spectrum: choice, choppiness: 1.0, ..SeaParams::default() };
+//! let mut scene = OceanScene::new(OceanSettings { sea, ..OceanSettings::default() }, 64, 36).expect("a small sea");
+//! let picture = scene.snapshot()?;
+//! assert_eq!((picture.width(), picture.height()), (64, 36));
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 pub use crate::sim::looping::LoopPeriod;
-pub use crate::sim::patch::{PatchMaps, PatchSea};
-pub use crate::sim::sea_state::{beaufort_number, beaufort_speed_m_s, wmo_sea_state, wmo_sea_state_name};
+pub use crate::sim::sea_state::beaufort_speed_m_s;
 pub use crate::sim::spectra::swell::{Swell, Swells};
-pub use crate::sim::spectra::{
-    Depth, Jonswap, SeaSpectrum, SpectrumChoice, SpectrumChoiceError, SpectrumKind, Spreading,
-};
+pub use crate::sim::spectra::{Depth, Jonswap, SpectrumChoice, SpectrumChoiceError, SpectrumKind, Spreading};

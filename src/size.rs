@@ -36,6 +36,7 @@ impl Size {
         Ok(size)
     }
 
+    #[cfg(any(test, feature = "cli", feature = "testing"))]
     /// A size known at compile time; panics (at compile time in a `const`) when it is invalid.
     pub const fn of(width: u32, height: u32) -> Size {
         assert!(width >= 1 && height >= 1 && width <= MAX_SIDE && height <= MAX_SIDE);

@@ -15,9 +15,9 @@ use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicIsize, Ordering};
 use std::time::{Duration, Instant};
 
-use tidepool::play::{Bandwidth, GraphicsRequest, Host, HostConfig, LinkPath, Player, Screen, ScreenConfig};
-use tidepool::serve::{GroupKey, Groups, Membership, Source};
-use tidepool::terminal::{ColorMode, EncodeOptions};
+use tidepool::play::{Bandwidth, GraphicsRequest, HostConfig, LinkPath, ScreenConfig};
+use tidepool::play::{ColorMode, EncodeOptions};
+use tidepool::testing::{GroupKey, Groups, Host, Membership, Player, Screen, Source};
 use tidepool::{PoolSettings, SceneSpec};
 use tiny_skia::Pixmap;
 
@@ -63,7 +63,7 @@ fn player(t0: Instant) -> Player {
         color_auto: false,
         colour_hint: false,
         encode: EncodeOptions::default(),
-        graphics: GraphicsRequest::Force(tidepool::graphics::GraphicsMode::Cells),
+        graphics: GraphicsRequest::Force(tidepool::play::GraphicsMode::Cells),
         probe: None,
         link_path: LinkPath::Direct,
     };
@@ -106,7 +106,7 @@ impl Crowd {
         self.frame += 1;
         let now = self.t0 + FRAME * self.frame;
         if self.frame.is_multiple_of(8) {
-            self.host.apply(tidepool::play::Request::RandomStone { radius: 3 }, now);
+            self.host.apply(tidepool::testing::Request::RandomStone { radius: 3 }, now);
         }
         self.host.advance(now);
         self.host.render(&mut self.picture);

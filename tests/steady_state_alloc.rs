@@ -1,7 +1,7 @@
 //! The interactive loop's steady state must not allocate: a frame (steps, picture, status line
 //! and overlays, diff encoding, the write) reuses every buffer, for the pool and the lake. A
 //! counting allocator checks it, across every thread (rayon's workers and the frame writer).
-//! The player runs for real here, through `tidepool::tty::run` on a fake terminal: this is
+//! The player runs for real here, through `tidepool::testing::run` (the terminal door) on a fake terminal: this is
 //! also the proof that the loop runs on any byte stream.
 //! The ocean is the exception it measures: its foam makes four small vectors anew for every
 //! picture (`FoamClock::weights` and the two `taps` of `FoamTracker::update`,
@@ -17,8 +17,8 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use tidepool::play::{Bandwidth, GraphicsRequest, HostConfig, ScreenConfig};
-use tidepool::terminal::{ColorMode, EncodeOptions};
-use tidepool::tty::{PlayConfig, TerminalInput};
+use tidepool::play::{ColorMode, EncodeOptions};
+use tidepool::testing::{PlayConfig, TerminalInput};
 use tidepool::{LakeSettings, OceanSettings, PoolScene, PoolSettings, Scene, SceneSpec, Stone};
 
 struct Counting;
@@ -148,7 +148,7 @@ fn player_frames(scene: SceneSpec) -> usize {
         quit: Arc::clone(&quit),
     };
     let output = FrameCounter { frames: 0, marks: Arc::clone(&marks), quit };
-    tidepool::tty::run(&mut FakeTerminal { keys: Some(b"?l") }, output, config).unwrap();
+    tidepool::testing::run(&mut FakeTerminal { keys: Some(b"?l") }, output, config).unwrap();
     let marks = marks.lock().unwrap();
     marks[1] - marks[0]
 }

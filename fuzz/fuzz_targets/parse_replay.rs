@@ -14,10 +14,10 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else { return };
     let path = std::path::Path::new("fuzz.jsonl");
     if let Ok(replay) = tidepool::replay::Replay::parse_with(path, text, &LIMITS) {
-        let [w, h] = replay.header.size;
+        let [w, h] = replay.size();
         assert!(u64::from(w) * u64::from(h) <= LIMITS.max_pixels, "the size limit holds");
         assert!(replay.end_step() <= LIMITS.max_steps, "the step limit holds");
-        assert!(replay.entries.len() <= LIMITS.max_events, "the event limit holds");
+        assert!(replay.script().len() <= LIMITS.max_events, "the event limit holds");
         let spec = replay.spec(tidepool::PoolSettings::default_floor());
         let _ = replay.simulate(&spec, None, &mut |_| {});
     }

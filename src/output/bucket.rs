@@ -46,6 +46,7 @@ impl ByteBucket {
         }
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// A rate limit: filled at `per_second`, starting full, holding and owing at most `burst`
     /// of the rate (a second for a server's limits: a short burst passes, a flood gets the rate).
     pub fn limit(per_second: f64, burst: Duration) -> ByteBucket {
@@ -118,6 +119,7 @@ impl ByteBucket {
         }
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// Takes `n` tokens at `now` if the bucket holds them (a rate limit: an action, a frame's
     /// bytes from a shared budget); says whether it did.
     pub fn try_take(&mut self, n: f64, now: Instant) -> bool {
@@ -132,6 +134,7 @@ impl ByteBucket {
         }
     }
 
+    #[cfg(any(feature = "testing", test))]
     /// Whether the bucket is in debt (see [`ByteBucket::owe`]).
     pub fn in_debt(&self) -> bool {
         self.rate.is_some() && self.level < 0.0

@@ -95,7 +95,7 @@ const CUBE_LEVELS: [u8; 6] = [0, 95, 135, 175, 215, 255];
 impl ColorMode {
     /// The terminal colour for pixel `rgb` at `(x, y)` (the position only steers the dither).
     #[inline]
-    pub fn quantize(self, rgb: Rgb, x: u32, y: u32) -> Color {
+    pub(crate) fn quantize(self, rgb: Rgb, x: u32, y: u32) -> Color {
         match self {
             ColorMode::TrueColor => Color::Rgb(rgb),
             ColorMode::Palette256 => Color::Index(nearest_256(rgb)),

@@ -20,7 +20,9 @@
 //!   switched off; a frame with no change is no bytes at all.
 
 use crate::output::color::Color;
-use crate::output::cursor::{self, Cursor};
+#[cfg(any(test, feature = "testing"))]
+use crate::output::cursor;
+use crate::output::cursor::Cursor;
 use crate::output::frame::{Cell, Frame};
 
 /// Start of a synchronized update (DEC mode 2026).
@@ -167,6 +169,7 @@ pub(crate) fn best_draw(cell: Cell, fg: Option<Color>, bg: Option<Color>) -> Dra
     }
 }
 
+#[cfg(any(test, feature = "testing"))]
 /// Encodes the change from `shown` to `next`: returns the bytes and what the terminal shows
 /// after them. When `shown` has no frame or one of another size, every cell is sent.
 pub fn encode(shown: &Shown, next: &Frame, options: EncodeOptions) -> (Vec<u8>, Shown) {
@@ -176,6 +179,7 @@ pub fn encode(shown: &Shown, next: &Frame, options: EncodeOptions) -> (Vec<u8>, 
     (out, state)
 }
 
+#[cfg(any(test, feature = "testing"))]
 /// [`encode`] without allocating: appends the bytes to `out` and updates `shown` in place.
 pub fn encode_into(shown: &mut Shown, next: &Frame, options: EncodeOptions, out: &mut Vec<u8>) {
     let start = out.len();

@@ -26,6 +26,7 @@ pub fn push_fg(out: &mut Vec<u8>, [r, g, b]: Rgb) {
     let _ = write!(out, "\x1b[38;2;{r};{g};{b}m");
 }
 
+#[cfg(any(test, feature = "player", feature = "ratatui"))]
 /// The picture, in pixels, that `cols x rows` half-block cells show: a pixel a column, two a
 /// row. The one place this is computed: the play screen's picture and a serve group's
 /// (`play/screen/compose.rs`), the cells layout (`output/graphics/geometry.rs`) and the widget

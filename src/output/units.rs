@@ -1,7 +1,9 @@
 //! Byte counts and rates for people, in one unit everywhere: SI kilobytes (1 kB = 1000 bytes).
 
+#[cfg(any(feature = "player", test))]
 use std::fmt::Write;
 
+#[cfg(any(feature = "cli", feature = "testing", test))]
 /// `850 B`, `12.3 kB`, `1.20 MB`.
 pub fn human_bytes(bytes: u64) -> String {
     let mut text = String::new();
@@ -9,6 +11,7 @@ pub fn human_bytes(bytes: u64) -> String {
     text
 }
 
+#[cfg(any(feature = "player", test))]
 /// [`human_bytes`] into a reused buffer (appended; allocates nothing once it has grown).
 pub fn write_human_bytes(out: &mut String, bytes: u64) {
     let b = bytes as f64;

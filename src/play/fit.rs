@@ -8,10 +8,12 @@
 //! cap, scaled by the terminal or the sixel encoder), so its fit is one to one; a shared scene
 //! (`tidepool serve`) has one size for everyone and is letterboxed into each terminal.
 
+#[cfg(any(feature = "serve", feature = "testing", test))]
 use tiny_skia::{FilterQuality, Pixmap, PixmapPaint, Transform};
 
 use crate::output::graphics::geometry::Layout;
 
+#[cfg(any(feature = "serve", feature = "testing", test))]
 /// The bars' colour around a picture that does not fill the terminal (the status line's blue,
 /// darker).
 pub const BAR_RGB: [u8; 3] = [8, 12, 20];
@@ -68,11 +70,13 @@ impl Fit {
         self.scene
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// The terminal's picture size in pixels.
     pub fn target(&self) -> (u32, u32) {
         self.target
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// Whether the scene fills the picture pixel for pixel (then no letterboxing is drawn).
     pub fn one_to_one(&self) -> bool {
         self.scene == self.target
@@ -139,6 +143,7 @@ impl Fit {
         (step(cell_w, self.scene.0, w), step(cell_h, self.scene.1, h))
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// `scene` fitted into a picture of the target's size, in `old`'s pixels when it has that
     /// size (a shared scene's pictures are reused from frame to frame).
     pub fn fitted(&self, scene: &Pixmap, old: Option<Pixmap>) -> Option<Pixmap> {
@@ -155,6 +160,7 @@ impl Fit {
         Some(picture)
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// Draws `scene` (of the scene's size) into `out` (of the target's size): scaled, centred,
     /// bars around it. Whole-number growth stays sharp; anything else is filtered.
     pub fn draw(&self, scene: &Pixmap, out: &mut Pixmap) {

@@ -388,6 +388,7 @@ impl Membership {
         })
     }
 
+    #[cfg(any(feature = "testing", test))]
     /// Whether the player's terminal shows its group's frames now.
     pub fn in_step(&self) -> bool {
         self.pinned.is_some()

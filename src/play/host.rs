@@ -19,7 +19,9 @@ use super::clock::SimClock;
 use super::request::Request;
 use crate::error::{Result, ValueError};
 use crate::replay::{FORMAT, Header, PoolOptions, Recorder};
-use crate::scene::{Action, Event, Playable, SceneKind, SceneSpec};
+#[cfg(any(feature = "testing", test))]
+use crate::scene::SceneKind;
+use crate::scene::{Action, Event, Playable, SceneSpec};
 
 /// Random stones use their own generator, seeded from the seed xor this, so that pressing
 /// `space` does not change the rain.
@@ -169,11 +171,13 @@ impl Host {
         self.scene.size()
     }
 
+    #[cfg(any(feature = "testing", test))]
     /// Which scene is shown.
     pub fn kind(&self) -> SceneKind {
         self.scene.kind()
     }
 
+    #[cfg(any(feature = "testing", test))]
     /// Simulation steps run so far.
     pub fn step(&self) -> u64 {
         self.step

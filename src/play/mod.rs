@@ -2,37 +2,27 @@
 //! core that any byte stream drives. It does no I/O and reads no clock: bytes and `now` go in,
 //! requests and frame bytes come out.
 //!
-//! - [`Host`]: the only owner of a scene, its clock, its random stones, the scene list and the
-//!   recorder. [`Host::apply`] takes a [`Request`].
-//! - [`Player`]: one person at one terminal: their seat beside their [`Screen`]. The seat
-//!   (crate-private) is what the person holds between frames, apart from any terminal: aim,
-//!   stone size, drag, help, messages, the [`Fit`] between their terminal and the scene, and
-//!   the one place a key or a click gets its meaning (an input becomes [`Request`]s).
-//! - [`Screen`]: one terminal: the graphics probe, the link control and byte budget, the
-//!   rate-controlled cell encoder and the picture encoders. It takes the terminal's bytes
-//!   (replies stay in the screen, inputs come out) and appends a frame's bytes; its methods
-//!   are the crate's, the doors reach it through a [`Driver`].
+//! The API is a [`Session`], in quinn-proto's shape (`handle_*` for inputs, `poll_*` for
+//! outputs, time passed in): `handle_bytes`, `handle_resize`, `handle_timeout(now)`;
+//! `poll_event` for a [`SessionEvent`] (the bytes that restore the terminal, an [`Effect`] such
+//! as a screenshot to save, quit), `poll_timeout` for when to come back, and `poll_transmit`
+//! for a [`Transmit`]: a frame's bytes and the [`FileWrite`]s to do before them. A
+//! [`ScreenConfig`] says how to draw (frame rate, [`Bandwidth`], [`ColorMode`],
+//! [`EncodeOptions`], [`GraphicsRequest`] and the [`ProbeOptions`] to find what the terminal
+//! shows), a [`HostConfig`] what to play (scenes, seed, a [`Recording`]). Files, the clock and
+//! sockets are the caller's.
 //!
-//! - [`crate::serve::Groups`]: screens alike enough to share frames, encoded once per group
-//!   (`tidepool serve`); a player's [`crate::serve::Membership`] takes the group's bytes while
-//!   its terminal shows the group's model.
-//!
-//! The surface the doors drive, in quinn-proto's shape (`handle_*` for inputs, `poll_*` for
-//! outputs, time passed in): a [`Driver`] is the one turn of one person at one terminal
-//! (`handle_bytes`, `handle_resize`, `handle_picture`, `handle_timeout(now)`; `poll_event`
-//! for the seat's requests, a new layout, quit; `poll_timeout`; `poll_frame` and
-//! `transmit`); a [`Session`] is a driver beside its own host (`poll_event` adds the host's
-//! [`Effect`]s, files to save, and `poll_transmit` hands out a [`Transmit`]: the frame's bytes
-//! and the [`FileWrite`]s to do before them). Files, the clock and sockets are the doors'.
-//!
-//! Two doors drive them: [`crate::tty::run`] (and [`crate::tty::play`], for this process's own
-//! terminal) runs a [`Session`] on one terminal; `tidepool serve` runs one host on a thread and
-//! a [`Driver`] per SSH channel. A key's route is straight: bytes -> [`Driver::handle_bytes`] ->
-//! an input -> the seat -> [`Request`] -> [`Host::apply`] -> the scene.
+//! Inside (crate-private, in `tidepool::testing` for the tests): a `Host` is the only owner of
+//! a scene; a `Player` is one person at one terminal, their seat beside their `Screen` (the
+//! graphics probe, the link control, the encoders); a `Driver` is the one turn every door
+//! takes; a `Session` is a driver beside its own host. Two doors drive them: the terminal door
+//! (`src/term/`, `tidepool play`) runs a `Session`; `tidepool serve` (`src/cli/serve/`) runs one
+//! host on a thread and a `Driver` per SSH channel, and `group.rs` encodes once for screens
+//! that are alike.
 //!
 //! ```
 //! use std::time::{Duration, Instant};
-//! use tidepool::play::{Bandwidth, HostConfig, Screen, ScreenConfig, Session, Transmit};
+//! use tidepool::play::{Bandwidth, HostConfig, ScreenConfig, Session, Transmit};
 //! use tidepool::{PoolSettings, SceneSpec};
 //!
 //! let t0 = Instant::now();
@@ -57,7 +47,8 @@
 //! assert!(session.poll_event().is_some(), "the restore prefix, once the host is made");
 //! let mut out = Transmit::default();
 //! assert!(session.poll_transmit(now, true, &mut out)?);
-//! assert!(out.bytes.starts_with(Screen::ENTER) && out.files.is_empty());
+//! // The alternate screen, the cursor hidden, the mouse on: the terminal entered.
+//! assert!(out.bytes.starts_with(b"\x1b[?1049h\x1b[?25l") && out.files.is_empty());
 //! assert!(session.poll_timeout().is_some_and(|t| t > now), "the next frame, the next step");
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
@@ -65,6 +56,8 @@
 pub(crate) mod clock;
 pub(crate) mod driver;
 pub(crate) mod fit;
+// Only `tidepool serve` shares frames between screens (and the tests, through `testing`).
+#[cfg(any(feature = "serve", feature = "testing", test))]
 pub(crate) mod group;
 pub(crate) mod host;
 pub(crate) mod input;
@@ -75,17 +68,34 @@ pub(crate) mod screen;
 pub(crate) mod seat;
 pub(crate) mod session;
 
+pub use crate::output::color::ColorMode;
+pub use crate::output::diff::EncodeOptions;
+pub use crate::output::graphics::GraphicsMode;
 pub use crate::output::graphics::stream::FileWrite;
-pub use driver::{Driver, DriverEvent, Pacing, Transmit};
-pub use fit::Fit;
-pub use host::{Effect, Host, HostConfig, Recording, SceneStatus};
-pub use player::Player;
-pub use request::Request;
-pub use screen::probe::{
-    EnvHints, GraphicsChoice, GraphicsRequest, GraphicsSupport, ProbeOptions, SixelSupport, WinSize,
-};
-pub use screen::{Bandwidth, LinkPath, Screen, ScreenConfig};
+pub use driver::Transmit;
+pub use host::{Effect, HostConfig, Recording};
+pub use screen::probe::{EnvHints, GraphicsRequest, ProbeOptions, WinSize};
+pub use screen::{Bandwidth, LinkPath, ScreenConfig};
 pub use session::{Session, SessionEvent};
+
+// The pieces the doors (the terminal door, `tidepool serve`) assemble a session from: the
+// crate's, not the API's (a library user drives a [`Session`]).
+#[cfg(any(feature = "serve", feature = "testing"))]
+pub(crate) use driver::{Driver, DriverEvent, Pacing};
+#[cfg(any(feature = "serve", feature = "testing"))]
+pub(crate) use fit::Fit;
+#[cfg(any(feature = "cli", feature = "testing"))]
+pub(crate) use host::Host;
+#[cfg(any(feature = "serve", feature = "testing"))]
+pub(crate) use host::SceneStatus;
+#[cfg(any(feature = "cli", feature = "testing"))]
+pub(crate) use player::Player;
+#[cfg(any(feature = "cli", feature = "testing"))]
+pub(crate) use request::Request;
+#[cfg(any(feature = "cli", feature = "testing"))]
+pub(crate) use screen::Screen;
+#[cfg(any(feature = "cli", feature = "testing"))]
+pub(crate) use screen::probe::{GraphicsChoice, GraphicsSupport};
 
 #[cfg(test)]
 pub(crate) mod tests;

@@ -7,6 +7,7 @@ use std::time::Instant;
 
 use tiny_skia::Pixmap;
 
+#[cfg(any(feature = "serve", feature = "testing", test))]
 use super::fit::Fit;
 use super::host::SceneStatus;
 use super::input::Input;
@@ -46,11 +47,13 @@ impl Player {
         Player { seat, screen, inputs: Vec::new(), greeting: Some(greeting.unwrap_or_default()) }
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// How their terminal's cells map to the scene's pixels (the seat's).
     pub fn fit(&self) -> &Fit {
         self.seat.fit()
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// The passing message on their status line at `now` (the greeting, a notice), if any:
     /// players who show the same one share a group's frames ([`GroupKey::with_note`]).
     ///
@@ -59,6 +62,7 @@ impl Player {
         self.seat.message(now)
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// A player whose `s` key says screenshots are off instead of asking the host (a shared
     /// scene saves no files on a player's behalf).
     pub fn without_screenshots(mut self) -> Player {

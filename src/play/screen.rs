@@ -34,6 +34,7 @@ use super::input::{Input, InputParser, Received};
 use super::replies::Reply;
 use crate::output::bucket::ByteBucket;
 use crate::output::color::ColorMode;
+#[cfg(any(feature = "serve", feature = "testing", test))]
 use crate::output::cursor::Cursor;
 use crate::output::diff::{EncodeOptions, Shown};
 use crate::output::frame::Frame;
@@ -86,14 +87,17 @@ pub struct ScreenConfig {
 /// Where a frame's cells come from: composed and encoded here (a lone screen), or shared with
 /// the other screens of a group ([`crate::play::group`]).
 #[derive(Clone, Copy, Debug)]
+/// `Toward` and `Taken` are a group's (`tidepool serve`); without it only `Own` is made.
 pub(crate) enum CellSource<'a> {
     /// Composed and encoded here; `figures`: the status line's figures instead of this
     /// screen's own (a group's, so that its members' status lines are alike).
     Own { figures: Option<Figures> },
     /// Encoded here, towards these cells exactly (a group's screen model: catching up with it).
+    #[cfg_attr(not(any(feature = "serve", feature = "testing")), allow(dead_code))]
     Toward(&'a Frame),
     /// Encoded elsewhere (a group's frames, from the model this screen's terminal shows); the
     /// screen's own model is left as it was, the group's stands for it.
+    #[cfg_attr(not(any(feature = "serve", feature = "testing")), allow(dead_code))]
     Taken(&'a [u8]),
 }
 
@@ -176,6 +180,7 @@ impl Screen {
     /// (buttons and drags only, mode 1002, not every motion; SGR coordinates, mode 1006),
     /// screen cleared.
     pub const ENTER: &'static [u8] = b"\x1b[?1049h\x1b[?25l\x1b[?1000h\x1b[?1002h\x1b[?1006h\x1b[0m\x1b[2J";
+    #[cfg(any(test, feature = "cli", feature = "testing"))]
     /// Sent when the session ends (after the restore prefix, see [`Screen::farewell`]): abort any cut sequence,
     /// end synchronized output, reset colours, mouse off, cursor on, back to the normal screen.
     pub const RESTORE: &'static [u8] = b"\x18\x1b[?2026l\x1b[0m\x1b[?1006l\x1b[?1002l\x1b[?1000l\x1b[?25h\x1b[?1049l";
@@ -315,6 +320,7 @@ impl Screen {
         self.layout_changed = true;
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// The terminal's size in cells.
     pub(crate) fn term(&self) -> (u16, u16) {
         self.term
@@ -389,26 +395,31 @@ impl Screen {
         }
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// The link's rate in effect, bytes a second (`None`: no limit).
     pub fn rate(&self) -> Option<f64> {
         self.bucket.rate()
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// How the screen draws.
     pub(crate) fn config(&self) -> &ScreenConfig {
         &self.config
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// What the encoder takes the terminal to show.
     pub(crate) fn shown(&self) -> &Shown {
         &self.shown
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// The terminal shows `shown` (a group's model: this screen leaves the group).
     pub(crate) fn set_shown(&mut self, shown: &Shown) {
         self.shown.clone_from(shown);
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// Forgets the cursor and the colours in effect, so that the next frame starts with an
     /// absolute move and explicit colours: a group's frame is then right for every terminal
     /// whose cells are the group's, wherever its cursor is.
@@ -416,6 +427,7 @@ impl Screen {
         (self.shown.cursor, self.shown.fg, self.shown.bg) = (Cursor::Unknown, None, None);
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// Frees what only a screen that encodes needs (its model of the terminal: the encoder's
     /// buffers are the process's, borrowed per frame): a group member in step takes its
     /// group's bytes instead. The model comes back, at its cost, when it encodes again.
@@ -424,6 +436,7 @@ impl Screen {
         self.largest_frame = 0;
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// A screen that writes to no terminal (a group's): no set-up bytes before its first frame.
     pub(crate) fn without_enter(mut self) -> Screen {
         self.entered = true;
@@ -447,6 +460,7 @@ impl Screen {
         out
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// The bytes that hand the terminal back: what the picture needs undone (kitty's image
     /// deleted, pixel mouse reports off), then [`Screen::RESTORE`].
     pub fn farewell(&self, out: &mut Vec<u8>) {
@@ -454,11 +468,13 @@ impl Screen {
         out.extend_from_slice(Self::RESTORE);
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// Frames and bytes a second over the last whole second.
     pub(crate) fn figures(&self) -> (u32, u64) {
         (self.meter.fps, self.meter.bytes_per_second)
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// The protocol drawing the picture.
     pub(crate) fn mode(&self) -> GraphicsMode {
         self.choice.mode

@@ -76,6 +76,7 @@ impl Seat {
         }
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// A seat whose `s` key says screenshots are off instead of asking the host for one.
     pub fn without_screenshots(mut self) -> Seat {
         self.screenshots = false;
@@ -98,6 +99,7 @@ impl Seat {
         self.aim = self.clamped(self.aim);
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// The fit in effect.
     pub fn fit(&self) -> &Fit {
         &self.fit

@@ -220,13 +220,9 @@ impl Session {
         self.driver.player().screen.awaiting_answers()
     }
 
-    /// The player (its seat and screen).
-    pub fn player(&self) -> &Player {
-        self.driver.player()
-    }
-
+    #[cfg(any(test, feature = "cli", feature = "testing"))]
     /// The host, once the probe is over.
-    pub fn host(&self) -> Option<&Host> {
+    pub(crate) fn host(&self) -> Option<&Host> {
         self.host.as_ref()
     }
 

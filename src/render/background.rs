@@ -1,12 +1,15 @@
 //! Background images: decoding user files safely and fitting them to the output size.
 
 use std::io::Cursor;
+#[cfg(any(feature = "cli", feature = "testing", test))]
 use std::path::Path;
 
 use image::{ImageReader, Limits};
 use tiny_skia::{ColorU8, FilterQuality, Pixmap, PixmapPaint, Transform};
 
-use crate::error::{Error, Result};
+#[cfg(any(feature = "cli", feature = "testing", test))]
+use crate::error::Error;
+use crate::error::Result;
 
 /// The largest image side tidepool decodes. A header claiming more is refused before any
 /// pixel memory is allocated.
@@ -24,6 +27,7 @@ pub fn pool_floor() -> Pixmap {
     decode(POOL_FLOOR_PNG).expect("the built-in pool floor is a valid PNG")
 }
 
+#[cfg(any(feature = "cli", feature = "testing", test))]
 /// Reads and decodes a PNG or JPEG file into an opaque pixmap.
 ///
 /// Any format `image` was built with works, in any bit depth or colour type (16-bit, grey,

@@ -180,6 +180,7 @@ impl PoolRenderer {
         }
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Draws with another instruction set this CPU runs (every one gives the same picture).
     pub fn set_simd(&mut self, simd: Simd) {
         self.simd = simd;

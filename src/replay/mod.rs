@@ -16,7 +16,7 @@
 //! of the session, across resizes): re-simulating means, for each step, applying that step's
 //! events in file order and then stepping ([`crate::scene::Script`]). Events are *resolved*: a
 //! random stone is recorded where it landed, so a replay never needs the player's random
-//! choices. The format is serde's form of [`Header`] and [`Event`]; every value is checked by
+//! choices. The format is serde's form of a header and [`Event`]s; every value is checked by
 //! the constructor the command line uses, and every count is bounded ([`Limits`]).
 //!
 //! The player keeps the file in memory while playing and saves it whole when the session ends
@@ -83,7 +83,7 @@ impl Default for Limits {
 
 /// The first line of a replay.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Header {
+pub(crate) struct Header {
     /// The format number (1 today).
     #[serde(rename = "tidepool_replay")]
     pub format: u64,
@@ -103,7 +103,7 @@ pub struct Header {
 
 /// The pool's pixel-changing settings, as a replay header records them.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct PoolOptions {
+pub(crate) struct PoolOptions {
     /// Damping (`"5"`, `"off"`).
     pub damping: Damping,
     /// Raindrops per step.
@@ -142,6 +142,7 @@ pub struct PoolOptions {
 }
 
 impl PoolOptions {
+    #[cfg(any(test, feature = "player"))]
     /// The options of pool `settings` whose floor came from `background` (`None`: built in).
     pub fn of(settings: &PoolSettings, background: Option<PathBuf>) -> PoolOptions {
         let caustics = settings.look.caustics;
@@ -181,7 +182,7 @@ impl PoolOptions {
 
 /// An event and the step it happened at.
 #[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct Entry {
+pub(crate) struct Entry {
     /// Simulation steps run before the event.
     pub step: u64,
     /// What happened.
@@ -193,9 +194,9 @@ pub struct Entry {
 #[derive(Clone, Debug, PartialEq)]
 pub struct Replay {
     /// The header.
-    pub header: Header,
+    pub(crate) header: Header,
     /// The events in order, the `end` event last.
-    pub entries: Vec<Entry>,
+    pub(crate) entries: Vec<Entry>,
 }
 
 impl Replay {
@@ -213,6 +214,11 @@ impl Replay {
     /// answered quickly).
     pub fn parse_with(path: &Path, text: &str, limits: &Limits) -> Result<Replay> {
         parse_with(path, text, limits)
+    }
+
+    /// The picture's size at the start, in pixels (width, height).
+    pub fn size(&self) -> [u32; 2] {
+        self.header.size
     }
 
     /// The replay as a file holds it: the header line, then one line an event (what

@@ -255,10 +255,12 @@ impl PoolScene {
     }
 
     /// The water (`grid` times the picture's size in cells).
+    #[cfg(any(test, feature = "testing"))]
     pub fn pool(&self) -> &RipplePool {
         &self.pool
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Runs the simulation and the picture with another instruction set this CPU runs (every
     /// one gives the same water and the same pixels; the default is [`Simd::detect`]).
     pub fn set_simd(&mut self, simd: Simd) {

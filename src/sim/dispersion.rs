@@ -9,6 +9,7 @@ use super::spectrum::G;
 /// Above this k·h, tanh(k·h) is 1 to double precision and the water counts as deep.
 const DEEP_KH: f64 = 20.0;
 
+#[cfg(any(test, feature = "cli", feature = "testing"))]
 /// ω (rad/s) of a wave of wavenumber `k` (rad/m) in water `depth_m` deep (None = deep).
 pub fn angular_frequency(k: f64, depth_m: Option<f64>) -> f64 {
     let k = k.max(0.0);
@@ -41,6 +42,7 @@ pub fn wavenumber(omega: f64, depth_m: Option<f64>) -> f64 {
     k
 }
 
+#[cfg(any(test, feature = "cli", feature = "testing"))]
 /// dω/dk (the group speed, m/s) at wavenumber `k` in water `depth_m` deep.
 pub fn group_speed(k: f64, depth_m: Option<f64>) -> f64 {
     let omega = angular_frequency(k, depth_m);

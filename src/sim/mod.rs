@@ -8,6 +8,8 @@ pub mod lake;
 pub mod looping;
 pub mod noise;
 pub mod ocean;
+// The tileable patch and its maps: `tidepool maps` (and the tests).
+#[cfg(any(feature = "cli", feature = "testing", test))]
 pub mod patch;
 pub mod rain;
 pub mod ripple;

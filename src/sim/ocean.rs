@@ -230,7 +230,7 @@ impl Default for SeaParams {
 
 impl SeaParams {
     /// The wind sea's spectrum, spread as asked.
-    pub fn wind_spectrum(&self) -> SeaSpectrum {
+    pub(crate) fn wind_spectrum(&self) -> SeaSpectrum {
         SeaSpectrum::new(self.wind_m_s, self.spectrum).with_spreading(self.spreading)
     }
 

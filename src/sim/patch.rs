@@ -421,16 +421,19 @@ impl PatchSea {
         Ok(PatchSea { params, size, extent_m, sea, foam })
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Lattice points per side.
     pub fn size(&self) -> usize {
         self.size
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The variance the lattice carries, m² (Σa²/2).
     pub fn lattice_variance(&self) -> f64 {
         self.sea.amp.iter().map(|a| 0.5 * f64::from(a.norm_sqr())).sum()
     }
 
+    #[cfg(any(test, feature = "testing"))]
     fn time(&self, time_s: f64) -> SeaTime {
         match self.params.loop_period {
             Some(p) => SeaTime::Ticks(p.ticks(time_s)),
@@ -475,6 +478,7 @@ impl PatchSea {
         (Lagrangian { h_dx, dy_hx, hy_gxy, gxx_gyy }, b)
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The maps at `time_s`. Foam continues from the previous call when time moved forward
     /// by less than the foam's memory, and computes the memory otherwise; the maps are the
     /// same bits either way.
@@ -495,6 +499,7 @@ impl PatchSea {
         self.resample(time, foam.as_ref())
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The maps at `time_s` without foam (its `foam` is all 0): heights, displacement and
     /// normals only, without the foam's memory.
     pub fn surface(&self, time_s: f64) -> PatchMaps {

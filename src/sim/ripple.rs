@@ -121,6 +121,7 @@ impl RipplePool {
         self.damping = damping;
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Runs the step with another instruction set this CPU runs (every one gives the same
     /// water; the default is [`Simd::detect`]).
     pub fn set_simd(&mut self, simd: Simd) {
@@ -203,6 +204,7 @@ impl RipplePool {
         }
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Advances the water by one step.
     pub fn step(&mut self) {
         self.advance(1);

@@ -9,6 +9,7 @@ pub const BEAUFORT_SPEEDS_M_S: [f64; 13] =
 /// The lower bound of each Beaufort number's wind range at 10 m, m/s (WMO).
 pub const BEAUFORT_LOWER_M_S: [f64; 13] = [0.0, 0.3, 1.6, 3.4, 5.5, 8.0, 10.8, 13.9, 17.2, 20.8, 24.5, 28.5, 32.7];
 
+#[cfg(any(feature = "cli", test))]
 /// The upper bound of significant wave height (m) for WMO sea-state codes 0..=8; code 9 is
 /// everything above 14 m.
 pub const WMO_UPPER_HS_M: [f64; 9] = [0.0, 0.1, 0.5, 1.25, 2.5, 4.0, 6.0, 9.0, 14.0];
@@ -23,11 +24,13 @@ pub fn beaufort_number(wind_m_s: f64) -> u8 {
     BEAUFORT_LOWER_M_S.iter().rposition(|&lower| lower <= wind_m_s).unwrap_or(0) as u8
 }
 
+#[cfg(any(feature = "cli", test))]
 /// The WMO sea-state code (0 = calm, glassy .. 9 = phenomenal) of a significant wave height.
 pub fn wmo_sea_state(hs_m: f64) -> u8 {
     WMO_UPPER_HS_M.iter().position(|&upper| hs_m <= upper).unwrap_or(9) as u8
 }
 
+#[cfg(any(feature = "cli", test))]
 /// The WMO name of a sea-state code.
 pub fn wmo_sea_state_name(code: u8) -> &'static str {
     const NAMES: [&str; 10] = [

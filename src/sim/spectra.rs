@@ -131,6 +131,7 @@ impl SeaSpectrum {
         self.pm.wind_m_s()
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// True for a wind of 0.
     pub fn is_calm(&self) -> bool {
         self.pm.is_calm()
@@ -141,11 +142,13 @@ impl SeaSpectrum {
         self.choice.depth_m()
     }
 
+    #[cfg(any(test, feature = "cli", feature = "testing"))]
     /// The Phillips constant α in force.
     pub fn alpha(&self) -> f64 {
         self.alpha
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// γ (1 for Pierson–Moskowitz).
     pub fn gamma(&self) -> f64 {
         match self.choice {
@@ -258,6 +261,7 @@ impl SeaSpectrum {
         table[i] + (table[i + 1] - table[i]) * t
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The variance carried by frequencies in `f_lo..f_hi`, m².
     pub fn band_variance(&self, f_lo_hz: f64, f_hi_hz: f64) -> f64 {
         self.cumulative_variance(f_hi_hz) - self.cumulative_variance(f_lo_hz)
@@ -273,6 +277,7 @@ impl SeaSpectrum {
         4.0 * self.m0.sqrt()
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The omnidirectional wavenumber spectrum E(k) = E(f)·df/dk, m³/rad, at `k` rad/m.
     pub fn wavenumber_energy(&self, k: f64) -> f64 {
         if k <= 0.0 {
@@ -283,6 +288,7 @@ impl SeaSpectrum {
         self.energy(f) * dispersion::group_speed(k, depth) / (2.0 * PI)
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The wavenumber where E(k) peaks, rad/m (None for a calm): found on a fine grid and
     /// refined by golden-section search. It lies below the k of fp (for PM, 0.913 times it).
     pub fn wavenumber_peak(&self) -> Option<f64> {

@@ -250,9 +250,10 @@ fn save_recording(session: &mut Session, storage: Option<&dyn Storage>) -> Resul
     }
 }
 
+#[cfg(any(feature = "testing", test))]
 /// Runs a session on any terminal until the person quits (or the input closes, or
 /// `config.quit` is set), reading `input` and writing to `output`: the door an embedding
-/// program (or a test) uses for a byte stream of its own. [`crate::tty::play`] is the door of
+/// program (or a test) uses for a byte stream of its own. `crate::term::tty::play` is the door of
 /// this process's terminal.
 pub fn run(
     input: &mut dyn TerminalInput,

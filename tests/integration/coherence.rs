@@ -76,7 +76,7 @@ fn read_frames(dir: &Path) -> Vec<Luma> {
     let mut names: Vec<_> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
     names.retain(|p| p.extension().is_some_and(|e| e == "png"));
     names.sort();
-    names.iter().map(|p| Luma::of_pixmap(&tidepool::load_image(p).unwrap())).collect()
+    names.iter().map(|p| Luma::of_pixmap(&tidepool::testing::load_image(p).unwrap())).collect()
 }
 
 /// Renders 300 frames at 30 fps with `args` (a `render` command without its output) and

@@ -171,7 +171,7 @@ fn true_colour(profile: &Profile) -> bool {
     use crate::common::fake_terminal::{Sgr, Tcap};
     profile.tcap == Tcap::Rgb
         || profile.sgr == Sgr::TrueColor
-        || tidepool::terminal::ColorMode::detect(None, Some(profile.term)) == tidepool::terminal::ColorMode::TrueColor
+        || tidepool::play::ColorMode::detect(None, Some(profile.term)) == tidepool::play::ColorMode::TrueColor
 }
 
 #[test]

@@ -3,8 +3,9 @@
 //! is tested to produce the same pictures in `pool.rs`, `ocean.rs` and `lake.rs`.
 
 use tidepool::sea::beaufort_speed_m_s;
+use tidepool::testing::Script;
 use tidepool::{
-    Event, LakeParams, LakeSettings, OceanSettings, OceanView, PoolLook, PoolSettings, Refraction, SceneSpec, Script,
+    Event, LakeParams, LakeSettings, OceanSettings, OceanView, PoolLook, PoolSettings, Refraction, SceneSpec,
     SeaParams, SeaShading, Stone, Sun,
 };
 use tiny_skia::Pixmap;

@@ -7,8 +7,8 @@
 use std::time::Duration;
 
 use crate::common::pty::{DA1_ANSWER, Player, cooked, find, rfind, temp_dir};
-use tidepool::graphics::kitty::KittyOptions;
-use tidepool::play::Screen;
+use tidepool::testing::KittyOptions;
+use tidepool::testing::Screen;
 use tidepool::testing::kitty_decode;
 
 const ENTER: &[u8] = Screen::ENTER;

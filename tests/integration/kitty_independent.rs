@@ -6,10 +6,11 @@
 
 use std::time::{Duration, Instant};
 
-use tidepool::graphics::kitty::{KittyEncoder, KittyOptions};
-use tidepool::graphics::{GraphicsMode, push_rgb};
-use tidepool::graphics::{Layout, layout};
+use tidepool::play::GraphicsMode;
+use tidepool::testing::push_rgb;
 use tidepool::testing::{Budget, Part, PictureStream, Protocol, resample};
+use tidepool::testing::{KittyEncoder, KittyOptions};
+use tidepool::testing::{Layout, layout};
 use tiny_skia::Pixmap;
 
 use crate::common::fake_terminal::FakeTerminal;

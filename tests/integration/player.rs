@@ -5,7 +5,7 @@
 use std::time::Duration;
 
 use crate::common::pty::{Player, cooked, find, rfind, temp_dir};
-use tidepool::play::Screen;
+use tidepool::testing::Screen;
 
 const ENTER: &[u8] = Screen::ENTER;
 const RESTORE: &[u8] = Screen::RESTORE;
@@ -202,21 +202,20 @@ fn keys_and_clicks_drop_stones_where_expected_and_replay_exactly() {
 
     let path = p.dir.join("session.jsonl");
     let replay = tidepool::replay::Replay::read(&path).unwrap();
-    assert_eq!(replay.header.size, [40, 22]);
+    assert_eq!(replay.size(), [40, 22]);
+    // Every (step, event) the file holds, the end last.
+    let entries = replay.script();
     let stones: Vec<Stone> =
-        replay.entries.iter().filter_map(|e| if let Event::Stone(s) = e.event { Some(s) } else { None }).collect();
-    assert_eq!(stones.len(), 4, "{:?}", replay.entries);
+        entries.iter().filter_map(|(_, e)| if let Event::Stone(s) = e { Some(*s) } else { None }).collect();
+    assert_eq!(stones.len(), 4, "{:?}", entries);
     assert_eq!(stones[1], Stone::new(9, 4, 3, 128).unwrap(), "left click: the cell's upper pixel");
     assert_eq!(stones[2], Stone::new(29, 14, 6, 256).unwrap(), "right click: a big stone");
     assert_eq!(stones[3], Stone::new(26, 8, 3, 128).unwrap(), "aim: centre (20, 10) + 3 columns, 1 row up");
-    let step = replay.entries[0].step;
-    assert!(replay.entries.iter().all(|e| e.step == step), "paused: every event at one step");
-    let shot = replay
-        .entries
-        .iter()
-        .find_map(|e| if let Event::Screenshot(f) = &e.event { Some(f.clone()) } else { None })
-        .unwrap();
-    assert!(replay.entries.iter().any(|e| e.event == Event::Resize([30, 18])));
+    let step = entries[0].0;
+    assert!(entries.iter().all(|(s, _)| *s == step), "paused: every event at one step");
+    let shot =
+        entries.iter().find_map(|(_, e)| if let Event::Screenshot(f) = e { Some(f.clone()) } else { None }).unwrap();
+    assert!(entries.iter().any(|(_, e)| *e == Event::Resize([30, 18])));
 
     // The picture on screen before the resize is the replay at the screenshot.
     let spec = replay.spec(tidepool::PoolSettings::default_floor());

@@ -8,7 +8,8 @@
 use std::fmt::Write as _;
 use std::path::Path;
 
-use tidepool::{BreezeStyle, Event, PoolLook, PoolScene, PoolSettings, Refraction, Scene, Simd, Stone, Sun};
+use tidepool::testing::Simd;
+use tidepool::{BreezeStyle, Event, PoolLook, PoolScene, PoolSettings, Refraction, Scene, Stone, Sun};
 
 /// One pool to hash: its name, size and settings.
 struct Case {

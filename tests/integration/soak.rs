@@ -10,7 +10,8 @@
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use tidepool::terminal::{ColorMode, EncodeOptions, Frame, Shown, encode_into};
+use tidepool::play::{ColorMode, EncodeOptions};
+use tidepool::testing::{Frame, Shown, encode_into};
 use tidepool::{Action, Controls, Damping, Event, PoolScene, PoolSettings, Scene};
 
 /// Resident memory of this process in KiB (Linux), for the "memory stays flat" check.

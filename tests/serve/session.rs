@@ -281,7 +281,7 @@ async fn a_remote_kitty_terminal_gets_kitty_pictures_and_a_silent_one_gets_cells
         let from = tidepool::testing::SYNC_BEGIN;
         let start = t.raw.windows(from.len()).position(|w| w == from)?;
         let state = tidepool::testing::kitty_decode(&t.raw[start..]).ok()?;
-        state.images.get(&tidepool::graphics::kitty::KittyOptions::IMAGE_ID).cloned()
+        state.images.get(&tidepool::testing::KittyOptions::IMAGE_ID).cloned()
     };
     tk.read_until(|t| decoded(t).is_some_and(|i| i.width == 480)).await;
     let image = decoded(&tk).expect("the kitty image");

@@ -36,6 +36,7 @@ impl Iterm2Encoder {
         Iterm2Encoder { origin, cells, tmux, shown: None }
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Forgets what the terminal shows: the next picture is sent.
     pub fn invalidate(&mut self) {
         self.shown = None;

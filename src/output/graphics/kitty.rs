@@ -88,6 +88,7 @@ pub struct KittyOptions {
 
 impl KittyOptions {
     /// The image id tidepool's pictures use unless told otherwise (`new` sets it).
+    #[cfg(any(test, feature = "testing"))]
     pub const IMAGE_ID: u32 = IMAGE_ID;
 
     /// Direct transmission of [`KittyOptions::IMAGE_ID`] over `cells` at the top-left corner; no tmux, no
@@ -128,17 +129,20 @@ impl KittyEncoder {
         KittyEncoder { options, shown: None, rect: Vec::new(), zlib: Vec::new(), files: 0, placeholders_due: true }
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The options in force.
     pub fn options(&self) -> &KittyOptions {
         &self.options
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Changes the options (after a resize: a new cell area); the next frame is sent whole.
     pub fn set_options(&mut self, options: KittyOptions) {
         self.options = options;
         self.invalidate();
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Forgets what the terminal shows (the screen was cleared): the next frame is sent whole.
     pub fn invalidate(&mut self) {
         self.shown = None;
@@ -229,6 +233,7 @@ impl KittyEncoder {
         Ok(())
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Appends the bytes that delete the image and its data (for the restore; also after a
     /// switch to another mode). Harmless when nothing was shown.
     pub fn push_delete(&self, out: &mut Vec<u8>) {
@@ -356,9 +361,12 @@ pub fn changed_rect(old: &[u8], new: &[u8], width: u32, height: u32) -> Option<(
 }
 
 mod files;
-#[cfg(feature = "player")]
+pub use files::write_temp_file;
+// The door's (the command line's terminal door) and the tests'.
+#[cfg(any(test, feature = "cli", feature = "testing"))]
+pub use files::temp_dir;
+#[cfg(any(feature = "cli", feature = "testing"))]
 pub use files::write_new_file;
-pub use files::{temp_dir, write_temp_file};
 
 #[cfg(test)]
 mod tests;

@@ -13,6 +13,11 @@
 //!
 //! The player drives these through `crate::term::picture`, `render --out -` through the
 //! binary's `commands/inline.rs`; detection lives in [`crate::term::probe`].
+// The standalone encoders (`KittyEncoder`, `SixelEncoder`, `Iterm2Encoder`: a picture written
+// once, `tidepool render --out -`) are the command line's and the tests'; the play session
+// drives the protocols through its picture stream. Without `cli` or `testing` their parts that
+// only the standalone encoders use are unused: allowed here rather than a `cfg` on each field.
+#![cfg_attr(not(any(test, feature = "cli", feature = "testing")), allow(dead_code))]
 
 pub mod geometry;
 pub mod iterm2;

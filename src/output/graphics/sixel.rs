@@ -72,6 +72,7 @@ pub enum Registers {
     /// Each register is defined once, the first time any image uses it, and kept: only for a
     /// terminal whose images share their registers (xterm after `ESC [ ? 1070 l`, which the player
     /// does not send: it draws `PerImage`). [`SixelEncoder::forget_registers`] starts over.
+    #[cfg(any(test, feature = "testing"))]
     Shared,
 }
 
@@ -136,6 +137,7 @@ impl SixelEncoder {
         }
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// The palette.
     pub fn palette(&self) -> &SixelPalette {
         &self.palette
@@ -170,6 +172,7 @@ impl SixelEncoder {
         self.shown = None;
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Forgets what the terminal shows (a resize, a cleared screen): the next picture is sent
     /// whole.
     pub fn invalidate(&mut self) {

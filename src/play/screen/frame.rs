@@ -215,6 +215,7 @@ impl Screen {
         sent
     }
 
+    #[cfg(any(feature = "serve", feature = "testing", test))]
     /// The bytes a frame may send now (the byte bucket, and on an auto link the window of
     /// unanswered bytes): whether a group's frame fits this screen's link.
     pub(crate) fn budget(&mut self, now: Instant) -> usize {

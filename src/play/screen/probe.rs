@@ -314,6 +314,7 @@ pub struct Probe {
     leftover: Vec<Input>,
 }
 
+#[cfg(any(test, feature = "cli", feature = "testing"))]
 /// What the probe found, and the keys that were typed meanwhile.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ProbeOutcome {
@@ -393,6 +394,7 @@ impl Probe {
         std::mem::take(&mut self.leftover)
     }
 
+    #[cfg(any(test, feature = "cli", feature = "testing"))]
     /// What the replies say. The probe may end early ([`Probe::done`]) or at its deadline.
     pub fn finish(mut self) -> ProbeOutcome {
         let leftover = self.take_leftover();
@@ -504,6 +506,7 @@ pub struct GraphicsChoice {
     pub hint: Option<&'static str>,
 }
 
+#[cfg(any(test, feature = "cli", feature = "testing"))]
 /// Whether to probe at all: only when both input and output are terminals (`render --out -`
 /// into a pipe or file sends no query and draws cells).
 pub fn should_probe(stdin_is_tty: bool, stdout_is_tty: bool) -> bool {

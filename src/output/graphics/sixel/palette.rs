@@ -78,6 +78,7 @@ impl SixelPalette {
         self.percent.len()
     }
 
+    #[cfg(any(test, feature = "testing"))]
     /// Whether the palette is empty (never: at least one colour).
     pub fn is_empty(&self) -> bool {
         self.percent.is_empty()
