@@ -52,6 +52,12 @@ fn play(profile: Profile, args: &[&str], ssh: bool) -> (Shown, Arc<Mutex<FakeTer
             }
         }
         if Instant::now() >= deadline {
+            let last = watch.last_look(&fake.lock().unwrap()).map(|glance| glance.check(profile.name));
+            if let Some(Ok(shown)) = last {
+                let coverage = fake.lock().unwrap().canvas.coverage();
+                println!("{}: {shown:?} painted over {:.0} % of its area in {HANG:?}", profile.name, coverage * 100.0);
+                break shown;
+            }
             let rates: Vec<String> = rates.iter().map(|(t, b, r)| format!("{t:.1} s {b} B: {r}")).collect();
             panic!(
                 "{}: {not_yet} for {HANG:?}: {bytes} bytes, status line {:?}; the rate: {}",

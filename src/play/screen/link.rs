@@ -434,7 +434,14 @@ impl LinkControl {
         let over = link_queue > high && (explained || queue > high + slow);
         let last_queue = self.last_queue.replace((link_queue, over));
         let was_over = last_queue.is_some_and(|(_, was_over)| was_over);
-        if let Some(took) = took {
+        // The link is first measured by a take that says something of it: a sender that used its
+        // budget, and after the first question more than the set-up's few bytes. Until then the
+        // window stays the first one (`window`): a capacity taken from 57 bytes of set-up
+        // answered in 66 ms (857 B/s) held the window at its 4 kB floor, every frame then
+        // filled it, the takes stayed small, and a loaded machine's late answers took the rate
+        // down to 2-4 kB/s (the fake WezTerm with forced sixel over SSH, blank for 20 s in CI).
+        let measures = self.capacity.is_some() || (!app_limited && (!first || bytes >= FIRST_WINDOW / 4));
+        if let Some(took) = took.filter(|_| measures) {
             self.capacity = Some(match self.capacity {
                 // A queue says the link was the limit; from a terminal slow on its own only a
                 // standing one (two answers over the mark in a row): its late answers must not

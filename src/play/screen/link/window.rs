@@ -25,9 +25,9 @@ impl LinkControl {
     }
 
     /// The window: the bytes that may be unanswered for at `now` (holds and bytes in flight
-    /// aside).
+    /// aside); the first window until an answer has measured the link's capacity.
     pub(super) fn window(&self, now: Instant) -> u64 {
-        if self.answered {
+        if self.answered && self.capacity.is_some() {
             // The bandwidth-delay product: one question at a time, so two round trips (each
             // with the queue the window allows) and a frame; never below what the rate sends
             // in that time, and the link's capacity as seen, not a rate still growing past it.
