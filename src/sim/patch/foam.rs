@@ -1,7 +1,10 @@
 //! A patch's foam: the model of `sim::foam` on the foam lattice, one FFT pass a foam step.
 
 use super::*;
-use crate::sim::foam::{fir, quantize, taps};
+use crate::sim::foam::{fir_pairs, quantize, taps};
+
+/// Points of the foam lattice whose cover is summed together (see [`fir_pairs`]).
+const POINTS: usize = 4;
 
 impl PatchFoam {
     /// Brings the memory up to the foam step after `time` and returns the cover at `time` on
@@ -20,14 +23,13 @@ impl PatchFoam {
         self.top = Some(top);
         let m = self.lattice.n;
         let (taps_now, taps_next) = (taps(&self.weights, now, slots), taps(&self.weights, now + 1, slots));
-        let cover = self
-            .ring
-            .par_chunks(slots)
-            .map(|history| {
-                let (a, b) = (fir(history, &taps_now), fir(history, &taps_next));
-                a + (b - a) * frac
-            })
-            .collect();
+        let mut cover = vec![0.0f32; m * m];
+        cover.par_chunks_mut(POINTS).zip(self.ring.par_chunks(slots * POINTS)).for_each(|(out, ring)| {
+            let sums: [(f32, f32); POINTS] = fir_pairs(ring, slots, &taps_now, &taps_next);
+            for (f, (a, b)) in out.iter_mut().zip(sums) {
+                *f = a + (b - a) * frac;
+            }
+        });
         (m, cover)
     }
 
