@@ -2,8 +2,8 @@
 
 use super::*;
 
-/// Rows of `N` buffers, one from each.
-type Rows<'a, const N: usize> = Vec<&'a mut [Complex32]>;
+/// One row of each of a fill's buffers.
+type Rows<'a> = Vec<&'a mut [Complex32]>;
 
 impl Lattice {
     /// For each of `N` pairs of real fields, the spectrum one complex inverse transform turns
@@ -34,8 +34,8 @@ impl Lattice {
             sf + Complex32::new(0.0, 1.0) * sg
         };
         let (pairs, even) = ((n - 1) / 2, n.is_multiple_of(2));
-        let (mut row0, mut middle): (Rows<N>, Rows<N>) = (Vec::with_capacity(N), Vec::with_capacity(N));
-        let mut pair_rows: Vec<(Rows<N>, Rows<N>)> =
+        let (mut row0, mut middle): (Rows, Rows) = (Vec::with_capacity(N), Vec::with_capacity(N));
+        let mut pair_rows: Vec<(Rows, Rows)> =
             (0..pairs).map(|_| (Vec::with_capacity(N), Vec::with_capacity(N))).collect();
         for buf in bufs {
             buf.resize(n * n, Complex32::new(0.0, 0.0));
@@ -49,7 +49,7 @@ impl Lattice {
                 rows.1.push(row_m);
             }
         }
-        let own_mirror = |r: usize, rows: &mut Rows<N>| {
+        let own_mirror = |r: usize, rows: &mut Rows| {
             for c in 0..n {
                 let (i, mirror) = (r * n + c, r * n + mirror_col(c));
                 let (a, b) = (coefficients(i, waves[i]), coefficients(mirror, waves[mirror]));
