@@ -26,7 +26,7 @@ pub(super) struct Workspace {
     b: Vec<Complex32>,
     /// The Lagrangian height with its second-order part, m.
     h_l: Vec<f32>,
-    /// The displacement in lattice units (east, south): the Euler iterations read it four
+    /// The displacement in lattice units (east, north): the Euler iterations read it four
     /// times a texel.
     carried: Vec<[f32; 2]>,
     /// Slopes and the displacement's gradient side by side: hx, hy, gxx, gyy, gxy.
