@@ -109,6 +109,8 @@ struct PatchFoam {
     ring: Vec<u16>,
     /// The newest step in the ring.
     top: Option<i64>,
+    /// A foam step and the cover of it and the next at every point (see `cover`).
+    sums: Option<(i64, Vec<(f32, f32)>)>,
 }
 
 impl std::fmt::Debug for PatchSea {
@@ -382,6 +384,7 @@ impl PatchSea {
                 clock,
                 weights: clock.weights(),
                 top: None,
+                sums: None,
             }
         });
         Ok(PatchSea { params, size, extent_m, sea, foam, work: Workspace::default() })

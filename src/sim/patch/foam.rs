@@ -22,15 +22,28 @@ impl PatchFoam {
         }
         self.top = Some(top);
         let m = self.lattice.n;
+        // The ring always holds steps top + 1 - slots..=top, each a function of its step
+        // alone, so the sums of step `now` are too: kept until the series passes the step
+        // (a 1024² series at 30 frames a second meets each foam step six times).
+        if self.sums.as_ref().map(|(step, _)| *step) != Some(now) {
+            let mut sums = self.sums.take().map(|(_, v)| v).unwrap_or_default();
+            self.fir_sums(now, slots, &mut sums);
+            self.sums = Some((now, sums));
+        }
+        let sums = self.sums.as_ref().map_or(&[][..], |(_, v)| v);
+        (m, sums.par_iter().map(|&(a, b)| a + (b - a) * frac).collect())
+    }
+
+    /// The cover of foam steps `now` and `now + 1` at every point, into `sums`.
+    fn fir_sums(&self, now: i64, slots: usize, sums: &mut Vec<(f32, f32)>) {
         let (taps_now, taps_next) = (taps(&self.weights, now, slots), taps(&self.weights, now + 1, slots));
-        let mut cover = vec![0.0f32; m * m];
-        cover.par_chunks_mut(POINTS).zip(self.ring.par_chunks(slots * POINTS)).for_each(|(out, ring)| {
-            let sums: [(f32, f32); POINTS] = fir_pairs(ring, slots, &taps_now, &taps_next);
-            for (f, (a, b)) in out.iter_mut().zip(sums) {
-                *f = a + (b - a) * frac;
+        sums.resize(self.lattice.n * self.lattice.n, (0.0, 0.0));
+        sums.par_chunks_mut(POINTS).zip(self.ring.par_chunks(slots * POINTS)).for_each(|(out, ring)| {
+            let group: [(f32, f32); POINTS] = fir_pairs(ring, slots, &taps_now, &taps_next);
+            for (sum, pair) in out.iter_mut().zip(group) {
+                *sum = pair;
             }
         });
-        (m, cover)
     }
 
     /// The source of foam step `step` at every point, into its slot of the ring.
