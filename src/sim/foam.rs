@@ -365,6 +365,27 @@ pub(crate) fn fir(history: &[u16], taps: &[(f32, usize)]) -> f32 {
     sum / SOURCE_SCALE
 }
 
+/// [`fir`] by the taps of steps n (`now`) and n + 1 (`next`: the same weights, in the same
+/// order) for up to `N` points of a ring (`slots` a point): each sum the same additions in
+/// the same order as `fir`'s, so the same bits, but 2·N independent chains of additions for
+/// the processor to overlap (one point's sum at a time waited on every addition).
+#[inline(always)]
+pub(crate) fn fir_pairs<const N: usize>(
+    ring: &[u16],
+    slots: usize,
+    now: &[(f32, usize)],
+    next: &[(f32, usize)],
+) -> [(f32, f32); N] {
+    let mut sums = [(0.0f32, 0.0f32); N];
+    for (&(w, a), &(_, b)) in now.iter().zip(next) {
+        for (sum, history) in sums.iter_mut().zip(ring.chunks_exact(slots)) {
+            sum.0 += w * f32::from(history[a]);
+            sum.1 += w * f32::from(history[b]);
+        }
+    }
+    sums.map(|(a, b)| (a / SOURCE_SCALE, b / SOURCE_SCALE))
+}
+
 #[cfg(test)]
 #[path = "foam_tests.rs"]
 mod measured;
