@@ -368,7 +368,9 @@ pub(crate) fn fir(history: &[u16], taps: &[(f32, usize)]) -> f32 {
 /// [`fir`] by the taps of steps n (`now`) and n + 1 (`next`: the same weights, in the same
 /// order) for up to `N` points of a ring (`slots` a point): each sum the same additions in
 /// the same order as `fir`'s, so the same bits, but 2·N independent chains of additions for
-/// the processor to overlap (one point's sum at a time waited on every addition).
+/// the processor to overlap (one point's sum at a time waited on every addition). The patch's
+/// (compiled with it).
+#[cfg(any(feature = "cli", feature = "testing", test))]
 #[inline(always)]
 pub(crate) fn fir_pairs<const N: usize>(
     ring: &[u16],
