@@ -52,9 +52,11 @@ fn play(profile: Profile, args: &[&str], ssh: bool) -> (Shown, Arc<Mutex<FakeTer
             }
         }
         if Instant::now() >= deadline {
-            let last = watch.last_look(&fake.lock().unwrap()).map(|glance| glance.check(profile.name));
-            if let Some(Ok(shown)) = last {
-                let coverage = fake.lock().unwrap().canvas.coverage();
+            let (last, coverage) = {
+                let f = fake.lock().unwrap();
+                (watch.last_look(&f), f.canvas.coverage())
+            };
+            if let Some(Ok(shown)) = last.map(|glance| glance.check(profile.name)) {
                 println!("{}: {shown:?} painted over {:.0} % of its area in {HANG:?}", profile.name, coverage * 100.0);
                 break shown;
             }
