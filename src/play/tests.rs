@@ -51,6 +51,78 @@ pub(crate) fn session(t0: Instant, script: &[(u32, &[u8])], frames: u32) -> Vec<
     out.bytes
 }
 
+/// One step of a session whose pictures come from elsewhere (`tidepool serve`'s pacing).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum Step {
+    /// The terminal sends these bytes.
+    Bytes(&'static [u8]),
+    /// The next picture (with its scene's status) is there.
+    Picture,
+}
+
+/// The instant a door whose timers count whole milliseconds from `t0` (tokio's) wakes for a
+/// deadline at `t`: the next whole millisecond.
+fn on_the_millisecond(t0: Instant, t: Instant) -> Instant {
+    let nanos = t.saturating_duration_since(t0).as_nanos().div_ceil(1_000_000);
+    t0 + Duration::from_millis(u64::try_from(nanos).unwrap_or(u64::MAX))
+}
+
+/// Plays `player` paced by pictures from elsewhere: `pictures[0]` is there from `t0` on, and
+/// each [`Step::Picture`] of `script` (steps at whole milliseconds from `t0`) brings the next.
+/// A turn for every step and for every deadline of the driver's (woken on the millisecond, as
+/// a door's timers are): the canonical turn of a door whose pictures are shared, the writer
+/// always free. Returns every byte handed out (the screen's farewell last, once the person
+/// quits) and the requests for the host. A deadline at a step's very millisecond would leave
+/// the order to the door's scheduling: the script must not put one there (checked).
+pub(crate) fn pictured_session(
+    t0: Instant,
+    player: Player,
+    scene: (u32, u32),
+    pictures: &[(tiny_skia::Pixmap, SceneStatus)],
+    script: &[(u64, Step)],
+) -> (Vec<u8>, Vec<Request>) {
+    let mut driver = Driver::new(player, Pacing::Pictures);
+    let (mut out, mut requests) = (Transmit::default(), Vec::new());
+    driver.start(t0, &mut out.bytes);
+    let (mut shown, mut steps) = (0, script.iter().peekable());
+    loop {
+        let tick = driver.poll_timeout().map(|t| on_the_millisecond(t0, t));
+        let step = steps.peek().map(|(at, step)| (t0 + Duration::from_millis(*at), *step));
+        let now = match (tick, step) {
+            (Some(tick), Some((at, _))) if tick == at => panic!("a deadline at the step at {at:?}: move the step"),
+            (Some(tick), None) => tick,
+            (Some(tick), Some((at, _))) if tick < at => tick,
+            (_, Some((at, step))) => {
+                steps.next();
+                match step {
+                    Step::Bytes(bytes) => _ = driver.handle_bytes(bytes, at),
+                    Step::Picture => {
+                        shown += 1;
+                        driver.handle_picture();
+                    }
+                }
+                at
+            }
+            (None, None) => panic!("the script ended before the person quit"),
+        };
+        let (picture, status) = &pictures[shown];
+        driver.handle_timeout(now, status);
+        while let Some(event) = driver.poll_event() {
+            match event {
+                DriverEvent::Request(request) => requests.push(request),
+                DriverEvent::Layout => driver.refit(scene),
+                DriverEvent::Quit => {
+                    driver.player().screen.farewell(&mut out.bytes);
+                    return (out.bytes, requests);
+                }
+            }
+        }
+        if driver.poll_frame(now, true) {
+            driver.transmit(now, picture, status, &mut out);
+        }
+    }
+}
+
 /// What a 100x20 terminal shows after `bytes`.
 fn shown(bytes: &[u8]) -> Vt {
     let mut vt = Vt::new(100, 20);

@@ -429,7 +429,7 @@ impl russh::server::Handler for ClientHandler {
             return Ok(());
         }
         if let Some(input) = &self.input
-            && input.try_send((Instant::now(), data.to_vec())).is_err()
+            && input.try_send((super::channel::now(), data.to_vec())).is_err()
         {
             self.hub.stats.input_dropped.fetch_add(1, Ordering::Relaxed);
         }

@@ -4,10 +4,9 @@
 use std::time::Duration;
 
 use bytes::Bytes;
-use russh::ChannelWriteHalf;
-use russh::server::Msg;
 use tokio_util::sync::CancellationToken;
 
+use super::channel::Channel;
 use super::limits::FAREWELL_TIMEOUT;
 
 /// Time a player's connection may stay open after its game ended before it is cut.
@@ -60,7 +59,7 @@ pub(crate) async fn say_goodbye(
     reason: Leave,
     scene: &str,
     restore: Vec<u8>,
-    write: &ChannelWriteHalf<Msg>,
+    write: &impl Channel,
     kill: &CancellationToken,
 ) {
     let mut goodbye = restore;
@@ -68,7 +67,7 @@ pub(crate) async fn say_goodbye(
         Some(message) => {
             goodbye.extend_from_slice(format!("{message}\r\n").as_bytes());
             let _ = tokio::time::timeout(FAREWELL_TIMEOUT, async {
-                write.data_bytes(Bytes::from(goodbye)).await.ok()?;
+                write.data(Bytes::from(goodbye)).await.ok()?;
                 write.exit_status(0).await.ok()?;
                 write.eof().await.ok()?;
                 // No DISCONNECT after this: OpenSSH exits on DISCONNECT before writing channel
@@ -79,7 +78,7 @@ pub(crate) async fn say_goodbye(
         }
         None if reason == Leave::ClientClosed => {
             let _ = tokio::time::timeout(FAREWELL_TIMEOUT, async {
-                write.data_bytes(Bytes::from(goodbye)).await.ok()?;
+                write.data(Bytes::from(goodbye)).await.ok()?;
                 write.close().await.ok()
             })
             .await;

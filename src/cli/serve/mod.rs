@@ -15,6 +15,7 @@ pub mod address_pattern;
 pub mod authorized_keys;
 #[cfg(feature = "bus")]
 pub mod bus;
+mod channel;
 pub mod game;
 mod gate;
 pub mod handler;

@@ -19,11 +19,10 @@ use crate::output::bucket::ByteBucket;
 use crate::play::group::{Membership, Source};
 use crate::play::{Driver, DriverEvent, Pacing, Player, Screen, ScreenConfig};
 use bytes::Bytes;
-use russh::ChannelWriteHalf;
-use russh::server::Msg;
 use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
+use super::channel::{Channel, now as clock};
 use super::game::{SharedFrame, Viewing};
 use super::gate::RequestGate;
 use super::hub::Hub;
@@ -40,12 +39,13 @@ pub struct TerminalState {
     pub closed: bool,
 }
 
-/// Everything the task owns.
-pub(crate) struct ViewerCtx {
+/// Everything the task owns; `W` is the channel's write half (`ChannelWriteHalf`, or a test's
+/// memory).
+pub(crate) struct ViewerCtx<W> {
     pub hub: Arc<Hub>,
     pub id: u64,
     pub peer: SocketAddr,
-    pub write: ChannelWriteHalf<Msg>,
+    pub write: W,
     pub terminal: watch::Receiver<TerminalState>,
     /// The channel's packets and when each arrived: the link's answers are timed by their
     /// arrival, not by when this task got to them (after a frame's encoding or a write that
@@ -68,14 +68,10 @@ thread_local! {
 const RESIZE_RETRY: std::time::Duration = std::time::Duration::from_millis(100);
 
 /// Runs the player until it leaves, then says goodbye (bounded in time) and frees its place.
-pub(crate) async fn run(ctx: ViewerCtx) {
+pub(crate) async fn run<W: Channel>(ctx: ViewerCtx<W>) {
     let ViewerCtx { hub, id, peer, write, mut terminal, mut input, screen, kill, slot } = ctx;
-    let now = Instant::now();
-    let screen = Screen::new(screen, terminal.borrow().size, now);
-    let mut player = Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into()));
-    if !hub.screenshots {
-        player = player.without_screenshots();
-    }
+    let now = clock();
+    let player = new_player(&hub, screen, terminal.borrow().size, now);
     let viewing = Viewing { fit: *player.fit(), group: None, note: None };
     hub.fits.lock().unwrap_or_else(|p| p.into_inner()).insert(id, viewing.clone());
     let mut frames = hub.frames.clone();
@@ -108,6 +104,13 @@ pub(crate) async fn run(ctx: ViewerCtx) {
     leave::say_goodbye(reason, scene_name, goodbye, &write, &kill).await;
 }
 
+/// A new player on a terminal of `size` cells at `now`, as the server greets them.
+fn new_player(hub: &Hub, screen: ScreenConfig, size: (u16, u16), now: Instant) -> Player {
+    let screen = Screen::new(screen, size, now);
+    let player = Player::new(screen, hub.scene_size, Some("shared pool: all see your stones".into()));
+    if hub.screenshots { player } else { player.without_screenshots() }
+}
+
 /// One player's state beside its driver: its group membership, what it views, its limits.
 struct Viewer {
     hub: Arc<Hub>,
@@ -133,7 +136,7 @@ impl Viewer {
     /// turn; send the frame when one goes. Returns why the player left.
     async fn play(
         &mut self,
-        write: &ChannelWriteHalf<Msg>,
+        write: &impl Channel,
         terminal: &mut watch::Receiver<TerminalState>,
         input: &mut mpsc::Receiver<(Instant, Vec<u8>)>,
         frames: &mut watch::Receiver<Arc<SharedFrame>>,
@@ -141,8 +144,8 @@ impl Viewer {
     ) -> Leave {
         let hub = self.hub.clone();
         let mut asked = Vec::new();
-        self.driver.start(Instant::now(), &mut asked);
-        if !asked.is_empty() && write.data_bytes(Bytes::from(asked)).await.is_err() {
+        self.driver.start(clock(), &mut asked);
+        if !asked.is_empty() && write.data(Bytes::from(asked)).await.is_err() {
             return Leave::Cut;
         }
         loop {
@@ -163,12 +166,12 @@ impl Viewer {
                 bytes = input.recv() => {
                     let Some((arrived, bytes)) = bytes else { return Leave::Cut };
                     if self.driver.handle_bytes(&bytes, arrived) {
-                        self.last_input = Instant::now();
+                        self.last_input = clock();
                     }
                 }
                 _ = tokio::time::sleep_until(tick.unwrap_or(idle_at).into()), if tick.is_some() => {}
                 _ = tokio::time::sleep_until(idle_at.into()) => {
-                    if self.last_input + hub.limits.idle_timeout <= Instant::now() {
+                    if self.last_input + hub.limits.idle_timeout <= clock() {
                         hub.stats.idle_kicks.fetch_add(1, Ordering::Relaxed);
                         return Leave::Idle;
                     }
@@ -178,7 +181,7 @@ impl Viewer {
                     self.driver.handle_picture();
                 }
             }
-            let now = Instant::now();
+            let now = clock();
             let shared = frames.borrow().clone();
             if let Some(leave) = self.turn(now, &shared) {
                 return leave;
@@ -265,16 +268,16 @@ impl Viewer {
         true
     }
 
-    /// Sends `self.out` (and lets it go). data_bytes waits for the client's SSH window and for
+    /// Sends `self.out` (and lets it go). The write waits for the client's SSH window and for
     /// room in russh's queue: that wait is the backpressure (newer pictures replace older ones
     /// in the slot meanwhile). `Some` when the player is cut.
-    async fn send(&mut self, write: &ChannelWriteHalf<Msg>, kill: &CancellationToken) -> Option<Leave> {
+    async fn send(&mut self, write: &impl Channel, kill: &CancellationToken) -> Option<Leave> {
         let (hub, len) = (&self.hub, self.out.len());
         tokio::select! {
             biased;
             _ = kill.cancelled() => Some(Leave::Cut),
             _ = hub.shutdown.cancelled() => Some(Leave::Shutdown),
-            done = write.data_bytes(std::mem::take(&mut self.out)) => {
+            done = write.data(std::mem::take(&mut self.out)) => {
                 if done.is_err() { return Some(Leave::Cut); }
                 self.tally.sent += 1;
                 self.tally.from_group += u64::from(self.from_group);
@@ -289,3 +292,6 @@ impl Viewer {
         }
     }
 }
+
+#[cfg(test)]
+mod tests;
