@@ -28,6 +28,9 @@ struct Ssh {
     writer: std::sync::Arc<std::sync::Mutex<Box<dyn Write + Send>>>,
     rx: mpsc::Receiver<Vec<u8>>,
     seen: Vec<u8>,
+    /// While set, the terminal reads nothing (a terminal frozen, or scrolled back with output
+    /// held): the pty fills, then ssh's buffers, then the channel's window.
+    paused: std::sync::Arc<std::sync::atomic::AtomicBool>,
     _master: Box<dyn portable_pty::MasterPty + Send>,
 }
 
@@ -53,10 +56,17 @@ impl Ssh {
         let writer = std::sync::Arc::new(std::sync::Mutex::new(pair.master.take_writer().unwrap()));
         let answers = std::sync::Arc::clone(&writer);
         let (tx, rx) = mpsc::channel();
+        let paused = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+        let held = std::sync::Arc::clone(&paused);
         std::thread::spawn(move || {
             let mut buf = [0u8; 8192];
             let mut tail = Vec::new();
-            while let Ok(n) = reader.read(&mut buf) {
+            loop {
+                if held.load(std::sync::atomic::Ordering::Relaxed) {
+                    std::thread::sleep(Duration::from_millis(10));
+                    continue;
+                }
+                let Ok(n) = reader.read(&mut buf) else { break };
                 if n == 0 || tx.send(buf[..n].to_vec()).is_err() {
                     break;
                 }
@@ -71,7 +81,12 @@ impl Ssh {
                 }
             }
         });
-        Ssh { child, writer, rx, seen: Vec::new(), _master: pair.master }
+        Ssh { child, writer, rx, seen: Vec::new(), paused, _master: pair.master }
+    }
+
+    fn press(&self, keys: &[u8]) {
+        let mut w = self.writer.lock().unwrap();
+        w.write_all(keys).and_then(|()| w.flush()).unwrap();
     }
 
     fn text(&self) -> String {
@@ -207,4 +222,61 @@ fn measure_the_bytes_on_the_wire_with_and_without_compression() {
             size.1
         );
     }
+}
+
+/// A terminal that stops reading for a while (output held, a frozen window) and then reads
+/// again: the session is still there, the keys pressed meanwhile act once ssh runs again, and
+/// `q` ends it cleanly. While the terminal does not read, OpenSSH (whose terminal file
+/// descriptors stay blocking) is stopped in its write and sends no keys either, so `q` can only
+/// work after the pause; the server must neither cut the player for the pause nor bury the
+/// terminal in a backlog it then has to draw for long.
+#[test]
+fn openssh_whose_terminal_stops_reading_for_a_while_plays_on_and_quits() {
+    require_ssh();
+    let flags = ["--breeze", "0", "--handshake-timeout-ms", "5000"];
+    let s = Server::start(&flags);
+    let home = tempfile::tempdir().unwrap();
+    let mut ssh = Ssh::spawn_sized(s.port, home.path(), &["localhost"], (160, 48));
+    ssh.wait_for("1 playing");
+    // Rain and stones: every frame is big, the pty and ssh's write fill within the pause.
+    ssh.press(b"r");
+    ssh.paused.store(true, std::sync::atomic::Ordering::Relaxed);
+    for _ in 0..20 {
+        ssh.press(b" ");
+        std::thread::sleep(Duration::from_millis(200));
+    }
+    ssh.paused.store(false, std::sync::atomic::Ordering::Relaxed);
+    let resumed = Instant::now();
+    // Caught up: the frames held while it paused arrive, then new ones (the status line
+    // counts the stones the paused keys dropped).
+    let before = ssh.seen.len();
+    ssh.wait_for("1 playing");
+    let mut slices = Vec::new();
+    for _ in 0..10 {
+        let until = Instant::now() + Duration::from_millis(100);
+        let mut n = 0;
+        while let Ok(chunk) = ssh.rx.recv_timeout(until.saturating_duration_since(Instant::now())) {
+            n += chunk.len();
+            ssh.seen.extend_from_slice(&chunk);
+        }
+        slices.push(n);
+    }
+
+    let caught_up = ssh.seen.len() - before;
+    // (On this machine: 55 kB in the first 100 ms, what the pty, ssh and the socket held, then
+    // the rate climbing again from the safe rate: 3-7 kB per 100 ms to 420 kB.)
+    eprintln!("bytes per 100 ms after the pause: {slices:?}");
+    ssh.press(b"q");
+    assert_eq!(ssh.finish(), 0);
+    let text = ssh.text();
+    assert!(text.contains("bye from the pool"), "no goodbye after the pause");
+    let (_, log) = s.stop(15);
+    let line = log.iter().find(|l| l.contains(" left (")).expect("the player's leaving line");
+    eprintln!(
+        "{caught_up} bytes in the first second after a 4 s pause; {:.1} s to quit; {line}",
+        resumed.elapsed().as_secs_f64()
+    );
+    assert!(line.contains(" left (quit)"), "{line}");
+    // Every key pressed in the pause was taken once ssh ran again: 20 stones and the rain.
+    assert!(line.contains(" 20 actions taken, 0 dropped, 1 scene keys taken"), "{line}");
 }

@@ -561,9 +561,13 @@ impl LinkControl {
         for q in self.questions.list[..self.questions.len].iter_mut().flatten() {
             // A terminal that has never answered is not congested: it is silent (below).
             if self.answered && !q.foreign && !q.overdue && age(q) > limit {
-                // Its bytes are taken as delivered, or the window would never open again; it
-                // keeps its place, so its late answer is still paired with it.
-                self.acknowledged = self.acknowledged.max(q.bytes);
+                // A small part of its bytes is taken as delivered, so a status line can still
+                // go (the window, shrunk by the fall, stays shut for frames); all of them were,
+                // and a stalled link or a paused terminal got a whole window more each second
+                // (at 2 Mbit/s a 3 s stall queued 0.7 s, at 150 ms 1.2 s). It keeps its place,
+                // so its late answer still opens the window; a terminal that never answers
+                // again is silent at SILENCE and needs no window.
+                self.acknowledged = self.acknowledged.max(q.bytes.min(self.acknowledged + MIN_WINDOW));
                 q.overdue = true;
                 lost |= 2 * q.in_flight >= age(q) || !self.answer_time.treat_as_slow(marks);
             }

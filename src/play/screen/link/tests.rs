@@ -45,6 +45,9 @@ struct Link {
     /// The share of the link's speed the terminal reads at, `t` seconds in (a terminal that
     /// falls behind now and then: [`slow_reader`]); `None`: the link's speed.
     reads: Option<fn(f64) -> f64>,
+    /// From and to these seconds the terminal reads nothing (a paused terminal, a stalled
+    /// link): what would drain then waits for the end.
+    pause: Option<(f64, f64)>,
 }
 
 impl Link {
@@ -59,6 +62,7 @@ impl Link {
             spend_share: 1.0,
             answer_time: None,
             reads: None,
+            pause: None,
         }
     }
 }
@@ -145,7 +149,14 @@ fn simulate(path: LinkPath, link: Link, seconds: f64, demand: impl Fn(f64) -> f6
         control.frame_sent(bytes as usize, budget as usize);
         sent += bytes as u64;
         let speed = link.capacity * link.reads.map_or(1.0, |share| share(t));
-        drained = drained.max(now) + Duration::from_secs_f64(bytes / speed);
+        let start = drained.max(now);
+        drained = start + Duration::from_secs_f64(bytes / speed);
+        if let Some((from, to)) = link.pause.map(|(from, to)| (at(from), at(to)))
+            && drained > from
+            && start < to
+        {
+            drained += to - start.max(from);
+        }
         if control.probe_due() && (bytes > 0.0 || control.question_wanted(now, sent)) {
             control.probed(now, sent);
             asked += 1;
@@ -594,3 +605,5 @@ fn a_terminal_slow_to_read_is_a_queue_not_its_own_time() {
         assert!(p90 <= bound, "{rtt:?}: the queue's p90 is {:.0} ms, over {:.0} ms", p90 * 1e3, bound * 1e3);
     }
 }
+
+mod stalls;

@@ -20,6 +20,14 @@ impl LinkControl {
             // flight are answered for and the bare question has gone out.
             return 0;
         }
+        if self.waited_past_window(now) {
+            // The window in time as in bytes: on a link faster than the frames need, the
+            // bytes' window holds seconds of frames (5 MB/s for 0.35 s is 1.8 MB, 8 s of 7 kB
+            // frames), and a terminal that stopped reading (paused, or its link stalled) got
+            // them, to draw stale when it read again. Nothing more until the question is
+            // answered or the terminal found silent.
+            return 0;
+        }
         let window = self.window(now);
         usize::try_from(window.saturating_sub(bytes_sent.saturating_sub(self.acknowledged))).unwrap_or(usize::MAX)
     }
@@ -32,9 +40,7 @@ impl LinkControl {
             // with the queue the window allows) and a frame; never below what the rate sends
             // in that time, and the link's capacity as seen, not a rate still growing past it.
             let taken = self.capacity.unwrap_or(self.rate).min(self.rate);
-            let base = self.base().unwrap_or(Duration::ZERO).min(WINDOW_RTT_MAX);
-            let time = 2.0 * (base + WINDOW_QUEUE).as_secs_f64() + FRAME_ALLOWANCE.as_secs_f64();
-            (taken * time).max(MIN_WINDOW as f64) as u64
+            (taken * self.window_time().as_secs_f64()).max(MIN_WINDOW as f64) as u64
         } else {
             let waited = self
                 .questions
@@ -43,6 +49,23 @@ impl LinkControl {
                 .map_or(Duration::ZERO, |q| now.saturating_duration_since(q.asked));
             FIRST_WINDOW + (FIRST_TRICKLE * waited.as_secs_f64()) as u64
         }
+    }
+
+    /// The time the window is sized for: one question at a time, so two round trips (each
+    /// with the queue the window allows) and a frame.
+    fn window_time(&self) -> Duration {
+        let base = self.base().unwrap_or(Duration::ZERO).min(WINDOW_RTT_MAX);
+        2 * (base + WINDOW_QUEUE) + FRAME_ALLOWANCE
+    }
+
+    /// Whether one of the link's questions has waited longer than the window's time, once the
+    /// link is measured (before, the first window and the silence rule bound it); an overdue
+    /// one too: its replacement would let another window's time of frames go each second.
+    fn waited_past_window(&self, now: Instant) -> bool {
+        let time = self.window_time();
+        self.answered
+            && self.capacity.is_some()
+            && self.questions.iter().any(|q| !q.foreign && now.saturating_duration_since(q.asked) > time)
     }
 
     /// Whether a question should follow even a frame that wrote nothing, `bytes_sent`
