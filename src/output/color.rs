@@ -71,7 +71,10 @@ impl Color {
 
 /// `TERM` names of terminals that always draw 24-bit colour (each sets its own name and has
 /// no palette-only mode): kitty, Ghostty, WezTerm (with its terminfo installed), foot,
-/// Alacritty, Contour, Rio, iTerm2's own entry.
+/// Alacritty, Contour, Rio, iTerm2's own entry; and mlterm, which takes 24-bit colours and
+/// draws them finer than the 256-colour palette (Debian's mlterm 3.9 under Xvfb: a grey ramp
+/// from 40 to 119 in 16 steps, the palette's 8), though it reads the probe's colour back as
+/// the palette's `38;5;16`, so the probe alone gave it 256 colours.
 pub const TRUE_COLOR_TERMS: &[&str] = &[
     "xterm-kitty",
     "xterm-ghostty",
@@ -84,6 +87,8 @@ pub const TRUE_COLOR_TERMS: &[&str] = &[
     "contour-latest",
     "rio",
     "iterm2",
+    "mlterm",
+    "mlterm-256color",
 ];
 
 /// Bayer 4x4 thresholds, 0..16.
@@ -223,6 +228,7 @@ mod tests {
         assert_eq!(ColorMode::detect(Some(""), Some("xterm-kitty")), TrueColor);
         assert_eq!(ColorMode::detect(None, Some("xterm-ghostty")), TrueColor);
         assert_eq!(ColorMode::detect(None, Some("foot")), TrueColor);
+        assert_eq!(ColorMode::detect(None, Some("mlterm")), TrueColor);
         assert_eq!(ColorMode::detect(None, Some("xterm-256color")), Palette256);
         assert_eq!(ColorMode::detect(None, Some("linux")), Palette16);
         assert_eq!(ColorMode::detect(None, None), Palette16);
