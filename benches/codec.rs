@@ -200,7 +200,7 @@ fn clips() -> Vec<Clip> {
         let wind = tidepool::sea::beaufort_speed_m_s(6).expect("Beaufort 6");
         let defaults = OceanSettings::default();
         let ocean = OceanSettings {
-            sea: tidepool::SeaParams { wind_m_s: wind, ..defaults.sea },
+            sea: defaults.sea.with_wind_m_s(wind),
             view: OceanView { ssaa: 1, ..OceanView::default() },
             ..defaults
         };

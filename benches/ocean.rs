@@ -33,7 +33,7 @@ fn render_ocean(c: &mut Criterion) {
         ("1920x1080_ssaa2_chop_foam", 1920, 1080, 2, SeaParams::DEFAULT_CHOPPINESS),
     ];
     for (name, w, h, ssaa, choppiness) in cases {
-        let mut s = scene(w, h, ssaa, SeaParams { choppiness, ..SeaParams::default() });
+        let mut s = scene(w, h, ssaa, SeaParams::default().with_choppiness(choppiness));
         let mut out = Pixmap::new(w, h).unwrap();
         s.render(&mut out);
         eprintln!("render/ocean/{name}: {}", s.describe());
@@ -54,7 +54,7 @@ fn render_ocean(c: &mut Criterion) {
     group.finish();
     let mut group = c.benchmark_group("still");
     group.sample_size(10);
-    let gale = SeaParams { wind_m_s: beaufort_speed_m_s(8).unwrap(), ..SeaParams::default() };
+    let gale = SeaParams::default().with_wind_m_s(beaufort_speed_m_s(8).unwrap());
     for (name, sea) in [("1920x1080_ssaa2_beaufort8", gale), ("1920x1080_ssaa2_default", SeaParams::default())] {
         let mut out = Pixmap::new(1920, 1080).unwrap();
         group.bench_function(name, |b| b.iter(|| scene(1920, 1080, 2, sea).render(&mut out)));
@@ -65,7 +65,7 @@ fn render_ocean(c: &mut Criterion) {
 fn maps(c: &mut Criterion) {
     let mut group = c.benchmark_group("maps");
     group.sample_size(10);
-    let params = SeaParams { wind_m_s: 12.0, choppiness: SeaParams::DEFAULT_CHOPPINESS, ..SeaParams::default() };
+    let params = SeaParams::default().with_wind_m_s(12.0).with_choppiness(SeaParams::DEFAULT_CHOPPINESS);
     let mut patch = PatchSea::new(params, 1024, 1000.0).expect("valid patch");
     let mut t = 0.0;
     patch.maps(t);
@@ -79,7 +79,7 @@ fn maps(c: &mut Criterion) {
     group.bench_function("1024_cold", |b| {
         b.iter(|| PatchSea::new(params, 1024, 1000.0).expect("valid patch").maps(5.0))
     });
-    let small = SeaParams { wind_m_s: beaufort_speed_m_s(5).unwrap(), ..params };
+    let small = params.with_wind_m_s(beaufort_speed_m_s(5).unwrap());
     let mut patch = PatchSea::new(small, 256, 900.0).expect("valid patch");
     let mut t = 0.0;
     patch.maps(t);

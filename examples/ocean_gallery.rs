@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 
 use tiny_skia::{Pixmap, PixmapPaint, Transform};
 
-use tidepool::sea::{Depth, Jonswap, SpectrumChoice, Swell, Swells, beaufort_speed_m_s};
+use tidepool::sea::beaufort_speed_m_s;
 use tidepool::testing::PatchSea;
 use tidepool::{CameraPose, OceanScene, OceanSettings, OceanView, Scene, SeaParams, SeaShading};
 
@@ -73,40 +73,22 @@ fn save(dir: &Path, name: &str, p: &Pixmap) {
 fn main() {
     let dir = PathBuf::from(std::env::args().nth(1).unwrap_or_else(|| "docs/gallery".into()));
     std::fs::create_dir_all(&dir).expect("gallery folder");
-    let chop = |wind: f64, from: f64| SeaParams {
-        wind_m_s: wind,
-        wind_from_deg: from,
-        choppiness: SeaParams::DEFAULT_CHOPPINESS,
-        ..SeaParams::default()
+    let chop = |wind: f64, from: f64| {
+        SeaParams::default().with_wind_m_s(wind).with_wind_from_deg(from).with_choppiness(SeaParams::DEFAULT_CHOPPINESS)
     };
     let b = |n: u8| beaufort_speed_m_s(n).expect("a Beaufort number");
-    let fetch = Jonswap::new(3.3, Some(15.0)).expect("valid");
     let shots = [
         gallery("sea-beaufort-3.png", chop(b(3), 330.0), (15.0, 22.0)),
         gallery("sea-beaufort-6.png", chop(b(6), 60.0), (15.0, 22.0)),
         gallery("sea-beaufort-9.png", chop(b(9), 330.0), (200.0, 12.0)),
         gallery("sea-beaufort-10.png", chop(b(10), 330.0), (15.0, 22.0)),
-        gallery(
-            "sea-swell.png",
-            SeaParams {
-                swells: Swells::new(&[Swell::new(1.5, 12.0, 250.0).expect("valid")]).expect("one swell"),
-                ..chop(b(4), 330.0)
-            },
-            (15.0, 22.0),
-        ),
+        gallery("sea-swell.png", chop(b(4), 330.0).with_swell(1.5, 12.0, 250.0).expect("one swell"), (15.0, 22.0)),
         gallery(
             "sea-jonswap-fetch-15km.png",
-            SeaParams { spectrum: SpectrumChoice::Jonswap(fetch), ..chop(15.0, 330.0) },
+            chop(15.0, 330.0).with_jonswap(Some(3.3), Some(15.0)).expect("a 15 km fetch"),
             (15.0, 22.0),
         ),
-        gallery(
-            "sea-tma-4m.png",
-            SeaParams {
-                spectrum: SpectrumChoice::Tma(Jonswap::default(), Depth::new(4.0).expect("valid")),
-                ..chop(12.0, 330.0)
-            },
-            (15.0, 22.0),
-        ),
+        gallery("sea-tma-4m.png", chop(12.0, 330.0).with_tma(None, None, 4.0).expect("4 m of water"), (15.0, 22.0)),
     ];
     for shot in &shots {
         save(&dir, shot.name, &render(shot));
@@ -115,7 +97,7 @@ fn main() {
     // samples a pixel), cropped.
     let gale = Shot {
         name: "",
-        params: SeaParams { wind_m_s: b(9), ..SeaParams::default() },
+        params: SeaParams::default().with_wind_m_s(b(9)),
         sun: (200.0, 12.0),
         size: (1920, 1080),
         ssaa: 2,
@@ -127,7 +109,7 @@ fn main() {
     // `play` draws it, magnified.
     let term = Shot {
         name: "",
-        params: SeaParams { wind_m_s: b(6), ..SeaParams::default() },
+        params: SeaParams::default().with_wind_m_s(b(6)),
         sun: (15.0, 22.0),
         size: (160, 94),
         ssaa: 1,

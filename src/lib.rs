@@ -98,7 +98,7 @@ pub mod testing {
     pub use crate::scene::Script;
     pub use crate::sim::patch::{PatchMaps, PatchSea};
     pub use crate::sim::ripple::RipplePool;
-    pub use crate::sim::spectra::SeaSpectrum;
+    pub use crate::sim::spectra::{Depth, Jonswap, SeaSpectrum, SpectrumChoice, SpectrumChoiceError, SpectrumKind};
     pub use crate::sim::spectrum::PiersonMoskowitz;
     pub use crate::simd::Simd;
     pub use crate::size::Size;

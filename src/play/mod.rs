@@ -74,7 +74,7 @@ pub use crate::output::graphics::GraphicsMode;
 pub use crate::output::graphics::stream::FileWrite;
 pub use driver::Transmit;
 pub use host::{Effect, HostConfig, Recording};
-pub use screen::probe::{EnvHints, GraphicsRequest, ProbeOptions, WinSize};
+pub use screen::probe::{GraphicsRequest, ProbeOptions};
 pub use screen::{Bandwidth, LinkPath, ScreenConfig};
 pub use session::{Session, SessionEvent};
 

@@ -242,7 +242,7 @@ fn sea_heading(params: &SeaParams, sea: &SeaSpectrum, swells: &[SwellSpectrum]) 
         .iter()
         .map(|s| {
             let w = s.swell();
-            format!("{} m {} s from {}", label(w.height_m()), label(w.period_s()), label(w.from_deg()))
+            format!("{} m {} s from {}", label(w.height_m()), label(w.period_s()), label(w.direction_from_deg()))
         })
         .collect();
     (heading, Some(format!("swell {}", swell_text.join(", "))))

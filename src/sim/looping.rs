@@ -70,11 +70,6 @@ impl LoopPeriod {
         self.seconds
     }
 
-    /// The frequency step 1/T, Hz.
-    pub fn frequency_step_hz(&self) -> f64 {
-        1.0 / self.seconds
-    }
-
     /// Ticks (2³² a loop) from t = 0 to `time_s`, rounded to the nearest: the clock of a
     /// looping sea. A moment given as a start and a time elapsed since it is best counted as
     /// `ticks(start) + ticks(elapsed)`: an elapsed whole number of loops is then exactly a

@@ -78,6 +78,7 @@ use super::trig::fast_sincos;
 
 mod build;
 mod fold;
+mod params;
 mod surface;
 pub(crate) use fold::{FOLD_ROWS, PhaseRows};
 pub use surface::SeaSurface;
@@ -193,6 +194,19 @@ pub struct Component {
 /// Everything that defines a sea. `Default` is the command line's sea: Pierson–Moskowitz with
 /// the paper's spreading, no swell, the physical choppiness ([`SeaParams::DEFAULT_CHOPPINESS`]), no loop,
 /// a 10 m/s wind from 330°, seed 1.
+///
+/// The four numbers are public fields; the spectrum, the swells and the loop are set through
+/// the `with_*` builders, which check them, so their types (JONSWAP's γ and fetch, a TMA depth,
+/// a swell list, a loop length) stay out of the API. With private fields a struct literal cannot
+/// use `..SeaParams::default()`; a sea is one expression with the builders instead:
+///
+/// ```
+/// use tidepool::SeaParams;
+///
+/// let sea = SeaParams::default().with_wind_m_s(12.0).with_jonswap(None, Some(50.0))?.with_swell(1.5, 12.0, 250.0)?;
+/// assert_eq!(sea.wind_m_s, 12.0);
+/// # Ok::<(), tidepool::ValueError>(())
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SeaParams {
     /// Wind speed at 10 m, m/s (0 = flat calm).
@@ -202,15 +216,15 @@ pub struct SeaParams {
     /// Seed of phases, jitter and the tail.
     pub seed: u64,
     /// The wind sea's spectrum.
-    pub spectrum: SpectrumChoice,
+    pub(crate) spectrum: SpectrumChoice,
     /// How the wind sea spreads over directions.
-    pub spreading: Spreading,
+    pub(crate) spreading: Spreading,
     /// Swell from distant storms, summed with the wind sea.
-    pub swells: Swells,
+    pub(crate) swells: Swells,
     /// λ, the scale of the horizontal displacement ([`SeaParams::check_choppiness`]); 0 = none.
     pub choppiness: f64,
     /// Repeat exactly every this many seconds (None = never).
-    pub loop_period: Option<LoopPeriod>,
+    pub(crate) loop_period: Option<LoopPeriod>,
 }
 
 impl Default for SeaParams {
@@ -235,7 +249,7 @@ impl SeaParams {
     }
 
     /// The longest peak period of the wind sea and the swells, s (None: a calm without swell).
-    /// A loop must last at least ten of these ([`LoopPeriod::new`]).
+    /// A loop must last at least ten of these ([`SeaParams::with_loop_s`]).
     pub fn longest_peak_period_s(&self) -> Option<f64> {
         let wind = self.wind_spectrum().peak_period_s();
         self.swells.iter().map(|s| s.period_s()).chain(wind).reduce(f64::max)

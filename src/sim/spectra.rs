@@ -35,7 +35,13 @@ mod choice;
 mod spreading;
 pub mod swell;
 
-pub use choice::{Depth, Jonswap, SpectrumChoice, SpectrumChoiceError, SpectrumKind};
+// JONSWAP's γ and fetch and a TMA depth are checked values the command line and the tests
+// build; a library user gives plain numbers to `SeaParams::with_jonswap` and `with_tma`.
+#[cfg(any(test, feature = "testing"))]
+pub use choice::Depth;
+#[cfg(any(test, feature = "cli", feature = "testing"))]
+pub use choice::Jonswap;
+pub use choice::{SpectrumChoice, SpectrumChoiceError, SpectrumKind};
 
 pub use spreading::Spreading;
 use spreading::{donelan_banner_beta, sech2_spreading};

@@ -99,7 +99,7 @@ fn caustics_throw_rings_of_light_on_the_floor() {
 fn sea(beaufort: u8, direction: f64, ssaa: u32, time_s: f64, shading: SeaShading) -> SceneSpec {
     let wind = beaufort_speed_m_s(beaufort).unwrap();
     SceneSpec::Ocean(OceanSettings {
-        sea: SeaParams { wind_m_s: wind, wind_from_deg: direction, seed: 1, ..SeaParams::default() },
+        sea: SeaParams::default().with_wind_m_s(wind).with_wind_from_deg(direction).with_seed(1),
         view: OceanView { ssaa, shading, ..OceanView::default() },
         start_time_s: time_s,
         ..OceanSettings::default()

@@ -18,12 +18,10 @@ fn the_command_line_draws_the_librarys_seas() {
     // Pictures are flat-shaded by default, text smooth (see `the_help_names_the_shading_it_draws`).
     let spec = |ssaa, time, shading| {
         SceneSpec::Ocean(OceanSettings {
-            sea: SeaParams {
-                wind_m_s: beaufort_speed_m_s(8).unwrap(),
-                wind_from_deg: 200.0,
-                seed: 1,
-                ..SeaParams::default()
-            },
+            sea: SeaParams::default()
+                .with_wind_m_s(beaufort_speed_m_s(8).unwrap())
+                .with_wind_from_deg(200.0)
+                .with_seed(1),
             view: OceanView { ssaa, shading, ..OceanView::default() },
             start_time_s: time,
             ..OceanSettings::default()

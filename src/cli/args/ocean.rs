@@ -4,10 +4,10 @@ use std::path::PathBuf;
 
 use clap::Args;
 
-use crate::sea::{
-    Jonswap, LoopPeriod, SpectrumChoice, SpectrumChoiceError, SpectrumKind, Spreading, Swell, Swells,
-    beaufort_speed_m_s,
-};
+use crate::sim::looping::LoopPeriod;
+use crate::sim::sea_state::beaufort_speed_m_s;
+use crate::sim::spectra::swell::{Swell, Swells};
+use crate::sim::spectra::{Jonswap, SpectrumChoice, SpectrumChoiceError, SpectrumKind, Spreading};
 use crate::{CameraPose, SeaParams, SeaShading};
 
 use crate::cli::error::{Error, Result};

@@ -7,8 +7,8 @@
 //! significant height and the sea state are the whole sea's.
 
 use crate::SeaParams;
-use crate::sea::SpectrumChoice;
 use crate::sim::sea_state::{beaufort_number, wmo_sea_state, wmo_sea_state_name};
+use crate::sim::spectra::SpectrumChoice;
 
 use crate::cli::args::ocean::{SpectrumCommand, wind_of};
 use crate::cli::error::{Error, Result};
@@ -56,7 +56,7 @@ fn sea_lines(params: &SeaParams) -> String {
             i + 1,
             format_value(s.height_m()),
             format_value(s.period_s()),
-            format_value(s.from_deg())
+            format_value(s.direction_from_deg())
         ));
     }
     out
@@ -104,7 +104,7 @@ pub fn json(params: &SeaParams) -> String {
                 "{{\"height_m\": {}, \"period_s\": {}, \"from_deg\": {}}}",
                 format_value(s.height_m()),
                 format_value(s.period_s()),
-                format_value(s.from_deg())
+                format_value(s.direction_from_deg())
             )
         })
         .collect();
@@ -175,7 +175,7 @@ mod tests {
 
     #[test]
     fn jonswap_and_tma_print_their_parameters() {
-        use crate::sea::{SpectrumChoice as C, SpectrumKind};
+        use crate::sim::spectra::{SpectrumChoice as C, SpectrumKind};
         let fetch = sea(15.0, C::new(SpectrumKind::Jonswap, None, Some(15.0), None).unwrap());
         let t = text(&fetch);
         assert!(t.starts_with("spectrum: jonswap\n") && t.contains("peak enhancement gamma: 3.300\n"), "{t}");
@@ -193,7 +193,7 @@ mod tests {
 
     #[test]
     fn swells_add_lines_and_their_height() {
-        use crate::sea::{Swell, Swells};
+        use crate::sim::spectra::swell::{Swell, Swells};
         let swell = Swell::new(2.0, 12.0, 250.0).unwrap();
         let p = SeaParams { swells: Swells::new(&[swell]).unwrap(), ..pm(10.0) };
         let t = text(&p);

@@ -18,7 +18,10 @@ use tokio::sync::watch;
 use tokio_util::sync::CancellationToken;
 
 use crate::play::{ColorMode, EncodeOptions};
-use crate::play::{EnvHints, GraphicsRequest, ProbeOptions, ScreenConfig, WinSize};
+// The hints and the window size are the doors' (crate-private); the API's `ProbeOptions` is
+// built from numbers.
+use crate::play::screen::probe::{EnvHints, WinSize};
+use crate::play::{GraphicsRequest, ProbeOptions, ScreenConfig};
 use tokio::sync::mpsc;
 
 use super::authorized_keys::Refused;

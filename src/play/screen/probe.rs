@@ -140,22 +140,25 @@ impl WinSize {
     }
 }
 
-/// What the probe starts from.
+/// What the probe starts from: the terminal's size, what its environment says, and whether
+/// to ask about kitty's file medium. Built with [`ProbeOptions::new`] and its `with_*`
+/// builders (`probe/options.rs`); the fields are the crate's, so the hint and size types the
+/// doors fill them with are not part of the API.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct ProbeOptions {
     /// The environment hints.
-    pub env: EnvHints,
+    pub(crate) env: EnvHints,
     /// The window size.
-    pub winsize: WinSize,
+    pub(crate) winsize: WinSize,
     /// A temporary file holding one RGB pixel (3 bytes) whose name carries
     /// `TEMP_FILE_MARKER`, for the file-medium query; `None` skips that query (always
     /// over SSH). The caller writes it before and removes it after the probe if the terminal
     /// did not.
-    pub kitty_file: Option<std::path::PathBuf>,
+    pub(crate) kitty_file: Option<std::path::PathBuf>,
     /// Ask whether the terminal draws 24-bit colour (`COLOUR_QUERIES`): set by the screen
     /// when `--color auto` guessed 256 colours from the environment (a guess of 16 is a
     /// terminal too plain for the question's 24-bit SGR colour).
-    pub colours: bool,
+    pub(crate) colours: bool,
 }
 
 /// Sixel support.
@@ -566,5 +569,6 @@ pub fn choose(request: GraphicsRequest, support: Option<&GraphicsSupport>) -> Gr
     }
 }
 
+mod options;
 #[cfg(test)]
 mod tests;

@@ -35,6 +35,8 @@ impl FromStr for SpectrumKind {
 }
 
 impl SpectrumKind {
+    // The command line's spectrum report and the plots (`cli`, `testing`) read it.
+    #[cfg_attr(not(any(feature = "cli", feature = "testing")), allow(dead_code))]
     /// The short name (`pm`, `jonswap`, `tma`).
     pub fn name(self) -> &'static str {
         match self {
@@ -228,6 +230,8 @@ impl SpectrumChoice {
         }
     }
 
+    // The command line's spectrum report and the plots (`cli`, `testing`) read it.
+    #[cfg_attr(not(any(feature = "cli", feature = "testing")), allow(dead_code))]
     /// The kind.
     pub fn kind(&self) -> SpectrumKind {
         match self {

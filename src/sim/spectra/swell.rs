@@ -83,7 +83,7 @@ impl Swell {
     }
 
     /// Where it comes from, degrees clockwise from north (it travels the other way).
-    pub fn from_deg(&self) -> f64 {
+    pub fn direction_from_deg(&self) -> f64 {
         self.from_deg
     }
 }
@@ -144,6 +144,8 @@ impl Swells {
         self.list.iter().flatten()
     }
 
+    // The command line's spectrum report and the plots (`cli`, `testing`) read it.
+    #[cfg_attr(not(any(feature = "cli", feature = "testing")), allow(dead_code))]
     /// True without swell.
     pub fn is_empty(&self) -> bool {
         self.list[0].is_none()
@@ -247,7 +249,7 @@ mod tests {
     #[test]
     fn swells_are_checked_and_parsed() {
         let s: Swell = "1.5, 12, -110".parse().unwrap();
-        assert_eq!((s.height_m(), s.period_s(), s.from_deg()), (1.5, 12.0, 250.0));
+        assert_eq!((s.height_m(), s.period_s(), s.direction_from_deg()), (1.5, 12.0, 250.0));
         for bad in ["1.5,12", "0,12,0", "1,1,0", "1,40,0", "x,12,0", "1,12,inf", "21,10,0", "nan,10,0"] {
             assert!(bad.parse::<Swell>().is_err(), "{bad}");
         }
