@@ -20,6 +20,9 @@ pub struct Band {
     entries: Vec<u64>,
     /// The same entries by register, then column: `column << 8 | bits`.
     sorted: Vec<u32>,
+    /// For each of the band's six rows, a column's mask of the rows with the same register
+    /// when the row is the first of them, otherwise 0 (see [`Band::collect`]).
+    masks: Vec<u8>,
     /// The bytes that skip `n` columns (`?` to `???`, then `!n?`), eight bytes and the
     /// length used, for every `n` up to the widest band seen: written as eight bytes and cut,
     /// with no branch on the length.
@@ -59,11 +62,8 @@ impl Band {
         for dy in rows..6 {
             lines[dy] = lines[rows - 1];
         }
-        let n = self.collect(&lines, rows, w);
         let mut counts = [0u32; 256];
-        for &e in &self.entries[..n] {
-            counts[(e >> 32) as usize] += 1;
-        }
+        let n = self.collect(&lines, rows, w, &mut counts);
         while self.skips.len() <= w.min(MAX_SKIP) {
             let mut code = Vec::with_capacity(8);
             push_run(&mut code, b'?', self.skips.len());
@@ -106,25 +106,55 @@ impl Band {
         out.push(b'-');
     }
 
-    /// Writes the band's (register, column, bits) to `entries` and says how many: columns
-    /// ascending, within a column in the order of each register's first row. Without branches
-    /// on the pixels: each of a column's six rows is compared with all six, and its entry is
-    /// written always and kept (the count moved on) only when its row is the first of its
-    /// register (a loop over the column's registers mispredicted about once a column).
-    #[allow(clippy::needless_range_loop, reason = "a column is read across the six rows")]
-    fn collect(&mut self, lines: &[&[u8]; 6], rows: usize, w: usize) -> usize {
+    /// Writes the band's (register, column, bits) to `entries`, counts them by register in
+    /// `counts` and says how many: columns ascending, within a column in the order of each
+    /// register's first row.
+    ///
+    /// In two passes, neither with a branch on the pixels: the first compares, for each row,
+    /// every column's register with the five others of its column (a loop along the row, over
+    /// bytes, that the compiler vectorizes) and keeps the row's mask of equal rows where the
+    /// row is the first of its register (0 elsewhere: a first row's mask holds its own bit);
+    /// the second writes each column's six entries always and keeps those with a mask (the
+    /// count moved on). One pass doing both a column at a time was scalar, six by six
+    /// comparisons a column.
+    fn collect(&mut self, lines: &[&[u8]; 6], rows: usize, w: usize, counts: &mut [u32; 256]) -> usize {
         if self.entries.len() < 6 * w {
             self.entries.resize(6 * w, 0);
         }
+        self.masks.resize(6 * w, 0);
+        let lines: [&[u8]; 6] = lines.map(|line| &line[..w]);
         let valid = (1u8 << rows) - 1;
+        for (dy, masks) in self.masks.chunks_exact_mut(w).enumerate() {
+            if valid >> dy & 1 == 0 {
+                masks.fill(0);
+                continue;
+            }
+            let earlier = (1u8 << dy) - 1;
+            // Every slice exactly `w` long, so the loop carries no bounds checks.
+            let (masks, line) = (&mut masks[..w], &lines[dy][..w]);
+            let [l0, l1, l2, l3, l4, l5] = lines.map(|line| &line[..w]);
+            for x in 0..w {
+                let c = line[x];
+                let same = (u8::from(l0[x] == c)
+                    | u8::from(l1[x] == c) << 1
+                    | u8::from(l2[x] == c) << 2
+                    | u8::from(l3[x] == c) << 3
+                    | u8::from(l4[x] == c) << 4
+                    | u8::from(l5[x] == c) << 5)
+                    & valid;
+                masks[x] = if same & earlier == 0 { same } else { 0 };
+            }
+        }
+        let masks: [&[u8]; 6] = std::array::from_fn(|dy| &self.masks[dy * w..(dy + 1) * w]);
+        let entries = &mut self.entries[..6 * w];
         let mut n = 0;
         for x in 0..w {
-            let px: [u8; 6] = std::array::from_fn(|dy| lines[dy][x]);
-            for (dy, &c) in px.iter().enumerate() {
-                let same = px.iter().enumerate().fold(0u8, |m, (k, &p)| m | u8::from(p == c) << k) & valid;
-                let first = (same & ((1u8 << dy) - 1) == 0) & (valid >> dy & 1 == 1);
-                self.entries[n] = u64::from(c) << 32 | (x as u64) << 8 | u64::from(same);
-                n += usize::from(first);
+            for dy in 0..6 {
+                let (c, same) = (lines[dy][x], masks[dy][x]);
+                let kept = u32::from(same != 0);
+                entries[n] = u64::from(c) << 32 | (x as u64) << 8 | u64::from(same);
+                counts[usize::from(c)] += kept;
+                n += kept as usize;
             }
         }
         n
