@@ -294,6 +294,7 @@ impl SixelEncoder {
     /// Appends the registers of row `y` of a picture one pixel a screen pixel (`rgb`, 3 bytes a
     /// pixel), dithered by position: what [`SixelEncoder::dither_into`] does for each row, for a
     /// caller that makes the picture a row at a time (the stream's enlargement to the screen).
+    #[inline(always)]
     pub fn dither_row(&mut self, rgb: &[u8], y: usize, out: &mut Vec<u8>) {
         let start = out.len();
         out.resize(start + rgb.len() / 3, 0);

@@ -116,6 +116,7 @@ impl ColourMap {
     /// into `out` (one a pixel): [`ColourMap::register`] of each pixel at its Bayer threshold,
     /// in two passes: the channels moved and cut to the table's bits in a loop along the row
     /// that the compiler vectorizes, then a table load a pixel (one pass doing both was scalar).
+    #[inline(always)]
     pub fn registers_row(&mut self, rgb: &[u8], y: usize, out: &mut [u8]) {
         let offsets = &self.row_offsets[y % BAYER_SIDE];
         self.quantized.resize(rgb.len(), 0);
