@@ -20,6 +20,8 @@ pub struct Band {
     entries: Vec<u64>,
     /// The same entries by register, then column: `column << 8 | bits`.
     sorted: Vec<u32>,
+    /// One colour pass's bytes, written by position ([`colour_pass`]); grown, never cleared.
+    pass: Vec<u8>,
     /// For each of the band's six rows, a column's mask of the rows with the same register
     /// when the row is the first of them, otherwise 0 (see [`Band::collect`]).
     masks: Vec<u8>,
@@ -101,7 +103,8 @@ impl Band {
                 push_decimal(out, c);
                 registers.defined[c] = true;
             }
-            push_colour_pass(out, &self.sorted[start as usize..(start + n) as usize], &self.skips);
+            let len = colour_pass(&mut self.pass, &self.sorted[start as usize..(start + n) as usize], &self.skips);
+            out.extend_from_slice(&self.pass[..len]);
         }
         out.push(b'-');
     }
@@ -161,36 +164,69 @@ impl Band {
     }
 }
 
-/// Appends one colour's pass over a band from its covered columns (`column << 8 | sixel bits`,
-/// ascending): empty sixels (`?`) up to each covered column, runs of equal sixels as `!n`.
-/// `skips`: the bytes of each skip (see [`Band`]).
-fn push_colour_pass(out: &mut Vec<u8>, cols: &[u32], skips: &[([u8; 8], u8)]) {
+/// The most bytes one entry of a colour pass writes: a skip (`!n?`) and a run (`!nx`), each
+/// at most `!`, 20 digits and a character.
+const MAX_ENTRY_BYTES: usize = 2 * 22;
+
+/// Writes one colour's pass over a band from its covered columns (`column << 8 | sixel bits`,
+/// ascending) to the start of `buf` and says how long it is: empty sixels (`?`) up to each
+/// covered column, runs of equal sixels as `!n`. `skips`: the bytes of each skip (see
+/// [`Band`]). Written by position into a buffer long enough for the worst case, so the loop
+/// keeps its length in a register (a `Vec` that grows checked and stored its length at every
+/// push).
+fn colour_pass(buf: &mut Vec<u8>, cols: &[u32], skips: &[([u8; 8], u8)]) -> usize {
+    let most = MAX_ENTRY_BYTES * cols.len() + 8;
+    if buf.len() < most {
+        buf.resize(most, 0);
+    }
+    let buf = &mut buf[..most];
+    let mut at = 0;
     let mut next = 0usize; // the column the pass has reached
     let mut i = 0;
     while i < cols.len() {
         let (x, sixel) = ((cols[i] >> 8) as usize, cols[i] as u8);
         match skips.get(x - next) {
             Some((bytes, len)) => {
-                let at = out.len();
-                out.extend_from_slice(bytes);
-                out.truncate(at + usize::from(*len));
+                buf[at..at + 8].copy_from_slice(bytes);
+                at += usize::from(*len);
             }
-            None => push_run(out, b'?', x - next),
+            None => at += write_run(&mut buf[at..], b'?', x - next),
         }
         let mut run = 1;
         while i + run < cols.len() && cols[i + run] == cols[i] + ((run as u32) << 8) {
             run += 1;
         }
         if run < MIN_RUN {
-            let at = out.len();
-            out.extend_from_slice(&[63 + sixel; MIN_RUN]);
-            out.truncate(at + run);
+            buf[at..at + MIN_RUN].copy_from_slice(&[63 + sixel; MIN_RUN]);
+            at += run;
         } else {
-            push_run(out, 63 + sixel, run);
+            at += write_run(&mut buf[at..], 63 + sixel, run);
         }
         next = x + run;
         i += run;
     }
+    at
+}
+
+/// Writes `!n` and `ch` (a run of `n`, at least [`MIN_RUN`]) to the start of `buf` and says
+/// how many bytes.
+fn write_run(buf: &mut [u8], ch: u8, n: usize) -> usize {
+    let mut digits = [0u8; 20];
+    let mut v = n;
+    let mut first = digits.len();
+    loop {
+        first -= 1;
+        digits[first] = b'0' + (v % 10) as u8;
+        v /= 10;
+        if v == 0 {
+            break;
+        }
+    }
+    let len = digits.len() - first;
+    buf[0] = b'!';
+    buf[1..1 + len].copy_from_slice(&digits[first..]);
+    buf[1 + len] = ch;
+    len + 2
 }
 
 /// Appends `n` copies of the sixel character `ch`.
