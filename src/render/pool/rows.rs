@@ -26,7 +26,7 @@ struct SpanScratch {
     across: [i32; SPAN],
     along: [i32; SPAN],
     /// The texel at the position and its right neighbour, and the two below them, each pair
-    /// as it lies in memory (see [`split`]).
+    /// in one word (see [`split`]).
     top: [u64; SPAN],
     bottom: [u64; SPAN],
     gain: [u8; SPAN],
@@ -162,8 +162,8 @@ impl PoolRenderer {
             let sx = ((x << 8) + xoff * q).clamp(0, (w - 1) << 8);
             let sy = (((y as i32) << 8) + yoff * q).clamp(0, (h - 1) << 8);
             let (tx, ty) = (sx >> 8, sy >> 8);
-            // The texel's byte offset.
-            index[i] = ((ty * w + tx) * 4) as u32;
+            // The texel's index.
+            index[i] = (ty * w + tx) as u32;
             fx[i] = (sx & 255) as u32;
             fy[i] = (sy & 255) as u32;
             let lx = (tx - shift_x).clamp(0, w - 1) >> lshift;
@@ -192,26 +192,33 @@ impl PoolRenderer {
                 }
             }
         }
-        // The fetches: the texels (a pair in one load) and the floor's light, in a loop of
-        // its own for each case (one loop with a test of the case inside kept its pointers on
-        // the stack). Offsets are in range by construction; the `min`s let the compiler see it.
-        let stride = 4 * w as usize;
+        // The fetches: the four texels and the floor's light, in a loop of its own for each
+        // case (one loop with a test of the case inside kept its pointers on the stack). Each
+        // texel is read from a slice of the same length `n` (the texel, its right neighbour,
+        // the two below), so one `min` puts the index in range of all four and the compiler
+        // drops their bounds checks; indices are in range by construction anyway.
+        let stride = w as usize;
         let texels = &self.texels[..];
-        let last = texels.len() - stride - 8;
-        let pair = |at: usize| u64::from_ne_bytes(texels[at..at + 8].try_into().expect("eight bytes"));
+        let n = texels.len().saturating_sub(stride + 1).max(1);
+        let (top_left, top_right) = (&texels[..n], &texels[1..n + 1]);
+        let (bottom_left, bottom_right) = (&texels[stride..stride + n], &texels[stride + 1..stride + 1 + n]);
+        let last = n - 1;
+        let pair = |left: &[u32], right: &[u32], at: usize| u64::from(left[at]) | u64::from(right[at]) << 32;
         let gains = &self.light.gains[..];
         let texel_pairs = top.iter_mut().zip(bottom.iter_mut()).zip(&*index);
         if self.look.caustics.is_some() && !gains.is_empty() {
             let last_gain = gains.len() - 1;
             for (((top, bottom), &index), (gain, &light)) in texel_pairs.zip(gain.iter_mut().zip(&*light_index)) {
                 let at = (index as usize).min(last);
-                (*top, *bottom) = (pair(at), pair(at + stride));
+                *top = pair(top_left, top_right, at);
+                *bottom = pair(bottom_left, bottom_right, at);
                 *gain = gains[(light as usize).min(last_gain)];
             }
         } else {
             for ((top, bottom), &index) in texel_pairs {
                 let at = (index as usize).min(last);
-                (*top, *bottom) = (pair(at), pair(at + stride));
+                *top = pair(top_left, top_right, at);
+                *bottom = pair(bottom_left, bottom_right, at);
             }
             gain.fill(caustics::UNIT_GAIN);
         }
@@ -231,11 +238,10 @@ impl PoolRenderer {
     }
 }
 
-/// Two neighbouring texels read as one word from memory: (the left, the right) packed words.
+/// Two neighbouring texels in one word, the left in the low half: (the left, the right).
 #[inline(always)]
 fn split(pair: u64) -> (u32, u32) {
-    let (low, high) = (pair as u32, (pair >> 32) as u32);
-    if cfg!(target_endian = "little") { (low, high) } else { (high, low) }
+    (pair as u32, (pair >> 32) as u32)
 }
 
 /// Grid 1: the fine row is the picture's row.

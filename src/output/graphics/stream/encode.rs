@@ -4,10 +4,10 @@
 
 use tiny_skia::Pixmap;
 
+use super::ladder::{Resampler, RowSink};
 use super::{FileWrite, Part, PictureStream, Protocol};
 use crate::output::graphics::kitty::{self, KittyOptions, Medium};
 use crate::output::graphics::pack::{Packing, pack};
-use super::ladder::{Resampler, RowSink};
 use crate::output::graphics::sixel::SixelEncoder;
 use crate::output::graphics::{iterm2, scan};
 use crate::simd::{Simd, Tier};
