@@ -148,12 +148,16 @@ impl Band {
                 masks[x] = if same & earlier == 0 { same } else { 0 };
             }
         }
-        let masks: [&[u8]; 6] = std::array::from_fn(|dy| &self.masks[dy * w..(dy + 1) * w]);
+        // Each row and its masks as a slice of its own, exactly `w` long: indexed through an
+        // array of slices, every read was checked against a length loaded from the stack.
+        let [l0, l1, l2, l3, l4, l5] = lines;
+        let [m0, m1, m2, m3, m4, m5]: [&[u8]; 6] = std::array::from_fn(|dy| &self.masks[dy * w..(dy + 1) * w]);
         let entries = &mut self.entries[..6 * w];
         let mut n = 0;
         for x in 0..w {
-            for dy in 0..6 {
-                let (c, same) = (lines[dy][x], masks[dy][x]);
+            let column =
+                [(l0[x], m0[x]), (l1[x], m1[x]), (l2[x], m2[x]), (l3[x], m3[x]), (l4[x], m4[x]), (l5[x], m5[x])];
+            for (c, same) in column {
                 let kept = u32::from(same != 0);
                 entries[n] = u64::from(c) << 32 | (x as u64) << 8 | u64::from(same);
                 counts[usize::from(c)] += kept;
