@@ -215,17 +215,7 @@ fn colour_pass(buf: &mut Vec<u8>, cols: &[u32], skips: &[([u8; 8], u8)]) -> usiz
 /// Writes `!n` and `ch` (a run of `n`, at least [`MIN_RUN`]) to the start of `buf` and says
 /// how many bytes.
 fn write_run(buf: &mut [u8], ch: u8, n: usize) -> usize {
-    let mut digits = [0u8; 20];
-    let mut v = n;
-    let mut first = digits.len();
-    loop {
-        first -= 1;
-        digits[first] = b'0' + (v % 10) as u8;
-        v /= 10;
-        if v == 0 {
-            break;
-        }
-    }
+    let (digits, first) = decimal(n);
     let len = digits.len() - first;
     buf[0] = b'!';
     buf[1..1 + len].copy_from_slice(&digits[first..]);
@@ -260,16 +250,22 @@ pub fn push_decimal(out: &mut Vec<u8>, v: usize) {
         out.push(b'0' + (v % 10) as u8);
         return;
     }
+    let (digits, first) = decimal(v);
+    out.extend_from_slice(&digits[first..]);
+}
+
+/// The decimal digits of `v`, right-aligned, and where the first is.
+fn decimal(v: usize) -> ([u8; 20], usize) {
     let mut digits = [0u8; 20];
     let mut n = v;
-    let mut i = digits.len();
+    let mut first = digits.len();
     loop {
-        i -= 1;
-        digits[i] = b'0' + (n % 10) as u8;
+        first -= 1;
+        digits[first] = b'0' + (n % 10) as u8;
         n /= 10;
         if n == 0 {
             break;
         }
     }
-    out.extend_from_slice(&digits[i..]);
+    (digits, first)
 }
