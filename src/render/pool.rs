@@ -44,10 +44,10 @@ const STENCIL_SPAN: f32 = 6.0;
 #[derive(Clone, Debug)]
 pub struct PoolRenderer {
     background: Pixmap,
-    /// The background's RGBA pixels ([`PoolRenderer::texel`] reads one as a packed word, for
+    /// The background's RGBA pixels, each a packed word (its bytes in memory order, for
     /// two-channels-at-a-time filtering), followed by a copy of the last row and one more
     /// pixel.
-    texels: Vec<u8>,
+    texels: Vec<u32>,
     look: PoolLook,
     refraction_q8: i32,
     /// The caustics' light on the floor, rebuilt every frame.
@@ -129,9 +129,10 @@ impl PoolRenderer {
         // One extra row and texel past the end, so the filter's right and lower neighbours can be
         // fetched without a check at the last column and row (their weight is 0 there).
         let (w, h) = (background.width() as usize, background.height() as usize);
-        let mut texels = background.data().to_vec();
-        texels.extend_from_within((h - 1) * w * 4..h * w * 4);
-        texels.extend_from_within(texels.len() - 4..);
+        let mut texels: Vec<u32> =
+            background.data().chunks_exact(4).map(|p| u32::from_ne_bytes(p.try_into().expect("four bytes"))).collect();
+        texels.extend_from_within((h - 1) * w..h * w);
+        texels.extend_from_within(texels.len() - 1..);
         let sun = look.sun.direction();
         let horizontal = (sun[0] * sun[0] + sun[1] * sun[1]).sqrt().max(1e-6);
         // Sunlight enters the water at (90° - elevation) from the vertical and is bent
@@ -326,7 +327,7 @@ impl PoolRenderer {
     /// Texel `i` (row-major, the extra row and pixel included) as a packed word.
     #[inline(always)]
     fn texel(&self, i: usize) -> u32 {
-        u32::from_ne_bytes(self.texels[4 * i..4 * i + 4].try_into().expect("four bytes"))
+        self.texels[i]
     }
 
     /// The background at an 8.8 fixed-point position inside the picture, bilinearly filtered.

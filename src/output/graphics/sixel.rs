@@ -294,16 +294,11 @@ impl SixelEncoder {
     /// Appends the registers of row `y` of a picture one pixel a screen pixel (`rgb`, 3 bytes a
     /// pixel), dithered by position: what [`SixelEncoder::dither_into`] does for each row, for a
     /// caller that makes the picture a row at a time (the stream's enlargement to the screen).
+    #[inline(always)]
     pub fn dither_row(&mut self, rgb: &[u8], y: usize, out: &mut Vec<u8>) {
-        let thresholds = &BAYER8[y % BAYER_SIDE];
         let start = out.len();
         out.resize(start + rgb.len() / 3, 0);
-        // Eight pixels at a time, one row of the Bayer matrix.
-        for (o, p) in out[start..].chunks_mut(BAYER_SIDE).zip(rgb.chunks(3 * BAYER_SIDE)) {
-            for ((o, p), &t) in o.iter_mut().zip(p.chunks_exact(3)).zip(thresholds) {
-                *o = self.map.register([p[0], p[1], p[2]], usize::from(t));
-            }
-        }
+        self.map.registers_row(rgb, y, &mut out[start..]);
     }
 
     /// Appends the bytes that make the terminal show `rgb` (`width x height`, 3 bytes a pixel)

@@ -10,7 +10,7 @@
 //! whatever the split and the set.
 
 use super::{GUST_REFRACTION, GUST_UNITS};
-use crate::sim::breeze::gusts::{GUST_LANES, GustField};
+use crate::sim::breeze::gusts::{GUST_BLOCK, GustField};
 use crate::simd::{Simd, Tier};
 
 /// Pools with fewer cells are composed on one thread.
@@ -44,8 +44,9 @@ impl Composer {
         let tasks = n.div_ceil(chunk);
         self.rows.resize_with(tasks, Vec::new);
         let run = |(task, ((light, refraction), row)): BandTask<'_>| {
-            // Room for the packets' padding past the last column (see `GustField::add_row`).
-            row.resize(cols + GUST_LANES, 0.0);
+            // Whole blocks, room for the packets' padding past the last column (see
+            // `GustField::add_row_blocks`).
+            row.resize(cols.next_multiple_of(GUST_BLOCK), 0.0);
             let band = Band { sources, first_row: task * rows_per_task };
             match simd.tier() {
                 // SAFETY: a `Simd` of this tier exists only when run-time detection found the
@@ -93,7 +94,7 @@ impl Band<'_> {
         for (i, (light, refraction)) in rows.enumerate() {
             let y = self.first_row + i;
             ripples.fill(0.0);
-            self.sources.gusts.add_row(y, ripples);
+            self.sources.gusts.add_row_blocks(y, ripples);
             let heights = &self.sources.heights[y * cols..(y + 1) * cols];
             fill_units((light, refraction), heights, ripples, GUST_REFRACTION);
         }

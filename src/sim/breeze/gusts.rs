@@ -85,9 +85,11 @@ const WAVE_SPEED: f32 = std::f32::consts::FRAC_1_SQRT_2;
 const SEED_SALT: u64 = 0x0067_7573_7473; // "gusts"
 /// The most packets alive at once (a bound on work per picture, whatever the pool's size).
 pub const MAX_PACKETS: usize = 64;
-/// The gusts' columns are added this many at a time ([`GustField::add_row`]): a vector of
-/// AVX-512, two of AVX2.
-pub const GUST_LANES: usize = 16;
+/// The gusts' columns are added in blocks of this many ([`GustField::add_row_blocks`]): four
+/// vectors of AVX-512, eight of AVX2, held in registers while every packet over the block is
+/// added. Each packet's column factors start and end on a block's edge (zeros outside the
+/// packet), so a block is either wholly in a packet's factors or not in them.
+pub const GUST_BLOCK: usize = 64;
 
 /// One packet: where it was born, where it goes, its wave and its strength.
 // Its fields are the crate's so that the pool's snapshot (`scene/pool/state.rs`) can hold it.
@@ -245,7 +247,7 @@ impl Gusts {
         // later frame allocates when more packets are alive than before (reserved, the pages
         // untouched until used).
         patches.reserve(MAX_PACKETS);
-        let most = MAX_PACKETS * (width + GUST_LANES + height);
+        let most = MAX_PACKETS * (width + 2 * GUST_BLOCK + height);
         real.reserve(most.saturating_sub(real.len()));
         imaginary.reserve(most.saturating_sub(imaginary.len()));
         let life = self.shape.life_steps.max(1) as f32;
@@ -273,16 +275,20 @@ impl Gusts {
                 let angle = p.wavenumber * along * offset;
                 (envelope * libm::cosf(angle), envelope * libm::sinf(angle))
             };
+            // Zeros from the block edge before the packet's first column and after its last
+            // up to the next (see `GUST_BLOCK`).
             let columns = real.len();
+            let first = xs.start / GUST_BLOCK * GUST_BLOCK;
+            let blocks = first..xs.end.next_multiple_of(GUST_BLOCK);
+            real.resize(columns + (xs.start - first), 0.0);
+            imaginary.resize(columns + (xs.start - first), 0.0);
             for x in xs.clone() {
                 let (re, im) = factor(x as f32 - centre.0, p.direction.0);
                 real.push(re);
                 imaginary.push(im);
             }
-            // Zeros up to a whole number of vectors (see `GustField::add_row`).
-            let padded = columns + xs.len().next_multiple_of(GUST_LANES);
-            real.resize(padded, 0.0);
-            imaginary.resize(padded, 0.0);
+            real.resize(columns + blocks.len(), 0.0);
+            imaginary.resize(columns + blocks.len(), 0.0);
             let rows = real.len();
             let (pc, ps) = (amplitude * libm::cosf(p.phase), amplitude * libm::sinf(p.phase));
             for y in ys.clone() {
@@ -290,7 +296,7 @@ impl Gusts {
                 real.push(c * pc - s * ps);
                 imaginary.push(c * ps + s * pc);
             }
-            patches.push(Patch { columns: xs, rows: ys, column_factors: columns, row_factors: rows });
+            patches.push(Patch { columns: blocks, rows: ys, column_factors: columns, row_factors: rows });
         }
         GustField { patches, real, imaginary }
     }
@@ -299,6 +305,8 @@ impl Gusts {
 /// Where one live packet draws: the cells it covers and where its factors are.
 #[derive(Clone, Debug, Default)]
 struct Patch {
+    /// The columns of its factors: the columns it covers widened to whole [`GUST_BLOCK`]s
+    /// (the factors are zero outside the packet).
     columns: std::ops::Range<usize>,
     rows: std::ops::Range<usize>,
     /// Where its column factors (one a column) and its row factors (one a row) start in
@@ -326,14 +334,13 @@ pub struct GustField<'a> {
 }
 
 impl GustField<'_> {
-    /// Adds the gusts' heights in row `y` to `row` (the pool's width, or more: see below):
-    /// every packet that covers the row in the order they were born, so each cell sums the
-    /// same terms in the same order whichever rows are drawn together and on whichever thread.
+    /// Adds the gusts' heights in row `y` to `row` (the pool's width): every packet that covers
+    /// the row in the order they were born, so each cell sums the same terms in the same order
+    /// whichever rows are drawn together and on whichever thread.
     ///
-    /// Each packet's columns are added [`GUST_LANES`] at a time, its column factors padded
-    /// with zeros to a whole number of them; a `row` at least [`GUST_LANES`] longer than the
-    /// pool takes the padding too and needs no scalar remainder. Adding a zero leaves every
-    /// cell as it is: a sum that starts at +0 never becomes -0, and +0 + ±0 is +0.
+    /// A packet's factors reach past its cells to whole blocks (`GUST_BLOCK`), zeros there:
+    /// adding a zero leaves every cell as it is (a sum that starts at +0 never becomes -0, and
+    /// +0 + ±0 is +0), so the cells the factors cover beyond the packet add nothing.
     #[inline(always)]
     pub fn add_row(&self, y: usize, row: &mut [f32]) {
         for p in self.patches {
@@ -342,14 +349,48 @@ impl GustField<'_> {
             }
             let at = p.row_factors + (y - p.rows.start);
             let (yr, yi) = (self.real[at], self.imaginary[at]);
-            let end = (p.columns.start + p.columns.len().next_multiple_of(GUST_LANES)).min(row.len());
-            let out = &mut row[p.columns.start..end];
+            let end = p.columns.end.min(row.len());
+            let out = &mut row[p.columns.start.min(end)..end];
             let n = out.len();
             let xr = &self.real[p.column_factors..p.column_factors + n];
             let xi = &self.imaginary[p.column_factors..p.column_factors + n];
             for i in 0..n {
                 out[i] += xr[i] * yr - xi[i] * yi;
             }
+        }
+    }
+
+    /// [`GustField::add_row`] for a `row` of whole blocks (`GUST_BLOCK`) that holds every
+    /// packet's factors (the pool's width rounded up to a block): the same sums, a block at a
+    /// time, each block's sums kept in registers while every packet over it is added (one
+    /// packet at a time over the whole row loaded and stored the row once a packet).
+    #[inline(always)]
+    pub fn add_row_blocks(&self, y: usize, row: &mut [f32]) {
+        // The packets over this row, in the order they were born: (their factors' columns,
+        // where their column factors start, their row factor).
+        let mut active = [((0, 0), 0, 0.0f32, 0.0f32); MAX_PACKETS];
+        let mut count = 0;
+        for p in self.patches.iter().filter(|p| p.rows.contains(&y)) {
+            let at = p.row_factors + (y - p.rows.start);
+            active[count] = ((p.columns.start, p.columns.end), p.column_factors, self.real[at], self.imaginary[at]);
+            count += 1;
+        }
+        let active = &active[..count];
+        for (b, block) in row.chunks_exact_mut(GUST_BLOCK).enumerate() {
+            let x0 = b * GUST_BLOCK;
+            let mut sums: [f32; GUST_BLOCK] = block.try_into().expect("a block");
+            for &((start, end), factors, yr, yi) in active {
+                if !(start..end).contains(&x0) {
+                    continue;
+                }
+                let at = factors + (x0 - start);
+                let xr: &[f32; GUST_BLOCK] = self.real[at..at + GUST_BLOCK].try_into().expect("a block");
+                let xi: &[f32; GUST_BLOCK] = self.imaginary[at..at + GUST_BLOCK].try_into().expect("a block");
+                for i in 0..GUST_BLOCK {
+                    sums[i] += xr[i] * yr - xi[i] * yi;
+                }
+            }
+            block.copy_from_slice(&sums);
         }
     }
 }

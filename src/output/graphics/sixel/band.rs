@@ -20,6 +20,11 @@ pub struct Band {
     entries: Vec<u64>,
     /// The same entries by register, then column: `column << 8 | bits`.
     sorted: Vec<u32>,
+    /// One colour pass's bytes, written by position ([`colour_pass`]); grown, never cleared.
+    pass: Vec<u8>,
+    /// For each of the band's six rows, a column's mask of the rows with the same register
+    /// when the row is the first of them, otherwise 0 (see [`Band::collect`]).
+    masks: Vec<u8>,
     /// The bytes that skip `n` columns (`?` to `???`, then `!n?`), eight bytes and the
     /// length used, for every `n` up to the widest band seen: written as eight bytes and cut,
     /// with no branch on the length.
@@ -59,11 +64,8 @@ impl Band {
         for dy in rows..6 {
             lines[dy] = lines[rows - 1];
         }
-        let n = self.collect(&lines, rows, w);
         let mut counts = [0u32; 256];
-        for &e in &self.entries[..n] {
-            counts[(e >> 32) as usize] += 1;
-        }
+        let n = self.collect(&lines, rows, w, &mut counts);
         while self.skips.len() <= w.min(MAX_SKIP) {
             let mut code = Vec::with_capacity(8);
             push_run(&mut code, b'?', self.skips.len());
@@ -101,66 +103,124 @@ impl Band {
                 push_decimal(out, c);
                 registers.defined[c] = true;
             }
-            push_colour_pass(out, &self.sorted[start as usize..(start + n) as usize], &self.skips);
+            let len = colour_pass(&mut self.pass, &self.sorted[start as usize..(start + n) as usize], &self.skips);
+            out.extend_from_slice(&self.pass[..len]);
         }
         out.push(b'-');
     }
 
-    /// Writes the band's (register, column, bits) to `entries` and says how many: columns
-    /// ascending, within a column in the order of each register's first row. Without branches
-    /// on the pixels: each of a column's six rows is compared with all six, and its entry is
-    /// written always and kept (the count moved on) only when its row is the first of its
-    /// register (a loop over the column's registers mispredicted about once a column).
-    #[allow(clippy::needless_range_loop, reason = "a column is read across the six rows")]
-    fn collect(&mut self, lines: &[&[u8]; 6], rows: usize, w: usize) -> usize {
+    /// Writes the band's (register, column, bits) to `entries`, counts them by register in
+    /// `counts` and says how many: columns ascending, within a column in the order of each
+    /// register's first row.
+    ///
+    /// In two passes, neither with a branch on the pixels: the first compares, for each row,
+    /// every column's register with the five others of its column (a loop along the row, over
+    /// bytes, that the compiler vectorizes) and keeps the row's mask of equal rows where the
+    /// row is the first of its register (0 elsewhere: a first row's mask holds its own bit);
+    /// the second writes each column's six entries always and keeps those with a mask (the
+    /// count moved on). One pass doing both a column at a time was scalar, six by six
+    /// comparisons a column.
+    fn collect(&mut self, lines: &[&[u8]; 6], rows: usize, w: usize, counts: &mut [u32; 256]) -> usize {
         if self.entries.len() < 6 * w {
             self.entries.resize(6 * w, 0);
         }
+        self.masks.resize(6 * w, 0);
+        let lines: [&[u8]; 6] = lines.map(|line| &line[..w]);
         let valid = (1u8 << rows) - 1;
+        for (dy, masks) in self.masks.chunks_exact_mut(w).enumerate() {
+            if valid >> dy & 1 == 0 {
+                masks.fill(0);
+                continue;
+            }
+            let earlier = (1u8 << dy) - 1;
+            // Every slice exactly `w` long, so the loop carries no bounds checks.
+            let (masks, line) = (&mut masks[..w], &lines[dy][..w]);
+            let [l0, l1, l2, l3, l4, l5] = lines.map(|line| &line[..w]);
+            for x in 0..w {
+                let c = line[x];
+                let same = (u8::from(l0[x] == c)
+                    | u8::from(l1[x] == c) << 1
+                    | u8::from(l2[x] == c) << 2
+                    | u8::from(l3[x] == c) << 3
+                    | u8::from(l4[x] == c) << 4
+                    | u8::from(l5[x] == c) << 5)
+                    & valid;
+                masks[x] = if same & earlier == 0 { same } else { 0 };
+            }
+        }
+        // Each row and its masks as a slice of its own, exactly `w` long: indexed through an
+        // array of slices, every read was checked against a length loaded from the stack.
+        let [l0, l1, l2, l3, l4, l5] = lines;
+        let [m0, m1, m2, m3, m4, m5]: [&[u8]; 6] = std::array::from_fn(|dy| &self.masks[dy * w..(dy + 1) * w]);
+        let entries = &mut self.entries[..6 * w];
         let mut n = 0;
         for x in 0..w {
-            let px: [u8; 6] = std::array::from_fn(|dy| lines[dy][x]);
-            for (dy, &c) in px.iter().enumerate() {
-                let same = px.iter().enumerate().fold(0u8, |m, (k, &p)| m | u8::from(p == c) << k) & valid;
-                let first = (same & ((1u8 << dy) - 1) == 0) & (valid >> dy & 1 == 1);
-                self.entries[n] = u64::from(c) << 32 | (x as u64) << 8 | u64::from(same);
-                n += usize::from(first);
+            let column =
+                [(l0[x], m0[x]), (l1[x], m1[x]), (l2[x], m2[x]), (l3[x], m3[x]), (l4[x], m4[x]), (l5[x], m5[x])];
+            for (c, same) in column {
+                let kept = u32::from(same != 0);
+                entries[n] = u64::from(c) << 32 | (x as u64) << 8 | u64::from(same);
+                counts[usize::from(c)] += kept;
+                n += kept as usize;
             }
         }
         n
     }
 }
 
-/// Appends one colour's pass over a band from its covered columns (`column << 8 | sixel bits`,
-/// ascending): empty sixels (`?`) up to each covered column, runs of equal sixels as `!n`.
-/// `skips`: the bytes of each skip (see [`Band`]).
-fn push_colour_pass(out: &mut Vec<u8>, cols: &[u32], skips: &[([u8; 8], u8)]) {
+/// The most bytes one entry of a colour pass writes: a skip (`!n?`) and a run (`!nx`), each
+/// at most `!`, 20 digits and a character.
+const MAX_ENTRY_BYTES: usize = 2 * 22;
+
+/// Writes one colour's pass over a band from its covered columns (`column << 8 | sixel bits`,
+/// ascending) to the start of `buf` and says how long it is: empty sixels (`?`) up to each
+/// covered column, runs of equal sixels as `!n`. `skips`: the bytes of each skip (see
+/// [`Band`]). Written by position into a buffer long enough for the worst case, so the loop
+/// keeps its length in a register (a `Vec` that grows checked and stored its length at every
+/// push).
+fn colour_pass(buf: &mut Vec<u8>, cols: &[u32], skips: &[([u8; 8], u8)]) -> usize {
+    let most = MAX_ENTRY_BYTES * cols.len() + 8;
+    if buf.len() < most {
+        buf.resize(most, 0);
+    }
+    let buf = &mut buf[..most];
+    let mut at = 0;
     let mut next = 0usize; // the column the pass has reached
     let mut i = 0;
     while i < cols.len() {
         let (x, sixel) = ((cols[i] >> 8) as usize, cols[i] as u8);
         match skips.get(x - next) {
             Some((bytes, len)) => {
-                let at = out.len();
-                out.extend_from_slice(bytes);
-                out.truncate(at + usize::from(*len));
+                buf[at..at + 8].copy_from_slice(bytes);
+                at += usize::from(*len);
             }
-            None => push_run(out, b'?', x - next),
+            None => at += write_run(&mut buf[at..], b'?', x - next),
         }
         let mut run = 1;
         while i + run < cols.len() && cols[i + run] == cols[i] + ((run as u32) << 8) {
             run += 1;
         }
         if run < MIN_RUN {
-            let at = out.len();
-            out.extend_from_slice(&[63 + sixel; MIN_RUN]);
-            out.truncate(at + run);
+            buf[at..at + MIN_RUN].copy_from_slice(&[63 + sixel; MIN_RUN]);
+            at += run;
         } else {
-            push_run(out, 63 + sixel, run);
+            at += write_run(&mut buf[at..], 63 + sixel, run);
         }
         next = x + run;
         i += run;
     }
+    at
+}
+
+/// Writes `!n` and `ch` (a run of `n`, at least [`MIN_RUN`]) to the start of `buf` and says
+/// how many bytes.
+fn write_run(buf: &mut [u8], ch: u8, n: usize) -> usize {
+    let (digits, first) = decimal(n);
+    let len = digits.len() - first;
+    buf[0] = b'!';
+    buf[1..1 + len].copy_from_slice(&digits[first..]);
+    buf[1 + len] = ch;
+    len + 2
 }
 
 /// Appends `n` copies of the sixel character `ch`.
@@ -190,16 +250,22 @@ pub fn push_decimal(out: &mut Vec<u8>, v: usize) {
         out.push(b'0' + (v % 10) as u8);
         return;
     }
+    let (digits, first) = decimal(v);
+    out.extend_from_slice(&digits[first..]);
+}
+
+/// The decimal digits of `v`, right-aligned, and where the first is.
+fn decimal(v: usize) -> ([u8; 20], usize) {
     let mut digits = [0u8; 20];
     let mut n = v;
-    let mut i = digits.len();
+    let mut first = digits.len();
     loop {
-        i -= 1;
-        digits[i] = b'0' + (n % 10) as u8;
+        first -= 1;
+        digits[first] = b'0' + (n % 10) as u8;
         n /= 10;
         if n == 0 {
             break;
         }
     }
-    out.extend_from_slice(&digits[i..]);
+    (digits, first)
 }

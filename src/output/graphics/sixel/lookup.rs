@@ -58,6 +58,10 @@ pub struct ColourMap {
     table: Vec<u16>,
     /// The grey-axis offset for each Bayer threshold, in 8-bit levels.
     offsets: [i16; 64],
+    /// The offsets along each row of the Bayer matrix, one a channel (three a pixel).
+    row_offsets: [[i16; 3 * BAYER_SIDE]; BAYER_SIDE],
+    /// A row's channels moved by their offsets and cut to the table's bits.
+    quantized: Vec<u8>,
 }
 
 impl ColourMap {
@@ -67,7 +71,8 @@ impl ColourMap {
         let rgbs: Vec<[f32; 3]> = (0..palette.len()).map(|i| palette.rgb(i as u8).map(f32::from)).collect();
         let spread = Self::spread(&rgbs) * SPREAD_STEPS;
         let offsets = std::array::from_fn(|t| (((t as f32 + 0.5) / 64.0 - 0.5) * spread).round() as i16);
-        ColourMap { labs, rgbs, table: vec![EMPTY; 1 << (3 * BITS)], offsets }
+        let row_offsets = BAYER8.map(|row| std::array::from_fn(|k| offsets[usize::from(row[k / 3])]));
+        ColourMap { labs, rgbs, table: vec![EMPTY; 1 << (3 * BITS)], offsets, row_offsets, quantized: Vec::new() }
     }
 
     /// The palette's typical step: the median distance (luma-weighted, in 8-bit levels: a
@@ -105,6 +110,30 @@ impl ColourMap {
             EMPTY => self.fill(cell),
             reg => reg as u8,
         }
+    }
+
+    /// The registers of row `y` of a picture one pixel a screen pixel (`rgb`, 3 bytes a pixel)
+    /// into `out` (one a pixel): [`ColourMap::register`] of each pixel at its Bayer threshold,
+    /// in two passes: the channels moved and cut to the table's bits in a loop along the row
+    /// that the compiler vectorizes, then a table load a pixel (one pass doing both was scalar).
+    #[inline(always)]
+    pub fn registers_row(&mut self, rgb: &[u8], y: usize, out: &mut [u8]) {
+        let offsets = &self.row_offsets[y % BAYER_SIDE];
+        self.quantized.resize(rgb.len(), 0);
+        for (q, p) in self.quantized.chunks_mut(3 * BAYER_SIDE).zip(rgb.chunks(3 * BAYER_SIDE)) {
+            for ((q, &v), &o) in q.iter_mut().zip(p).zip(offsets) {
+                *q = ((i16::from(v) + o).clamp(0, 255) >> (8 - BITS)) as u8;
+            }
+        }
+        let quantized = std::mem::take(&mut self.quantized);
+        for (o, q) in out.iter_mut().zip(quantized.chunks_exact(3)) {
+            let cell = usize::from(q[0]) << (2 * BITS) | usize::from(q[1]) << BITS | usize::from(q[2]);
+            *o = match self.table[cell] {
+                EMPTY => self.fill(cell),
+                reg => reg as u8,
+            };
+        }
+        self.quantized = quantized;
     }
 
     /// The register nearest the centre of table cell `cell`, stored there.

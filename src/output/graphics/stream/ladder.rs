@@ -36,6 +36,24 @@ pub fn rungs(top: (u32, u32), bottom: (u32, u32)) -> Vec<(u32, u32)> {
     out
 }
 
+/// Where [`Resampler::resample_rows`] hands each row. A trait rather than a closure, so that
+/// a caller compiled for a wider instruction set can have the row's work inlined (a closure's
+/// body stayed a call, compiled for the baseline).
+pub trait RowSink {
+    /// Takes target row `y` (RGB).
+    fn row(&mut self, y: usize, row: &[u8]);
+}
+
+/// Appends every row to a picture.
+struct Append<'a>(&'a mut Vec<u8>);
+
+impl RowSink for Append<'_> {
+    #[inline(always)]
+    fn row(&mut self, _: usize, row: &[u8]) {
+        self.0.extend_from_slice(row);
+    }
+}
+
 /// A separable resampler from one size to another: a tent filter whose radius is one source
 /// pixel when enlarging (bilinear) and the scale when shrinking (an area-like average), so
 /// water neither aliases when shrunk nor blocks when enlarged. Weights are computed once per
@@ -111,7 +129,7 @@ impl Resampler {
     pub fn resample(&mut self, source: &[u8], bpp: usize, from: (u32, u32), to: (u32, u32), out: &mut Vec<u8>) {
         out.clear();
         out.reserve(to.0 as usize * to.1 as usize * 3);
-        self.resample_rows(source, bpp, from, to, |_, row| out.extend_from_slice(row));
+        self.resample_rows(source, bpp, from, to, &mut Append(out));
     }
 
     /// Resamples as [`Resampler::resample`], handing each target row (RGB, top to bottom) to
@@ -122,13 +140,14 @@ impl Resampler {
     /// The arithmetic is the same, in the same order, as one pixel at a time (each target
     /// value is `0 + w0 * s0 + w1 * s1 + ...` in f32, IEEE basic operations): only the loops
     /// are turned so the vertical pass runs along a row, which the compiler vectorizes.
+    #[inline(always)]
     pub fn resample_rows(
         &mut self,
         source: &[u8],
         bpp: usize,
         from: (u32, u32),
         to: (u32, u32),
-        mut row: impl FnMut(usize, &[u8]),
+        sink: &mut impl RowSink,
     ) {
         assert_eq!(source.len(), from.0 as usize * from.1 as usize * bpp, "source does not match {from:?}");
         let (tw, sw) = (to.0 as usize, from.0 as usize);
@@ -136,7 +155,7 @@ impl Resampler {
             for (y, line) in source.chunks_exact(sw * bpp).enumerate() {
                 self.line.clear();
                 line.chunks_exact(bpp).for_each(|p| self.line.extend_from_slice(&p[..3]));
-                row(y, &self.line);
+                sink.row(y, &self.line);
             }
             return;
         }
@@ -189,7 +208,7 @@ impl Resampler {
             }
             self.line.clear();
             self.line.extend(self.acc.iter().map(|&a| to_byte(a)));
-            row(y, &self.line);
+            sink.row(y, &self.line);
         }
     }
 }
@@ -199,7 +218,7 @@ impl Resampler {
 /// a value, about a tenth of the sixel player's CPU at the screen's size. `v + 2^23` holds
 /// `v` rounded to the nearest integer (ties to even) in its low mantissa bits; one is taken
 /// off when that rounded up, which gives the truncation `as` does.
-#[inline]
+#[inline(always)]
 #[allow(clippy::manual_clamp, reason = "max and min map NaN to 0 as the cast does; clamp keeps NaN")]
 fn to_byte(a: f32) -> u8 {
     const SHIFT: f32 = 8_388_608.0; // 2^23
