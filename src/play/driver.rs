@@ -111,7 +111,7 @@ impl Driver {
         self.player.screen.resize(size);
     }
 
-    #[cfg(any(feature = "serve", feature = "testing", test))]
+    #[cfg(feature = "serve")]
     /// A new picture is there to draw ([`Pacing::Pictures`]).
     pub fn handle_picture(&mut self) {
         self.fresh = true;

@@ -80,13 +80,13 @@ pub use session::{Session, SessionEvent};
 
 // The pieces the doors (the terminal door, `tidepool serve`) assemble a session from: the
 // crate's, not the API's (a library user drives a [`Session`]).
-#[cfg(any(feature = "serve", feature = "testing"))]
+#[cfg(feature = "serve")]
 pub(crate) use driver::{Driver, DriverEvent, Pacing};
-#[cfg(any(feature = "serve", feature = "testing"))]
+#[cfg(feature = "serve")]
 pub(crate) use fit::Fit;
 #[cfg(any(feature = "cli", feature = "testing"))]
 pub(crate) use host::Host;
-#[cfg(any(feature = "serve", feature = "testing"))]
+#[cfg(feature = "serve")]
 pub(crate) use host::SceneStatus;
 #[cfg(any(feature = "cli", feature = "testing"))]
 pub(crate) use player::Player;

@@ -52,6 +52,7 @@ pub(crate) fn session(t0: Instant, script: &[(u32, &[u8])], frames: u32) -> Vec<
 }
 
 /// One step of a session whose pictures come from elsewhere (`tidepool serve`'s pacing).
+#[cfg(feature = "serve")]
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum Step {
     /// The terminal sends these bytes.
@@ -62,6 +63,7 @@ pub(crate) enum Step {
 
 /// The instant a door whose timers count whole milliseconds from `t0` (tokio's) wakes for a
 /// deadline at `t`: the next whole millisecond.
+#[cfg(feature = "serve")]
 fn on_the_millisecond(t0: Instant, t: Instant) -> Instant {
     let nanos = t.saturating_duration_since(t0).as_nanos().div_ceil(1_000_000);
     t0 + Duration::from_millis(u64::try_from(nanos).unwrap_or(u64::MAX))
@@ -74,6 +76,7 @@ fn on_the_millisecond(t0: Instant, t: Instant) -> Instant {
 /// always free. Returns every byte handed out (the screen's farewell last, once the person
 /// quits) and the requests for the host. A deadline at a step's very millisecond would leave
 /// the order to the door's scheduling: the script must not put one there (checked).
+#[cfg(feature = "serve")]
 pub(crate) fn pictured_session(
     t0: Instant,
     player: Player,
