@@ -120,12 +120,10 @@ fn openssh_without_keys_sees_the_pool_drops_a_stone_and_q_restores_its_terminal(
     let mut ssh = Ssh::spawn(s.port, home.path(), &["localhost"]);
     ssh.wait_for("\x1b[?1049h");
     ssh.wait_for("1 playing");
-    ssh.writer.lock().unwrap().write_all(b" ").unwrap();
-    ssh.writer.lock().unwrap().flush().unwrap();
+    ssh.press(b" ");
     // The stone reaches the shared scene: the game logs each applied action at exit.
     ssh.wait_for("\x1b[?2026h");
-    ssh.writer.lock().unwrap().write_all(b"q").unwrap();
-    ssh.writer.lock().unwrap().flush().unwrap();
+    ssh.press(b"q");
     let code = ssh.finish();
     let text = ssh.text();
     let auth = text.lines().find(|l| l.contains("Authenticated to")).unwrap_or("").trim().to_string();
@@ -154,8 +152,7 @@ fn compression_asked_of(server_flags: &[&str]) -> (String, bool) {
     let home = tempfile::tempdir().unwrap();
     let mut ssh = Ssh::spawn(s.port, home.path(), &["-C", "localhost"]);
     ssh.wait_for("1 playing");
-    ssh.writer.lock().unwrap().write_all(b"q").unwrap();
-    ssh.writer.lock().unwrap().flush().unwrap();
+    ssh.press(b"q");
     assert_eq!(ssh.finish(), 0);
     let text = ssh.text();
     let kex = text.lines().find(|l| l.contains("kex: server->client cipher")).unwrap_or("").trim().to_string();
@@ -183,17 +180,15 @@ fn session_bytes(extra: &[&str], size: (u16, u16), secs: u64) -> u64 {
     let mut ssh = Ssh::spawn_sized(s.port, home.path(), &args, size);
     ssh.wait_for("1 playing");
     // Rain, and a stone every second: busy water, the same keys at the same times.
-    ssh.writer.lock().unwrap().write_all(b"r").unwrap();
+    ssh.press(b"r");
     for _ in 0..secs {
-        ssh.writer.lock().unwrap().write_all(b" ").unwrap();
-        ssh.writer.lock().unwrap().flush().unwrap();
+        ssh.press(b" ");
         let until = Instant::now() + Duration::from_secs(1);
         while let Ok(chunk) = ssh.rx.recv_timeout(until.saturating_duration_since(Instant::now())) {
             ssh.seen.extend_from_slice(&chunk);
         }
     }
-    ssh.writer.lock().unwrap().write_all(b"q").unwrap();
-    ssh.writer.lock().unwrap().flush().unwrap();
+    ssh.press(b"q");
     assert_eq!(ssh.finish(), 0);
     let (_, log) = s.stop(15);
     socket_bytes_out(&log)

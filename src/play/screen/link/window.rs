@@ -35,7 +35,7 @@ impl LinkControl {
     /// The window: the bytes that may be unanswered for at `now` (holds and bytes in flight
     /// aside); the first window until an answer has measured the link's capacity.
     pub(super) fn window(&self, now: Instant) -> u64 {
-        if self.answered && self.capacity.is_some() {
+        if self.measured() {
             // The bandwidth-delay product: one question at a time, so two round trips (each
             // with the queue the window allows) and a frame; never below what the rate sends
             // in that time, and the link's capacity as seen, not a rate still growing past it.
@@ -51,6 +51,12 @@ impl LinkControl {
         }
     }
 
+    /// Whether an answer has measured the link's capacity (the window is then its
+    /// bandwidth-delay product, and bounded in time too).
+    fn measured(&self) -> bool {
+        self.answered && self.capacity.is_some()
+    }
+
     /// The time the window is sized for: one question at a time, so two round trips (each
     /// with the queue the window allows) and a frame.
     fn window_time(&self) -> Duration {
@@ -63,9 +69,7 @@ impl LinkControl {
     /// one too: its replacement would let another window's time of frames go each second.
     fn waited_past_window(&self, now: Instant) -> bool {
         let time = self.window_time();
-        self.answered
-            && self.capacity.is_some()
-            && self.questions.iter().any(|q| !q.foreign && now.saturating_duration_since(q.asked) > time)
+        self.measured() && self.questions.iter().any(|q| !q.foreign && now.saturating_duration_since(q.asked) > time)
     }
 
     /// Whether a question should follow even a frame that wrote nothing, `bytes_sent`
