@@ -155,6 +155,15 @@ pub const FOREIGN_WAIT: Duration = Duration::from_secs(1);
 pub const GIVE_UP: Duration = Duration::from_secs(10);
 /// Questions remembered at most (one link question at a time, overdue ones, foreign ones).
 const MAX_QUESTIONS: usize = 8;
+/// What the terminal took between answers, remembered for the capacity (the most of them
+/// within [`CAPACITY_MEMORY`]).
+const RECENT_TAKES: usize = 8;
+/// How long a take still counts for the capacity when a standing queue measures it anew: one
+/// answer's take is low when that answer was read late (a loaded machine, a terminal busy
+/// drawing), and a window cut to it let the sender take less, and the next take less again.
+/// Half a second: a link that truly slows is followed within it (a terminal reading at half
+/// speed kept its queue's p90 under 200 ms).
+const CAPACITY_MEMORY: Duration = Duration::from_millis(500);
 /// Round trips remembered for the base (the shortest of them).
 const BASE_SAMPLES: usize = 16;
 
@@ -188,8 +197,15 @@ pub struct LinkControl {
     questions: Questions,
     /// The last answer: when it came and the bytes its question followed.
     last_answer: Option<(Instant, u64)>,
-    /// What the terminal was last seen to take, bytes per second.
+    /// What the terminal was seen to take between the last two answers, bytes per second.
     delivered: Option<f64>,
+    /// What it was seen to take the interval before: a late answer (a terminal busy drawing,
+    /// a player whose machine is loaded and reads it late) stretches its own interval, not
+    /// the one before it.
+    delivered_before: Option<f64>,
+    /// The last takes and when they were measured ([`CAPACITY_MEMORY`]).
+    recent_takes: [Option<(Instant, f64)>; RECENT_TAKES],
+    take_count: usize,
     /// What the link can carry, bytes per second, for the window: what the terminal took while
     /// a queue stood (then the link was the limit), else the most it was seen to take (still
     /// water takes little and must not shrink the window).
@@ -258,6 +274,9 @@ impl LinkControl {
             questions: Questions { list: [None; MAX_QUESTIONS], len: 0 },
             last_answer: None,
             delivered: None,
+            delivered_before: None,
+            recent_takes: [None; RECENT_TAKES],
+            take_count: 0,
             capacity: None,
             samples: [Duration::ZERO; BASE_SAMPLES],
             sample_count: 0,
@@ -386,7 +405,7 @@ impl LinkControl {
         .filter(|&(dt, _)| dt > 0.0)
         .map(|(dt, b)| b as f64 / dt);
         if let Some(rate) = took.filter(|_| self.last_answer.is_some() && !app_limited) {
-            self.delivered = Some(rate);
+            self.delivered_before = self.delivered.replace(rate);
         }
         if took.is_some() || self.last_answer.is_none() {
             self.last_answer = Some((now, bytes));
@@ -447,8 +466,16 @@ impl LinkControl {
                 // standing one (two answers over the mark in a row): its late answers must not
                 // shrink the window to one frame's take.
                 Some(c) if !(over && (was_over || !slow_terminal)) => c.max(took),
-                _ => took,
+                _ => self
+                    .recent_takes
+                    .iter()
+                    .flatten()
+                    .filter(|(at, _)| now.saturating_duration_since(*at) <= CAPACITY_MEMORY)
+                    .map(|(_, t)| *t)
+                    .fold(took, f64::max),
             });
+            self.recent_takes[self.take_count % RECENT_TAKES] = Some((now, took));
+            self.take_count += 1;
         }
         if !self.path.answered_at_far_end() {
             // The answers come from this side of the link (a multiplexer, mosh-server): they
@@ -490,8 +517,11 @@ impl LinkControl {
         let not_draining = last_queue.is_none_or(|(last, _)| link_queue >= last);
         // One answer alone confirms a queue only when the bytes in flight explain it: a single
         // late answer is the terminal's (kitty 0.26 under llvmpipe took up to a second now and
-        // then), never a collapse of the link.
-        let confirmed = was_over || (link_queue > 2 * QUEUE_HIGH_MIN && explained);
+        // then), never a collapse of the link. That holds for a terminal not found slow on
+        // its own too: a loaded machine reads answers late whatever the terminal (a slow
+        // kitty's rate fell to the floor by one late answer in four).
+        let bytes_explain = 2 * question.in_flight >= link_queue;
+        let confirmed = was_over || (link_queue > 2 * QUEUE_HIGH_MIN && explained && bytes_explain);
         // A sender that left its budget unspent cannot have built a queue of a few marks: only
         // a deep one lowers the rate then.
         let caused = !app_limited || link_queue > 2 * high;
@@ -502,7 +532,13 @@ impl LinkControl {
             // a standing queue of its own making) never takes the rate under a quarter of the
             // link seen: kitty 0.26 stalling under load fell to 4 kB/s on a 250 kB/s link.
             let floor = if explained { MIN_RATE } else { self.capacity.map_or(SAFE_RATE, |c| c * 0.25).max(SAFE_RATE) };
-            self.fall(now, if link_queue > 2 * high { DEEP_DRAIN_SHARE } else { DRAIN_SHARE }, floor);
+            let deep = link_queue > 2 * high;
+            // What the terminal took measures the link only when a queue stood from the
+            // interval's start: else the sender set it (the rate, or less), and a fall to a
+            // share of it is a fall to a share of the rate, again at every late answer (a
+            // loaded machine's late reads took a slow kitty from 75 to 3 kB/s in 8 s).
+            let stood = last_queue.is_some_and(|(last, _)| last >= low);
+            self.fall(now, if deep { DEEP_DRAIN_SHARE } else { DRAIN_SHARE }, floor, stood);
             Change::Down
         } else if link_queue < low && self.rate < self.ceiling {
             // Only a sender that used its budget learns that the link carries more: one that
@@ -518,9 +554,14 @@ impl LinkControl {
         }
     }
 
-    /// Lowers the rate to under what the terminal was seen to take, never under `floor`.
-    fn fall(&mut self, now: Instant, share: f64, floor: f64) {
-        let target = match self.delivered {
+    /// Lowers the rate to under what the terminal was seen to take (`measured`: while a queue
+    /// stood, so the link set it), else by [`DRAIN_SHARE`]; never under `floor`.
+    fn fall(&mut self, now: Instant, share: f64, floor: f64, measured: bool) {
+        let delivered = self.delivered.map(|d| d.max(self.delivered_before.unwrap_or(0.0)));
+        let target = match delivered {
+            // Far under the rate, though, the link (or the terminal) is the limit whatever
+            // stood before: a start rate far over a slow link comes down at once.
+            Some(d) if !measured && d >= self.rate * 0.5 => self.rate * DRAIN_SHARE,
             // Under what the link was seen to carry (an estimate from two answers, so never
             // below a quarter of the rate in one fall: a rate far over the link comes down in
             // one or two round trips), and never up.
@@ -583,7 +624,7 @@ impl LinkControl {
             return Change::Down;
         }
         if lost {
-            self.fall(now, DRAIN_SHARE, MIN_RATE);
+            self.fall(now, DRAIN_SHARE, MIN_RATE, true);
             Change::Down
         } else {
             Change::Hold
