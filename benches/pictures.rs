@@ -25,6 +25,7 @@
 //!     PICTURES=table PICTURES_MODES=sixel,cells cargo bench --bench pictures   # some modes
 //!     PICTURES=cpu cargo bench --bench pictures
 //!     PICTURES=table PICTURES_PHASE=4 cargo bench --bench pictures   # SSIM on sixel's frames
+//!     PICTURES=table PICTURES_RATES=4e6,8e6,unlimited cargo bench --bench pictures   # other rates
 
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -57,6 +58,18 @@ const STEPS_PER_FRAME: u64 = 2;
 /// SSIM every this many frames.
 const SAMPLE_EVERY: usize = 6;
 const RATES: [Option<f64>; 4] = [Some(50e3), Some(250e3), Some(2e6), None];
+
+/// The rates the table is made at: [`RATES`] unless `PICTURES_RATES` lists others (bytes a
+/// second, comma-separated, `unlimited` for no limit), to find where a mode overtakes cells.
+fn rates() -> Vec<Option<f64>> {
+    let Ok(list) = std::env::var("PICTURES_RATES") else { return RATES.to_vec() };
+    list.split(',')
+        .map(|r| match r.trim() {
+            "unlimited" => None,
+            r => Some(r.parse::<f64>().unwrap_or_else(|_| panic!("PICTURES_RATES: {r:?} is not bytes a second"))),
+        })
+        .collect()
+}
 const MODES: [&str; 4] = ["kitty", "sixel", "iterm2", "cells"];
 
 /// The fixture at the pixel modes' scene size: one picture per frame.
@@ -367,7 +380,7 @@ fn table() {
     println!("| rate | mode | pictures/s | sent kB/s | mean SSIM | 5th pct SSIM | median ms/frame | last rung |");
     println!("|---|---|---|---|---|---|---|---|");
     let mut picks = Vec::new();
-    for rate in RATES {
+    for rate in rates() {
         let mut means = Vec::new();
         let label = rate.map_or("unlimited".to_string(), |r| format!("{:.0} kB/s", r / 1000.0));
         let only = std::env::var("PICTURES_MODES").unwrap_or_default();

@@ -14,6 +14,7 @@ use std::time::Instant;
 
 use tiny_skia::Pixmap;
 
+use super::link::START_RATE;
 use super::probe::{GraphicsChoice, GraphicsSupport};
 use crate::output::diff::{SYNC_BEGIN, SYNC_END};
 use crate::output::graphics::GraphicsMode;
@@ -214,6 +215,10 @@ pub fn switch_notice(pixels: GraphicsMode, to: GraphicsMode, rate: Option<f64>) 
     }
     match to {
         GraphicsMode::Cells if at.is_empty() => format!("{} over a link: half-block cells are truer", pixels.name()),
+        // Cells at no limit: the start on a link still to be measured, below the crossover.
+        GraphicsMode::Cells if rate.is_none() => {
+            format!("{} over a link: half-block cells are truer below {at}", pixels.name())
+        }
         GraphicsMode::Cells => format!("link {link}: half-block cells (truer than {} below {at})", pixels.name()),
         _ => format!("link {link}: pixels again"),
     }
@@ -224,8 +229,10 @@ pub fn switch_notice(pixels: GraphicsMode, to: GraphicsMode, rate: Option<f64>) 
 /// its pictures do not cross the link: it keeps them whatever the rate is measured at (see
 /// [`AutoSwitch::local`]).
 ///
-/// A protocol that never beats cells over a link (sixel: no crossover) starts in cells when
-/// the link will be measured: its pictures would only show for the seconds before the switch.
+/// A link still to be measured starts in the truer mode at the rate its measure starts from
+/// ([`START_RATE`]): kitty and iTerm2 (crossovers below it) with pixels, sixel (its crossover is
+/// tens of MB/s) with cells, and the switch moves to pixels once the link is measured past the
+/// crossover; pictures started there would only show for the seconds before the switch.
 pub fn auto_switch(
     choice: &GraphicsChoice,
     support: &GraphicsSupport,
@@ -234,8 +241,8 @@ pub fn auto_switch(
 ) -> AutoSwitch {
     if choice.mode == GraphicsMode::Kitty && support.kitty_temp_file && !choice.tmux_wrap {
         AutoSwitch::local(choice.mode)
-    } else if crossover(choice.mode).is_none() && measured {
-        AutoSwitch::new(choice.mode, Some(0.0))
+    } else if measured {
+        AutoSwitch::new(choice.mode, Some(START_RATE))
     } else {
         AutoSwitch::new(choice.mode, known)
     }

@@ -9,6 +9,7 @@
 
 use std::time::{Duration, Instant};
 
+use super::encode::FULL_PALETTE_RATE;
 use crate::output::graphics::GraphicsMode;
 
 /// The link rate (bytes per second) above which each protocol's pictures score a higher SSIM
@@ -27,13 +28,13 @@ pub fn crossover(mode: GraphicsMode) -> Option<f64> {
 /// measured, kitty already scored SSIM 0.583 against the cells' 0.519 (250 kB/s: 0.603), so the
 /// crossover is at or below it; 50 kB/s is taken until lower rates are measured.
 const KITTY_CROSSOVER: f64 = 50_000.0;
-/// sixel has no crossover: in `cargo bench --bench pictures` it loses to cells at every rate,
-/// with the fitted palette too (SSIM 0.47 against 0.52 at 50 kB/s, 0.54/0.58 at 250 kB/s,
-/// 0.58/0.63 at 2 MB/s, unlimited 0.52/0.67 measured a frame after the 15-a-second picture
-/// and 0.89 on its own frames; docs/pixels/sixel-palette.md): under a rate its bytes keep it
-/// on the bottom rung. A local terminal keeps it (no rate: the person asked for pixels by
-/// having them).
-const SIXEL_CROSSOVER: Option<f64> = None;
+/// sixel's crossover, bytes per second: it wins only where its pictures are the screen's own
+/// size with the terminal's whole palette, as without a rate (SSIM over time 0.706 against the
+/// cells' 0.671 unlimited, the mean of the frames it draws, 0.894, and the frames between,
+/// 0.518), which it fits from [`FULL_PALETTE_RATE`] on. Below it cells: 0.58 against 0.63 at 2
+/// MB/s, 0.61/0.66 at 4 MB/s, 0.57/0.67 at 8 MB/s, 0.64/0.67 at 16-24 MB/s (32 colours; the
+/// pictures cost more bytes a pixel than cells' half blocks); docs/pixels/cpu.md, Round 5.
+const SIXEL_CROSSOVER: Option<f64> = Some(FULL_PALETTE_RATE);
 /// iTerm2's crossover, bytes per second: JPEG won at 50 kB/s (0.604 against 0.519) and at
 /// 250 kB/s (0.664).
 const ITERM2_CROSSOVER: f64 = 50_000.0;
@@ -136,15 +137,33 @@ mod tests {
 
     #[test]
     fn locally_pixels_and_on_a_slow_link_cells() {
-        assert_eq!(truer_mode(GraphicsMode::Sixel, Some(100e6)), GraphicsMode::Cells, "sixel never won under a rate");
         assert_eq!(truer_mode(GraphicsMode::Sixel, None), GraphicsMode::Sixel, "locally pixels");
-        for mode in [GraphicsMode::Kitty, GraphicsMode::Iterm2] {
+        for mode in [GraphicsMode::Kitty, GraphicsMode::Iterm2, GraphicsMode::Sixel] {
             let at = crossover(mode).unwrap();
             assert_eq!(truer_mode(mode, None), mode);
             assert_eq!(truer_mode(mode, Some(at * 2.0)), mode);
             assert_eq!(truer_mode(mode, Some(at / 2.0)), GraphicsMode::Cells);
         }
         assert_eq!(truer_mode(GraphicsMode::Cells, None), GraphicsMode::Cells);
+    }
+
+    /// The pictures bench's table (docs/pixels/cpu.md, Round 5): sixel loses to cells at every
+    /// rate it was measured at below 32 MB/s and wins from there (its whole palette, as
+    /// unlimited).
+    #[test]
+    fn sixel_wins_where_the_pictures_bench_measured_it_winning() {
+        for rate in [50e3, 250e3, 2e6, 4e6, 8e6, 16e6, 24e6] {
+            assert_eq!(truer_mode(GraphicsMode::Sixel, Some(rate)), GraphicsMode::Cells, "{rate} B/s");
+        }
+        for rate in [32e6, 48e6] {
+            assert_eq!(truer_mode(GraphicsMode::Sixel, Some(rate)), GraphicsMode::Sixel, "{rate} B/s");
+        }
+        // A link measured past the crossover (with the margin) leaves cells for sixel.
+        let t0 = Instant::now();
+        let mut auto = AutoSwitch::new(GraphicsMode::Sixel, Some(2e6));
+        assert_eq!(auto.mode(), GraphicsMode::Cells);
+        assert_eq!(auto.update(Some(48e6), t0).0, GraphicsMode::Cells, "not before HOLD");
+        assert_eq!(auto.update(Some(48e6), t0 + AutoSwitch::HOLD), (GraphicsMode::Sixel, true));
     }
 
     #[test]

@@ -12,10 +12,25 @@ use crate::output::graphics::sixel::SixelEncoder;
 use crate::output::graphics::{iterm2, scan};
 use crate::simd::{Simd, Tier};
 
-/// The most colours a sixel palette fitted under a rate has (without a rate: the terminal's
-/// registers, up to 256). 32 scored 0.474 at 50 kB/s against 256's 0.434, and within 0.015 of
-/// it above (`benches/pictures.rs`).
+/// The most colours a sixel palette fitted under a rate below [`FULL_PALETTE_RATE`] has
+/// (without a rate, or above it: the terminal's registers, up to 256). 32 scored 0.474 at 50
+/// kB/s against 256's 0.434, and within 0.015 of it above (`benches/pictures.rs`).
 const LIMITED_COLOURS: u16 = 32;
+
+/// The rate (bytes a second) from which a sixel stream fits the terminal's whole palette, as
+/// without a rate: the screen-sized pictures with 256 colours average 28.7 MB/s at 15 a second
+/// in `benches/pictures.rs`, so from 32 MB/s they go as they would unlimited (SSIM 0.706 over
+/// time there, the cells' 0.671). Below it 32 colours: at 16-24 MB/s the same pictures with 32
+/// colours took 12.9 MB/s and scored 0.642 (docs/pixels/cpu.md, Round 5).
+pub(super) const FULL_PALETTE_RATE: f64 = 32e6;
+
+/// The colours a sixel palette is fitted with under `rate` (`None`: no limit).
+fn sixel_colours(rate: Option<f64>) -> u16 {
+    match rate {
+        Some(r) if r < FULL_PALETTE_RATE => LIMITED_COLOURS,
+        _ => u16::MAX,
+    }
+}
 
 impl PictureStream {
     /// Fills the candidate with its mean colour.
@@ -33,7 +48,9 @@ impl PictureStream {
 
     /// Encodes `picture` at `rung` into `self.bytes` (whole, or the changed box when that is
     /// cheaper) and its pixels into `self.candidate`; `None` when the terminal shows it already.
-    pub(super) fn encode(&mut self, picture: &Pixmap, rung: usize, limited: bool) -> Option<Part> {
+    /// `rate`: the budget's (`None`: no limit).
+    pub(super) fn encode(&mut self, picture: &Pixmap, rung: usize, rate: Option<f64>) -> Option<Part> {
+        let limited = rate.is_some();
         let size = self.rungs[rung];
         let from = (picture.width(), picture.height());
         self.bytes.clear();
@@ -45,7 +62,7 @@ impl PictureStream {
             // Under a rate, fewer colours: every register an image uses is defined in it and
             // costs a pass over each band, and a tile on a slow link must fit a few hundred
             // bytes.
-            let colours = if limited { LIMITED_COLOURS } else { u16::MAX };
+            let colours = sixel_colours(rate);
             if sixel.fit_to(picture.data(), 4, colours) {
                 self.shown = None;
             }

@@ -400,7 +400,7 @@ impl PictureStream {
         let mut rung = self.rung;
         let part = loop {
             // Unchanged: nothing to send, and nothing owed.
-            let Some(part) = self.encode(picture, rung, limited) else {
+            let Some(part) = self.encode(picture, rung, budget.rate) else {
                 self.next_due = Some(now + interval);
                 return None;
             };

@@ -383,3 +383,24 @@ fn a_local_sixel_terminal_gets_whole_pictures_at_full_resolution_and_over_a_link
     assert_eq!(forced.mode(), GraphicsMode::Sixel);
     assert!(forced.rate().is_some());
 }
+
+#[test]
+fn auto_draws_sixel_from_its_crossover_and_cells_below_it() {
+    // The pictures bench's table: sixel is truer than cells only with its whole palette at the
+    // screen's size (from its crossover); at 2 MB/s cells.
+    let t0 = Instant::now();
+    let at = crossover(GraphicsMode::Sixel).expect("sixel wins from a measured rate");
+    let mut slow = screen(config(Bandwidth::Fixed(2_000_000), GraphicsRequest::Auto), SIXEL, t0);
+    assert_eq!(slow.mode(), GraphicsMode::Cells);
+    let notice = slow.take_notice().unwrap();
+    assert!(notice.contains("half-block cells (truer than sixel below 32.00 MB/s)"), "{notice}");
+    let mut fast = screen(config(Bandwidth::Fixed(at as u64), GraphicsRequest::Auto), SIXEL, t0);
+    assert_eq!(fast.mode(), GraphicsMode::Sixel);
+    let _ = fast.take_notice();
+    // Whole screen-sized pictures there, as without a limit.
+    let water = Water::new(fast.picture_size(), 4);
+    let images: usize =
+        (1..=4u32).map(|n| count(&frame(&mut fast, &water, n as usize, t0 + FRAME * (2 * n)), b"\x1bP")).sum();
+    assert!(images >= 2, "{images} sixel images in four frames");
+    assert_eq!(fast.picture.as_ref().unwrap().state().size, (1280, 750), "the top rung");
+}
