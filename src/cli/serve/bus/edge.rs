@@ -196,8 +196,9 @@ impl Said {
 fn take_incoming(pool: &mut Lockstep, bus: &mut EdgeLinks, pending: &mut Pending, now: Instant) {
     while let Ok(message) = bus.incoming.try_recv() {
         match message {
-            Incoming::Entry { seq, bytes } => match pool.receive(seq, &bytes, now) {
-                Ok(()) => {
+            Incoming::Entry { seq, bytes } => match (seq > pool.last_seq(), pool.receive(seq, &bytes, now)) {
+                (false, Ok(())) => {} // delivered again after a reconnect
+                (true, Ok(())) => {
                     // Read again (checked already): which of this edge's requests it settles.
                     if let Ok(tick) = serde_json::from_slice::<protocol::Tick>(&bytes) {
                         pending.taken(seq, &tick);
@@ -206,12 +207,12 @@ fn take_incoming(pool: &mut Lockstep, bus: &mut EdgeLinks, pending: &mut Pending
                         }
                     }
                 }
-                Err(Missed::Gap { expected, got }) => {
+                (_, Err(Missed::Gap { expected, got })) => {
                     eprintln!("bus: log entry {got} came after {}; joining again from a snapshot", expected - 1);
                     bus.state.joined.store(false, Ordering::Relaxed);
                     let _ = bus.outgoing.try_send(Outgoing::Rejoin);
                 }
-                Err(Missed::Bad(why)) => {
+                (_, Err(Missed::Bad(why))) => {
                     bus.state.bad_entries.fetch_add(1, Ordering::Relaxed);
                     eprintln!("bus: log entry {seq} skipped (every edge skips it): {why}");
                 }

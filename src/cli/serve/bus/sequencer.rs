@@ -224,10 +224,14 @@ impl Sequencer {
             last: now,
         });
         player.last = now;
+        // A request sent again is not charged to its player: its first send may have been,
+        // by this term or the last, and a takeover's resends come in a burst. The edge's rate
+        // and the pool's still hold (a player's rate never held against a hostile edge, which
+        // may name as many players as it likes).
         let allowed = if submit.what.is_scene_key() {
-            player.scene_keys.try_take(1.0, now) && self.pool_keys.try_take(1.0, now)
+            (submit.again || player.scene_keys.try_take(1.0, now)) && self.pool_keys.try_take(1.0, now)
         } else {
-            player.actions.try_take(1.0, now)
+            submit.again || player.actions.try_take(1.0, now)
         };
         if !allowed {
             return Err(Refusal(format!("player {}/{} is over a rate", submit.edge, submit.player)));
