@@ -12,14 +12,14 @@ use std::collections::{BTreeSet, HashMap};
 use std::time::{Duration, Instant};
 
 use super::protocol::{RequestId, Submit};
-use super::sequencer::MAX_EDGES;
 
 /// Ids kept for one run of an edge. The edge keeps at most 512 requests for at most 10 s
 /// (`pending.rs`); an id stays here from its stamp until the edge's floor passes it, which a
 /// fast edge (3,000 requests a second, the sequencer's bound) moves within a few ticks.
 pub const MAX_IDS_PER_RUN: usize = 4096;
-/// Runs kept (an edge restarted gets a new run; the old one goes quiet).
-pub const MAX_RUNS: usize = 2 * MAX_EDGES;
+/// Runs kept: twice the sequencer's 256 edges (an edge restarted gets a new run; the old one
+/// goes quiet).
+pub const MAX_RUNS: usize = 512;
 /// A run quiet this long may be forgotten: its edge keeps nothing that old (10 s at most).
 const RUN_FORGET: Duration = Duration::from_secs(60);
 
