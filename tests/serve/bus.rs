@@ -20,6 +20,9 @@ use tokio::sync::mpsc;
 
 use crate::common::*;
 
+/// Requests kept until the log has them: none lost while the role moves, none applied twice.
+mod requests;
+
 /// The tests' ports: `TIDEPOOL_BUS_TEST_PORTS` (`FIRST-LAST`), the bus tests' 42000-42999 when
 /// unset (the binary's own bus test reads the same).
 fn ports() -> std::ops::Range<u16> {
@@ -214,11 +217,16 @@ pub struct Edge {
 
 impl Edge {
     pub fn start(url: &str, pool: &str, name: &str) -> Edge {
+        Edge::start_env(url, pool, name, &[])
+    }
+
+    /// As [`Edge::start`], with `env` added to the edge's environment.
+    pub fn start_env(url: &str, pool: &str, name: &str, env: &[(&str, &str)]) -> Edge {
         let shots = tempfile::tempdir().unwrap().keep();
         let mut args: Vec<&str> = WATER.to_vec();
         let shots_arg = shots.to_str().unwrap().to_owned();
         args.extend(["--bus", url, "--pool", pool, "--bus-edge", name, "--bus-shots", &shots_arg]);
-        let server = Server::start(&args);
+        let server = Server::start_env(&args, env);
         Edge { server, shots, name: name.into() }
     }
 

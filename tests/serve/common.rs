@@ -38,16 +38,27 @@ pub struct Server {
 impl Server {
     /// Starts the server with `args` added to `--listen 127.0.0.1:0 --host-key DIR/host_key`.
     pub fn start(args: &[&str]) -> Server {
+        Server::start_env(args, &[])
+    }
+
+    /// As [`Server::start`], with `env` added to the server's environment.
+    pub fn start_env(args: &[&str], env: &[(&str, &str)]) -> Server {
         let dir = tempfile::tempdir().unwrap();
-        let mut server = Server::start_in(dir.path(), args);
+        let mut server = Server::start_in_env(dir.path(), args, env);
         server.own_dir = Some(dir);
         server
     }
 
     /// As [`Server::start`], with the host key in `dir`.
     pub fn start_in(dir: &Path, args: &[&str]) -> Server {
+        Server::start_in_env(dir, args, &[])
+    }
+
+    /// As [`Server::start_in`], with `env` added to the server's environment.
+    pub fn start_in_env(dir: &Path, args: &[&str], env: &[(&str, &str)]) -> Server {
         let key = dir.join("host_key");
         let mut child = Command::new(env!("CARGO_BIN_EXE_tidepool"))
+            .envs(env.iter().copied())
             .args(["serve", "--listen", "127.0.0.1:0", "--host-key"])
             .arg(&key)
             .args(args)

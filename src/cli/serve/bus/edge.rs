@@ -15,11 +15,14 @@ use tiny_skia::Pixmap;
 use tokio::sync::{Notify, mpsc, oneshot};
 
 use super::lockstep::{Lockstep, Missed};
-use super::protocol::{self, Submit};
+use super::pending::{MAX_AGE, MAX_WAITING, Pending, PendingCounts};
+use super::protocol;
 use crate::cli::serve::game::{GameLinks, Publisher, with_players};
 
 /// The longest the thread sleeps before looking at the bus and the stop flag again.
 const NAP: Duration = Duration::from_millis(5);
+/// How often the requests not yet in the log are looked at for sending again.
+const RESEND_CHECK: Duration = Duration::from_millis(50);
 /// Most screenshots one edge saves while it runs (players press `s`; the disk is not theirs).
 pub const MAX_SHOTS: u32 = 1000;
 
@@ -59,7 +62,7 @@ pub struct BusState {
     pub leading: AtomicBool,
     /// The edge has its copy of the pool (from a snapshot or the log's start).
     pub joined: AtomicBool,
-    /// Requests not sent because the bus was away or the queue to it was full.
+    /// Requests not taken because the bus was away (the status line says stones are off).
     pub dropped: AtomicU64,
     /// Log entries skipped as malformed.
     pub bad_entries: AtomicU64,
@@ -112,7 +115,10 @@ pub fn run(scene: PoolScene, fps: u32, links: GameLinks, mut bus: EdgeLinks) {
     let frame_period = Duration::from_secs_f64(1.0 / f64::from(fps.max(1)));
     let mut next_frame = Instant::now();
     let mut publisher = Publisher::default();
-    let mut sent = 0u64;
+    // A number no earlier run of this edge's name used: a restarted edge counts anew.
+    let mut pending = Pending::new(&bus.edge, unix_us() as u64);
+    let mut said = Said::default();
+    let mut next_resend = Instant::now();
     let mut shots_left = MAX_SHOTS;
     let mut requests = links.requests;
     let links = GameLinks { requests: mpsc::channel(1).1, ..links };
@@ -125,15 +131,22 @@ pub fn run(scene: PoolScene, fps: u32, links: GameLinks, mut bus: EdgeLinks) {
                 bus.state.dropped.fetch_add(1, Ordering::Relaxed);
                 continue;
             }
-            sent += 1;
-            let bytes = protocol::bytes_of(&Submit { edge: bus.edge.clone(), player, n: sent, what });
-            if bus.outgoing.try_send(Outgoing::Submit(bytes)).is_err() {
-                bus.state.dropped.fetch_add(1, Ordering::Relaxed);
-            } else if bus.trace {
-                eprintln!("bus-trace sent {} {sent} {}", bus.edge, unix_us());
+            // Kept until the log has it: a full queue to the bus's task only delays it.
+            let bytes = pending.send(player, what, now);
+            if bus.outgoing.try_send(Outgoing::Submit(bytes)).is_ok() && bus.trace {
+                eprintln!("bus-trace sent {} {} {}", bus.edge, pending.last(), unix_us());
             }
         }
-        take_incoming(&mut pool, &mut bus, now);
+        take_incoming(&mut pool, &mut bus, &mut pending, now);
+        if bus.state.note().is_none() && now >= next_resend {
+            next_resend = now + RESEND_CHECK;
+            for bytes in pending.due(now) {
+                if bus.outgoing.try_send(Outgoing::Submit(bytes)).is_err() {
+                    break;
+                }
+            }
+        }
+        said.say(&pending, now);
         if now >= next_frame {
             next_frame = (next_frame + frame_period).max(now);
             let shots = bus.shots.clone();
@@ -149,22 +162,57 @@ pub fn run(scene: PoolScene, fps: u32, links: GameLinks, mut bus: EdgeLinks) {
     }
 }
 
+/// The edge's log of its requests sent again and given up: at most a line of each a second.
+#[derive(Default)]
+struct Said {
+    told: PendingCounts,
+    next: Option<Instant>,
+}
+
+impl Said {
+    fn say(&mut self, pending: &Pending, now: Instant) {
+        if self.next.is_some_and(|t| now < t) {
+            return;
+        }
+        self.next = Some(now + Duration::from_secs(1));
+        let (c, t) = (pending.counts(), self.told);
+        if c.resent > t.resent {
+            eprintln!("bus: sent {} requests again ({} not in the log yet)", c.resent - t.resent, pending.len());
+        }
+        let (full, old, rejoin) =
+            (c.dropped_full - t.dropped_full, c.dropped_old - t.dropped_old, c.dropped_rejoin - t.dropped_rejoin);
+        if full + old + rejoin > 0 {
+            eprintln!(
+                "bus: gave up {} requests not in the log ({full} over the {MAX_WAITING} kept, {old} older than {} s, {rejoin} on joining again)",
+                full + old + rejoin,
+                MAX_AGE.as_secs()
+            );
+        }
+        self.told = c;
+    }
+}
+
 /// Takes what the bus sent: log entries, a snapshot to start from, a request for ours.
-fn take_incoming(pool: &mut Lockstep, bus: &mut EdgeLinks, now: Instant) {
+fn take_incoming(pool: &mut Lockstep, bus: &mut EdgeLinks, pending: &mut Pending, now: Instant) {
     while let Ok(message) = bus.incoming.try_recv() {
         match message {
-            Incoming::Entry { seq, bytes } => match pool.receive(seq, &bytes, now) {
-                Ok(()) => {
-                    if bus.trace {
-                        trace_applied(&bytes, &bus.edge, pool.step());
+            Incoming::Entry { seq, bytes } => match (seq > pool.last_seq(), pool.receive(seq, &bytes, now)) {
+                (false, Ok(())) => {} // delivered again after a reconnect
+                (true, Ok(())) => {
+                    // Read again (checked already): which of this edge's requests it settles.
+                    if let Ok(tick) = serde_json::from_slice::<protocol::Tick>(&bytes) {
+                        pending.taken(seq, &tick);
+                        if bus.trace {
+                            trace_applied(&tick, bytes.len(), &bus.edge, pool.step());
+                        }
                     }
                 }
-                Err(Missed::Gap { expected, got }) => {
+                (_, Err(Missed::Gap { expected, got })) => {
                     eprintln!("bus: log entry {got} came after {}; joining again from a snapshot", expected - 1);
                     bus.state.joined.store(false, Ordering::Relaxed);
                     let _ = bus.outgoing.try_send(Outgoing::Rejoin);
                 }
-                Err(Missed::Bad(why)) => {
+                (_, Err(Missed::Bad(why))) => {
                     bus.state.bad_entries.fetch_add(1, Ordering::Relaxed);
                     eprintln!("bus: log entry {seq} skipped (every edge skips it): {why}");
                 }
@@ -172,6 +220,7 @@ fn take_incoming(pool: &mut Lockstep, bus: &mut EdgeLinks, now: Instant) {
             Incoming::Restore(bytes) => match pool.restore(&bytes, now) {
                 Ok(()) => {
                     eprintln!("bus: joined from a snapshot at step {} (log entry {})", pool.step(), pool.last_seq());
+                    pending.rejoined(pool.last_seq());
                     bus.state.joined.store(true, Ordering::Relaxed);
                 }
                 Err(why) => eprintln!("bus: {why}; waiting for another snapshot"),
@@ -189,11 +238,9 @@ fn take_incoming(pool: &mut Lockstep, bus: &mut EdgeLinks, now: Instant) {
 
 /// The trace's line for every event of another edge in a tick just taken (the ring shows at
 /// its step, within a frame and the lead of this moment).
-fn trace_applied(bytes: &[u8], me: &str, step: u64) {
-    if let Ok(tick) = serde_json::from_slice::<protocol::Tick>(bytes) {
-        for e in tick.events.iter().filter(|e| e.edge != me) {
-            eprintln!("bus-trace taken {} {} at {step} for {} {} {}", e.edge, e.n, tick.step, unix_us(), bytes.len());
-        }
+fn trace_applied(tick: &protocol::Tick, bytes: usize, me: &str, step: u64) {
+    for e in tick.events.iter().filter(|e| e.edge != me) {
+        eprintln!("bus-trace taken {} {} at {step} for {} {} {bytes}", e.edge, e.n, tick.step, unix_us());
     }
 }
 

@@ -66,6 +66,43 @@ impl Refusals {
     }
 }
 
+/// Most ticks kept whose fate is not known yet (a tick not acknowledged, with requests in it).
+const MAX_LIMBO: usize = 64;
+
+/// This term's ticks that were not acknowledged and carry requests, all published after the
+/// same log entry (the sequencer's last known one): at most one of them can be written there
+/// (the log's expected-last-sequence fence). Once that entry is known, the others never will
+/// be, and their requests are forgotten so that their edges' next sends are taken (a stone
+/// in no tick is lost; one in two ticks would be applied twice).
+#[derive(Default)]
+struct Limbo {
+    ticks: Vec<(Vec<u8>, Tick)>,
+}
+
+impl Limbo {
+    fn keep(&mut self, bytes: Vec<u8>, tick: Tick) {
+        if tick.events.is_empty() && tick.settled.is_empty() {
+            return;
+        }
+        if self.ticks.len() >= MAX_LIMBO {
+            // Its requests stay handled: if it was not written they are lost (said).
+            self.ticks.remove(0);
+            eprintln!("bus: {MAX_LIMBO} ticks not acknowledged; the oldest one's requests are no longer sent again");
+        }
+        self.ticks.push((bytes, tick));
+    }
+
+    /// The entry after the one they were fenced on is known: `written` (its bytes), or
+    /// `None` when a later tick took it.
+    fn resolve(&mut self, written: Option<&[u8]>, seq: &mut Sequencer) {
+        for (bytes, tick) in self.ticks.drain(..) {
+            if written != Some(bytes.as_slice()) {
+                seq.forget(&tick);
+            }
+        }
+    }
+}
+
 /// Renews the lease every [`lease::REFRESH`] until `give_up`; cancels `lost` and ends only
 /// when the compare-and-set says another edge holds it. Returns the lease as it left it.
 ///
@@ -304,7 +341,7 @@ impl Leader {
             self.role.limits,
             self.role.seed,
             last.as_ref(),
-            term,
+            (term, last_seq),
             now,
         );
         eprintln!("bus: this edge is the sequencer (term {term}), after log entry {last_seq}");
@@ -342,6 +379,7 @@ impl Leader {
         let mut refusals = Refusals::default();
         // Ticks not acknowledged in a row (said once when it starts and once when it ends).
         let mut unacked = 0u32;
+        let mut limbo = Limbo::default();
         loop {
             tokio::select! {
                 _ = stop.cancelled() => return Ended::Stopped,
@@ -355,11 +393,14 @@ impl Leader {
                 _ = ticks.tick() => {
                     refusals.summarize(Instant::now());
                     let tick = seq.tick(Instant::now());
-                    match self.publish(&tick, last_seq).await {
+                    let bytes = protocol::bytes_of(&tick);
+                    match self.publish(bytes.clone(), last_seq).await {
                         Ok(s) => {
                             if unacked > 0 {
                                 eprintln!("bus: ticks acknowledged again (entry {s}) after {unacked} that were not");
                             }
+                            // This tick took the entry after `last_seq`: no other can.
+                            limbo.resolve(None, &mut seq);
                             (last_seq, unacked) = (s, 0);
                         }
                         // Not acknowledged (the bus away, or the log's fence): carry on after
@@ -369,14 +410,20 @@ impl Leader {
                                 eprintln!("bus: a tick after log entry {last_seq} not acknowledged ({why}); trying again");
                             }
                             unacked += 1;
+                            limbo.keep(bytes, tick);
                             match self.end_of_term(term, last_seq).await {
-                                Some(Some(s)) => last_seq = s,
+                                Some(Some((s, written))) => {
+                                    if s != last_seq {
+                                        limbo.resolve(Some(&written), &mut seq);
+                                    }
+                                    last_seq = s;
+                                }
                                 Some(None) => {
                                     eprintln!("bus: the log moved on after entry {last_seq} without this sequencer; giving the sequencer's role up");
                                     return Ended::LostLease;
                                 }
-                                // Unreadable: this tick's events are lost (never acknowledged);
-                                // the next tick tries again after the same entry.
+                                // Unreadable: whether the tick was written is known once the
+                                // entry after `last_seq` is (the next tick tries again after it).
                                 None => {}
                             }
                         }
@@ -390,30 +437,30 @@ impl Leader {
 
     /// Publishes a tick after log entry `after`; its sequence, or why it was not acknowledged
     /// (refused by the log's fence, or the bus away: it may have been written).
-    async fn publish(&self, tick: &Tick, after: u64) -> Result<u64, String> {
-        let message = PublishMessage::build().payload(protocol::bytes_of(tick).into()).expected_last_sequence(after);
+    async fn publish(&self, tick: Vec<u8>, after: u64) -> Result<u64, String> {
+        let message = PublishMessage::build().payload(tick.into()).expected_last_sequence(after);
         let ack = self.pool.js.send_publish(self.pool.names.log.clone(), message).await.map_err(|e| e.to_string())?;
         ack.await.map(|ack| ack.sequence).map_err(|e| e.to_string())
     }
 
-    /// After a tick of `term` that was not acknowledged: the log's last entry if this term
-    /// wrote it or the log is still at `after` (`Some(None)`: something else wrote it, another
+    /// After a tick of `term` that was not acknowledged: the log's last entry and its bytes if
+    /// this term wrote it or the log is still at `after` (`Some(None)`: something else wrote it, another
     /// sequencer or a stray writer; `None`: the log could not be read). A publish whose
     /// acknowledgement was lost with the connection may have been written (a request queued
     /// while the bus was away is sent when it is back); a later tick would then be fenced out
     /// after it, and the role would move for nothing. Reading the end and carrying on after
     /// it whoever wrote it would instead open the fence to a sequencer that lost the role.
-    async fn end_of_term(&self, term: u64, after: u64) -> Option<Option<u64>> {
+    async fn end_of_term(&self, term: u64, after: u64) -> Option<Option<(u64, Vec<u8>)>> {
         let last = match self.pool.stream.get_last_raw_message_by_subject(&self.pool.names.log).await {
             Ok(message) => message,
             Err(e) if after == 0 && (e.to_string().contains("no message") || e.to_string().contains("not found")) => {
-                return Some(Some(0));
+                return Some(Some((0, Vec::new())));
             }
             Err(_) => return None,
         };
         let mine = last.sequence == after
             || protocol::read_tick(&last.payload, self.role.size).is_ok_and(|tick| tick.term == term);
-        Some(mine.then_some(last.sequence))
+        Some(mine.then(|| (last.sequence, last.payload.to_vec())))
     }
 
     /// Asks the game thread for its state and stores it as the latest snapshot.

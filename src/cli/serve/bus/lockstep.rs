@@ -226,7 +226,7 @@ mod tests {
     }
 
     fn tick(step: u64, events: &[Wire]) -> Vec<u8> {
-        let events = events.iter().map(|&what| Stamped { what, edge: "a".into(), n: 0 }).collect();
+        let events = events.iter().map(|&what| Stamped { what, edge: "a".into(), run: 0, n: 0 }).collect();
         bytes_of(&Tick { step, events, ..Tick::default() })
     }
 

@@ -1,7 +1,9 @@
 //! `tidepool serve --bus nats://HOST:PORT --pool NAME`: one pool across many machines. The
 //! simulation is deterministic, so the machines (edges) share events, not pictures:
 //!
-//! - every edge sends its players' requests to the pool's sequencer ([`protocol::Submit`]);
+//! - every edge sends its players' requests to the pool's sequencer ([`protocol::Submit`]),
+//!   keeps each until the log has it and sends it again meanwhile (`pending.rs`); the
+//!   sequencer stamps a request once (`handled.rs`);
 //! - one edge at a time holds the sequencer's lease ([`lease`]) in the pool's JetStream
 //!   key-value bucket (on a thread and a runtime of its own, where the connection's task runs
 //!   too: the players' tasks cannot starve it); it checks every request (bounds, rates per player, per edge, per pool:
@@ -16,10 +18,12 @@
 //! types tested without a server; `link.rs` and `lead.rs` are the async-nats glue.
 
 pub mod edge;
+mod handled;
 mod lead;
 pub mod lease;
 mod link;
 pub mod lockstep;
+mod pending;
 pub mod protocol;
 pub mod sequencer;
 

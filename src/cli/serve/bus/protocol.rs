@@ -21,6 +21,9 @@ pub const MAX_PRESENCE_BYTES: usize = 256;
 pub const MAX_TICK_BYTES: usize = 64 * 1024;
 /// The most events one tick carries (the pool's event rate is bounded below this).
 pub const MAX_EVENTS_PER_TICK: usize = 256;
+/// The most settled requests one tick names (more are not named: their edges give them up
+/// by age, and the sequencer ignores them meanwhile).
+pub const MAX_SETTLED_PER_TICK: usize = 256;
 /// The longest pool name: letters, digits, `-` and `_` (it is part of subjects and bucket names).
 pub const MAX_POOL_NAME: usize = 32;
 /// The longest edge name, same characters.
@@ -78,18 +81,61 @@ pub enum Wire {
     Shot,
 }
 
-/// One player's request, from an edge to the sequencer.
+/// One player's request, from an edge to the sequencer. `(edge, run, n)` names it: the edge
+/// keeps it until that id is in the log (stamped or refused) and sends it again meanwhile, and
+/// the sequencer stamps an id once (`bus/pending.rs`, `bus/handled.rs`).
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Submit {
     /// The edge's name.
     pub edge: String,
+    /// The edge's run (a number the process picked when it started): a restarted edge of the
+    /// same name counts its requests anew.
+    #[serde(default)]
+    pub run: u64,
     /// The player's number on that edge.
     pub player: u64,
-    /// The edge's count of submits so far (a key's latency is measured by it).
+    /// The edge's count of submits so far in this run (a key's latency is measured by it).
     pub n: u64,
+    /// Every request of this run below this count is settled for the edge (in the log or
+    /// given up): the sequencer forgets what it remembers of them.
+    #[serde(default)]
+    pub floor: u64,
+    /// The last log entry the edge had read when it sent this.
+    #[serde(default)]
+    pub seen: u64,
+    /// Sent before: a sequencer whose term began after entry `seen` cannot know whether an
+    /// earlier term stamped it, and leaves it for the edge to send again once it read on.
+    #[serde(default)]
+    pub again: bool,
     /// What was asked.
     pub what: Wire,
+}
+
+impl Submit {
+    /// A first send of request `n` of `edge`'s run 0 (for the tests).
+    #[cfg(test)]
+    pub fn new(edge: &str, player: u64, n: u64, what: Wire) -> Submit {
+        Submit { edge: edge.into(), run: 0, player, n, floor: 0, seen: 0, again: false, what }
+    }
+
+    /// Its id.
+    pub fn id(&self) -> RequestId {
+        RequestId { edge: self.edge.clone(), run: self.run, n: self.n }
+    }
+}
+
+/// The id of a request: its edge, the edge's run and its count there.
+#[derive(Clone, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RequestId {
+    /// The edge's name.
+    pub edge: String,
+    /// The edge's run.
+    #[serde(default)]
+    pub run: u64,
+    /// Its count there.
+    pub n: u64,
 }
 
 /// An edge's players, every second.
@@ -111,6 +157,9 @@ pub struct Stamped {
     pub what: Wire,
     /// The edge that sent it.
     pub edge: String,
+    /// The edge's run.
+    #[serde(default)]
+    pub run: u64,
     /// Its submit count there.
     pub n: u64,
 }
@@ -130,6 +179,11 @@ pub struct Tick {
     pub players: u32,
     /// The events at `step`.
     pub events: Vec<Stamped>,
+    /// Requests the sequencer handled since the last tick without an event (refused over a
+    /// rate or a bound, or a pause): their edges stop sending them. At most
+    /// [`MAX_SETTLED_PER_TICK`].
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub settled: Vec<RequestId>,
 }
 
 /// Why a message was refused.
@@ -252,7 +306,16 @@ impl Wire {
 
 /// Reads a [`Submit`]: within [`MAX_SUBMIT_BYTES`], well-formed, a valid edge name, its
 /// values within a scene of `size`.
+#[cfg(test)]
 pub fn read_submit(bytes: &[u8], size: (u32, u32)) -> Result<Submit, Refusal> {
+    let submit = parse_submit(bytes)?;
+    submit.what.check(size)?;
+    Ok(submit)
+}
+
+/// Reads a [`Submit`] within [`MAX_SUBMIT_BYTES`], well-formed, with a valid edge name; its
+/// values are left to [`Wire::check`] (a refusal of them names the request's id).
+pub fn parse_submit(bytes: &[u8]) -> Result<Submit, Refusal> {
     if bytes.len() > MAX_SUBMIT_BYTES {
         return refuse(format!("{} bytes, at most {MAX_SUBMIT_BYTES}", bytes.len()));
     }
@@ -260,7 +323,6 @@ pub fn read_submit(bytes: &[u8], size: (u32, u32)) -> Result<Submit, Refusal> {
     if !valid_name(&submit.edge, MAX_EDGE_NAME) {
         return refuse("bad edge name");
     }
-    submit.what.check(size)?;
     Ok(submit)
 }
 
@@ -286,6 +348,9 @@ pub fn read_tick(bytes: &[u8], size: (u32, u32)) -> Result<Tick, Refusal> {
     if tick.events.len() > MAX_EVENTS_PER_TICK {
         return refuse(format!("{} events, at most {MAX_EVENTS_PER_TICK}", tick.events.len()));
     }
+    if tick.settled.len() > MAX_SETTLED_PER_TICK {
+        return refuse(format!("{} settled requests, at most {MAX_SETTLED_PER_TICK}", tick.settled.len()));
+    }
     for e in &tick.events {
         if matches!(e.what, Wire::RandomStone { .. } | Wire::Pause) {
             return refuse("an unresolved request in the log");
@@ -307,7 +372,7 @@ mod tests {
     const SIZE: (u32, u32) = (160, 90);
 
     fn submit(what: Wire) -> Vec<u8> {
-        bytes_of(&Submit { edge: "a".into(), player: 1, n: 1, what })
+        bytes_of(&Submit::new("a", 1, 1, what))
     }
 
     #[test]
@@ -353,7 +418,7 @@ mod tests {
 
     #[test]
     fn ticks_are_bounded_and_hold_resolved_events_only() {
-        let event = |what| Stamped { what, edge: "a".into(), n: 0 };
+        let event = |what| Stamped { what, edge: "a".into(), run: 0, n: 0 };
         let good = Tick { step: 9, events: vec![event(Wire::Clear), event(Wire::Shot)], ..Tick::default() };
         assert_eq!(read_tick(&bytes_of(&good), SIZE).unwrap(), good);
         let unresolved = Tick { events: vec![event(Wire::RandomStone { radius: 2 })], ..Tick::default() };

@@ -12,7 +12,10 @@ use crate::output::bucket::ByteBucket;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
-use super::protocol::{self, MAX_EVENTS_PER_TICK, Refusal, Stamped, Tick, Wire};
+use super::handled::{Handled, Verdict};
+use super::protocol::{
+    self, MAX_EVENTS_PER_TICK, MAX_SETTLED_PER_TICK, Refusal, RequestId, Stamped, Submit, Tick, Wire,
+};
 
 /// Steps between the sequencer's step and the step it stamps events at: an edge runs behind
 /// by about this much, so a tick that comes this late still never stops it. At 60 steps a
@@ -67,6 +70,11 @@ pub struct SequencerCounts {
     pub refused: u64,
     /// Ticks made.
     pub ticks: u64,
+    /// Requests handled before in this term (sent again by their edge): ignored.
+    pub duplicates: u64,
+    /// Requests sent again by an edge that had not read the log up to this term: left for
+    /// its next send (an earlier term may have stamped them).
+    pub deferred: u64,
 }
 
 /// The pool's sequencer.
@@ -79,7 +87,12 @@ pub struct Sequencer {
     paused: bool,
     frontier: u64,
     term: u64,
+    /// The log's last entry when this term began: what came before is earlier terms'.
+    after: u64,
     events: Vec<Stamped>,
+    /// Requests handled without an event (refused, or a pause) since the last tick.
+    settled: Vec<RequestId>,
+    handled: Handled,
     rng: ChaCha8Rng,
     players: HashMap<(String, u64), PlayerBuckets>,
     edges: HashMap<String, EdgeSeen>,
@@ -89,14 +102,16 @@ pub struct Sequencer {
 
 impl Sequencer {
     /// A sequencer for a scene of `size` pixels at `steps_per_second`, taking over after
-    /// `last` (the log's last tick; `None` for a new pool) with lease revision `term`.
+    /// `last` (the log's last tick; `None` for a new pool) with lease revision `term`, the
+    /// log's last entry being `after`.
+    #[allow(clippy::too_many_arguments)] // each is one fact of the term; a struct would only rename them
     pub fn new(
         size: (u32, u32),
         steps_per_second: f64,
         limits: SequencerLimits,
         seed: u64,
         last: Option<&Tick>,
-        term: u64,
+        (term, after): (u64, u64),
         now: Instant,
     ) -> Sequencer {
         let (frontier, paused) = last.map_or((0, false), |t| (t.step, t.paused));
@@ -109,7 +124,10 @@ impl Sequencer {
             paused,
             frontier,
             term,
+            after,
             events: Vec::new(),
+            settled: Vec::new(),
+            handled: Handled::default(),
             rng: ChaCha8Rng::seed_from_u64(seed ^ STONE_SEED_MIX ^ term),
             players: HashMap::new(),
             edges: HashMap::new(),
@@ -127,18 +145,59 @@ impl Sequencer {
         self.base.0 + (elapsed * self.steps_per_second) as u64
     }
 
-    /// Takes a player's request, or says why not.
+    /// Takes a player's request, or says why not. A request handled before in this term is
+    /// ignored, and one sent again by an edge that had not read the log up to this term is
+    /// left for later (both `Ok`, counted apart).
     pub fn submit(&mut self, bytes: &[u8], now: Instant) -> Result<(), Refusal> {
-        let result = self.take(bytes, now);
-        match result {
-            Ok(()) => self.counts.accepted += 1,
-            Err(_) => self.counts.refused += 1,
+        let submit = match protocol::parse_submit(bytes) {
+            Ok(submit) => submit,
+            Err(why) => {
+                self.counts.refused += 1;
+                return Err(why);
+            }
+        };
+        match self.handled.check(&submit, now) {
+            Verdict::New => {}
+            Verdict::Duplicate => {
+                self.counts.duplicates += 1;
+                return Ok(());
+            }
+            Verdict::Full => {
+                self.counts.refused += 1;
+                return Err(Refusal("too many edges".into()));
+            }
         }
-        result
+        if submit.again && submit.seen < self.after {
+            self.counts.deferred += 1;
+            return Ok(());
+        }
+        let id = submit.id();
+        let result = self.take(submit, now);
+        self.handled.mark(&id);
+        match result {
+            Ok(true) => self.counts.accepted += 1,
+            Ok(false) => {
+                self.counts.accepted += 1;
+                self.settle(id);
+            }
+            Err(_) => {
+                self.counts.refused += 1;
+                self.settle(id);
+            }
+        }
+        result.map(|_| ())
     }
 
-    fn take(&mut self, bytes: &[u8], now: Instant) -> Result<(), Refusal> {
-        let submit = protocol::read_submit(bytes, self.size)?;
+    /// Tells the request's edge, in the next tick, that it is handled without an event.
+    fn settle(&mut self, id: RequestId) {
+        if self.settled.len() < MAX_SETTLED_PER_TICK {
+            self.settled.push(id);
+        }
+    }
+
+    /// Takes a checked request: `Ok(true)` when it is an event of the next tick.
+    fn take(&mut self, submit: Submit, now: Instant) -> Result<bool, Refusal> {
+        submit.what.check(self.size)?;
         if self.events.len() >= MAX_EVENTS_PER_TICK {
             return Err(Refusal("the pool's events for this tick are full".into()));
         }
@@ -165,10 +224,14 @@ impl Sequencer {
             last: now,
         });
         player.last = now;
+        // A request sent again is not charged to its player: its first send may have been,
+        // by this term or the last, and a takeover's resends come in a burst. The edge's rate
+        // and the pool's still hold (a player's rate never held against a hostile edge, which
+        // may name as many players as it likes).
         let allowed = if submit.what.is_scene_key() {
-            player.scene_keys.try_take(1.0, now) && self.pool_keys.try_take(1.0, now)
+            (submit.again || player.scene_keys.try_take(1.0, now)) && self.pool_keys.try_take(1.0, now)
         } else {
-            player.actions.try_take(1.0, now)
+            submit.again || player.actions.try_take(1.0, now)
         };
         if !allowed {
             return Err(Refusal(format!("player {}/{} is over a rate", submit.edge, submit.player)));
@@ -182,12 +245,24 @@ impl Sequencer {
                 let step = self.step(now);
                 self.paused = !self.paused;
                 self.base = (step, now);
-                return Ok(());
+                return Ok(false);
             }
             other => other,
         };
-        self.events.push(Stamped { what, edge: submit.edge, n: submit.n });
-        Ok(())
+        self.events.push(Stamped { what, edge: submit.edge, run: submit.run, n: submit.n });
+        Ok(true)
+    }
+
+    /// A tick of this term that never reached the log: its events did not happen, so their
+    /// ids are forgotten (their edges send them again and they are taken then); what it
+    /// settled stays settled (a pause toggled the clock all the same) and is told again.
+    pub fn forget(&mut self, tick: &Tick) {
+        for e in &tick.events {
+            self.handled.forget(&RequestId { edge: e.edge.clone(), run: e.run, n: e.n });
+        }
+        for id in &tick.settled {
+            self.settle(id.clone());
+        }
     }
 
     /// Notes an edge's player count.
@@ -236,6 +311,7 @@ impl Sequencer {
             paused: self.paused,
             players,
             events: std::mem::take(&mut self.events),
+            settled: std::mem::take(&mut self.settled),
         }
     }
 
@@ -254,11 +330,13 @@ mod tests {
         SequencerLimits { actions_per_second: 30.0, scene_keys_per_second: 4.0, pool_scene_keys_per_second: 8.0 };
 
     fn sequencer(now: Instant) -> Sequencer {
-        Sequencer::new((160, 90), 60.0, LIMITS, 1, None, 1, now)
+        Sequencer::new((160, 90), 60.0, LIMITS, 1, None, (1, 0), now)
     }
 
     fn submit(edge: &str, player: u64, what: Wire) -> Vec<u8> {
-        bytes_of(&Submit { edge: edge.into(), player, n: 0, what })
+        // Each its own id: the sequencer stamps an id once.
+        static N: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+        bytes_of(&Submit::new(edge, player, N.fetch_add(1, std::sync::atomic::Ordering::Relaxed), what))
     }
 
     #[test]
@@ -271,7 +349,7 @@ mod tests {
         let later = s.tick(t0 + Duration::from_secs(1));
         assert_eq!((later.step, later.events.len()), (60 + LEAD_STEPS, 0));
         // A sequencer taking over goes on from the last frontier.
-        let next = Sequencer::new((160, 90), 60.0, LIMITS, 1, Some(&later), 2, t0).tick(t0);
+        let next = Sequencer::new((160, 90), 60.0, LIMITS, 1, Some(&later), (2, 2), t0).tick(t0);
         assert_eq!((next.step, next.term), (later.step, 2));
     }
 
@@ -312,7 +390,7 @@ mod tests {
         assert!(why.0.contains("outside"), "{why}");
         assert!(s.submit(b"\xff\xfe", t0).is_err());
         assert_eq!(s.tick(t0).events, vec![]);
-        assert_eq!(s.counts(), SequencerCounts { accepted: 0, refused: 2, ticks: 1 });
+        assert_eq!(s.counts(), SequencerCounts { accepted: 0, refused: 2, ticks: 1, ..SequencerCounts::default() });
     }
 
     #[test]
