@@ -156,10 +156,8 @@ fn twiddle(index: usize, len: usize) -> Complex32 {
 struct Radix4 {
     /// 8 or 16.
     base: usize,
-    /// For each position of the transform's working order, the input element it takes (the
+    /// For each input element, its position in the transform's working order (rustfft's
     /// bit-reversed transpose).
-    order: Vec<usize>,
-    /// For each input element, its position in the working order.
     place: Vec<usize>,
     /// The radix-4 layers' twiddles, the first layer's first, three a column.
     twiddles: Vec<Complex32>,
@@ -187,10 +185,10 @@ impl Radix4 {
             }
             r
         };
-        let order: Vec<usize> = (0..n).map(|j| reversed(j / base) + (j % base) * width).collect();
+        // Position j takes element reversed(j / base) + (j % base)·width.
         let mut place = vec![0; n];
-        for (j, &i) in order.iter().enumerate() {
-            place[i] = j;
+        for j in 0..n {
+            place[reversed(j / base) + (j % base) * width] = j;
         }
         let mut twiddles = Vec::with_capacity(n);
         let mut cross = base;
@@ -202,10 +200,10 @@ impl Radix4 {
             }
         }
         let t16 = [twiddle(1, 16), twiddle(2, 16), twiddle(3, 16)];
-        Some(Radix4 { base, order, place, twiddles, t16, root2: 0.5f64.sqrt() as f32 })
+        Some(Radix4 { base, place, twiddles, t16, root2: 0.5f64.sqrt() as f32 })
     }
 
-    /// The transforms of `x` (in working order: gathered by `order`), in place.
+    /// The transforms of `x` (in working order: gathered by `place`), in place.
     #[inline(always)]
     fn run(&self, x: &mut [Lanes]) {
         if self.base == 16 {
@@ -310,12 +308,13 @@ impl InverseFft2 {
             buf.par_chunks_mut(n * 16).for_each(|rows| self.rows.process(rows));
             return;
         };
-        // The columns: strip s holds columns 16s..16s + 16, position j of the working order
-        // from row order[j]; transformed, its entry j is row j.
+        // The columns: strip s holds columns 16s..16s + 16, row r at position place[r] of the
+        // working order (read in the rows' order: a constant stride the prefetcher follows);
+        // transformed, its entry j is row j.
         scratch.strips.resize(n * n / W, Lanes::ZERO);
         scratch.strips.par_chunks_mut(n).enumerate().for_each(|(s, strip)| {
-            for (lanes, &row) in strip.iter_mut().zip(&plan.order) {
-                *lanes = Lanes::load(&buf[row * n + s * W..]);
+            for (row, &j) in plan.place.iter().enumerate() {
+                strip[j] = Lanes::load(&buf[row * n + s * W..]);
             }
             plan.run_on(simd, strip);
         });
