@@ -12,8 +12,8 @@
 //! complex one come from five complex inverse FFTs (two real fields packed in each, by the
 //! Hermitian halves of their spectra): height, displacement, slopes, the displacement's
 //! gradient and B = Σ a·√k·e^(iθ) for the second-order height. The waves' rotations use
-//! tidepool's own sine ([`sincos_turns`]) and the FFT rustfft's scalar planner,
-//! so the maps are the same bytes on every machine.
+//! tidepool's own sine ([`sincos_turns`]) and the FFT the arithmetic of rustfft's scalar
+//! planner ([`fft`]), so the maps are the same bytes on every machine.
 //!
 //! Heights are resampled at the fixed lattice points (Eulerian: what a height field holds),
 //! like [`super::ocean::SeaSurface::height`]; normals are those of that surface.
@@ -28,25 +28,25 @@
 
 use crate::error::ValueError;
 use std::f64::consts::PI;
-use std::sync::Arc;
 
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use rustfft::num_complex::Complex32;
-use rustfft::{Fft, FftPlannerScalar};
 
 use super::dispersion;
 use super::foam::{FoamClock, FoamModel};
 
+mod fft;
 mod fill;
 mod foam;
 mod moment;
 mod sampling;
 use super::ocean::{EULER_ITERATIONS, Sea, SeaParams, SeaTime, sizing_wavelength_m};
 use super::trig::fast_sincos;
+use fft::{FftScratch, InverseFft2};
 use moment::Workspace;
-use sampling::{Bilinear, cubic, round_even, sincos_turns, transpose_into};
+use sampling::{Bilinear, cubic, round_even, sincos_turns};
 
 /// Smallest and largest lattice side.
 pub const PATCH_SIZE_RANGE: (usize, usize) = (8, 4096);
@@ -73,7 +73,7 @@ pub struct PatchMaps {
 }
 
 /// The waves of a square lattice: per point (row-major, FFT order) a·e^(iφ), ω, the loop
-/// harmonic and the wavenumber; and the inverse FFT of its side.
+/// harmonic and the wavenumber; and its inverse 2-D FFT.
 struct Lattice {
     n: usize,
     amp: Vec<Complex32>,
@@ -83,7 +83,7 @@ struct Lattice {
     ky: Vec<f32>,
     /// |k| (1 where k = 0, whose wave is silent).
     k: Vec<f32>,
-    fft: Arc<dyn Fft<f32>>,
+    fft: InverseFft2,
 }
 
 /// A periodic patch of sea and the foam it has made so far.
@@ -238,9 +238,7 @@ impl Lattice {
                 ky[r * n + c] = (-(signed(r, n) as f64) * dk) as f32;
             }
         }
-        // The scalar planner: rustfft's AVX, SSE and NEON plans pick other algorithms and round
-        // differently, and maps must be the same bytes on every machine.
-        let fft = FftPlannerScalar::new().plan_fft_inverse(n);
+        let fft = InverseFft2::new(n);
         let k = kx.iter().zip(&ky).map(|(x, y)| if *x == 0.0 && *y == 0.0 { 1.0 } else { x.hypot(*y) }).collect();
         Lattice {
             n,
@@ -308,15 +306,9 @@ impl Lattice {
     }
 
     /// The inverse 2-D FFT, in place, of a spectrum in the lattice's order (`buf[r·n + c]`),
-    /// by way of `scratch` (n², any contents): transposed into `scratch`, along ky on its rows,
-    /// transposed back, along kx on the rows, which leaves the field in row-major order. Rows
-    /// and transposes in parallel: the same result on any number of cores.
-    fn ifft2(&self, buf: &mut [Complex32], scratch: &mut [Complex32]) {
-        let n = self.n;
-        transpose_into(buf, scratch, n);
-        scratch.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
-        transpose_into(scratch, buf, n);
-        buf.par_chunks_mut(n * 16).for_each(|rows| self.fft.process(rows));
+    /// leaving the field in row-major order ([`InverseFft2`]).
+    fn ifft2(&self, buf: &mut [Complex32], scratch: &mut FftScratch) {
+        self.fft.process(buf, scratch);
     }
 
     /// Two real fields from one complex transform. `coefficients(i, w)` gives, for the
@@ -328,7 +320,7 @@ impl Lattice {
         &self,
         waves: &[Complex32],
         coefficients: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
-        scratch: &mut [Complex32],
+        scratch: &mut FftScratch,
     ) -> (Vec<f32>, Vec<f32>) {
         let mut buf = Vec::new();
         self.real_fields_into(waves, coefficients, &mut buf, scratch);
@@ -337,14 +329,14 @@ impl Lattice {
     }
 
     /// As [`Lattice::real_fields`], into `buf` (resized to the lattice), the two fields left packed as the transform gives them:
-    /// f in the real parts, g in the imaginary ones; `scratch` (n², any contents) is the
-    /// transform's working space, shared by a moment's transforms.
+    /// f in the real parts, g in the imaginary ones; `scratch` is the
+    /// transforms' working space, shared by a moment's transforms.
     fn real_fields_into(
         &self,
         waves: &[Complex32],
         coefficients: impl Fn(usize, Complex32) -> (Complex32, Complex32) + Sync,
         buf: &mut Vec<Complex32>,
-        scratch: &mut [Complex32],
+        scratch: &mut FftScratch,
     ) {
         self.fill_packed(waves, |i, w| [coefficients(i, w)], [buf]);
         self.ifft2(buf, scratch);
@@ -359,7 +351,7 @@ impl Lattice {
             let (kx, ky, k) = (self.kx[i], self.ky[i], self.k[i]);
             (kx * kx / k, ky * ky / k, kx * ky / k)
         };
-        let mut scratch = vec![Complex32::new(0.0, 0.0); self.n * self.n];
+        let mut scratch = FftScratch::default();
         let (gxx, gyy) = self.real_fields(waves, |i, w| (w * coef(i).0, w * coef(i).1), &mut scratch);
         let (gxy, _) = self.real_fields(waves, |i, w| (w * coef(i).2, Complex32::new(0.0, 0.0)), &mut scratch);
         (gxx, gyy, gxy)
@@ -531,7 +523,7 @@ mod tests {
         let l = &patch.sea;
         let waves = l.waves(patch.time(2.0));
         let coefficients = |i: usize, w: Complex32| (w, Complex32::new(0.0, 1.0) * w * l.kx[i]);
-        let mut scratch = vec![Complex32::new(0.0, 0.0); n * n];
+        let mut scratch = FftScratch::default();
         let packed = l.real_fields(&waves, coefficients, &mut scratch);
         let cell = extent / n as f64;
         let direct = |r: usize, c: usize| -> (f64, f64) {

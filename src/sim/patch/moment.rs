@@ -18,7 +18,7 @@ const LANES: usize = 8;
 #[derive(Default)]
 pub(super) struct Workspace {
     waves: Vec<Complex32>,
-    scratch: Vec<Complex32>,
+    scratch: FftScratch,
     /// Two real fields to a complex buffer as the inverse transforms leave them (re, im):
     /// (h, dx), (dy, hx), (hy, gxy), (gxx, gyy).
     packed: [Vec<Complex32>; 4],
@@ -47,7 +47,6 @@ impl PatchSea {
         let i_unit = Complex32::new(0.0, 1.0);
         let unit = |i: usize| (l.kx[i] / l.k[i], l.ky[i] / l.k[i], l.k[i]);
         l.waves_into(time, &mut work.waves);
-        sized(&mut work.scratch, nn);
         let (waves, scratch) = (&work.waves, &mut work.scratch);
         // The displacement per unit λ is -Σ a·û·sin θ = re Σ (i·û·w)·e^(ik·x); slopes
         // re Σ (i·k·w)·e^(ik·x); the displacement's gradient per unit λ, each times -1,
