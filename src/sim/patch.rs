@@ -452,7 +452,6 @@ impl PatchSea {
     }
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -520,7 +519,8 @@ mod tests {
             normal: vec![[f32::INFINITY; 3]; 64 * 64],
             foam: vec![2.0; 64 * 64],
         };
-        let (mut kept, mut fresh) = (PatchSea::new(params, 64, 300.0).unwrap(), PatchSea::new(params, 64, 300.0).unwrap());
+        let (mut kept, mut fresh) =
+            (PatchSea::new(params, 64, 300.0).unwrap(), PatchSea::new(params, 64, 300.0).unwrap());
         for k in 0..3 {
             kept.maps_after(3.0, f64::from(k) / 7.0, &mut reused);
             let mut new = PatchMaps::default();
