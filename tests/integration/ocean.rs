@@ -335,8 +335,10 @@ fn independent_exr_check(args: &[&std::path::Path]) -> String {
 /// `--map-format exr` writes half-float OpenEXR maps beside the .npy and PNG files; read back
 /// by an independent reader (OpenEXR's Python bindings) they equal the .npy fields within
 /// half precision and the PNGs within their 8-bit step, they tile, and a loop later they are
-/// the same bytes.
+/// the same bytes. Ignored by the README's test command (a fresh machine has no OpenEXR reader):
+/// `scripts/exr_tests.sh` installs the reader and runs it, and `.ci/run` runs that script.
 #[test]
+#[ignore = "needs OpenEXR's Python reader: scripts/exr_tests.sh installs it and runs this test"]
 fn exr_maps_read_back_by_an_independent_reader() {
     let dir = scratch("ocean_maps_exr");
     let out =
