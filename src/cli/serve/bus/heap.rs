@@ -95,7 +95,7 @@ mod tests {
         let after = rss_kb();
         eprintln!("resident: {before} kB before the trim, {after} kB after, in {took:?} ({} blocks kept)", kept.len());
         // 63 MB were freed; at least half of them must leave (other tests run beside this one).
-        assert!(before.saturating_sub(after) >= 32 << 10, "the trim gave back {} kB of 63 MB freed", before - after);
+        assert!(before.saturating_sub(after) >= 32 << 10, "the trim gave back {} kB of 63 MB freed", before as i64 - after as i64);
         drop(kept);
     }
 }
