@@ -69,10 +69,9 @@ mod tests {
     }
 
     /// A thread fills its arena with 64 MB of small blocks and frees all but every 64th (as
-    /// an edge's threads free most of what a busy minute allocated): the arena keeps the pages,
-    /// so the resident memory stays up until [`trim`] gives them back.
-    #[test]
-    fn a_trim_gives_back_what_a_thread_freed() {
+    /// an edge's threads free most of what a busy minute allocated), then returns what it
+    /// kept; the resident memory (and what the trim gave back) in kB.
+    fn freed_by_a_thread_then_trimmed() -> (u64, u64, Duration) {
         const BLOCK: usize = 4096;
         const BLOCKS: usize = (64 << 20) / BLOCK;
         let kept = std::thread::spawn(|| {
@@ -94,13 +93,26 @@ mod tests {
         let took = started.elapsed();
         assert!(!t.due(Instant::now()), "once a period");
         let after = rss_kb();
-        eprintln!("resident: {before} kB before the trim, {after} kB after, in {took:?} ({} blocks kept)", kept.len());
-        // 63 MB were freed; at least half of them must leave (other tests run beside this one).
-        assert!(
-            before.saturating_sub(after) >= 32 << 10,
-            "the trim gave back {} kB of 63 MB freed",
-            before as i64 - after as i64
-        );
         drop(kept);
+        (before, after, took)
+    }
+
+    /// The arena keeps the freed pages, so the resident memory stays up until [`trim`] gives
+    /// them back: at least half of the 63 MB freed must leave. The resident memory is the
+    /// whole test process's, and other tests run beside this one: a test allocating 32 MB
+    /// between the two reads could hide the drop, so up to three tries are made (a trim that
+    /// does nothing fails all three).
+    #[test]
+    fn a_trim_gives_back_what_a_thread_freed() {
+        let mut tries = Vec::new();
+        for _ in 0..3 {
+            let (before, after, took) = freed_by_a_thread_then_trimmed();
+            eprintln!("resident: {before} kB before the trim, {after} kB after, in {took:?}");
+            if before.saturating_sub(after) >= 32 << 10 {
+                return;
+            }
+            tries.push(before as i64 - after as i64);
+        }
+        panic!("the trim gave back {tries:?} kB of 63 MB freed, in three tries");
     }
 }
