@@ -14,6 +14,7 @@ use crate::{Controls, PoolScene};
 use tiny_skia::Pixmap;
 use tokio::sync::{Notify, mpsc, oneshot};
 
+use super::heap::Trim;
 use super::lockstep::{Lockstep, Missed};
 use super::pending::{MAX_AGE, MAX_WAITING, Pending, PendingCounts};
 use super::protocol;
@@ -120,6 +121,8 @@ pub fn run(scene: PoolScene, fps: u32, links: GameLinks, mut bus: EdgeLinks) {
     let mut said = Said::default();
     let mut next_resend = Instant::now();
     let mut shots_left = MAX_SHOTS;
+    // What the process freed goes back to the system every few seconds (`heap.rs`).
+    let mut trim = Trim::new(Instant::now());
     let mut requests = links.requests;
     let links = GameLinks { requests: mpsc::channel(1).1, ..links };
     while !links.stop.load(Ordering::Relaxed) {
@@ -147,6 +150,7 @@ pub fn run(scene: PoolScene, fps: u32, links: GameLinks, mut bus: EdgeLinks) {
             }
         }
         said.say(&pending, now);
+        trim.due(now);
         if now >= next_frame {
             next_frame = (next_frame + frame_period).max(now);
             let shots = bus.shots.clone();

@@ -5,8 +5,9 @@
 //! Bounded three ways: per run of an edge, the ids below the floor the edge reports (every
 //! request below it is settled for the edge) are forgotten, and at most
 //! [`MAX_IDS_PER_RUN`] are kept (past it the oldest go and the floor rises: a request older
-//! than that is taken for handled); at most [`MAX_RUNS`] runs are kept, the quiet ones
-//! forgotten first.
+//! than that is taken for handled); at most [`MAX_RUNS`] runs are kept, and a run quiet for
+//! [`RUN_FORGET`] is forgotten (every second, by [`Handled::forget_quiet`]; and at once when
+//! the table is full).
 
 use std::collections::{BTreeSet, HashMap};
 use std::time::{Duration, Instant};
@@ -20,7 +21,8 @@ pub const MAX_IDS_PER_RUN: usize = 4096;
 /// Runs kept: twice the sequencer's 256 edges (an edge restarted gets a new run; the old one
 /// goes quiet).
 pub const MAX_RUNS: usize = 512;
-/// A run quiet this long may be forgotten: its edge keeps nothing that old (10 s at most).
+/// A run quiet this long is forgotten: its edge keeps nothing that old (10 s at most), so no
+/// send of it can come again.
 const RUN_FORGET: Duration = Duration::from_secs(60);
 
 struct Run {
@@ -80,6 +82,18 @@ impl Handled {
             run.floor = oldest + 1;
             run.ids = run.ids.split_off(&run.floor);
         }
+    }
+
+    /// Forgets the runs quiet for [`RUN_FORGET`] (the sequencer calls it every second: without
+    /// it a run was forgotten only once [`MAX_RUNS`] were kept).
+    pub fn forget_quiet(&mut self, now: Instant) {
+        self.runs.retain(|_, r| now.saturating_duration_since(r.last) < RUN_FORGET);
+    }
+
+    /// Runs remembered.
+    #[cfg(test)]
+    pub fn runs(&self) -> usize {
+        self.runs.len()
     }
 
     /// Forgets `id`: a tick that carried it never reached the log, so its edge's next send of

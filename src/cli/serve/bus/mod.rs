@@ -19,10 +19,13 @@
 
 pub mod edge;
 mod handled;
+mod heap;
 mod lead;
 pub mod lease;
 mod link;
 pub mod lockstep;
+#[cfg(test)]
+mod memory_tests;
 mod pending;
 pub mod protocol;
 pub mod sequencer;

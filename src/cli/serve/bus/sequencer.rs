@@ -29,8 +29,14 @@ const PRESENCE_LIFETIME: Duration = Duration::from_secs(3);
 pub const MAX_EDGES: usize = 256;
 /// Most players whose buckets are kept; beyond it the quiet ones are forgotten first.
 pub const MAX_TRACKED_PLAYERS: usize = 20_000;
-/// A player quiet this long may be forgotten (their buckets are full again by then).
+/// A player quiet this long is forgotten (their buckets are full again by then, so forgetting
+/// changes no verdict).
 const PLAYER_FORGET: Duration = Duration::from_secs(10);
+/// An edge heard from neither by presence nor by a request this long is forgotten (its bucket
+/// is full again and its presence no longer counts).
+const EDGE_FORGET: Duration = Duration::from_secs(10);
+/// How often the quiet players, edges and runs are forgotten (a sweep of the tables).
+const FORGET_EVERY: Duration = Duration::from_secs(1);
 /// Events one edge may send a second, all its players together.
 pub const EDGE_EVENTS_PER_SECOND: f64 = 3_000.0;
 /// The burst every bucket allows.
@@ -58,7 +64,10 @@ struct PlayerBuckets {
 struct EdgeSeen {
     events: ByteBucket,
     players: u32,
+    /// Its last presence.
     last: Instant,
+    /// Its last message of any kind.
+    heard: Instant,
 }
 
 /// Counters for the log line and the tests.
@@ -78,6 +87,14 @@ pub struct SequencerCounts {
 }
 
 /// The pool's sequencer.
+///
+/// Its memory is bounded by the players and edges of the last seconds, not by how long it has
+/// run nor by how many players ever came: every [`FORGET_EVERY`] it forgets the players quiet
+/// for [`PLAYER_FORGET`], the edges quiet for [`EDGE_FORGET`] and the edges' runs quiet for a
+/// minute (`handled.rs`); at most [`MAX_TRACKED_PLAYERS`] players, [`MAX_EDGES`] edges and 512
+/// runs of at most 4,096 ids each at any time. Before, the quiet were forgotten only once a
+/// table was full: a pool whose players come and go kept every player who ever pressed a key,
+/// up to 20,000 (docs/serve/bus.md, round 6).
 pub struct Sequencer {
     size: (u32, u32),
     limits: SequencerLimits,
@@ -98,6 +115,8 @@ pub struct Sequencer {
     edges: HashMap<String, EdgeSeen>,
     pool_keys: ByteBucket,
     counts: SequencerCounts,
+    /// When the quiet are next forgotten.
+    next_forget: Instant,
 }
 
 impl Sequencer {
@@ -133,6 +152,7 @@ impl Sequencer {
             edges: HashMap::new(),
             pool_keys: ByteBucket::limit(limits.pool_scene_keys_per_second, BURST),
             counts: SequencerCounts::default(),
+            next_forget: now + FORGET_EVERY,
         }
     }
 
@@ -209,7 +229,9 @@ impl Sequencer {
             events: ByteBucket::limit(EDGE_EVENTS_PER_SECOND, BURST),
             players: 0,
             last: now,
+            heard: now,
         });
+        edge.heard = now;
         if !edge.events.try_take(1.0, now) {
             return Err(Refusal(format!("edge {} is over {EDGE_EVENTS_PER_SECOND} events a second", submit.edge)));
         }
@@ -278,9 +300,10 @@ impl Sequencer {
             events: ByteBucket::limit(EDGE_EVENTS_PER_SECOND, BURST),
             players: 0,
             last: now,
+            heard: now,
         });
         edge.players = p.players;
-        edge.last = now;
+        (edge.last, edge.heard) = (now, now);
         Ok(())
     }
 
@@ -294,9 +317,29 @@ impl Sequencer {
         }
     }
 
+    /// Forgets, every [`FORGET_EVERY`], the players, edges and runs quiet long enough that
+    /// remembering them changes no verdict (their buckets full again; their runs' requests
+    /// given up by their edges).
+    fn forget_old(&mut self, now: Instant) {
+        if now < self.next_forget {
+            return;
+        }
+        self.next_forget = now + FORGET_EVERY;
+        self.players.retain(|_, p| now.saturating_duration_since(p.last) < PLAYER_FORGET);
+        self.edges.retain(|_, e| now.saturating_duration_since(e.heard) < EDGE_FORGET);
+        self.handled.forget_quiet(now);
+    }
+
+    /// Players, edges and runs remembered, and the ids of the runs (for the memory's test).
+    #[cfg(test)]
+    pub fn kept(&self) -> (usize, usize, usize, usize) {
+        (self.players.len(), self.edges.len(), self.handled.runs(), self.handled.len())
+    }
+
     /// The next tick: the frontier moved up to the clock's step plus the lead, and the events
     /// taken since the last tick stamped at it.
     pub fn tick(&mut self, now: Instant) -> Tick {
+        self.forget_old(now);
         self.frontier = self.frontier.max(self.step(now) + LEAD_STEPS);
         self.counts.ticks += 1;
         let players = self
