@@ -4,7 +4,7 @@
 
 use std::f64::consts::PI;
 
-use rustfft::FftPlanner;
+use rustfft::FftPlannerScalar;
 use rustfft::num_complex::Complex64;
 
 use super::swell::{Swell, Swells};
@@ -55,7 +55,7 @@ fn mean_abs_cosine(law: Spreading, r: f64, wind: f64, fp: f64) -> f64 {
 /// exponent does not matter).
 pub(crate) fn fft2(values: &[f32], n: usize) -> Vec<Complex64> {
     let mut data: Vec<Complex64> = values.iter().map(|&v| Complex64::new(f64::from(v), 0.0)).collect();
-    let fft = FftPlanner::new().plan_fft_forward(n);
+    let fft = FftPlannerScalar::new().plan_fft_forward(n);
     for _ in 0..2 {
         for row in data.chunks_mut(n) {
             fft.process(row);
@@ -157,7 +157,7 @@ fn spectrum_of(s: &[f64]) -> Vec<Complex64> {
         .enumerate()
         .map(|(i, v)| Complex64::new(v * (0.5 - 0.5 * (2.0 * PI * i as f64 / n as f64).cos()), 0.0))
         .collect();
-    FftPlanner::new().plan_fft_forward(n).process(&mut data);
+    FftPlannerScalar::new().plan_fft_forward(n).process(&mut data);
     data
 }
 
