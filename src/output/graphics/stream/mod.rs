@@ -212,6 +212,22 @@ pub struct FileWrite {
 struct Pending {
     rung: usize,
     part: Part,
+    /// What the commit does to the model of where the shown picture came from.
+    model: Model,
+    /// The offer makes the shown picture the source's own pixels at the top rung.
+    exact: bool,
+}
+
+/// What a commit does to `sent` and `source_shown` (see [`PictureStream`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Model {
+    /// The offer was encoded from this frame's `target` and `source_now`: they become `sent`
+    /// and `source_shown`.
+    Set,
+    /// The offer refined what was shown towards `sent`: both stay.
+    Keep,
+    /// The offer is not an encoding of a known source picture: both are forgotten.
+    Clear,
 }
 
 /// One terminal's pictures under rate control (see the module documentation).
@@ -233,6 +249,22 @@ pub struct PictureStream {
     shown: Option<(usize, Vec<u8>)>,
     /// The picture being offered (same form as `shown`).
     candidate: Vec<u8>,
+    /// Under a rate (kitty and iTerm2): this frame's picture at the rung as the source gives it
+    /// (the lossy packings show something near it), and the one the shown picture was encoded
+    /// from with its rung: changes are found between these two, not against `shown`, which a
+    /// lossy packing leaves a little off everywhere.
+    target: Vec<u8>,
+    sent: Option<(usize, Vec<u8>)>,
+    /// Under a rate: this frame's source picture and the one `sent` was made from (RGBA as
+    /// given): equal, the scene is still and the bytes go to refining what is shown
+    /// (`refine.rs`).
+    source_now: Vec<u8>,
+    source_shown: Vec<u8>,
+    /// The terminal shows the source's own pixels at the top rung (a still scene is done).
+    shown_exact: bool,
+    /// The bytes of the last exact whole picture a protocol without frame edits refined to:
+    /// it is not encoded again until the bucket holds them.
+    refine_cost: Option<usize>,
     pending: Option<Pending>,
     /// The next tile (its index in raster order) when pictures go in tiles.
     next_tile: usize,
@@ -282,6 +314,12 @@ impl PictureStream {
             next_due: None,
             shown: None,
             candidate: Vec::new(),
+            target: Vec::new(),
+            sent: None,
+            source_now: Vec::new(),
+            source_shown: Vec::new(),
+            shown_exact: false,
+            refine_cost: None,
             pending: None,
             next_tile: 0,
             state: State { size: layout.picture, packing: None, rate, part: Part::Whole },
@@ -315,6 +353,7 @@ impl PictureStream {
     pub fn invalidate(&mut self) {
         self.forget_pending();
         self.shown = None;
+        self.forget_model();
         self.next_due = None;
         self.next_tile = 0;
         self.placeholders_due = true;
@@ -350,7 +389,16 @@ impl PictureStream {
         self.cost = vec![None; self.rungs.len()];
         self.rung = 0;
         self.shown = None;
+        self.forget_model();
         self.next_tile = 0;
+    }
+
+    /// Forgets where the shown picture came from.
+    fn forget_model(&mut self) {
+        self.sent = None;
+        self.source_shown.clear();
+        self.shown_exact = false;
+        self.refine_cost = None;
     }
 
     /// The picture `picture` encoded for the terminal within `budget`, or `None` (see the
@@ -376,11 +424,16 @@ impl PictureStream {
         let allowance = self.plan(budget);
         let room = allowance.min(budget.available);
         let limited = budget.rate.is_some();
-        // The protocol's picture rate; a picture at most once a frame. Due half a frame early,
-        // so that an interval of two frames is two and not three when the clock's ticks fall a
-        // nanosecond short.
-        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
-        let interval = Duration::from_secs_f64(1.0 / most).max(budget.frame_interval) - budget.frame_interval / 2;
+        // A still scene under a rate: the bytes refine what is shown towards the source.
+        if limited && self.still(picture) {
+            let interval = self.interval(budget);
+            return self.refine(budget, room, now, interval);
+        }
+        if limited && !matches!(self.protocol, Protocol::Sixel { .. }) {
+            self.source_now.clear();
+            self.source_now.extend_from_slice(picture.data());
+        }
+        let interval = self.interval(budget);
         // The bucket does not hold what this rung costs yet: no picture is encoded for nothing.
         if limited
             && !budget.overdraw
@@ -442,7 +495,7 @@ impl PictureStream {
                 self.flatten_candidate();
                 self.bytes.clear();
                 self.push_part(Part::Whole, rung, Some(Packing::Zlib(6)));
-                return self.offer(rung, Part::Whole, limited, now + FRAME_MIN);
+                return self.offer_as(rung, Part::Whole, limited, now + FRAME_MIN, Model::Clear, false);
             }
             _ => {}
         }
@@ -450,9 +503,36 @@ impl PictureStream {
         self.offer(rung, part, limited, now + interval)
     }
 
-    /// Offers `self.bytes` (the caller has checked they fit).
+    /// The least time between pictures: the protocol's picture rate, a picture at most once a
+    /// frame. Due half a frame early, so that an interval of two frames is two and not three
+    /// when the clock's ticks fall a nanosecond short.
+    fn interval(&self, budget: Budget) -> Duration {
+        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
+        Duration::from_secs_f64(1.0 / most).max(budget.frame_interval) - budget.frame_interval / 2
+    }
+
+    /// Offers `self.bytes` (the caller has checked they fit); what the commit does to the model
+    /// follows from the packing: a limited kitty or iTerm2 picture encoded from this frame's
+    /// target sets it.
     fn offer(&mut self, rung: usize, part: Part, limited: bool, next: Instant) -> Option<Offer<'_>> {
-        self.pending = Some(Pending { rung, part });
+        let model = match (self.packing(limited, rung), part) {
+            (Some(Packing::LossyPng(_) | Packing::Jpeg(_)), Part::Whole | Part::Changed(..)) => Model::Set,
+            _ => Model::Clear,
+        };
+        self.offer_as(rung, part, limited, next, model, false)
+    }
+
+    /// Offers `self.bytes` with what the commit does to the model.
+    fn offer_as(
+        &mut self,
+        rung: usize,
+        part: Part,
+        limited: bool,
+        next: Instant,
+        model: Model,
+        exact: bool,
+    ) -> Option<Offer<'_>> {
+        self.pending = Some(Pending { rung, part, model, exact });
         self.state = State { size: self.rungs[rung], packing: self.packing(limited, rung), rate: self.rate, part };
         self.next_due = Some(next);
         Some(Offer { bytes: &self.bytes, state: self.state })
@@ -460,12 +540,29 @@ impl PictureStream {
 
     /// The offer was written: the terminal shows it from now on.
     pub fn commit(&mut self) {
-        let Some(Pending { rung, part }) = self.pending.take() else { return };
+        let Some(Pending { rung, part, model, exact }) = self.pending.take() else { return };
         self.committed_files.extend(self.pending_file.take());
         let sixel = matches!(self.protocol, Protocol::Sixel { .. });
         let (stride, bpp) = self.stride(rung);
+        match model {
+            Model::Set => {
+                let target = std::mem::take(&mut self.target);
+                self.target = self.sent.take().map(|(_, v)| v).unwrap_or_default();
+                self.sent = Some((rung, target));
+                std::mem::swap(&mut self.source_shown, &mut self.source_now);
+                self.refine_cost = None;
+            }
+            Model::Keep => {}
+            Model::Clear => {
+                self.sent = None;
+                self.source_shown.clear();
+            }
+        }
+        self.shown_exact = exact;
         match (part, &mut self.shown) {
-            (Part::Tile(x, y, w, h), Some((r, shown))) if *r == rung || sixel => {
+            // Only the box: outside it the candidate is what was shown (lossless: equal; lossy:
+            // the shown picture with the box re-encoded).
+            (Part::Tile(x, y, w, h) | Part::Changed(x, y, w, h), Some((r, shown))) if *r == rung || sixel => {
                 *r = rung;
                 for row in y as usize..(y + h) as usize {
                     let a = row * stride + x as usize * bpp;
@@ -516,7 +613,7 @@ impl PictureStream {
     fn packing(&self, limited: bool, rung: usize) -> Option<Packing> {
         match &self.protocol {
             Protocol::Kitty(o) if matches!(o.medium, Medium::TempFile(_)) => None,
-            Protocol::Kitty(_) if limited => Some(Packing::Png),
+            Protocol::Kitty(_) if limited => Some(Packing::LossyPng(self.lossy_step(rung))),
             Protocol::Kitty(_) => Some(Packing::Zlib(1)),
             Protocol::Iterm2 { .. } if limited => Some(Packing::Jpeg(self.jpeg_quality(rung))),
             Protocol::Iterm2 { .. } => Some(Packing::Png),
@@ -524,9 +621,17 @@ impl PictureStream {
         }
     }
 
+    /// kitty's lossy PNG step under a rate.
+    fn lossy_step(&self, _rung: usize) -> u8 {
+        std::env::var("TIDEPOOL_Q").ok().and_then(|v| v.parse().ok()).unwrap_or(8)
+    }
+
     /// iTerm2's JPEG quality: lower on the lower rungs, where each pixel is bigger on screen
     /// and the rung was chosen because bytes are short.
     fn jpeg_quality(&self, rung: usize) -> u8 {
+        if let Some(q) = std::env::var("TIDEPOOL_JQ").ok().and_then(|v| v.parse().ok()) {
+            return q;
+        }
         let from_bottom = self.rungs.len() - 1 - rung;
         [40, 50, 60, 70, 75, 80].get(from_bottom).copied().unwrap_or(85)
     }
@@ -540,7 +645,8 @@ impl PictureStream {
             return usize::MAX;
         };
         let burst = (rate * MAX_BURST.as_secs_f64()).max(MIN_CAPACITY);
-        let allowance = (rate / MIN_RATE).min(burst) * PICTURE_SHARE;
+        let min_rate: f64 = std::env::var("TIDEPOOL_MINRATE").ok().and_then(|v| v.parse().ok()).unwrap_or(MIN_RATE);
+        let allowance = (rate / min_rate).min(burst) * PICTURE_SHARE;
         let last = self.rungs.len() - 1;
         let mut rung = (0..self.rungs.len()).find(|&r| self.predict(r).is_none_or(|c| c <= allowance)).unwrap_or(last);
         // Hysteresis: a bigger rung only when it fits with room to spare.
@@ -573,6 +679,7 @@ impl PictureStream {
 }
 
 mod encode;
+mod refine;
 
 #[cfg(test)]
 mod tests;

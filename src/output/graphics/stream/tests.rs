@@ -223,3 +223,97 @@ fn sixel_streams_write_the_same_bytes_as_before() {
     }
     assert_eq!(hash, 10844920514458207448, "the sixel bytes changed");
 }
+
+/// Plays `moving` frames of moving water and then `still` frames of the last one through
+/// `stream` with a bucket of `rate` bytes a second (no overdraw), committing every offer and
+/// feeding kitty's to a decoder. Checks every offer against the bytes available and the
+/// decoded image against the stream's model of what is shown. Returns the frame (counted from
+/// the first still one) from which the decoded image is the exact source at the top rung and
+/// stays so with nothing sent (`None`: never), and the bytes sent.
+fn still_after_moving(stream: &mut PictureStream, rate: f64, moving_frames: u32, still: u32) -> (Option<u32>, usize) {
+    let t0 = Instant::now();
+    let mut bucket = ByteBucket::new(rate);
+    bucket.refill(t0);
+    let mut terminal = kitty_decode::KittyState::default();
+    let kitty = matches!(stream.protocol, Protocol::Kitty(_));
+    let last = moving(moving_frames);
+    let mut exact = Vec::new();
+    Resampler::default().resample(last.data(), 4, (640, 360), (640, 360), &mut exact);
+    let (mut converged, mut total) = (None, 0);
+    for n in 1..=moving_frames + still {
+        let now = t0 + FRAME * n;
+        bucket.refill(now);
+        let budget = Budget::new(bucket.budget(), Some(rate), FRAME);
+        let picture = if n <= moving_frames { moving(n) } else { last.clone() };
+        let offer = stream.prepare(&picture, budget, now).map(|o| o.bytes.to_vec());
+        if let Some(bytes) = &offer {
+            assert!(
+                bytes.len() <= budget.available,
+                "frame {n}: {} bytes, {} available",
+                bytes.len(),
+                budget.available
+            );
+            bucket.spend(bytes.len());
+            total += bytes.len();
+            stream.commit();
+            if kitty {
+                terminal.feed(bytes).expect("the stream decodes");
+                let image = &terminal.images[&kitty::IMAGE_ID];
+                let (rung, shown) = stream.shown.as_ref().expect("shown after a commit");
+                assert_eq!((image.width, image.height), stream.rungs[*rung], "frame {n}");
+                assert!(&image.rgb == shown, "frame {n}: the terminal shows what the stream believes");
+            }
+        }
+        if n > moving_frames {
+            let at_top = stream.shown.as_ref().is_some_and(|(r, s)| *r == 0 && *s == exact);
+            match (at_top && offer.is_none(), converged) {
+                (true, None) => converged = Some(n - moving_frames),
+                (false, Some(_)) => panic!("frame {n}: sent {:?} bytes after converging", offer.map(|b| b.len())),
+                _ => {}
+            }
+        }
+    }
+    (converged, total)
+}
+
+#[test]
+fn the_block_codec_never_exceeds_its_budget_and_still_water_converges_to_the_exact_picture() {
+    // kitty with frame edits at 50 and 250 kB/s: lossy pictures while the water moves, then
+    // the worst blocks made exact, the climb to the top rung, and nothing once it is exact.
+    for rate in [50e3, 250e3] {
+        let mut stream = kitty_stream();
+        let (converged, bytes) = still_after_moving(&mut stream, rate, 45, 1200);
+        let frames = converged.unwrap_or_else(|| panic!("{rate} B/s: still water never became exact"));
+        let seconds = f64::from(45 + frames) / 30.0;
+        assert!(bytes as f64 <= rate * seconds * 1.05 + rate / 10.0, "{rate} B/s: {bytes} bytes in {seconds} s");
+    }
+}
+
+#[test]
+fn nothing_changes_nothing_is_sent() {
+    // Unlimited: the second identical picture sends nothing (every picture is exact).
+    let t0 = Instant::now();
+    for mut stream in [kitty_stream(), iterm2_stream()] {
+        let picture = moving(3);
+        assert!(stream.prepare(&picture, Budget::unlimited(FRAME), t0).is_some());
+        stream.commit();
+        for n in 1..30u32 {
+            assert!(stream.prepare(&picture, Budget::unlimited(FRAME), t0 + FRAME * n).is_none(), "frame {n}");
+        }
+    }
+    // Under a rate: iTerm2 (no partial update) sends its exact picture once the bucket holds
+    // it (here: the caller overdraws), and nothing after.
+    let mut stream = iterm2_stream();
+    let picture = moving(3);
+    let mut sent = Vec::new();
+    for n in 0..60u32 {
+        let budget = Budget { overdraw: true, ..Budget::new(200_000, Some(2e6), FRAME) };
+        if let Some(offer) = stream.prepare(&picture, budget, t0 + FRAME * (2 * n)) {
+            sent.push(offer.state.packing);
+            stream.commit();
+        }
+    }
+    assert_eq!(sent.len(), 2, "a JPEG, then the exact PNG, then nothing: {sent:?}");
+    assert_eq!(sent[1], Some(Packing::Png));
+    assert!(stream.shown_exact);
+}
