@@ -77,7 +77,8 @@ impl PictureStream {
         if !fits(self.bytes.len()) {
             return None;
         }
-        self.offer_as(0, Part::Whole, true, now + interval, Model::Set, true)
+        // (Labelled as unlimited pictures are: a lossless PNG.)
+        self.offer_as(0, Part::Whole, false, now + interval, Model::Set, true)
     }
 
     /// The worst blocks of the shown picture made exact by frame edits, or the climb to the
