@@ -68,36 +68,15 @@ use std::time::{Duration, Instant};
 use tiny_skia::Pixmap;
 
 use self::ladder::Resampler;
-use crate::output::bucket::{MAX_BURST, MIN_CAPACITY};
+#[cfg(test)]
+use self::plan::KITTY_STEP;
+use self::plan::{MIN_RATE, PICTURE_SHARE};
 use crate::output::graphics::geometry::Layout;
 use crate::output::graphics::kitty::{KittyOptions, Medium};
 use crate::output::graphics::pack::Packing;
 use crate::output::graphics::scan;
 use crate::output::graphics::sixel::{Registers, SixelEncoder, SixelPalette, TMUX_MAX_IMAGE_BYTES};
 
-/// The share of a picture interval's bytes a picture may take: the rest is left for the status
-/// line and the cells' own changes.
-const PICTURE_SHARE: f64 = 0.85;
-/// The picture rate the rung is chosen for: the rung's whole picture fits a tenth of a second
-/// of the rate, so a moving picture keeps at least this many pictures a second.
-const MIN_RATE: f64 = 10.0;
-/// A rung above the current one is taken only when it is predicted to fit this share of the
-/// allowance (hysteresis: no flapping between two rungs).
-const UP_SHARE: f64 = 0.85;
-/// The weight of the newest measurement in a rung's cost average.
-const LEARN: f64 = 0.3;
-/// How per-pixel cost grows as a rung shrinks: bytes a pixel scale as (pixels ratio) ^ this.
-const DENSITY_EXPONENT: f64 = 0.2;
-/// kitty's lossy PNG step under a rate (`lossy_png`): in the pictures bench 24 scored above 16
-/// and 8 at 50 kB/s, 250 kB/s and 2 MB/s (0.636, 0.687, 0.779 against 0.620, 0.676, 0.747 for
-/// 8): the coarser step buys a larger rung, and a larger rung is worth more than the step's
-/// error (docs/pixels/block-codec.md).
-const KITTY_STEP: u8 = 24;
-/// iTerm2's JPEG quality under a rate: 70 on every rung. At 2 MB/s it lets the top rung go 30
-/// times a second (SSIM 0.931 against 0.858 with 85 at 22 a second); at 250 kB/s it costs
-/// 0.02 against the former table (85 on that rung), at 50 kB/s it gains 0.003
-/// (docs/pixels/block-codec.md).
-const ITERM2_QUALITY: u8 = 70;
 /// The soonest the next picture may follow a base image sent for tiles.
 const FRAME_MIN: Duration = Duration::from_millis(1);
 
@@ -278,8 +257,9 @@ pub struct PictureStream {
     source_shown: Vec<u8>,
     /// The terminal shows the source's own pixels at the top rung (a still scene is done).
     shown_exact: bool,
-    /// The bytes of the last exact whole picture a protocol without frame edits refined to:
-    /// it is not encoded again until the bucket holds them.
+    /// The bytes of the last whole picture a refinement encoded and the bucket did not hold
+    /// (the exact picture of a protocol without frame edits, kitty's first picture of a climb
+    /// to a higher rung): it is not encoded again until the bucket holds them.
     refine_cost: Option<usize>,
     pending: Option<Pending>,
     /// The next tile (its index in raster order) when pictures go in tiles.
@@ -443,7 +423,7 @@ impl PictureStream {
         // A still scene under a rate: the bytes refine what is shown towards the source.
         if limited && self.still(picture) {
             let interval = self.interval(budget);
-            return self.refine(budget, room, now, interval);
+            return self.refine(budget, (room, allowance), now, interval);
         }
         if limited && !matches!(self.protocol, Protocol::Sixel { .. }) {
             self.source_now.clear();
@@ -519,84 +499,6 @@ impl PictureStream {
         self.offer(rung, part, limited, now + interval)
     }
 
-    /// The least time between pictures: the protocol's picture rate, a picture at most once a
-    /// frame. Due half a frame early, so that an interval of two frames is two and not three
-    /// when the clock's ticks fall a nanosecond short.
-    fn interval(&self, budget: Budget) -> Duration {
-        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
-        Duration::from_secs_f64(1.0 / most).max(budget.frame_interval) - budget.frame_interval / 2
-    }
-
-    /// Offers `self.bytes` (the caller has checked they fit); what the commit does to the model
-    /// follows from the packing: a limited kitty or iTerm2 picture encoded from this frame's
-    /// target sets it.
-    fn offer(&mut self, rung: usize, part: Part, limited: bool, next: Instant) -> Option<Offer<'_>> {
-        let model = match (self.packing(limited, rung), part) {
-            (Some(Packing::LossyPng(_) | Packing::Jpeg(_)), Part::Whole | Part::Changed(..)) => Model::Set,
-            _ => Model::Clear,
-        };
-        self.offer_as(rung, part, limited, next, model, false)
-    }
-
-    /// Offers `self.bytes` with what the commit does to the model.
-    fn offer_as(
-        &mut self,
-        rung: usize,
-        part: Part,
-        limited: bool,
-        next: Instant,
-        model: Model,
-        exact: bool,
-    ) -> Option<Offer<'_>> {
-        self.pending = Some(Pending { rung, part, model, exact });
-        self.state = State { size: self.rungs[rung], packing: self.packing(limited, rung), rate: self.rate, part };
-        self.next_due = Some(next);
-        Some(Offer { bytes: &self.bytes, state: self.state })
-    }
-
-    /// The offer was written: the terminal shows it from now on.
-    pub fn commit(&mut self) {
-        let Some(Pending { rung, part, model, exact }) = self.pending.take() else { return };
-        self.committed_files.extend(self.pending_file.take());
-        let sixel = matches!(self.protocol, Protocol::Sixel { .. });
-        let (stride, bpp) = self.stride(rung);
-        match model {
-            Model::Set => {
-                let target = std::mem::take(&mut self.target);
-                self.target = self.sent.take().map(|(_, v)| v).unwrap_or_default();
-                self.sent = Some((rung, target));
-                std::mem::swap(&mut self.source_shown, &mut self.source_now);
-                self.refine_cost = None;
-            }
-            Model::Keep => {}
-            Model::Clear => {
-                self.sent = None;
-                self.source_shown.clear();
-            }
-        }
-        self.shown_exact = exact;
-        match (part, &mut self.shown) {
-            // Only the box: outside it the candidate is what was shown (lossless: equal; lossy:
-            // the shown picture with the box re-encoded).
-            (Part::Tile(x, y, w, h) | Part::Changed(x, y, w, h), Some((r, shown))) if *r == rung || sixel => {
-                *r = rung;
-                for row in y as usize..(y + h) as usize {
-                    let a = row * stride + x as usize * bpp;
-                    let b = a + w as usize * bpp;
-                    shown[a..b].copy_from_slice(&self.candidate[a..b]);
-                }
-            }
-            (_, shown) => {
-                let old = shown.take().map(|(_, v)| v).unwrap_or_default();
-                *shown = Some((rung, std::mem::replace(&mut self.candidate, old)));
-                if matches!(self.protocol, Protocol::Kitty(_)) && part == Part::Whole {
-                    self.placeholders_due = false;
-                }
-            }
-        }
-        self.rung = rung;
-    }
-
     /// An offer not committed: its temporary file is never written.
     fn forget_pending(&mut self) {
         self.pending = None;
@@ -625,70 +527,11 @@ impl PictureStream {
             _ => (self.rungs[rung].0 as usize * 3, 3),
         }
     }
-
-    fn packing(&self, limited: bool, rung: usize) -> Option<Packing> {
-        match &self.protocol {
-            Protocol::Kitty(o) if matches!(o.medium, Medium::TempFile(_)) => None,
-            Protocol::Kitty(_) if limited => Some(Packing::LossyPng(self.lossy_step(rung))),
-            Protocol::Kitty(_) => Some(Packing::Zlib(1)),
-            Protocol::Iterm2 { .. } if limited => Some(Packing::Jpeg(self.jpeg_quality(rung))),
-            Protocol::Iterm2 { .. } => Some(Packing::Png),
-            Protocol::Sixel { .. } => None,
-        }
-    }
-
-    /// kitty's lossy PNG step under a rate ([`KITTY_STEP`] on every rung).
-    fn lossy_step(&self, _rung: usize) -> u8 {
-        KITTY_STEP
-    }
-
-    /// iTerm2's JPEG quality under a rate ([`ITERM2_QUALITY`] on every rung).
-    fn jpeg_quality(&self, _rung: usize) -> u8 {
-        ITERM2_QUALITY
-    }
-
-    /// Chooses the rung for `budget` and returns the bytes one picture may take.
-    fn plan(&mut self, budget: Budget) -> usize {
-        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
-        let Some(rate) = budget.rate else {
-            self.rate = most;
-            self.rung = 0;
-            return usize::MAX;
-        };
-        let burst = (rate * MAX_BURST.as_secs_f64()).max(MIN_CAPACITY);
-        let allowance = (rate / MIN_RATE).min(burst) * PICTURE_SHARE;
-        let last = self.rungs.len() - 1;
-        let mut rung = (0..self.rungs.len()).find(|&r| self.predict(r).is_none_or(|c| c <= allowance)).unwrap_or(last);
-        // Hysteresis: a bigger rung only when it fits with room to spare.
-        if rung < self.rung && self.predict(rung).is_some_and(|c| c > UP_SHARE * allowance) {
-            rung = self.rung.min(last);
-        }
-        self.rung = rung;
-        self.rate = self.predict(rung).map_or(most, |c| (rate * PICTURE_SHARE / c.max(1.0)).min(most));
-        allowance as usize
-    }
-
-    /// A whole picture's predicted bytes at `rung`: learned, or scaled from the nearest rung
-    /// learned; `None` when nothing is known yet (the first picture tries the top).
-    fn predict(&self, rung: usize) -> Option<f64> {
-        let pixels = |r: usize| f64::from(self.rungs[r].0) * f64::from(self.rungs[r].1);
-        let (known, bpp) =
-            (0..self.rungs.len()).filter_map(|r| self.cost[r].map(|c| (r, c))).min_by_key(|(r, _)| r.abs_diff(rung))?;
-        Some(bpp * (pixels(known) / pixels(rung)).powf(DENSITY_EXPONENT) * pixels(rung))
-    }
-
-    fn learn(&mut self, rung: usize, part: Part) {
-        if part != Part::Whole {
-            return;
-        }
-        let (w, h) = self.rungs[rung];
-        let bpp = self.bytes.len() as f64 / (f64::from(w) * f64::from(h));
-        let c = &mut self.cost[rung];
-        *c = Some(c.map_or(bpp, |old| old + LEARN * (bpp - old)));
-    }
 }
 
+mod commit;
 mod encode;
+mod plan;
 mod refine;
 
 #[cfg(test)]

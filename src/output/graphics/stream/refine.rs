@@ -8,11 +8,15 @@
 //!
 //! - kitty with frame edits: the shown picture is cut into [`BLOCK`]-pixel blocks, ordered by
 //!   their error (the sum of the byte differences from the picture at that rung), and the worst
-//!   blocks go as exact (lossless PNG) frame edits while they fit the bytes available now.
-//!   When the rung is exact and below the top, the picture climbs: a new image at the top rung
-//!   whose pixels are the shown picture enlarged (a lossy PNG of a smooth picture: nearly every
-//!   difference rounds to zero, a few kilobytes; a flat image of its mean colour when even that
-//!   does not fit), which the blocks then make exact.
+//!   blocks go as exact (lossless PNG) frame edits while they fit the bytes available now. On
+//!   a slow link where even the worst block alone is more than a picture may take, the blocks
+//!   are halved (8, 4, 2, 1 pixels) until it fits, as a picture's tiles are: a few hundred
+//!   bytes a frame still make a still picture exact.
+//!   When the rung is exact and below the top, the picture climbs: a new image at the highest
+//!   rung whose first picture fits, that picture being the shown one enlarged (a lossy PNG of
+//!   a smooth picture: nearly every difference rounds to zero, a few kilobytes; a flat image
+//!   of its mean colour when even that does not fit), which the blocks then make exact; and
+//!   so on up to the top rung.
 //! - iTerm2 and kitty without frame edits (no partial update): the source's own pixels at the
 //!   top rung as one lossless PNG, when the bucket holds it (or the caller can overdraw).
 //!
@@ -27,7 +31,7 @@ use crate::output::graphics::pack::Packing;
 
 /// The side of a refinement block, pixels of the rung.
 const BLOCK: u32 = 16;
-/// The lossy step of the base image a still picture climbs to the top rung with.
+/// The lossy step of the first picture a still picture climbs to a higher rung with.
 const BASE_STEP: u8 = 8;
 
 impl PictureStream {
@@ -45,7 +49,7 @@ impl PictureStream {
     pub(super) fn refine(
         &mut self,
         budget: Budget,
-        room: usize,
+        (room, allowance): (usize, usize),
         now: Instant,
         interval: Duration,
     ) -> Option<Offer<'_>> {
@@ -54,7 +58,7 @@ impl PictureStream {
             return None;
         }
         match &self.protocol {
-            Protocol::Kitty(o) if o.frame_edits => self.refine_blocks(room, now, interval),
+            Protocol::Kitty(o) if o.frame_edits => self.refine_blocks(room, allowance, now, interval),
             _ => self.refine_whole(budget, now, interval),
         }
     }
@@ -81,84 +85,126 @@ impl PictureStream {
         self.offer_as(0, Part::Whole, false, now + interval, Model::Set, true)
     }
 
-    /// The worst blocks of the shown picture made exact by frame edits, or the climb to the
-    /// top rung when the shown rung is exact.
-    fn refine_blocks(&mut self, room: usize, now: Instant, interval: Duration) -> Option<Offer<'_>> {
-        let (rung, errors) = {
-            let (Some((rung, shown)), Some((_, sent))) = (&self.shown, &self.sent) else { return None };
-            (*rung, block_errors(shown, sent, self.rungs[*rung]))
-        };
-        if errors.is_empty() {
-            if rung == 0 {
-                self.shown_exact = true;
-                self.next_due = Some(now + interval);
-                return None;
+    /// The worst blocks of the shown picture made exact by frame edits, or the climb to a
+    /// higher rung when the shown rung is exact. A block whose edit alone is more than a
+    /// picture may take (`allowance`) is halved, and halved again, until the worst one fits:
+    /// on a link of a few hundred bytes a frame a still picture still becomes exact, in
+    /// smaller pieces. One that fits the allowance but not the bytes available now waits for
+    /// the bucket.
+    fn refine_blocks(&mut self, room: usize, allowance: usize, now: Instant, interval: Duration) -> Option<Offer<'_>> {
+        let rung = self.shown.as_ref()?.0;
+        let mut side = BLOCK;
+        loop {
+            let errors = {
+                let (Some((_, shown)), Some((_, sent))) = (&self.shown, &self.sent) else { return None };
+                block_errors(shown, sent, self.rungs[rung], side)
+            };
+            if errors.is_empty() {
+                if rung == 0 {
+                    self.shown_exact = true;
+                    self.next_due = Some(now + interval);
+                    return None;
+                }
+                return self.climb(rung, room, allowance, now);
             }
-            return self.climb(rung, room, now);
+            match self.pack_blocks(rung, &errors, side, room) {
+                Ok(((x0, y0, x1, y1), all)) => {
+                    let (part, exact) = (Part::Changed(x0, y0, x1 - x0, y1 - y0), all && rung == 0);
+                    return self.offer_as(rung, part, true, now + interval, Model::Keep, exact);
+                }
+                Err(worst) if worst <= allowance || side == 1 => return None,
+                Err(_) => side /= 2,
+            }
         }
+    }
+
+    /// Puts the worst of `errors` (blocks of `side` pixels at `rung`) in `self.bytes` as exact
+    /// frame edits while they fit `room`, and the shown picture with them in the candidate:
+    /// the box around them and whether every block went, or the bytes of the worst block
+    /// alone when even it does not fit.
+    fn pack_blocks(
+        &mut self,
+        rung: usize,
+        errors: &[(u64, u32)],
+        side: u32,
+        room: usize,
+    ) -> Result<((u32, u32, u32, u32), bool), usize> {
         let size = self.rungs[rung];
-        let (cols, stride) = (size.0.div_ceil(BLOCK), size.0 as usize * 3);
+        let (cols, stride) = (size.0.div_ceil(side), size.0 as usize * 3);
         self.candidate.clear();
         self.candidate.extend_from_slice(&self.shown.as_ref().expect("shown").1);
         self.bytes.clear();
-        let (mut sent_all, mut bbox) = (true, None::<(u32, u32, u32, u32)>);
-        for &(_, index) in &errors {
-            let (x, y) = ((index % cols) * BLOCK, (index / cols) * BLOCK);
-            let (w, h) = (BLOCK.min(size.0 - x), BLOCK.min(size.1 - y));
-            let from = &self.sent.as_ref().expect("sent").1;
-            copy_box(from, &mut self.candidate, stride, (x, y, w, h));
+        let mut bbox = None::<(u32, u32, u32, u32)>;
+        for &(_, index) in errors {
+            let (x, y) = ((index % cols) * side, (index / cols) * side);
+            let (w, h) = (side.min(size.0 - x), side.min(size.1 - y));
+            copy_box(&self.sent.as_ref().expect("sent").1, &mut self.candidate, stride, (x, y, w, h));
             let mark = self.bytes.len();
             self.push_part(Part::Tile(x, y, w, h), rung, Some(Packing::Png));
             if self.bytes.len() > room {
+                let worst = self.bytes.len();
                 self.bytes.truncate(mark);
                 copy_box(&self.shown.as_ref().expect("shown").1, &mut self.candidate, stride, (x, y, w, h));
-                sent_all = false;
-                break;
+                return bbox.map(|b| (b, false)).ok_or(worst);
             }
             bbox =
                 Some(bbox.map_or((x, y, x + w, y + h), |b| (b.0.min(x), b.1.min(y), b.2.max(x + w), b.3.max(y + h))));
         }
-        let (x0, y0, x1, y1) = bbox?;
-        let exact = sent_all && rung == 0;
-        self.offer_as(rung, Part::Changed(x0, y0, x1 - x0, y1 - y0), true, now + interval, Model::Keep, exact)
+        Ok((bbox.expect("at least one block"), true))
     }
 
-    /// A new image at the top rung showing the exact picture at `rung` enlarged, which the
-    /// blocks then refine to the source's top rung.
-    fn climb(&mut self, rung: usize, room: usize, now: Instant) -> Option<Offer<'_>> {
-        let (from, top) = (self.rungs[rung], self.rungs[0]);
-        let shown = &self.shown.as_ref().expect("shown").1;
-        self.resampler.resample(shown, 3, from, top, &mut self.candidate);
-        self.bytes.clear();
-        self.push_part(Part::Whole, 0, Some(Packing::LossyPng(BASE_STEP)));
-        if self.bytes.len() > room {
-            self.flatten_candidate();
-            self.bytes.clear();
-            self.push_part(Part::Whole, 0, Some(Packing::Zlib(6)));
-            if self.bytes.len() > room {
-                return None;
-            }
+    /// A new image at the highest rung whose first picture fits a picture's bytes
+    /// (`allowance`): the exact picture at `rung` enlarged, which the blocks then refine to
+    /// the source at that rung. It waits for the bucket when it fits the allowance but not
+    /// `room` (its bytes are kept: it is not encoded again until the bucket holds them).
+    fn climb(&mut self, rung: usize, room: usize, allowance: usize, now: Instant) -> Option<Offer<'_>> {
+        if self.refine_cost.is_some_and(|c| c > room) {
+            return None;
         }
-        // What the blocks refine towards: the source at the top rung.
-        self.resampler.resample(&self.source_shown, 4, self.source, top, &mut self.target);
+        let to = (0..rung).find(|&to| self.climb_base(rung, to, allowance))?;
+        self.refine_cost = Some(self.bytes.len());
+        if self.bytes.len() > room {
+            return None;
+        }
+        // What the blocks refine towards: the source at that rung.
+        self.resampler.resample(&self.source_shown, 4, self.source, self.rungs[to], &mut self.target);
         self.source_now.clear();
         self.source_now.extend_from_slice(&self.source_shown);
-        self.offer_as(0, Part::Whole, true, now + FRAME_MIN, Model::Set, false)
+        self.offer_as(to, Part::Whole, true, now + FRAME_MIN, Model::Set, false)
+    }
+
+    /// Encodes the first picture of the climb from `rung` to `to` into `self.bytes` and the
+    /// candidate: the shown picture enlarged (a lossy PNG of a smooth picture, step
+    /// [`BASE_STEP`]: a few kilobytes), or a flat image of its mean colour when that is more
+    /// than `allowance`; whether it fits `allowance`.
+    fn climb_base(&mut self, rung: usize, to: usize, allowance: usize) -> bool {
+        let (from, size) = (self.rungs[rung], self.rungs[to]);
+        let shown = &self.shown.as_ref().expect("shown").1;
+        self.resampler.resample(shown, 3, from, size, &mut self.candidate);
+        self.bytes.clear();
+        self.push_part(Part::Whole, to, Some(Packing::LossyPng(BASE_STEP)));
+        if self.bytes.len() <= allowance {
+            return true;
+        }
+        self.flatten_candidate();
+        self.bytes.clear();
+        self.push_part(Part::Whole, to, Some(Packing::Zlib(6)));
+        self.bytes.len() <= allowance
     }
 }
 
-/// The blocks of `shown` that differ from `truth` (RGB of `size`): their error (the sum of the
-/// byte differences) and index in raster order, worst first (ties: raster order).
-fn block_errors(shown: &[u8], truth: &[u8], size: (u32, u32)) -> Vec<(u64, u32)> {
-    let (cols, rows) = (size.0.div_ceil(BLOCK), size.1.div_ceil(BLOCK));
+/// The `side`-pixel blocks of `shown` that differ from `truth` (RGB of `size`): their error (the
+/// sum of the byte differences) and index in raster order, worst first (ties: raster order).
+fn block_errors(shown: &[u8], truth: &[u8], size: (u32, u32), side: u32) -> Vec<(u64, u32)> {
+    let (cols, rows) = (size.0.div_ceil(side), size.1.div_ceil(side));
     let mut errors = vec![0u64; (cols * rows) as usize];
     for (y, (a, b)) in shown.chunks_exact(size.0 as usize * 3).zip(truth.chunks_exact(size.0 as usize * 3)).enumerate()
     {
         if a == b {
             continue;
         }
-        let row = &mut errors[(y as u32 / BLOCK * cols) as usize..][..cols as usize];
-        for (col, (p, q)) in a.chunks(BLOCK as usize * 3).zip(b.chunks(BLOCK as usize * 3)).enumerate() {
+        let row = &mut errors[(y as u32 / side * cols) as usize..][..cols as usize];
+        for (col, (p, q)) in a.chunks(side as usize * 3).zip(b.chunks(side as usize * 3)).enumerate() {
             row[col] += p.iter().zip(q).map(|(s, t)| u64::from(s.abs_diff(*t))).sum::<u64>();
         }
     }

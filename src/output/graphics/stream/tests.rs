@@ -236,15 +236,20 @@ fn sixel_streams_write_the_same_bytes_as_before() {
 /// decoded image against the stream's model of what is shown. Returns the frame (counted from
 /// the first still one) from which the decoded image is the exact source at the top rung and
 /// stays so with nothing sent (`None`: never), and the bytes sent.
-fn still_after_moving(stream: &mut PictureStream, rate: f64, moving_frames: u32, still: u32) -> (Option<u32>, usize) {
+fn still_after_moving(
+    stream: &mut PictureStream,
+    rate: f64,
+    (moving_frames, still): (u32, u32),
+    moving: &dyn Fn(u32) -> Pixmap,
+) -> (Option<u32>, usize) {
     let t0 = Instant::now();
     let mut bucket = ByteBucket::new(rate);
     bucket.refill(t0);
     let mut terminal = kitty_decode::KittyState::default();
     let kitty = matches!(stream.protocol, Protocol::Kitty(_));
     let last = moving(moving_frames);
-    let mut exact = Vec::new();
-    Resampler::default().resample(last.data(), 4, (640, 360), (640, 360), &mut exact);
+    let (mut exact, size) = (Vec::new(), (last.width(), last.height()));
+    Resampler::default().resample(last.data(), 4, size, size, &mut exact);
     let (mut converged, mut total) = (None, 0);
     for n in 1..=moving_frames + still {
         let now = t0 + FRAME * n;
@@ -288,11 +293,38 @@ fn the_block_codec_never_exceeds_its_budget_and_still_water_converges_to_the_exa
     // the worst blocks made exact, the climb to the top rung, and nothing once it is exact.
     for rate in [50e3, 250e3] {
         let mut stream = kitty_stream();
-        let (converged, bytes) = still_after_moving(&mut stream, rate, 45, 1200);
+        let (converged, bytes) = still_after_moving(&mut stream, rate, (45, 1200), &moving);
         let frames = converged.unwrap_or_else(|| panic!("{rate} B/s: still water never became exact"));
         let seconds = f64::from(45 + frames) / 30.0;
         assert!(bytes as f64 <= rate * seconds * 1.05 + rate / 10.0, "{rate} B/s: {bytes} bytes in {seconds} s");
     }
+}
+
+/// The golden pool shifted `k` pixels at 120x72: a 40x13 terminal's picture.
+fn small_moving(k: u32) -> Pixmap {
+    let (mut rgb, size) = (Vec::new(), (120, 72));
+    Resampler::default().resample(moving(k).data(), 4, (640, 360), size, &mut rgb);
+    let mut p = Pixmap::new(size.0, size.1).unwrap();
+    for (px, c) in p.pixels_mut().iter_mut().zip(rgb.chunks_exact(3)) {
+        *px = tiny_skia::ColorU8::from_rgba(c[0], c[1], c[2], 255).premultiply();
+    }
+    p
+}
+
+#[test]
+fn on_a_link_of_a_few_hundred_bytes_a_frame_still_water_still_becomes_exact() {
+    // 5 kB/s: 167 bytes a frame, at most 425 a picture, where one 16x16 block's exact edit
+    // alone is about a kilobyte: the blocks are halved until they fit. Every offer within the
+    // bucket, the decoded image the model, the exact source at the top rung, then nothing.
+    let l = layout(GraphicsMode::Kitty, (40, 13), Some((8, 16)), None, SCALED_CAP);
+    let mut stream =
+        PictureStream::new(Protocol::Kitty(KittyOptions { frame_edits: true, ..KittyOptions::new(l.cells) }), l);
+    let rate = 5e3;
+    let (converged, bytes) = still_after_moving(&mut stream, rate, (30, 3000), &small_moving);
+    let frames = converged.unwrap_or_else(|| panic!("{rate} B/s: still water never became exact"));
+    assert_eq!(stream.rungs[0], (120, 72));
+    let seconds = f64::from(30 + frames) / 30.0;
+    assert!(bytes as f64 <= rate * seconds * 1.05 + 500.0, "{rate} B/s: {bytes} bytes in {seconds} s");
 }
 
 #[test]
