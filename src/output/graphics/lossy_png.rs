@@ -57,21 +57,20 @@ pub fn encode(rgb: &mut [u8], width: u32, height: u32, q: u8, out: &mut Vec<u8>)
 
 /// Rewrites one row (`up`: the row above as rebuilt, zeros for the first) to what the decoder
 /// rebuilds and writes its Average-filtered bytes into `out`. The prediction of each byte
-/// depends on the byte just rebuilt three places to the left, so the loop is a chain of a
-/// table look-up and a few additions a byte (no division).
+/// depends on the byte just rebuilt to its left, so the loop is a chain of a table look-up and
+/// a few additions a byte (no division), the left pixel kept in registers (the first pixel's
+/// left is 0, as PNG has it).
 #[inline(always)]
 fn filter_row(row: &mut [u8], up: &[u8], out: &mut [u8], steps: &Steps) {
-    for i in 0..row.len().min(3) {
-        let predicted = i32::from(up[i]) / 2;
-        let value = steps.quantise(i32::from(row[i]), predicted);
-        row[i] = value as u8;
-        out[i] = (value - predicted) as u8;
-    }
-    for i in 3..row.len() {
-        let predicted = (i32::from(row[i - 3]) + i32::from(up[i])) / 2;
-        let value = steps.quantise(i32::from(row[i]), predicted);
-        row[i] = value as u8;
-        out[i] = (value - predicted) as u8;
+    let mut left = [0i32; 3];
+    for ((px, above), filtered) in row.chunks_exact_mut(3).zip(up.chunks_exact(3)).zip(out.chunks_exact_mut(3)) {
+        for c in 0..3 {
+            let predicted = (left[c] + i32::from(above[c])) / 2;
+            let value = steps.quantise(i32::from(px[c]), predicted);
+            px[c] = value as u8;
+            filtered[c] = (value - predicted) as u8;
+            left[c] = value;
+        }
     }
 }
 
