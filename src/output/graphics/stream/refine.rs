@@ -31,6 +31,9 @@ use crate::output::graphics::pack::Packing;
 
 /// The side of a refinement block, pixels of the rung.
 const BLOCK: u32 = 16;
+/// A box by its corners: left, top, right, bottom (exclusive), pixels of the rung.
+type Corners = (u32, u32, u32, u32);
+
 /// The lossy step of the first picture a still picture climbs to a higher rung with.
 const BASE_STEP: u8 = 8;
 
@@ -128,13 +131,13 @@ impl PictureStream {
         errors: &[(u64, u32)],
         side: u32,
         room: usize,
-    ) -> Result<((u32, u32, u32, u32), bool), usize> {
+    ) -> Result<(Corners, bool), usize> {
         let size = self.rungs[rung];
         let (cols, stride) = (size.0.div_ceil(side), size.0 as usize * 3);
         self.candidate.clear();
         self.candidate.extend_from_slice(&self.shown.as_ref().expect("shown").1);
         self.bytes.clear();
-        let mut bbox = None::<(u32, u32, u32, u32)>;
+        let mut bbox = None::<Corners>;
         for &(_, index) in errors {
             let (x, y) = ((index % cols) * side, (index / cols) * side);
             let (w, h) = (side.min(size.0 - x), side.min(size.1 - y));
