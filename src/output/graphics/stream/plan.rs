@@ -27,11 +27,13 @@ const DENSITY_EXPONENT: f64 = 0.2;
 /// 8): the coarser step buys a larger rung, and a larger rung is worth more than the step's
 /// error (docs/pixels/block-codec.md).
 pub(super) const KITTY_STEP: u8 = 24;
-/// iTerm2's JPEG quality under a rate on the top rung: at 2 MB/s 70 lets the top rung go 30
-/// times a second (SSIM 0.931 against 0.858 with 85 at 22 a second, docs/pixels/block-codec.md).
-const ITERM2_QUALITY_TOP: u8 = 70;
-/// iTerm2's JPEG quality under a rate below the top rung: at 250 kB/s 70 everywhere scored
-/// 0.019 below 85 (a larger rung at fewer pictures a second; docs/pixels/block-codec.md).
+/// iTerm2's JPEG quality under a rate on the top rung and on the rungs below half-block
+/// resolution: at 2 MB/s 70 lets the top rung go 30 times a second (SSIM 0.931 against 0.858
+/// with 85 at 22 a second), and at 50 kB/s 70 at 100x59 scored 0.6456 against 85 at 84x49's
+/// 0.6343 (docs/pixels/block-codec.md).
+const ITERM2_QUALITY_LOW: u8 = 70;
+/// iTerm2's JPEG quality under a rate on the rungs between: at 250 kB/s 85 at 201x118 scored
+/// 0.7146 against 70 at 284x167's 0.6959 (docs/pixels/block-codec.md).
 const ITERM2_QUALITY: u8 = 85;
 
 impl PictureStream {
@@ -60,10 +62,13 @@ impl PictureStream {
         KITTY_STEP
     }
 
-    /// iTerm2's JPEG quality under a rate: [`ITERM2_QUALITY_TOP`] on the top rung,
-    /// [`ITERM2_QUALITY`] below it.
+    /// iTerm2's JPEG quality under a rate: [`ITERM2_QUALITY_LOW`] on the top rung and on the
+    /// rungs with fewer pixels than half-block resolution (four times the bottom rung's),
+    /// [`ITERM2_QUALITY`] between.
     pub(super) fn jpeg_quality(&self, rung: usize) -> u8 {
-        if rung == 0 { ITERM2_QUALITY_TOP } else { ITERM2_QUALITY }
+        let pixels = |(w, h): (u32, u32)| u64::from(w) * u64::from(h);
+        let bottom = *self.rungs.last().expect("the ladder has a rung");
+        if rung == 0 || pixels(self.rungs[rung]) < 4 * pixels(bottom) { ITERM2_QUALITY_LOW } else { ITERM2_QUALITY }
     }
 
     /// Chooses the rung for `budget` and returns the bytes one picture may take.
