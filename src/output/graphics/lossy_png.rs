@@ -6,6 +6,14 @@
 //! full differences of rendered water took five to six: kitty (which decodes PNG and raw RGB,
 //! no JPEG) gets a picture several times smaller for an error of at most `q / 2` a channel.
 //!
+//! Flat regions start right: the first pixel of every row is written exactly, and the first
+//! row is predicted from its left neighbour alone (PNG's Sub filter) rather than from the
+//! mean with a row of zeros above. A flat run keeps the value it starts from (its differences
+//! round to 0), so a letterbox bar or a still flat area comes out exact, where starting from a
+//! rounded first pixel (and, on the first row, a prediction halved towards 0 at every pixel)
+//! left it off by up to half a step for as long as the picture was lossy (a dark bar tinted
+//! teal: `[0, 24, 31]` for `[8, 12, 20]` at step 24).
+//!
 //! The pixels are rewritten in place to what the decoder shows, so the caller's model of the
 //! terminal is exact. Deterministic: integers only, one pass in raster order; the same pixels
 //! give the same bytes. `q = 1` is lossless (the filter alone).
@@ -15,7 +23,9 @@ use std::io::Write;
 use flate2::Compression;
 use flate2::write::ZlibEncoder;
 
-/// PNG's Average filter type.
+/// PNG's Sub filter type (the first row: the left neighbour alone).
+const SUB: u8 = 1;
+/// PNG's Average filter type (every other row).
 const AVERAGE: u8 = 3;
 
 /// The deflate level: the differences are few distinct values, so a middling level finds most
@@ -23,7 +33,8 @@ const AVERAGE: u8 = 3;
 const LEVEL: u32 = 4;
 
 /// Rewrites `rgb` (`width x height`, 3 bytes a pixel) to the picture the decoder will show and
-/// writes that PNG (8-bit RGB, the Average filter on every row) into `out` (cleared first).
+/// writes that PNG (8-bit RGB, the Sub filter on the first row and the Average filter on the
+/// others) into `out` (cleared first).
 /// `q` (at least 1) is the step differences are rounded to.
 ///
 /// # Panics
@@ -34,12 +45,15 @@ pub fn encode(rgb: &mut [u8], width: u32, height: u32, q: u8, out: &mut Vec<u8>)
     let steps = Steps::new(i32::from(q.max(1)));
     let stride = w * 3;
     let mut filtered = vec![0u8; (stride + 1) * h];
-    let zeros = vec![0u8; stride];
     for (y, out_row) in filtered.chunks_exact_mut(stride + 1).enumerate() {
-        out_row[0] = AVERAGE;
         let (above, row) = rgb.split_at_mut(y * stride);
-        let up = if y == 0 { &zeros[..] } else { &above[(y - 1) * stride..] };
-        filter_row(&mut row[..stride], &up[..stride], &mut out_row[1..], &steps);
+        if y == 0 {
+            out_row[0] = SUB;
+            filter_row::<false>(&mut row[..stride], &[], &mut out_row[1..], &steps);
+        } else {
+            out_row[0] = AVERAGE;
+            filter_row::<true>(&mut row[..stride], &above[(y - 1) * stride..][..stride], &mut out_row[1..], &steps);
+        }
     }
     out.clear();
     out.extend_from_slice(b"\x89PNG\r\n\x1a\n");
@@ -55,21 +69,42 @@ pub fn encode(rgb: &mut [u8], width: u32, height: u32, q: u8, out: &mut Vec<u8>)
     chunk(out, b"IEND", &[]);
 }
 
-/// Rewrites one row (`up`: the row above as rebuilt, zeros for the first) to what the decoder
-/// rebuilds and writes its Average-filtered bytes into `out`. The prediction of each byte
-/// depends on the byte just rebuilt to its left, so the loop is a chain of a table look-up and
-/// a few additions a byte (no division), the left pixel kept in registers (the first pixel's
-/// left is 0, as PNG has it).
+/// Rewrites one row to what the decoder rebuilds and writes its filtered bytes into `out`:
+/// with `AVG` PNG's Average filter (`up`: the row above as rebuilt), without it the Sub filter
+/// (the first row; `up` is not read). The first pixel is written exactly (its prediction is
+/// PNG's: half the pixel above, or 0), so a flat run starts right. The prediction of each
+/// other byte depends on the byte just rebuilt to its left, so the loop is a chain of a table
+/// look-up and a few additions a byte (no division), the left pixel kept in registers.
 #[inline(always)]
-fn filter_row(row: &mut [u8], up: &[u8], out: &mut [u8], steps: &Steps) {
+fn filter_row<const AVG: bool>(row: &mut [u8], up: &[u8], out: &mut [u8], steps: &Steps) {
+    let Some((first, rest)) = row.split_at_mut_checked(3) else { return };
     let mut left = [0i32; 3];
-    for ((px, above), filtered) in row.chunks_exact_mut(3).zip(up.chunks_exact(3)).zip(out.chunks_exact_mut(3)) {
-        for c in 0..3 {
-            let predicted = (left[c] + i32::from(above[c])) / 2;
-            let value = steps.quantise(i32::from(px[c]), predicted);
-            px[c] = value as u8;
-            filtered[c] = (value - predicted) as u8;
-            left[c] = value;
+    for c in 0..3 {
+        let predicted = if AVG { i32::from(up[c]) / 2 } else { 0 };
+        left[c] = i32::from(first[c]);
+        out[c] = (left[c] - predicted) as u8;
+    }
+    let up = if AVG { &up[3..] } else { &[][..] };
+    let out = &mut out[3..];
+    if AVG {
+        for ((px, above), filtered) in rest.chunks_exact_mut(3).zip(up.chunks_exact(3)).zip(out.chunks_exact_mut(3)) {
+            for c in 0..3 {
+                let predicted = (left[c] + i32::from(above[c])) / 2;
+                let value = steps.quantise(i32::from(px[c]), predicted);
+                px[c] = value as u8;
+                filtered[c] = (value - predicted) as u8;
+                left[c] = value;
+            }
+        }
+    } else {
+        for (px, filtered) in rest.chunks_exact_mut(3).zip(out.chunks_exact_mut(3)) {
+            for c in 0..3 {
+                let predicted = left[c];
+                let value = steps.quantise(i32::from(px[c]), predicted);
+                px[c] = value as u8;
+                filtered[c] = (value - predicted) as u8;
+                left[c] = value;
+            }
         }
     }
 }
@@ -184,6 +219,36 @@ mod tests {
                     assert_eq!(steps.quantise(v, p), r, "{v} from {p} by {q}");
                 }
             }
+        }
+    }
+
+    #[test]
+    fn flat_regions_start_right_and_stay_exact() {
+        // The serve test's letterbox: a dark bar above and below the pool at 480x278, step 24.
+        // The bars, and the flat run at the start of each row (the left column exact), come
+        // out as the colour itself, not the colour rounded from a prediction of 0.
+        let (w, h, pool) = golden_pool();
+        let (bw, bh, bar) = (480u32, 278u32, [8u8, 12, 20]);
+        let mut rgb = Vec::new();
+        for y in 0..bh {
+            for x in 0..bw {
+                let inside = (4..bh - 4).contains(&y) && x >= 16;
+                let at = (((y % h) * w + x % w) * 3) as usize;
+                rgb.extend_from_slice(if inside { &pool[at..at + 3] } else { &bar });
+            }
+        }
+        let (mut shown, mut png) = (rgb.clone(), Vec::new());
+        encode(&mut shown, bw, bh, 24, &mut png);
+        let decoded = image::load_from_memory(&png).unwrap().to_rgb8().into_raw();
+        assert!(decoded == shown, "the decoder shows the rewritten pixels");
+        let stride = bw as usize * 3;
+        for y in 0..4 {
+            let row = &shown[y * stride..][..stride];
+            assert!(row.chunks_exact(3).all(|p| p == bar), "the bar's row {y}: {:?}", &row[..12]);
+        }
+        for y in 0..bh as usize {
+            let left = &shown[y * stride..][..16 * 3];
+            assert!(left.chunks_exact(3).all(|p| p == bar), "row {y}'s left bar: {:?}", &left[..12]);
         }
     }
 }

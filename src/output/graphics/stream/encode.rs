@@ -132,11 +132,11 @@ impl PictureStream {
         let size = self.rungs[rung];
         let part = match (&self.shown, &self.sent) {
             (Some((r, _)), Some((s, sent))) if *r == rung && *s == rung => {
+                // Any box short of the whole picture goes as an edit: the rest of what is
+                // shown is kept, and with it the still regions refined towards exact.
                 match scan::changed_box(sent, &self.target, size.0, 3, 0..size.1) {
                     None => return None,
-                    Some(b) if self.protocol.edits() && 2 * b.2 * b.3 <= size.0 * size.1 => {
-                        Part::Changed(b.0, b.1, b.2, b.3)
-                    }
+                    Some(b) if self.protocol.edits() && (b.2, b.3) != size => Part::Changed(b.0, b.1, b.2, b.3),
                     Some(_) => Part::Whole,
                 }
             }

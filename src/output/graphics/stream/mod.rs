@@ -56,6 +56,8 @@
 //! picture it was encoded from and of the source picture: changes are found against the
 //! picture encoded, not the lossy one shown, and a still scene's bytes go to the blocks
 //! furthest from the truth until the top rung is exact; then it sends nothing (`refine.rs`).
+//! While the scene moves, kitty's changed box goes as a lossy frame edit and the bytes a whole
+//! picture would have taken beyond it refine the blocks outside it, whose source is still.
 
 #[cfg(feature = "player")]
 pub mod crossover;
@@ -453,8 +455,12 @@ impl PictureStream {
                 self.next_due = Some(now + interval);
                 return None;
             };
-            self.learn(rung, part);
+            self.learn(rung, part, limited);
             if self.bytes.len() <= room || (budget.overdraw && self.bytes.len() <= allowance) {
+                // What a whole picture at this rung is expected to cost bounds the bytes
+                // still regions are refined with, so the moving picture keeps its rate.
+                let limit = room.min(self.predict(rung).map_or(allowance, |c| c as usize));
+                let part = if limited { self.refine_still(rung, part, limit) } else { part };
                 return self.offer(rung, part, limited, now + interval);
             }
             if self.bytes.len() <= allowance {

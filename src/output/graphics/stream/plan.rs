@@ -101,12 +101,21 @@ impl PictureStream {
         Some(bpp * (pixels(known) / pixels(rung)).powf(DENSITY_EXPONENT) * pixels(rung))
     }
 
-    pub(super) fn learn(&mut self, rung: usize, part: Part) {
-        if part != Part::Whole {
-            return;
-        }
+    /// Learns the bytes a pixel of `part` at `rung` (in `self.bytes`): a whole picture, or
+    /// kitty's lossy edit of a box at least half the picture (under a rate a moving scene goes
+    /// as such edits, and the box's pixels cost what the whole picture's do).
+    pub(super) fn learn(&mut self, rung: usize, part: Part, limited: bool) {
         let (w, h) = self.rungs[rung];
-        let bpp = self.bytes.len() as f64 / (f64::from(w) * f64::from(h));
+        let area = match part {
+            Part::Whole => f64::from(w) * f64::from(h),
+            Part::Changed(_, _, bw, bh)
+                if matches!(self.packing(limited, rung), Some(Packing::LossyPng(_))) && 2 * bw * bh >= w * h =>
+            {
+                f64::from(bw) * f64::from(bh)
+            }
+            _ => return,
+        };
+        let bpp = self.bytes.len() as f64 / area;
         let c = &mut self.cost[rung];
         *c = Some(c.map_or(bpp, |old| old + LEARN * (bpp - old)));
     }

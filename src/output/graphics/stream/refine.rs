@@ -21,6 +21,10 @@
 //!   top rung as one lossless PNG, when the bucket holds it (or the caller can overdraw).
 //!
 //! When the shown picture is exact, a still scene sends nothing.
+//!
+//! While the scene moves, kitty's bytes left after a frame's changed box go the same way to
+//! the blocks outside it ([`PictureStream::refine_still`]): there the source has not changed
+//! since it was sent, so a still region beside moving water becomes exact too.
 
 use std::time::{Duration, Instant};
 
@@ -33,6 +37,22 @@ use crate::output::graphics::pack::Packing;
 const BLOCK: u32 = 16;
 /// A box by its corners: left, top, right, bottom (exclusive), pixels of the rung.
 type Corners = (u32, u32, u32, u32);
+
+/// The smallest block the bytes left after a moving picture's changed box are spent on (each
+/// block is its own command and PNG: below this the headers outweigh the pixels).
+const STILL_MIN_SIDE: u32 = 4;
+/// The least bytes left after a changed box worth looking for still blocks with (a 4x4 block's
+/// edit alone is about a hundred bytes).
+const STILL_LEAST_BYTES: usize = 100;
+
+/// Where the exact pixels of a refinement block come from.
+#[derive(Clone, Copy)]
+enum Truth {
+    /// `sent`: the picture the still scene's shown picture was made from.
+    Sent,
+    /// `target`: this frame's picture at the rung.
+    Target,
+}
 
 /// The lossy step of the first picture a still picture climbs to a higher rung with.
 const BASE_STEP: u8 = 8;
@@ -100,7 +120,11 @@ impl PictureStream {
         loop {
             let errors = {
                 let (Some((_, shown)), Some((_, sent))) = (&self.shown, &self.sent) else { return None };
-                block_errors(shown, sent, self.rungs[rung], side)
+                let size = self.rungs[rung];
+                let mut errors = Vec::new();
+                block_errors(shown, sent, size, side, (0, 0, size.0, size.1), &mut errors);
+                worst_first(&mut errors);
+                errors
             };
             if errors.is_empty() {
                 if rung == 0 {
@@ -110,7 +134,10 @@ impl PictureStream {
                 }
                 return self.climb(rung, room, allowance, now);
             }
-            match self.pack_blocks(rung, &errors, side, room) {
+            self.candidate.clear();
+            self.candidate.extend_from_slice(&self.shown.as_ref().expect("shown").1);
+            self.bytes.clear();
+            match self.pack_blocks(rung, &errors, room, Truth::Sent) {
                 Ok(((x0, y0, x1, y1), all)) => {
                     let (part, exact) = (Part::Changed(x0, y0, x1 - x0, y1 - y0), all && rung == 0);
                     return self.offer_as(rung, part, true, now + interval, Model::Keep, exact);
@@ -121,39 +148,79 @@ impl PictureStream {
         }
     }
 
-    /// Puts the worst of `errors` (blocks of `side` pixels at `rung`) in `self.bytes` as exact
-    /// frame edits while they fit `room`, and the shown picture with them in the candidate:
-    /// the box around them and whether every block went, or the bytes of the worst block
-    /// alone when even it does not fit.
+    /// Appends exact frame edits of the worst of `errors` (blocks at `rung`, worst first)
+    /// to `self.bytes` while the whole stays within `limit`, the truth (`sent`, or this frame's
+    /// `target`) copied into the candidate with them: the box around those that went and
+    /// whether every block went, or the bytes of the worst block alone when even it does not
+    /// fit. The candidate is the shown picture wherever a block may go.
     fn pack_blocks(
         &mut self,
         rung: usize,
-        errors: &[(u64, u32)],
-        side: u32,
-        room: usize,
+        errors: &[Block],
+        limit: usize,
+        truth: Truth,
     ) -> Result<(Corners, bool), usize> {
-        let size = self.rungs[rung];
-        let (cols, stride) = (size.0.div_ceil(side), size.0 as usize * 3);
-        self.candidate.clear();
-        self.candidate.extend_from_slice(&self.shown.as_ref().expect("shown").1);
-        self.bytes.clear();
+        let stride = self.rungs[rung].0 as usize * 3;
         let mut bbox = None::<Corners>;
-        for &(_, index) in errors {
-            let (x, y) = ((index % cols) * side, (index / cols) * side);
-            let (w, h) = (side.min(size.0 - x), side.min(size.1 - y));
-            copy_box(&self.sent.as_ref().expect("sent").1, &mut self.candidate, stride, (x, y, w, h));
+        for &(_, (x, y, w, h)) in errors {
+            let from = match truth {
+                Truth::Sent => &self.sent.as_ref().expect("sent").1,
+                Truth::Target => &self.target,
+            };
+            copy_box(from, &mut self.candidate, stride, (x, y, w, h));
             let mark = self.bytes.len();
             self.push_part(Part::Tile(x, y, w, h), rung, Some(Packing::Png));
-            if self.bytes.len() > room {
-                let worst = self.bytes.len();
+            if self.bytes.len() > limit {
+                let worst = self.bytes.len() - mark;
                 self.bytes.truncate(mark);
                 copy_box(&self.shown.as_ref().expect("shown").1, &mut self.candidate, stride, (x, y, w, h));
                 return bbox.map(|b| (b, false)).ok_or(worst);
             }
-            bbox =
-                Some(bbox.map_or((x, y, x + w, y + h), |b| (b.0.min(x), b.1.min(y), b.2.max(x + w), b.3.max(y + h))));
+            bbox = Some(bbox.map_or((x, y, x + w, y + h), |b| union(b, (x, y, x + w, y + h))));
         }
         Ok((bbox.expect("at least one block"), true))
+    }
+
+    /// After a moving picture's changed box (kitty's lossy frame edit, in `self.bytes`): the
+    /// bytes left within `limit` go to the worst blocks outside the box, made exact. Outside
+    /// the box this frame's picture is the one last sent (the box holds every change), so
+    /// there the source has not changed and the shown picture is off only by the lossy
+    /// error: still regions beside moving water (a letterbox's bars, a still part of the
+    /// scene) become exact while the water moves, instead of only once the whole scene stands
+    /// still. Blocks are halved (down to [`STILL_MIN_SIDE`]) when the worst does not fit.
+    /// Returns the part the offer now covers: the box around the changed box and the blocks.
+    pub(super) fn refine_still(&mut self, rung: usize, part: Part, limit: usize) -> Part {
+        let Part::Changed(bx, by, bw, bh) = part else { return part };
+        let edits = matches!(&self.protocol, Protocol::Kitty(o) if o.frame_edits);
+        let lossy = matches!(self.packing(true, rung), Some(Packing::LossyPng(_)));
+        if !edits || !lossy || self.shown.as_ref().is_none_or(|(r, _)| *r != rung) {
+            return part;
+        }
+        let (w, h) = self.rungs[rung];
+        let (x1, y1) = (bx + bw, by + bh);
+        // Outside the box: the bands above and below it, and either side of it.
+        let outside = [(0, 0, w, by), (0, y1, w, h), (0, by, bx, y1), (x1, by, w, y1)];
+        let mut side = BLOCK;
+        let mut errors = Vec::new();
+        while self.bytes.len() + STILL_LEAST_BYTES <= limit {
+            errors.clear();
+            for region in outside {
+                block_errors(&self.candidate, &self.target, (w, h), side, region, &mut errors);
+            }
+            if errors.is_empty() {
+                break;
+            }
+            worst_first(&mut errors);
+            match self.pack_blocks(rung, &errors, limit, Truth::Target) {
+                Ok((blocks, _)) => {
+                    let (x0, y0, x1, y1) = union((bx, by, x1, y1), blocks);
+                    return Part::Changed(x0, y0, x1 - x0, y1 - y0);
+                }
+                Err(_) if side > STILL_MIN_SIDE => side /= 2,
+                Err(_) => break,
+            }
+        }
+        part
     }
 
     /// A new image at the highest rung whose first picture fits a picture's bytes
@@ -196,24 +263,46 @@ impl PictureStream {
     }
 }
 
-/// The `side`-pixel blocks of `shown` that differ from `truth` (RGB of `size`): their error (the
-/// sum of the byte differences) and index in raster order, worst first (ties: raster order).
-fn block_errors(shown: &[u8], truth: &[u8], size: (u32, u32), side: u32) -> Vec<(u64, u32)> {
-    let (cols, rows) = (size.0.div_ceil(side), size.1.div_ceil(side));
+/// A block: its error (the sum of the byte differences) and its box `(x, y, w, h)`.
+type Block = (u64, (u32, u32, u32, u32));
+
+/// Appends to `out` the `side`-pixel blocks of `region` (corners; blocks at its right and
+/// bottom edges are cut to it) where `shown` differs from `truth` (RGB of `size`).
+fn block_errors(shown: &[u8], truth: &[u8], size: (u32, u32), side: u32, region: Corners, out: &mut Vec<Block>) {
+    let (x0, y0, x1, y1) = region;
+    if x0 >= x1 || y0 >= y1 {
+        return;
+    }
+    let (cols, rows) = ((x1 - x0).div_ceil(side), (y1 - y0).div_ceil(side));
     let mut errors = vec![0u64; (cols * rows) as usize];
-    for (y, (a, b)) in shown.chunks_exact(size.0 as usize * 3).zip(truth.chunks_exact(size.0 as usize * 3)).enumerate()
-    {
+    let (stride, from, to) = (size.0 as usize * 3, x0 as usize * 3, x1 as usize * 3);
+    for y in y0..y1 {
+        let at = y as usize * stride;
+        let (a, b) = (&shown[at + from..at + to], &truth[at + from..at + to]);
         if a == b {
             continue;
         }
-        let row = &mut errors[(y as u32 / side * cols) as usize..][..cols as usize];
+        let row = &mut errors[((y - y0) / side * cols) as usize..][..cols as usize];
         for (col, (p, q)) in a.chunks(side as usize * 3).zip(b.chunks(side as usize * 3)).enumerate() {
             row[col] += p.iter().zip(q).map(|(s, t)| u64::from(s.abs_diff(*t))).sum::<u64>();
         }
     }
-    let mut out: Vec<(u64, u32)> = (0..).zip(errors).filter(|&(_, e)| e > 0).map(|(i, e)| (e, i)).collect();
-    out.sort_by_key(|&(e, i)| (std::cmp::Reverse(e), i));
-    out
+    for (i, e) in (0..).zip(errors) {
+        if e > 0 {
+            let (x, y) = (x0 + i % cols * side, y0 + i / cols * side);
+            out.push((e, (x, y, side.min(x1 - x), side.min(y1 - y))));
+        }
+    }
+}
+
+/// Orders blocks worst first (ties: raster order).
+fn worst_first(blocks: &mut [Block]) {
+    blocks.sort_by_key(|&(e, (x, y, _, _))| (std::cmp::Reverse(e), y, x));
+}
+
+/// The box around two boxes (corners).
+fn union(a: Corners, b: Corners) -> Corners {
+    (a.0.min(b.0), a.1.min(b.1), a.2.max(b.2), a.3.max(b.3))
 }
 
 /// Copies the box `(x, y, w, h)` of `from` into `to` (RGB pictures `stride` bytes a row).

@@ -355,3 +355,79 @@ fn nothing_changes_nothing_is_sent() {
     assert_eq!(sent[1], Some(Packing::Png));
     assert!(stream.shown_exact);
 }
+
+/// The golden pool with its rows from `STILL_ROWS` down shifted `k` pixels: water moving in
+/// the lower part of the picture, the upper part still.
+const STILL_ROWS: u32 = 150;
+
+fn partly_moving(k: u32) -> Pixmap {
+    let (still, moved) = (moving(0), moving(k));
+    let mut p = still.clone();
+    let at = (STILL_ROWS * still.width()) as usize;
+    p.pixels_mut()[at..].copy_from_slice(&moved.pixels()[at..]);
+    p
+}
+
+#[test]
+fn a_still_region_beside_moving_water_becomes_exact_while_the_water_moves() {
+    // kitty with frame edits under a rate, the lower part of the picture moving every frame
+    // for 8 seconds: the upper part's rows (those wholly from still source rows, at the rung
+    // shown) must become the exact source picture within a second and a half of the last
+    // whole picture and stay so, while the moving part keeps going at 10 pictures a second or
+    // more. Every offer within the bucket and decoded to the stream's model.
+    for rate in [250e3, 2e6] {
+        let mut stream = kitty_stream();
+        let t0 = Instant::now();
+        let mut bucket = ByteBucket::new(rate);
+        bucket.refill(t0);
+        let mut terminal = kitty_decode::KittyState::default();
+        let (frames, mut pictures, mut last_whole, mut exact_since) = (240u32, 0u32, 0u32, None::<u32>);
+        let mut moving_rows_seen = Vec::new();
+        for n in 1..=frames {
+            let now = t0 + FRAME * n;
+            bucket.refill(now);
+            let budget = Budget::new(bucket.budget(), Some(rate), FRAME);
+            let picture = partly_moving(n);
+            let Some(offer) = stream.prepare(&picture, budget, now) else { continue };
+            let (len, part) = (offer.bytes.len(), offer.state.part);
+            assert!(len <= budget.available, "{rate} B/s, frame {n}: {len} bytes, {} available", budget.available);
+            terminal.feed(offer.bytes).expect("the stream decodes");
+            bucket.spend(len);
+            stream.commit();
+            pictures += 1;
+            let image = &terminal.images[&kitty::IMAGE_ID];
+            let (rung, shown) = stream.shown.as_ref().expect("shown after a commit");
+            let size = stream.rungs[*rung];
+            assert_eq!((image.width, image.height), size, "frame {n}");
+            assert!(&image.rgb == shown, "{rate} B/s, frame {n}: the terminal shows what the stream believes");
+            if part == Part::Whole {
+                (last_whole, exact_since) = (n, None);
+            }
+            // The rows at the rung wholly from still source rows (the resampler's support
+            // reaches a row either side), and what they are exactly.
+            let mut truth = Vec::new();
+            Resampler::default().resample(picture.data(), 4, (640, 360), size, &mut truth);
+            let stride = size.0 as usize * 3;
+            let still_rows = (STILL_ROWS * size.1 / 360).saturating_sub(2) as usize;
+            assert!(still_rows > 10, "{size:?}");
+            let exact = image.rgb[..still_rows * stride] == truth[..still_rows * stride];
+            match (exact, exact_since) {
+                (true, None) => exact_since = Some(n),
+                (false, Some(since)) => panic!("{rate} B/s, frame {n}: the still rows were exact from frame {since}"),
+                _ => {}
+            }
+            moving_rows_seen.push(image.rgb[(size.1 as usize - 1) * stride..].to_vec());
+        }
+        let seconds = f64::from(frames) / 30.0;
+        assert!(f64::from(pictures) / seconds >= 10.0, "{rate} B/s: {pictures} pictures in {seconds} s");
+        let since = exact_since.unwrap_or_else(|| panic!("{rate} B/s: the still rows never became exact"));
+        assert!(
+            since - last_whole <= 45,
+            "{rate} B/s: exact {} frames after the last whole picture",
+            since - last_whole
+        );
+        let tail = &moving_rows_seen[moving_rows_seen.len() - 10..];
+        assert!(tail.windows(2).all(|w| w[0] != w[1]), "{rate} B/s: the moving part kept changing");
+        eprintln!("{rate} B/s: {pictures} pictures, last whole at frame {last_whole}, still rows exact from {since}");
+    }
+}
