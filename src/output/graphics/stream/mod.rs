@@ -501,8 +501,28 @@ impl PictureStream {
             }
             _ => {}
         }
-        let part = self.encode_tile(rung, part, room, limited)?;
+        let Some(part) = self.encode_tile(rung, part, room, limited) else {
+            self.tiles_done(rung, limited);
+            return None;
+        };
         self.offer(rung, part, limited, now + interval)
+    }
+
+    /// No tile to send: under a rate, when kitty's lossy tiles show all of this frame's
+    /// picture at `rung` (the shown picture is the candidate), the model learns where it came
+    /// from (this frame's picture at the rung and its source), so a still scene is refined to
+    /// exact and climbs from there (`refine.rs`) as it does after a whole picture. Without
+    /// this a link too slow for the bottom rung's whole picture kept a still picture at the
+    /// bottom rung's lossy tiles for good.
+    fn tiles_done(&mut self, rung: usize, limited: bool) {
+        let lossy = matches!(self.packing(limited, rung), Some(Packing::LossyPng(_)));
+        if !lossy || self.sent.is_some() || self.source_now.is_empty() {
+            return;
+        }
+        if self.shown.as_ref().is_some_and(|(r, shown)| *r == rung && *shown == self.candidate) {
+            self.sent = Some((rung, self.target.clone()));
+            self.source_shown.clone_from(&self.source_now);
+        }
     }
 
     /// An offer not committed: its temporary file is never written.
