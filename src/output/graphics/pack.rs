@@ -26,7 +26,7 @@ pub enum Packing {
     /// picture stream chooses it (feature `player`).
     #[cfg_attr(not(any(test, feature = "player", feature = "testing")), allow(dead_code))]
     Jpeg(u8),
-    /// A lossy PNG, differences rounded to this step ([`crate::output::graphics::lossy_png`]):
+    /// A lossy PNG, differences rounded to this step (`output::graphics::lossy_png`):
     /// kitty's `f=100` under a rate.
     #[cfg_attr(not(any(test, feature = "player", feature = "testing")), allow(dead_code))]
     LossyPng(u8),
