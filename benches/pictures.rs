@@ -439,6 +439,46 @@ fn cpu(c: &mut Criterion) {
         });
     }
     group.finish();
+    // kitty under a rate: the lossy PNG (`lossy_png`, step 24) of the scene's 480x282 picture
+    // alone, and the stream's whole frame at 2 MB/s (resampling, the changed box, the lossy
+    // PNG at the top rung, every frame a new picture).
+    let mut group = c.benchmark_group("pictures/kitty_lossy_480x282");
+    group.sample_size(20);
+    let rgbs: Vec<Vec<u8>> = shots
+        .iter()
+        .take(16)
+        .map(|p| {
+            let mut rgb = Vec::new();
+            tidepool::testing::push_rgb(p, &mut rgb);
+            rgb
+        })
+        .collect();
+    let (mut n, mut out, mut pixels) = (0usize, Vec::new(), Vec::new());
+    group.bench_function("lossy_png_step24", |b| {
+        b.iter(|| {
+            n += 1;
+            pixels.clear();
+            pixels.extend_from_slice(&rgbs[n % rgbs.len()]);
+            tidepool::testing::lossy_png(black_box(&mut pixels), SCENE.0, SCENE.1, 24, &mut out);
+            out.len()
+        })
+    });
+    let (mut stream, _) = stream("kitty");
+    let frame = Duration::from_nanos(1_000_000_000 / 30);
+    let t0 = Instant::now();
+    let mut n = 0u32;
+    group.bench_function("stream_frame_2MBps", |b| {
+        b.iter(|| {
+            n += 1;
+            let now = t0 + frame * (n * 4);
+            let budget = Budget::new(usize::MAX, Some(2e6), frame);
+            let len =
+                stream.prepare(black_box(&shots[n as usize % shots.len()]), budget, now).map_or(0, |o| o.bytes.len());
+            stream.commit();
+            len
+        })
+    });
+    group.finish();
 }
 
 fn main() {

@@ -4,10 +4,12 @@ answers like the terminal each mode is for.
 
     python3 scripts/pixel_cpu.py [--seconds 6] [--warm-up 2] [--rounds 3]
         [--scenes pool,ocean,lake] [--modes cells,kitty,kitty-direct,iterm2,sixel]
-        [--bin LABEL=PATH ...] [--sixel-fps 15]
+        [--bin LABEL=PATH ...] [--sixel-fps 15] [--bandwidth unlimited]
 
 Not part of `cargo test` (a measurement, never a timed test). Each run starts
-`PATH play SCENE --graphics MODE --bandwidth unlimited --seed 1` (the player's defaults
+`PATH play SCENE --graphics MODE --bandwidth unlimited --seed 1` (`--bandwidth` as given: a
+fixed link rate such as 250k measures the encoders that run under a rate, kitty-direct's lossy
+PNG and iTerm2's JPEG; kitty's temporary files carry raw pixels at any rate; the player's defaults
 otherwise: for the pool a grid of two cells a pixel, gusts, caustics) in a pty of 160x48 cells
 of 8x16 pixels (TIOCGWINSZ's pixel fields: 1280x768), as a session leader with the pty as its
 controlling terminal. This script plays the terminal, answering the probe as the terminal of
@@ -110,7 +112,7 @@ def run(binary, scene, mode, args):
     env.update(TERM="xterm-256color", COLORTERM="truecolor")
     if mode == "iterm2":
         env["TERM_PROGRAM"] = "iTerm.app"
-    command = [binary, "play", scene, "--graphics", GRAPHICS_FLAG[mode], "--bandwidth", "unlimited", "--seed", "1"]
+    command = [binary, "play", scene, "--graphics", GRAPHICS_FLAG[mode], "--bandwidth", args.bandwidth, "--seed", "1"]
     if mode == "sixel":
         command += ["--fps", str(args.sixel_fps)]
 
@@ -179,11 +181,15 @@ def main():
     parser.add_argument("--scenes", default="pool")
     parser.add_argument("--modes", default="cells,kitty,kitty-direct,iterm2,sixel")
     parser.add_argument("--sixel-fps", type=int, default=15)
+    parser.add_argument("--bandwidth", default="unlimited",
+                        help="the player's --bandwidth: unlimited or a rate such as 250k or 2M (default: unlimited)")
     parser.add_argument("--bin", action="append", default=[], metavar="LABEL=PATH",
                         help="a binary to measure (repeat to compare; default: this=target/release/tidepool)")
     args = parser.parse_args()
     if not (0 < args.seconds <= 600 and 0 <= args.warm_up <= 60 and 1 <= args.rounds <= 50):
         sys.exit("pixel_cpu.py: --seconds must be in (0, 600], --warm-up in [0, 60], --rounds in 1..=50")
+    if not re.fullmatch(r"unlimited|[0-9]{1,12}(\.[0-9]{1,6})?[kKmM]?", args.bandwidth):
+        sys.exit(f"pixel_cpu.py: --bandwidth {args.bandwidth!r} is not unlimited or a rate such as 250k")
     binaries = []
     for item in args.bin or [f"this={DEFAULT_BIN}"]:
         label, sep, path = item.partition("=")
@@ -195,7 +201,7 @@ def main():
     for m in modes:
         if m not in PROBE_ANSWERS:
             sys.exit(f"pixel_cpu.py: unknown mode {m!r}; choose from {', '.join(PROBE_ANSWERS)}")
-    print(f"{COLS}x{ROWS} cells of {CELL_W}x{CELL_H} px, --bandwidth unlimited, {args.seconds:g} s after a "
+    print(f"{COLS}x{ROWS} cells of {CELL_W}x{CELL_H} px, --bandwidth {args.bandwidth}, {args.seconds:g} s after a "
           f"{args.warm_up:g} s warm-up, {args.rounds} rounds; sixel at --fps {args.sixel_fps}; "
           f"load average before: {load()}", flush=True)
     results = {}

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant};
 
 use tidepool::play::GraphicsMode;
 use tidepool::testing::push_rgb;
-use tidepool::testing::{Budget, Part, PictureStream, Protocol, resample};
+use tidepool::testing::{Budget, ByteBucket, Part, PictureStream, Protocol, resample};
 use tidepool::testing::{KittyEncoder, KittyOptions};
 use tidepool::testing::{Layout, layout};
 use tiny_skia::Pixmap;
@@ -62,44 +62,49 @@ fn picture_stream_offers_decode_to_the_picture_at_its_rung() {
     let frame = Duration::from_nanos(1_000_000_000 / 30);
     let t0 = Instant::now();
     let (sw, sh) = (120, 72);
-    // PNG wholes and edits on a limited link, zlib wholes without a limit, a slow link's
-    // mean-colour base image and tiles (5 kB/s: no whole picture fits even at the lowest rung;
-    // once the picture holds still the tiles add up to it).
-    for (name, rate, available) in
-        [("unlimited", None, usize::MAX), ("2MBps", Some(2e6), usize::MAX), ("slow", Some(5e3), 400)]
-    {
+    // Zlib wholes without a limit; under a rate lossy PNG wholes and edits while the water
+    // moves, then (the picture held still) exact edits of the worst blocks until the terminal
+    // shows the exact picture at the top rung; at 5 kB/s (at most 500 bytes in the bucket)
+    // the blocks are halved until they fit. The bucket refills as a link does.
+    for (name, rate) in [("unlimited", None), ("2MBps", Some(2e6)), ("slow", Some(5e3))] {
         let mut stream =
             PictureStream::new(Protocol::Kitty(KittyOptions { frame_edits: true, ..KittyOptions::new(l.cells) }), l);
-        let mut wire = Vec::new();
-        let mut parts = Vec::new();
-        let mut last = None;
-        for n in 0..24u32 {
-            let picture = pool(sw, sh, 10 + u64::from(n / 8));
-            let budget = Budget::new(available, rate, frame);
-            if let Some(offer) = stream.prepare(&picture, budget, t0 + frame * (4 * n)) {
+        let mut bucket = rate.map_or_else(ByteBucket::unlimited, ByteBucket::new);
+        bucket.refill(t0);
+        let (mut wire, mut parts, mut last, mut quiet) = (Vec::new(), Vec::new(), None, 0);
+        // 24 frames of water that moves every 8 frames, then still until 60 frames in a row
+        // send nothing (at most 100 s).
+        for n in 1..3000u32 {
+            let picture = pool(sw, sh, 10 + u64::from(n.min(24) / 8));
+            let now = t0 + frame * n;
+            bucket.refill(now);
+            let budget = Budget::new(bucket.budget(), rate, frame);
+            if let Some(offer) = stream.prepare(&picture, budget, now) {
+                assert!(offer.bytes.len() <= budget.available, "{name}: frame {n} over the bucket");
+                bucket.spend(offer.bytes.len());
                 wire.extend_from_slice(offer.bytes);
                 parts.push(offer.state.part);
                 stream.commit();
-                last = Some((picture, stream.state().size));
-            }
-        }
-        let (picture, size) = last.expect("offers");
-        if name == "slow" {
-            assert!(parts.iter().any(|p| matches!(p, Part::Tile(..))), "{name}: {parts:?}");
-            // The picture holds still: the tiles go on until the terminal shows all of it.
-            for n in 24..400u32 {
-                let budget = Budget::new(available, rate, frame);
-                if let Some(offer) = stream.prepare(&picture, budget, t0 + frame * (4 * n)) {
-                    wire.extend_from_slice(offer.bytes);
-                    stream.commit();
+                (last, quiet) = (Some((picture, stream.state().size)), 0);
+            } else if n > 24 {
+                quiet += 1;
+                if quiet == 60 {
+                    break;
                 }
             }
+        }
+        assert_eq!(quiet, 60, "{name}: the still picture never stopped being sent ({} offers)", parts.len());
+        let (picture, size) = last.expect("offers");
+        // The top rung: the source's own size within the layout's picture.
+        assert_eq!(size, (sw, sh), "{name}: {parts:?}");
+        if rate.is_some() {
+            assert!(parts.iter().any(|p| matches!(p, Part::Changed(..))), "{name}: edits: {parts:?}");
         }
         let images = decode(name, &wire);
         let (_, iw, ih, pixels) = &images[0];
         assert_eq!((*iw, *ih), size, "{name}");
         let mut want = Vec::new();
         resample(picture.data(), 4, (sw, sh), size, &mut want);
-        assert!(*pixels == want, "{name}: decoded pixels differ from the picture at {size:?} ({parts:?})");
+        assert!(*pixels == want, "{name}: decoded pixels differ from the picture at {size:?} ({} offers)", parts.len());
     }
 }

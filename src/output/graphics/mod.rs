@@ -25,6 +25,7 @@ pub mod kitty;
 #[cfg(any(test, feature = "testing"))]
 pub mod kitty_decode;
 pub mod kitty_placeholder;
+pub mod lossy_png;
 pub mod pack;
 pub mod scan;
 pub mod sixel;

@@ -12,6 +12,8 @@ use std::io::Write;
 use flate2::Compression;
 use flate2::write::ZlibEncoder;
 
+use crate::output::graphics::lossy_png;
+
 /// How a picture's pixels are packed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Packing {
@@ -24,6 +26,10 @@ pub enum Packing {
     /// picture stream chooses it (feature `player`).
     #[cfg_attr(not(any(test, feature = "player", feature = "testing")), allow(dead_code))]
     Jpeg(u8),
+    /// A lossy PNG, differences rounded to this step (`output::graphics::lossy_png`):
+    /// kitty's `f=100` under a rate.
+    #[cfg_attr(not(any(test, feature = "player", feature = "testing")), allow(dead_code))]
+    LossyPng(u8),
 }
 
 impl Packing {
@@ -34,6 +40,7 @@ impl Packing {
             Packing::Zlib(level) => format!("zlib{level}"),
             Packing::Png => "png".to_string(),
             Packing::Jpeg(q) => format!("jpeg{q}"),
+            Packing::LossyPng(q) => format!("png/{q}"),
         }
     }
 }
@@ -55,6 +62,10 @@ pub fn pack(packing: Packing, rgb: &[u8], width: u32, height: u32, out: &mut Vec
             let mut writer = encoder.write_header().expect("a PNG header in memory");
             writer.write_image_data(rgb).expect("the pixels match the header");
             writer.finish().expect("writing into memory cannot fail");
+        }
+        Packing::LossyPng(q) => {
+            // The caller that keeps the pixels the decoder shows calls `lossy_png::encode`.
+            lossy_png::encode(&mut rgb.to_vec(), width, height, q, out);
         }
         Packing::Jpeg(quality) => {
             image::codecs::jpeg::JpegEncoder::new_with_quality(&mut *out, quality.clamp(1, 100))

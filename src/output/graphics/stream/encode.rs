@@ -9,7 +9,7 @@ use super::{FileWrite, Part, PictureStream, Protocol};
 use crate::output::graphics::kitty::{self, KittyOptions, Medium};
 use crate::output::graphics::pack::{Packing, pack};
 use crate::output::graphics::sixel::SixelEncoder;
-use crate::output::graphics::{iterm2, scan};
+use crate::output::graphics::{iterm2, lossy_png, scan};
 use crate::simd::{Simd, Tier};
 
 /// The most colours a sixel palette fitted under a rate below [`FULL_PALETTE_RATE`] has
@@ -100,6 +100,10 @@ impl PictureStream {
             return Some(part);
         }
         self.resampler.resample(picture.data(), 4, from, size, &mut self.candidate);
+        let packing = self.packing(limited, rung);
+        if let Some(Packing::LossyPng(q)) = packing {
+            return self.encode_lossy(rung, q);
+        }
         let part = match &self.shown {
             Some((r, old)) if *r == rung => match scan::changed_box(old, &self.candidate, size.0, 3, 0..size.1) {
                 None => return None,
@@ -110,8 +114,47 @@ impl PictureStream {
             },
             _ => Part::Whole,
         };
-        let packing = self.packing(limited, rung);
+        if limited {
+            // iTerm2's JPEG: what it was encoded from, for the commit (`Model::Set`).
+            self.target.clear();
+            self.target.extend_from_slice(&self.candidate);
+        }
         self.push_part(part, rung, packing);
+        Some(part)
+    }
+
+    /// [`PictureStream::encode`] for a lossy PNG with step `q` (kitty under a rate), the picture
+    /// at `rung` in `self.candidate`: what changed is found against the picture the shown one
+    /// was encoded from (`sent`), the changed box (or the whole picture) is encoded over what
+    /// is shown, and the candidate becomes exactly what the terminal will show.
+    fn encode_lossy(&mut self, rung: usize, q: u8) -> Option<Part> {
+        std::mem::swap(&mut self.target, &mut self.candidate);
+        let size = self.rungs[rung];
+        let part = match (&self.shown, &self.sent) {
+            (Some((r, _)), Some((s, sent))) if *r == rung && *s == rung => {
+                // Any box short of the whole picture goes as an edit: the rest of what is
+                // shown is kept, and with it the still regions refined towards exact.
+                match scan::changed_box(sent, &self.target, size.0, 3, 0..size.1) {
+                    None => return None,
+                    Some(b) if self.protocol.edits() && (b.2, b.3) != size => Part::Changed(b.0, b.1, b.2, b.3),
+                    Some(_) => Part::Whole,
+                }
+            }
+            _ => Part::Whole,
+        };
+        self.candidate.clear();
+        match (part, &self.shown) {
+            (Part::Changed(x, _, w, _), Some((_, shown))) => {
+                self.candidate.extend_from_slice(shown);
+                let (stride, x, w) = (size.0 as usize * 3, x as usize * 3, w as usize * 3);
+                for row in part_rows(part, size) {
+                    let at = row * stride + x;
+                    self.candidate[at..at + w].copy_from_slice(&self.target[at..at + w]);
+                }
+            }
+            _ => self.candidate.extend_from_slice(&self.target),
+        }
+        self.push_part(part, rung, Some(Packing::LossyPng(q)));
         Some(part)
     }
 
@@ -120,6 +163,18 @@ impl PictureStream {
     pub(super) fn push_part(&mut self, part: Part, rung: usize, packing: Option<Packing>) {
         let size = self.rungs[rung];
         let (x, y, w, h) = part_box(part, size);
+        if let Some(Packing::LossyPng(q)) = packing {
+            // Packed here, and the candidate's box rewritten to what the terminal will show.
+            let (stride, at, len) = (size.0 as usize * 3, x as usize * 3, w as usize * 3);
+            self.part_rgb.clear();
+            for row in y as usize..(y + h) as usize {
+                self.part_rgb.extend_from_slice(&self.candidate[row * stride + at..][..len]);
+            }
+            lossy_png::encode(&mut self.part_rgb, w, h, q, &mut self.packed);
+            for (row, shown) in (y as usize..(y + h) as usize).zip(self.part_rgb.chunks_exact(len)) {
+                self.candidate[row * stride + at..][..len].copy_from_slice(shown);
+            }
+        }
         let pixels: &[u8] = if (w, h) == size {
             &self.candidate
         } else {
@@ -152,7 +207,9 @@ impl PictureStream {
                     }
                     _ => {
                         let packing = packing.unwrap_or(Packing::Zlib(1));
-                        pack(packing, pixels, w, h, &mut self.packed);
+                        if !matches!(packing, Packing::LossyPng(_)) {
+                            pack(packing, pixels, w, h, &mut self.packed);
+                        }
                         let more: &[u8] = if whole { b"" } else { b"a=f," };
                         kitty::push_chunks(&mut self.bytes, &keys, more, packing, &self.packed, o.tmux);
                     }
@@ -176,6 +233,12 @@ pub(super) fn part_box(part: Part, size: (u32, u32)) -> (u32, u32, u32, u32) {
         Part::Whole => (0, 0, size.0, size.1),
         Part::Changed(x, y, w, h) | Part::Tile(x, y, w, h) => (x, y, w, h),
     }
+}
+
+/// The rows a part covers in a picture of `size`.
+pub(super) fn part_rows(part: Part, size: (u32, u32)) -> std::ops::Range<usize> {
+    let (_, y, _, h) = part_box(part, size);
+    y as usize..(y + h) as usize
 }
 
 /// The part of a sixel picture to send: the block of whole cells around the changes (its last

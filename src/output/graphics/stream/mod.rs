@@ -1,7 +1,8 @@
 //! One terminal's pictures under rate control: a [`PictureStream`] is the picture encoder of a
 //! pixel mode (kitty, sixel, iTerm2) together with the choices that fit it to a link — the
 //! resolution (a [`ladder`] from the source picture's size down to half-block resolution), the
-//! packing (kitty: zlib RGB or PNG, whole images or `a=f` frame edits of changed rectangles,
+//! packing (kitty: zlib RGB, or under a rate a lossy PNG ([`crate::output::graphics::lossy_png`]),
+//! whole images or `a=f` frame edits of changed rectangles,
 //! or temporary files for a terminal on this machine; sixel: changed cell blocks; iTerm2: PNG
 //! or JPEG) and the picture rate — so that a picture never costs more than the bytes the caller
 //! has now.
@@ -50,6 +51,13 @@
 //! the bucket holds it. Without a rate every picture goes at the source's own size (no
 //! interpolated pixels; sixel: at the screen's, the source enlarged smoothly, since the
 //! terminal does not scale sixel), in the packing that costs least CPU.
+//!
+//! Under a rate the stream keeps a model of what the terminal shows (the lossy pixels), of the
+//! picture it was encoded from and of the source picture: changes are found against the
+//! picture encoded, not the lossy one shown, and a still scene's bytes go to the blocks
+//! furthest from the truth until the top rung is exact; then it sends nothing (`refine.rs`).
+//! While the scene moves, kitty's changed box goes as a lossy frame edit and the bytes a whole
+//! picture would have taken beyond it refine the blocks outside it, whose source is still.
 
 #[cfg(feature = "player")]
 pub mod crossover;
@@ -62,26 +70,15 @@ use std::time::{Duration, Instant};
 use tiny_skia::Pixmap;
 
 use self::ladder::Resampler;
-use crate::output::bucket::{MAX_BURST, MIN_CAPACITY};
+#[cfg(test)]
+use self::plan::KITTY_STEP;
+use self::plan::{MIN_RATE, PICTURE_SHARE};
 use crate::output::graphics::geometry::Layout;
 use crate::output::graphics::kitty::{KittyOptions, Medium};
 use crate::output::graphics::pack::Packing;
 use crate::output::graphics::scan;
 use crate::output::graphics::sixel::{Registers, SixelEncoder, SixelPalette, TMUX_MAX_IMAGE_BYTES};
 
-/// The share of a picture interval's bytes a picture may take: the rest is left for the status
-/// line and the cells' own changes.
-const PICTURE_SHARE: f64 = 0.85;
-/// The picture rate the rung is chosen for: the rung's whole picture fits a tenth of a second
-/// of the rate, so a moving picture keeps at least this many pictures a second.
-const MIN_RATE: f64 = 10.0;
-/// A rung above the current one is taken only when it is predicted to fit this share of the
-/// allowance (hysteresis: no flapping between two rungs).
-const UP_SHARE: f64 = 0.85;
-/// The weight of the newest measurement in a rung's cost average.
-const LEARN: f64 = 0.3;
-/// How per-pixel cost grows as a rung shrinks: bytes a pixel scale as (pixels ratio) ^ this.
-const DENSITY_EXPONENT: f64 = 0.2;
 /// The soonest the next picture may follow a base image sent for tiles.
 const FRAME_MIN: Duration = Duration::from_millis(1);
 
@@ -212,6 +209,22 @@ pub struct FileWrite {
 struct Pending {
     rung: usize,
     part: Part,
+    /// What the commit does to the model of where the shown picture came from.
+    model: Model,
+    /// The offer makes the shown picture the source's own pixels at the top rung.
+    exact: bool,
+}
+
+/// What a commit does to `sent` and `source_shown` (see [`PictureStream`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Model {
+    /// The offer was encoded from this frame's `target` and `source_now`: they become `sent`
+    /// and `source_shown`.
+    Set,
+    /// The offer refined what was shown towards `sent`: both stay.
+    Keep,
+    /// The offer is not an encoding of a known source picture: both are forgotten.
+    Clear,
 }
 
 /// One terminal's pictures under rate control (see the module documentation).
@@ -233,6 +246,23 @@ pub struct PictureStream {
     shown: Option<(usize, Vec<u8>)>,
     /// The picture being offered (same form as `shown`).
     candidate: Vec<u8>,
+    /// Under a rate (kitty and iTerm2): this frame's picture at the rung as the source gives it
+    /// (the lossy packings show something near it), and the one the shown picture was encoded
+    /// from with its rung: changes are found between these two, not against `shown`, which a
+    /// lossy packing leaves a little off everywhere.
+    target: Vec<u8>,
+    sent: Option<(usize, Vec<u8>)>,
+    /// Under a rate: this frame's source picture and the one `sent` was made from (RGBA as
+    /// given): equal, the scene is still and the bytes go to refining what is shown
+    /// (`refine.rs`).
+    source_now: Vec<u8>,
+    source_shown: Vec<u8>,
+    /// The terminal shows the source's own pixels at the top rung (a still scene is done).
+    shown_exact: bool,
+    /// The bytes of the last whole picture a refinement encoded and the bucket did not hold
+    /// (the exact picture of a protocol without frame edits, kitty's first picture of a climb
+    /// to a higher rung): it is not encoded again until the bucket holds them.
+    refine_cost: Option<usize>,
     pending: Option<Pending>,
     /// The next tile (its index in raster order) when pictures go in tiles.
     next_tile: usize,
@@ -282,6 +312,12 @@ impl PictureStream {
             next_due: None,
             shown: None,
             candidate: Vec::new(),
+            target: Vec::new(),
+            sent: None,
+            source_now: Vec::new(),
+            source_shown: Vec::new(),
+            shown_exact: false,
+            refine_cost: None,
             pending: None,
             next_tile: 0,
             state: State { size: layout.picture, packing: None, rate, part: Part::Whole },
@@ -315,6 +351,7 @@ impl PictureStream {
     pub fn invalidate(&mut self) {
         self.forget_pending();
         self.shown = None;
+        self.forget_model();
         self.next_due = None;
         self.next_tile = 0;
         self.placeholders_due = true;
@@ -350,7 +387,16 @@ impl PictureStream {
         self.cost = vec![None; self.rungs.len()];
         self.rung = 0;
         self.shown = None;
+        self.forget_model();
         self.next_tile = 0;
+    }
+
+    /// Forgets where the shown picture came from.
+    fn forget_model(&mut self) {
+        self.sent = None;
+        self.source_shown.clear();
+        self.shown_exact = false;
+        self.refine_cost = None;
     }
 
     /// The picture `picture` encoded for the terminal within `budget`, or `None` (see the
@@ -376,11 +422,16 @@ impl PictureStream {
         let allowance = self.plan(budget);
         let room = allowance.min(budget.available);
         let limited = budget.rate.is_some();
-        // The protocol's picture rate; a picture at most once a frame. Due half a frame early,
-        // so that an interval of two frames is two and not three when the clock's ticks fall a
-        // nanosecond short.
-        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
-        let interval = Duration::from_secs_f64(1.0 / most).max(budget.frame_interval) - budget.frame_interval / 2;
+        // A still scene under a rate: the bytes refine what is shown towards the source.
+        if limited && self.still(picture) {
+            let interval = self.interval(budget);
+            return self.refine(budget, (room, allowance), now, interval);
+        }
+        if limited && !matches!(self.protocol, Protocol::Sixel { .. }) {
+            self.source_now.clear();
+            self.source_now.extend_from_slice(picture.data());
+        }
+        let interval = self.interval(budget);
         // The bucket does not hold what this rung costs yet: no picture is encoded for nothing.
         if limited
             && !budget.overdraw
@@ -404,8 +455,12 @@ impl PictureStream {
                 self.next_due = Some(now + interval);
                 return None;
             };
-            self.learn(rung, part);
+            self.learn(rung, part, limited);
             if self.bytes.len() <= room || (budget.overdraw && self.bytes.len() <= allowance) {
+                // What a whole picture at this rung is expected to cost bounds the bytes
+                // still regions are refined with, so the moving picture keeps its rate.
+                let limit = room.min(self.predict(rung).map_or(allowance, |c| c as usize));
+                let part = if limited { self.refine_still(rung, part, limit) } else { part };
                 return self.offer(rung, part, limited, now + interval);
             }
             if self.bytes.len() <= allowance {
@@ -442,46 +497,32 @@ impl PictureStream {
                 self.flatten_candidate();
                 self.bytes.clear();
                 self.push_part(Part::Whole, rung, Some(Packing::Zlib(6)));
-                return self.offer(rung, Part::Whole, limited, now + FRAME_MIN);
+                return self.offer_as(rung, Part::Whole, limited, now + FRAME_MIN, Model::Clear, false);
             }
             _ => {}
         }
-        let part = self.encode_tile(rung, part, room, limited)?;
+        let Some(part) = self.encode_tile(rung, part, room, limited) else {
+            self.tiles_done(rung, limited);
+            return None;
+        };
         self.offer(rung, part, limited, now + interval)
     }
 
-    /// Offers `self.bytes` (the caller has checked they fit).
-    fn offer(&mut self, rung: usize, part: Part, limited: bool, next: Instant) -> Option<Offer<'_>> {
-        self.pending = Some(Pending { rung, part });
-        self.state = State { size: self.rungs[rung], packing: self.packing(limited, rung), rate: self.rate, part };
-        self.next_due = Some(next);
-        Some(Offer { bytes: &self.bytes, state: self.state })
-    }
-
-    /// The offer was written: the terminal shows it from now on.
-    pub fn commit(&mut self) {
-        let Some(Pending { rung, part }) = self.pending.take() else { return };
-        self.committed_files.extend(self.pending_file.take());
-        let sixel = matches!(self.protocol, Protocol::Sixel { .. });
-        let (stride, bpp) = self.stride(rung);
-        match (part, &mut self.shown) {
-            (Part::Tile(x, y, w, h), Some((r, shown))) if *r == rung || sixel => {
-                *r = rung;
-                for row in y as usize..(y + h) as usize {
-                    let a = row * stride + x as usize * bpp;
-                    let b = a + w as usize * bpp;
-                    shown[a..b].copy_from_slice(&self.candidate[a..b]);
-                }
-            }
-            (_, shown) => {
-                let old = shown.take().map(|(_, v)| v).unwrap_or_default();
-                *shown = Some((rung, std::mem::replace(&mut self.candidate, old)));
-                if matches!(self.protocol, Protocol::Kitty(_)) && part == Part::Whole {
-                    self.placeholders_due = false;
-                }
-            }
+    /// No tile to send: under a rate, when kitty's lossy tiles show all of this frame's
+    /// picture at `rung` (the shown picture is the candidate), the model learns where it came
+    /// from (this frame's picture at the rung and its source), so a still scene is refined to
+    /// exact and climbs from there (`refine.rs`) as it does after a whole picture. Without
+    /// this a link too slow for the bottom rung's whole picture kept a still picture at the
+    /// bottom rung's lossy tiles for good.
+    fn tiles_done(&mut self, rung: usize, limited: bool) {
+        let lossy = matches!(self.packing(limited, rung), Some(Packing::LossyPng(_)));
+        if !lossy || self.sent.is_some() || self.source_now.is_empty() {
+            return;
         }
-        self.rung = rung;
+        if self.shown.as_ref().is_some_and(|(r, shown)| *r == rung && *shown == self.candidate) {
+            self.sent = Some((rung, self.target.clone()));
+            self.source_shown.clone_from(&self.source_now);
+        }
     }
 
     /// An offer not committed: its temporary file is never written.
@@ -512,67 +553,12 @@ impl PictureStream {
             _ => (self.rungs[rung].0 as usize * 3, 3),
         }
     }
-
-    fn packing(&self, limited: bool, rung: usize) -> Option<Packing> {
-        match &self.protocol {
-            Protocol::Kitty(o) if matches!(o.medium, Medium::TempFile(_)) => None,
-            Protocol::Kitty(_) if limited => Some(Packing::Png),
-            Protocol::Kitty(_) => Some(Packing::Zlib(1)),
-            Protocol::Iterm2 { .. } if limited => Some(Packing::Jpeg(self.jpeg_quality(rung))),
-            Protocol::Iterm2 { .. } => Some(Packing::Png),
-            Protocol::Sixel { .. } => None,
-        }
-    }
-
-    /// iTerm2's JPEG quality: lower on the lower rungs, where each pixel is bigger on screen
-    /// and the rung was chosen because bytes are short.
-    fn jpeg_quality(&self, rung: usize) -> u8 {
-        let from_bottom = self.rungs.len() - 1 - rung;
-        [40, 50, 60, 70, 75, 80].get(from_bottom).copied().unwrap_or(85)
-    }
-
-    /// Chooses the rung for `budget` and returns the bytes one picture may take.
-    fn plan(&mut self, budget: Budget) -> usize {
-        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
-        let Some(rate) = budget.rate else {
-            self.rate = most;
-            self.rung = 0;
-            return usize::MAX;
-        };
-        let burst = (rate * MAX_BURST.as_secs_f64()).max(MIN_CAPACITY);
-        let allowance = (rate / MIN_RATE).min(burst) * PICTURE_SHARE;
-        let last = self.rungs.len() - 1;
-        let mut rung = (0..self.rungs.len()).find(|&r| self.predict(r).is_none_or(|c| c <= allowance)).unwrap_or(last);
-        // Hysteresis: a bigger rung only when it fits with room to spare.
-        if rung < self.rung && self.predict(rung).is_some_and(|c| c > UP_SHARE * allowance) {
-            rung = self.rung.min(last);
-        }
-        self.rung = rung;
-        self.rate = self.predict(rung).map_or(most, |c| (rate * PICTURE_SHARE / c.max(1.0)).min(most));
-        allowance as usize
-    }
-
-    /// A whole picture's predicted bytes at `rung`: learned, or scaled from the nearest rung
-    /// learned; `None` when nothing is known yet (the first picture tries the top).
-    fn predict(&self, rung: usize) -> Option<f64> {
-        let pixels = |r: usize| f64::from(self.rungs[r].0) * f64::from(self.rungs[r].1);
-        let (known, bpp) =
-            (0..self.rungs.len()).filter_map(|r| self.cost[r].map(|c| (r, c))).min_by_key(|(r, _)| r.abs_diff(rung))?;
-        Some(bpp * (pixels(known) / pixels(rung)).powf(DENSITY_EXPONENT) * pixels(rung))
-    }
-
-    fn learn(&mut self, rung: usize, part: Part) {
-        if part != Part::Whole {
-            return;
-        }
-        let (w, h) = self.rungs[rung];
-        let bpp = self.bytes.len() as f64 / (f64::from(w) * f64::from(h));
-        let c = &mut self.cost[rung];
-        *c = Some(c.map_or(bpp, |old| old + LEARN * (bpp - old)));
-    }
 }
 
+mod commit;
 mod encode;
+mod plan;
+mod refine;
 
 #[cfg(test)]
 mod tests;

@@ -110,7 +110,8 @@ fn kitty_offers_decode_to_the_picture_on_the_wire_and_edits_apply_to_it() {
     let mut stream = kitty_stream();
     let t0 = Instant::now();
     let mut wire = Vec::new();
-    // Unlimited, then 2 MB/s until the rung settles, then a small change: a frame edit.
+    // Unlimited, then 2 MB/s until the rung settles, then a small change: a frame edit (of
+    // the lossy picture shown, found against the picture it was made from).
     let rates = [None, Some(2e6), Some(2e6), Some(2e6), Some(2e6), Some(2e6)];
     let mut picture = moving(0);
     for (n, rate) in (0u32..).zip(rates) {
@@ -130,7 +131,12 @@ fn kitty_offers_decode_to_the_picture_on_the_wire_and_edits_apply_to_it() {
         assert_eq!((image.width, image.height), size);
         let mut want = Vec::new();
         Resampler::default().resample(picture.data(), 4, (640, 360), size, &mut want);
-        assert!(image.rgb == want, "step {n} ({part:?}): the decoded image is not the picture at {size:?}");
+        // Unlimited: the picture itself; under a rate: the lossy PNG, which the stream's model
+        // of the terminal holds exactly and which is within a step of the picture.
+        assert!(image.rgb == stream.shown.as_ref().unwrap().1, "step {n} ({part:?}): the model is not what is shown");
+        let worst = image.rgb.iter().zip(&want).map(|(a, b)| a.abs_diff(*b)).max().unwrap();
+        let step = if rate.is_some() { KITTY_STEP } else { 0 };
+        assert!(worst <= step, "step {n} ({part:?}): {worst} from the picture at {size:?}");
         if n + 1 == rates.len() as u32 {
             assert!(matches!(part, Part::Changed(..)), "{part:?}");
         }
@@ -222,4 +228,206 @@ fn sixel_streams_write_the_same_bytes_as_before() {
         }
     }
     assert_eq!(hash, 10844920514458207448, "the sixel bytes changed");
+}
+
+/// Plays `moving` frames of moving water and then `still` frames of the last one through
+/// `stream` with a bucket of `rate` bytes a second (no overdraw), committing every offer and
+/// feeding kitty's to a decoder. Checks every offer against the bytes available and the
+/// decoded image against the stream's model of what is shown. Returns the frame (counted from
+/// the first still one) from which the decoded image is the exact source at the top rung and
+/// stays so with nothing sent (`None`: never), and the bytes sent.
+fn still_after_moving(
+    stream: &mut PictureStream,
+    rate: f64,
+    (moving_frames, still): (u32, u32),
+    moving: &dyn Fn(u32) -> Pixmap,
+) -> (Option<u32>, usize) {
+    let t0 = Instant::now();
+    let mut bucket = ByteBucket::new(rate);
+    bucket.refill(t0);
+    let mut terminal = kitty_decode::KittyState::default();
+    let kitty = matches!(stream.protocol, Protocol::Kitty(_));
+    let last = moving(moving_frames);
+    let (mut exact, size) = (Vec::new(), (last.width(), last.height()));
+    Resampler::default().resample(last.data(), 4, size, size, &mut exact);
+    let (mut converged, mut total) = (None, 0);
+    for n in 1..=moving_frames + still {
+        let now = t0 + FRAME * n;
+        bucket.refill(now);
+        let budget = Budget::new(bucket.budget(), Some(rate), FRAME);
+        let picture = if n <= moving_frames { moving(n) } else { last.clone() };
+        let offer = stream.prepare(&picture, budget, now).map(|o| o.bytes.to_vec());
+        if let Some(bytes) = &offer {
+            assert!(
+                bytes.len() <= budget.available,
+                "frame {n}: {} bytes, {} available",
+                bytes.len(),
+                budget.available
+            );
+            bucket.spend(bytes.len());
+            total += bytes.len();
+            stream.commit();
+            if kitty {
+                terminal.feed(bytes).expect("the stream decodes");
+                let image = &terminal.images[&kitty::IMAGE_ID];
+                let (rung, shown) = stream.shown.as_ref().expect("shown after a commit");
+                assert_eq!((image.width, image.height), stream.rungs[*rung], "frame {n}");
+                assert!(&image.rgb == shown, "frame {n}: the terminal shows what the stream believes");
+            }
+        }
+        if n > moving_frames {
+            let at_top = stream.shown.as_ref().is_some_and(|(r, s)| *r == 0 && *s == exact);
+            match (at_top && offer.is_none(), converged) {
+                (true, None) => converged = Some(n - moving_frames),
+                (false, Some(_)) => panic!("frame {n}: sent {:?} bytes after converging", offer.map(|b| b.len())),
+                _ => {}
+            }
+        }
+    }
+    (converged, total)
+}
+
+#[test]
+fn the_block_codec_never_exceeds_its_budget_and_still_water_converges_to_the_exact_picture() {
+    // kitty with frame edits at 50 and 250 kB/s: lossy pictures while the water moves, then
+    // the worst blocks made exact, the climb to the top rung, and nothing once it is exact.
+    for rate in [50e3, 250e3] {
+        let mut stream = kitty_stream();
+        let (converged, bytes) = still_after_moving(&mut stream, rate, (45, 1200), &moving);
+        let frames = converged.unwrap_or_else(|| panic!("{rate} B/s: still water never became exact"));
+        let seconds = f64::from(45 + frames) / 30.0;
+        assert!(bytes as f64 <= rate * seconds * 1.05 + rate / 10.0, "{rate} B/s: {bytes} bytes in {seconds} s");
+    }
+}
+
+/// The golden pool shifted `k` pixels at 120x72: a 40x13 terminal's picture.
+fn small_moving(k: u32) -> Pixmap {
+    let (mut rgb, size) = (Vec::new(), (120, 72));
+    Resampler::default().resample(moving(k).data(), 4, (640, 360), size, &mut rgb);
+    let mut p = Pixmap::new(size.0, size.1).unwrap();
+    for (px, c) in p.pixels_mut().iter_mut().zip(rgb.chunks_exact(3)) {
+        *px = tiny_skia::ColorU8::from_rgba(c[0], c[1], c[2], 255).premultiply();
+    }
+    p
+}
+
+#[test]
+fn on_a_link_of_a_few_hundred_bytes_a_frame_still_water_still_becomes_exact() {
+    // 5 kB/s: 167 bytes a frame, at most 425 a picture, where one 16x16 block's exact edit
+    // alone is about a kilobyte: the blocks are halved until they fit. Every offer within the
+    // bucket, the decoded image the model, the exact source at the top rung, then nothing.
+    let l = layout(GraphicsMode::Kitty, (40, 13), Some((8, 16)), None, SCALED_CAP);
+    let mut stream =
+        PictureStream::new(Protocol::Kitty(KittyOptions { frame_edits: true, ..KittyOptions::new(l.cells) }), l);
+    let rate = 5e3;
+    let (converged, bytes) = still_after_moving(&mut stream, rate, (30, 3000), &small_moving);
+    let frames = converged.unwrap_or_else(|| panic!("{rate} B/s: still water never became exact"));
+    assert_eq!(stream.rungs[0], (120, 72));
+    let seconds = f64::from(30 + frames) / 30.0;
+    assert!(bytes as f64 <= rate * seconds * 1.05 + 500.0, "{rate} B/s: {bytes} bytes in {seconds} s");
+}
+
+#[test]
+fn nothing_changes_nothing_is_sent() {
+    // Unlimited: the second identical picture sends nothing (every picture is exact).
+    let t0 = Instant::now();
+    for mut stream in [kitty_stream(), iterm2_stream()] {
+        let picture = moving(3);
+        assert!(stream.prepare(&picture, Budget::unlimited(FRAME), t0).is_some());
+        stream.commit();
+        for n in 1..30u32 {
+            assert!(stream.prepare(&picture, Budget::unlimited(FRAME), t0 + FRAME * n).is_none(), "frame {n}");
+        }
+    }
+    // Under a rate: iTerm2 (no partial update) sends its exact picture once the bucket holds
+    // it (here: the caller overdraws), and nothing after.
+    let mut stream = iterm2_stream();
+    let picture = moving(3);
+    let mut sent = Vec::new();
+    for n in 0..60u32 {
+        let budget = Budget { overdraw: true, ..Budget::new(200_000, Some(2e6), FRAME) };
+        if let Some(offer) = stream.prepare(&picture, budget, t0 + FRAME * (2 * n)) {
+            sent.push(offer.state.packing);
+            stream.commit();
+        }
+    }
+    assert_eq!(sent.len(), 2, "a JPEG, then the exact PNG, then nothing: {sent:?}");
+    assert_eq!(sent[1], Some(Packing::Png));
+    assert!(stream.shown_exact);
+}
+
+/// The golden pool with its rows from `STILL_ROWS` down shifted `k` pixels: water moving in
+/// the lower part of the picture, the upper part still.
+const STILL_ROWS: u32 = 150;
+
+fn partly_moving(k: u32) -> Pixmap {
+    let (still, moved) = (moving(0), moving(k));
+    let mut p = still.clone();
+    let at = (STILL_ROWS * still.width()) as usize;
+    p.pixels_mut()[at..].copy_from_slice(&moved.pixels()[at..]);
+    p
+}
+
+#[test]
+fn a_still_region_beside_moving_water_becomes_exact_while_the_water_moves() {
+    // kitty with frame edits under a rate, the lower part of the picture moving every frame
+    // for 8 seconds: the upper part's rows (those wholly from still source rows, at the rung
+    // shown) must become the exact source picture within a second and a half of the last
+    // whole picture and stay so, while the moving part keeps going at 10 pictures a second or
+    // more. Every offer within the bucket and decoded to the stream's model.
+    for rate in [250e3, 2e6] {
+        let mut stream = kitty_stream();
+        let t0 = Instant::now();
+        let mut bucket = ByteBucket::new(rate);
+        bucket.refill(t0);
+        let mut terminal = kitty_decode::KittyState::default();
+        let (frames, mut pictures, mut last_whole, mut exact_since) = (240u32, 0u32, 0u32, None::<u32>);
+        let mut moving_rows_seen = Vec::new();
+        for n in 1..=frames {
+            let now = t0 + FRAME * n;
+            bucket.refill(now);
+            let budget = Budget::new(bucket.budget(), Some(rate), FRAME);
+            let picture = partly_moving(n);
+            let Some(offer) = stream.prepare(&picture, budget, now) else { continue };
+            let (len, part) = (offer.bytes.len(), offer.state.part);
+            assert!(len <= budget.available, "{rate} B/s, frame {n}: {len} bytes, {} available", budget.available);
+            terminal.feed(offer.bytes).expect("the stream decodes");
+            bucket.spend(len);
+            stream.commit();
+            pictures += 1;
+            let image = &terminal.images[&kitty::IMAGE_ID];
+            let (rung, shown) = stream.shown.as_ref().expect("shown after a commit");
+            let size = stream.rungs[*rung];
+            assert_eq!((image.width, image.height), size, "frame {n}");
+            assert!(&image.rgb == shown, "{rate} B/s, frame {n}: the terminal shows what the stream believes");
+            if part == Part::Whole {
+                (last_whole, exact_since) = (n, None);
+            }
+            // The rows at the rung wholly from still source rows (the resampler's support
+            // reaches a row either side), and what they are exactly.
+            let mut truth = Vec::new();
+            Resampler::default().resample(picture.data(), 4, (640, 360), size, &mut truth);
+            let stride = size.0 as usize * 3;
+            let still_rows = (STILL_ROWS * size.1 / 360).saturating_sub(2) as usize;
+            assert!(still_rows > 10, "{size:?}");
+            let exact = image.rgb[..still_rows * stride] == truth[..still_rows * stride];
+            match (exact, exact_since) {
+                (true, None) => exact_since = Some(n),
+                (false, Some(since)) => panic!("{rate} B/s, frame {n}: the still rows were exact from frame {since}"),
+                _ => {}
+            }
+            moving_rows_seen.push(image.rgb[(size.1 as usize - 1) * stride..].to_vec());
+        }
+        let seconds = f64::from(frames) / 30.0;
+        assert!(f64::from(pictures) / seconds >= 10.0, "{rate} B/s: {pictures} pictures in {seconds} s");
+        let since = exact_since.unwrap_or_else(|| panic!("{rate} B/s: the still rows never became exact"));
+        assert!(
+            since - last_whole <= 45,
+            "{rate} B/s: exact {} frames after the last whole picture",
+            since - last_whole
+        );
+        let tail = &moving_rows_seen[moving_rows_seen.len() - 10..];
+        assert!(tail.windows(2).all(|w| w[0] != w[1]), "{rate} B/s: the moving part kept changing");
+        eprintln!("{rate} B/s: {pictures} pictures, last whole at frame {last_whole}, still rows exact from {since}");
+    }
 }

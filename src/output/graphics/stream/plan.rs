@@ -1,0 +1,122 @@
+//! How a [`PictureStream`] fits a link: the rung whose whole picture the rate pays for at
+//! [`MIN_RATE`] pictures a second (learned from what each rung cost), the picture rate that
+//! follows, and the packing and its lossy setting at each rung.
+
+use std::time::Duration;
+
+use super::{Budget, Part, PictureStream, Protocol};
+use crate::output::bucket::{MAX_BURST, MIN_CAPACITY};
+use crate::output::graphics::kitty::Medium;
+use crate::output::graphics::pack::Packing;
+
+/// The share of a picture interval's bytes a picture may take: the rest is left for the status
+/// line and the cells' own changes.
+pub(super) const PICTURE_SHARE: f64 = 0.85;
+/// The picture rate the rung is chosen for: the rung's whole picture fits a tenth of a second
+/// of the rate, so a moving picture keeps at least this many pictures a second.
+pub(super) const MIN_RATE: f64 = 10.0;
+/// A rung above the current one is taken only when it is predicted to fit this share of the
+/// allowance (hysteresis: no flapping between two rungs).
+const UP_SHARE: f64 = 0.85;
+/// The weight of the newest measurement in a rung's cost average.
+const LEARN: f64 = 0.3;
+/// How per-pixel cost grows as a rung shrinks: bytes a pixel scale as (pixels ratio) ^ this.
+const DENSITY_EXPONENT: f64 = 0.2;
+/// kitty's lossy PNG step under a rate (`lossy_png`): in the pictures bench 24 scored above 16
+/// and 8 at 50 kB/s, 250 kB/s and 2 MB/s (0.636, 0.687, 0.779 against 0.620, 0.676, 0.747 for
+/// 8): the coarser step buys a larger rung, and a larger rung is worth more than the step's
+/// error (docs/pixels/block-codec.md).
+pub(super) const KITTY_STEP: u8 = 24;
+/// iTerm2's JPEG quality under a rate on the top rung and on the rungs below half-block
+/// resolution: at 2 MB/s 70 lets the top rung go 30 times a second (SSIM 0.931 against 0.858
+/// with 85 at 22 a second), and at 50 kB/s 70 at 100x59 scored 0.6456 against 85 at 84x49's
+/// 0.6343 (docs/pixels/block-codec.md).
+const ITERM2_QUALITY_LOW: u8 = 70;
+/// iTerm2's JPEG quality under a rate on the rungs between: at 250 kB/s 85 at 201x118 scored
+/// 0.7146 against 70 at 284x167's 0.6959 (docs/pixels/block-codec.md).
+const ITERM2_QUALITY: u8 = 85;
+
+impl PictureStream {
+    /// The least time between pictures: the protocol's picture rate, a picture at most once a
+    /// frame. Due half a frame early, so that an interval of two frames is two and not three
+    /// when the clock's ticks fall a nanosecond short.
+    pub(super) fn interval(&self, budget: Budget) -> Duration {
+        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
+        Duration::from_secs_f64(1.0 / most).max(budget.frame_interval) - budget.frame_interval / 2
+    }
+
+    /// The packing at `rung` (`None`: sixel, kitty's temporary files).
+    pub(super) fn packing(&self, limited: bool, rung: usize) -> Option<Packing> {
+        match &self.protocol {
+            Protocol::Kitty(o) if matches!(o.medium, Medium::TempFile(_)) => None,
+            Protocol::Kitty(_) if limited => Some(Packing::LossyPng(self.lossy_step(rung))),
+            Protocol::Kitty(_) => Some(Packing::Zlib(1)),
+            Protocol::Iterm2 { .. } if limited => Some(Packing::Jpeg(self.jpeg_quality(rung))),
+            Protocol::Iterm2 { .. } => Some(Packing::Png),
+            Protocol::Sixel { .. } => None,
+        }
+    }
+
+    /// kitty's lossy PNG step under a rate ([`KITTY_STEP`] on every rung).
+    pub(super) fn lossy_step(&self, _rung: usize) -> u8 {
+        KITTY_STEP
+    }
+
+    /// iTerm2's JPEG quality under a rate: [`ITERM2_QUALITY_LOW`] on the top rung and on the
+    /// rungs with fewer pixels than half-block resolution (four times the bottom rung's),
+    /// [`ITERM2_QUALITY`] between.
+    pub(super) fn jpeg_quality(&self, rung: usize) -> u8 {
+        let pixels = |(w, h): (u32, u32)| u64::from(w) * u64::from(h);
+        let bottom = *self.rungs.last().expect("the ladder has a rung");
+        if rung == 0 || pixels(self.rungs[rung]) < 4 * pixels(bottom) { ITERM2_QUALITY_LOW } else { ITERM2_QUALITY }
+    }
+
+    /// Chooses the rung for `budget` and returns the bytes one picture may take.
+    pub(super) fn plan(&mut self, budget: Budget) -> usize {
+        let most = self.protocol.max_rate().min(1.0 / budget.frame_interval.as_secs_f64().max(1e-3));
+        let Some(rate) = budget.rate else {
+            self.rate = most;
+            self.rung = 0;
+            return usize::MAX;
+        };
+        let burst = (rate * MAX_BURST.as_secs_f64()).max(MIN_CAPACITY);
+        let allowance = (rate / MIN_RATE).min(burst) * PICTURE_SHARE;
+        let last = self.rungs.len() - 1;
+        let mut rung = (0..self.rungs.len()).find(|&r| self.predict(r).is_none_or(|c| c <= allowance)).unwrap_or(last);
+        // Hysteresis: a bigger rung only when it fits with room to spare.
+        if rung < self.rung && self.predict(rung).is_some_and(|c| c > UP_SHARE * allowance) {
+            rung = self.rung.min(last);
+        }
+        self.rung = rung;
+        self.rate = self.predict(rung).map_or(most, |c| (rate * PICTURE_SHARE / c.max(1.0)).min(most));
+        allowance as usize
+    }
+
+    /// A whole picture's predicted bytes at `rung`: learned, or scaled from the nearest rung
+    /// learned; `None` when nothing is known yet (the first picture tries the top).
+    pub(super) fn predict(&self, rung: usize) -> Option<f64> {
+        let pixels = |r: usize| f64::from(self.rungs[r].0) * f64::from(self.rungs[r].1);
+        let (known, bpp) =
+            (0..self.rungs.len()).filter_map(|r| self.cost[r].map(|c| (r, c))).min_by_key(|(r, _)| r.abs_diff(rung))?;
+        Some(bpp * (pixels(known) / pixels(rung)).powf(DENSITY_EXPONENT) * pixels(rung))
+    }
+
+    /// Learns the bytes a pixel of `part` at `rung` (in `self.bytes`): a whole picture, or
+    /// kitty's lossy edit of a box at least half the picture (under a rate a moving scene goes
+    /// as such edits, and the box's pixels cost what the whole picture's do).
+    pub(super) fn learn(&mut self, rung: usize, part: Part, limited: bool) {
+        let (w, h) = self.rungs[rung];
+        let area = match part {
+            Part::Whole => f64::from(w) * f64::from(h),
+            Part::Changed(_, _, bw, bh)
+                if matches!(self.packing(limited, rung), Some(Packing::LossyPng(_))) && 2 * bw * bh >= w * h =>
+            {
+                f64::from(bw) * f64::from(bh)
+            }
+            _ => return,
+        };
+        let bpp = self.bytes.len() as f64 / area;
+        let c = &mut self.cost[rung];
+        *c = Some(c.map_or(bpp, |old| old + LEARN * (bpp - old)));
+    }
+}
