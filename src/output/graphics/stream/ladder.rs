@@ -9,8 +9,6 @@
 //! about three quarters of its bytes: fine enough that the rung chosen for a link uses most
 //! of what the link carries.
 
-use crate::simd::{Simd, Tier};
-
 /// The most rungs (top and bottom included).
 const MAX_RUNGS: usize = 12;
 /// Each rung's side is this fraction of the one above (about 70% of the pixels).
@@ -54,14 +52,6 @@ impl RowSink for Append<'_> {
     fn row(&mut self, _: usize, row: &[u8]) {
         self.0.extend_from_slice(row);
     }
-}
-
-/// What [`Resampler::resample_on`] hands its compiled copies.
-struct Job<'a> {
-    source: &'a [u8],
-    bpp: usize,
-    from: (u32, u32),
-    to: (u32, u32),
 }
 
 /// A separable resampler from one size to another: a tent filter whose radius is one source
@@ -137,46 +127,9 @@ impl Resampler {
     /// Writes `source` (`from` pixels of `bpp` bytes, 3 or 4; the first three are taken as RGB)
     /// resampled to `to` as RGB into `out` (cleared first). Equal sizes copy the pixels.
     pub fn resample(&mut self, source: &[u8], bpp: usize, from: (u32, u32), to: (u32, u32), out: &mut Vec<u8>) {
-        self.resample_on(Simd::detect(), source, bpp, from, to, out);
-    }
-
-    /// [`Resampler::resample`] with its loops compiled for `simd`'s instruction set (about a
-    /// twentieth of the kitty player's CPU under a rate ran in 128-bit vectors before). The
-    /// same bytes on every tier: IEEE multiplications and additions in a fixed order (no fused
-    /// multiply-add), the rest integers.
-    pub fn resample_on(
-        &mut self,
-        simd: Simd,
-        source: &[u8],
-        bpp: usize,
-        from: (u32, u32),
-        to: (u32, u32),
-        out: &mut Vec<u8>,
-    ) {
         out.clear();
         out.reserve(to.0 as usize * to.1 as usize * 3);
-        let job = Job { source, bpp, from, to };
-        match simd.tier() {
-            // SAFETY: a `Simd` of this tier exists only when run-time detection found the
-            // feature (see `crate::simd`).
-            #[cfg(target_arch = "x86_64")]
-            Tier::Avx512 => unsafe { self.resample_avx512(job, out) },
-            #[cfg(target_arch = "x86_64")]
-            Tier::Avx2 => unsafe { self.resample_avx2(job, out) },
-            _ => self.resample_rows(source, bpp, from, to, &mut Append(out)),
-        }
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    fn resample_avx2(&mut self, Job { source, bpp, from, to }: Job<'_>, out: &mut Vec<u8>) {
-        self.resample_rows(source, bpp, from, to, &mut Append(out))
-    }
-
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx512f,avx512bw")]
-    fn resample_avx512(&mut self, Job { source, bpp, from, to }: Job<'_>, out: &mut Vec<u8>) {
-        self.resample_rows(source, bpp, from, to, &mut Append(out))
+        self.resample_rows(source, bpp, from, to, &mut Append(out));
     }
 
     /// Resamples as [`Resampler::resample`], handing each target row (RGB, top to bottom) to
@@ -336,24 +289,5 @@ mod tests {
         // Enlarging interpolates between neighbours.
         rs.resample(&[0, 0, 0, 100, 100, 100], 3, (2, 1), (4, 1), &mut out);
         assert_eq!(out.chunks_exact(3).map(|p| p[0]).collect::<Vec<_>>(), vec![0, 25, 75, 100]);
-    }
-
-    #[test]
-    fn every_tier_resamples_to_the_same_bytes() {
-        let (w, h, rgb) = crate::output::graphics::test_pictures::golden_pool();
-        let rgba: Vec<u8> = rgb.chunks_exact(3).flat_map(|p| [p[0], p[1], p[2], 255]).collect();
-        // Shrunk (the ladder's rungs, the tent wider than a pixel) and enlarged (pairs), from
-        // RGBA and RGB, and the same size (a copy).
-        for (bpp, source) in [(4, &rgba), (3, &rgb)] {
-            for to in [(w * 84 / 100, h * 84 / 100), (w / 3, h / 3), (w * 2 + 1, h * 3 / 2), (w, h)] {
-                let mut want = Vec::new();
-                Resampler::default().resample_on(Simd::PORTABLE, source, bpp, (w, h), to, &mut want);
-                for simd in Simd::supported() {
-                    let mut got = Vec::new();
-                    Resampler::default().resample_on(simd, source, bpp, (w, h), to, &mut got);
-                    assert!(got == want, "{simd:?}, {bpp} bytes a pixel, to {to:?}");
-                }
-            }
-        }
     }
 }
