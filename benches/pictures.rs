@@ -463,6 +463,17 @@ fn cpu(c: &mut Criterion) {
             out.len()
         })
     });
+    // The same with the encoder kept from picture to picture, as the stream keeps it.
+    let mut encoder = tidepool::testing::LossyPngEncoder::default();
+    group.bench_function("lossy_png_step24_kept", |b| {
+        b.iter(|| {
+            n += 1;
+            pixels.clear();
+            pixels.extend_from_slice(&rgbs[n % rgbs.len()]);
+            encoder.encode(black_box(&mut pixels), SCENE.0, SCENE.1, 24, &mut out);
+            out.len()
+        })
+    });
     let (mut stream, _) = stream("kitty");
     let frame = Duration::from_nanos(1_000_000_000 / 30);
     let t0 = Instant::now();

@@ -76,6 +76,7 @@ pub mod testing {
     pub use crate::output::graphics::iterm2::Iterm2Encoder;
     pub use crate::output::graphics::kitty::{KittyEncoder, KittyOptions, Medium, temp_dir as kitty_temp_dir};
     pub use crate::output::graphics::kitty_decode::{Image as KittyImage, KittyState, decode as kitty_decode};
+    pub use crate::output::graphics::lossy_png::Encoder as LossyPngEncoder;
     pub use crate::output::graphics::lossy_png::encode as lossy_png;
     pub use crate::output::graphics::pack::Packing;
     pub use crate::output::graphics::sixel::dithered_rgb;

@@ -18,55 +18,88 @@
 //! terminal is exact. Deterministic: integers only, one pass in raster order; the same pixels
 //! give the same bytes. `q = 1` is lossless (the filter alone).
 
-use std::io::Write;
-
-use flate2::Compression;
-use flate2::write::ZlibEncoder;
+use super::deflate::Zlib;
 
 /// PNG's Sub filter type (the first row: the left neighbour alone).
 const SUB: u8 = 1;
 /// PNG's Average filter type (every other row).
 const AVERAGE: u8 = 3;
 
-/// The deflate level: the differences are few distinct values, so a middling level finds most
+/// The deflate level (1..=9): the differences are few distinct values, so a middling level finds most
 /// of what there is (level 6 and 9 differ by under a percent on water).
 const LEVEL: u32 = 4;
 
 /// Rewrites `rgb` (`width x height`, 3 bytes a pixel) to the picture the decoder will show and
 /// writes that PNG (8-bit RGB, the Sub filter on the first row and the Average filter on the
 /// others) into `out` (cleared first).
-/// `q` (at least 1) is the step differences are rounded to.
+/// `q` (at least 1) is the step differences are rounded to. A caller that encodes a picture a
+/// frame keeps an [`Encoder`] instead: the same bytes without its buffers made anew each time.
 ///
 /// # Panics
 /// When `rgb` does not hold `width x height` pixels.
 pub fn encode(rgb: &mut [u8], width: u32, height: u32, q: u8, out: &mut Vec<u8>) {
-    let (w, h) = (width as usize, height as usize);
-    assert_eq!(rgb.len(), w * h * 3, "RGB buffer does not match {width}x{height}");
-    let steps = Steps::new(i32::from(q.max(1)));
-    let stride = w * 3;
-    let mut filtered = vec![0u8; (stride + 1) * h];
-    for (y, out_row) in filtered.chunks_exact_mut(stride + 1).enumerate() {
-        let (above, row) = rgb.split_at_mut(y * stride);
-        if y == 0 {
-            out_row[0] = SUB;
-            filter_row::<false>(&mut row[..stride], &[], &mut out_row[1..], &steps);
-        } else {
-            out_row[0] = AVERAGE;
-            filter_row::<true>(&mut row[..stride], &above[(y - 1) * stride..][..stride], &mut out_row[1..], &steps);
-        }
+    Encoder::default().encode(rgb, width, height, q, out);
+}
+
+/// [`encode`] with its scratch kept from picture to picture: the filtered bytes (a picture's
+/// size), the step's table and the deflate state (a few hundred kilobytes), which were each
+/// allocated, and the large ones zeroed, for every picture a stream sent (issue 29, Round 9 of
+/// `docs/pixels/block-codec.md`). The bytes are those of [`encode`]: the compressor is reset
+/// to the state of a new one, and is fed the same way.
+#[derive(Default)]
+pub struct Encoder {
+    /// The filter type byte and the filtered bytes of every row.
+    filtered: Vec<u8>,
+    /// The table of the last step.
+    steps: Option<Steps>,
+    /// The compressor, and its output (the IDAT's data).
+    zlib: Zlib,
+    idat: Vec<u8>,
+}
+
+impl std::fmt::Debug for Encoder {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Encoder").field("filtered", &self.filtered.len()).finish_non_exhaustive()
     }
-    out.clear();
-    out.extend_from_slice(b"\x89PNG\r\n\x1a\n");
-    let mut header = Vec::with_capacity(13);
-    header.extend_from_slice(&width.to_be_bytes());
-    header.extend_from_slice(&height.to_be_bytes());
-    header.extend_from_slice(&[8, 2, 0, 0, 0]); // 8 bits, RGB, deflate, adaptive filters, no interlace
-    chunk(out, b"IHDR", &header);
-    let mut z = ZlibEncoder::new(Vec::with_capacity(filtered.len() / 4), Compression::new(LEVEL));
-    z.write_all(&filtered).expect("writing into memory cannot fail");
-    let data = z.finish().expect("writing into memory cannot fail");
-    chunk(out, b"IDAT", &data);
-    chunk(out, b"IEND", &[]);
+}
+
+impl Encoder {
+    /// As [`encode`].
+    ///
+    /// # Panics
+    /// When `rgb` does not hold `width x height` pixels.
+    pub fn encode(&mut self, rgb: &mut [u8], width: u32, height: u32, q: u8, out: &mut Vec<u8>) {
+        let (w, h) = (width as usize, height as usize);
+        assert_eq!(rgb.len(), w * h * 3, "RGB buffer does not match {width}x{height}");
+        let q = i32::from(q.max(1));
+        let steps = match &mut self.steps {
+            Some(s) if s.q == q => s,
+            slot => slot.insert(Steps::new(q)),
+        };
+        let stride = w * 3;
+        // Every byte is written below: only a larger picture than before fills.
+        self.filtered.resize((stride + 1) * h, 0);
+        for (y, out_row) in self.filtered.chunks_exact_mut(stride + 1).enumerate() {
+            let (above, row) = rgb.split_at_mut(y * stride);
+            if y == 0 {
+                out_row[0] = SUB;
+                filter_row::<false>(&mut row[..stride], &[], &mut out_row[1..], steps);
+            } else {
+                out_row[0] = AVERAGE;
+                filter_row::<true>(&mut row[..stride], &above[(y - 1) * stride..][..stride], &mut out_row[1..], steps);
+            }
+        }
+        out.clear();
+        out.extend_from_slice(b"\x89PNG\r\n\x1a\n");
+        let mut header = [0u8; 13];
+        header[..4].copy_from_slice(&width.to_be_bytes());
+        header[4..8].copy_from_slice(&height.to_be_bytes());
+        header[8..].copy_from_slice(&[8, 2, 0, 0, 0]); // 8 bits, RGB, deflate, adaptive filters, no interlace
+        chunk(out, b"IHDR", &header);
+        self.zlib.compress(&self.filtered, LEVEL, &mut self.idat);
+        chunk(out, b"IDAT", &self.idat);
+        chunk(out, b"IEND", &[]);
+    }
 }
 
 /// Rewrites one row to what the decoder rebuilds and writes its filtered bytes into `out`:
@@ -84,27 +117,32 @@ fn filter_row<const AVG: bool>(row: &mut [u8], up: &[u8], out: &mut [u8], steps:
         left[c] = i32::from(first[c]);
         out[c] = (left[c] - predicted) as u8;
     }
-    let up = if AVG { &up[3..] } else { &[][..] };
-    let out = &mut out[3..];
+    let (rest, out) = (rest.as_chunks_mut::<3>().0, out[3..].as_chunks_mut::<3>().0);
     if AVG {
-        for ((px, above), filtered) in rest.chunks_exact_mut(3).zip(up.chunks_exact(3)).zip(out.chunks_exact_mut(3)) {
-            for c in 0..3 {
-                let predicted = (left[c] + i32::from(above[c])) / 2;
-                let value = steps.quantise(i32::from(px[c]), predicted);
-                px[c] = value as u8;
-                filtered[c] = (value - predicted) as u8;
-                left[c] = value;
-            }
-        }
+        filter_rest::<true>(rest, up[3..].as_chunks::<3>().0.iter(), out, left, steps);
     } else {
-        for (px, filtered) in rest.chunks_exact_mut(3).zip(out.chunks_exact_mut(3)) {
-            for c in 0..3 {
-                let predicted = left[c];
-                let value = steps.quantise(i32::from(px[c]), predicted);
-                px[c] = value as u8;
-                filtered[c] = (value - predicted) as u8;
-                left[c] = value;
-            }
+        filter_rest::<false>(rest, std::iter::repeat(&[0; 3]), out, left, steps);
+    }
+}
+
+/// The pixels after the first of [`filter_row`]'s row, `left` the first as rebuilt: one loop
+/// for both filters (with `AVG` the prediction is the mean of the left and upper bytes, without
+/// it the left byte alone; `above` is then never read).
+#[inline(always)]
+fn filter_rest<'a, const AVG: bool>(
+    row: &mut [[u8; 3]],
+    above: impl Iterator<Item = &'a [u8; 3]>,
+    out: &mut [[u8; 3]],
+    mut left: [i32; 3],
+    steps: &Steps,
+) {
+    for ((px, above), filtered) in row.iter_mut().zip(above).zip(out) {
+        for c in 0..3 {
+            let predicted = if AVG { (left[c] + i32::from(above[c])) / 2 } else { left[c] };
+            let value = steps.quantise(i32::from(px[c]), predicted);
+            px[c] = value as u8;
+            filtered[c] = (value - predicted) as u8;
+            left[c] = value;
         }
     }
 }
@@ -128,14 +166,10 @@ impl Steps {
     /// [`quantise`]`(value, predicted, q)`, both within 0..=255.
     #[inline(always)]
     fn quantise(&self, value: i32, predicted: i32) -> i32 {
-        let mut v = predicted + i32::from(self.rounded[(value - predicted + 255) as usize]);
-        while v > 255 {
-            v -= self.q;
-        }
-        while v < 0 {
-            v += self.q;
-        }
-        v
+        let v = predicted + i32::from(self.rounded[(value - predicted + 255) as usize]);
+        // The rounded value is within half a step of `value` (0..=255), so one step back in
+        // range is enough (the loops of [`quantise`] run at most once), and without a branch.
+        v - self.q * i32::from(v > 255) + self.q * i32::from(v < 0)
     }
 }
 
@@ -204,6 +238,27 @@ mod tests {
         }
         assert!(sizes.windows(2).all(|s| s[1] < s[0]), "a coarser step costs fewer bytes: {sizes:?}");
         assert!(sizes[2] * 2 < lossless.len(), "q 8 at most half the lossless PNG: {sizes:?} vs {}", lossless.len());
+    }
+
+    #[test]
+    fn a_kept_encoder_writes_what_a_new_one_writes() {
+        let (w, h, rgb) = golden_pool();
+        // Pictures of different sizes and steps one after another (a larger one after a
+        // smaller, a step back to an earlier one): each picture's bytes and rewritten pixels
+        // must be a new encoder's, whatever came before.
+        let half = h / 2;
+        let small = &rgb[..(w * half * 3) as usize];
+        let mut kept = Encoder::default();
+        for (pixels, height, q) in
+            [(&rgb[..], h, 24), (small, half, 24), (&rgb[..], h, 8), (small, half, 1), (&rgb[..], h, 24)]
+        {
+            let (mut fresh, mut fresh_png) = (pixels.to_vec(), Vec::new());
+            encode(&mut fresh, w, height, q, &mut fresh_png);
+            let (mut again, mut again_png) = (pixels.to_vec(), vec![7; 5]);
+            kept.encode(&mut again, w, height, q, &mut again_png);
+            assert!(again_png == fresh_png, "{w}x{height} at step {q}: the PNG");
+            assert!(again == fresh, "{w}x{height} at step {q}: the pixels shown");
+        }
     }
 
     #[test]

@@ -19,6 +19,7 @@
 // only the standalone encoders use are unused: allowed here rather than a `cfg` on each field.
 #![cfg_attr(not(any(test, feature = "cli", feature = "testing")), allow(dead_code))]
 
+pub mod deflate;
 pub mod geometry;
 pub mod iterm2;
 pub mod kitty;

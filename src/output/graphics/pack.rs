@@ -7,11 +7,7 @@
 //! ([`crate::output::graphics::stream`]) chooses among them per frame; these functions only
 //! pack.
 
-use std::io::Write;
-
-use flate2::Compression;
-use flate2::write::ZlibEncoder;
-
+use crate::output::graphics::deflate::Zlib;
 use crate::output::graphics::lossy_png;
 
 /// How a picture's pixels are packed.
@@ -77,10 +73,7 @@ pub fn pack(packing: Packing, rgb: &[u8], width: u32, height: u32, out: &mut Vec
 
 /// `data` under zlib at `level` (1..=9) into `out` (cleared first; its allocation reused).
 pub fn zlib(data: &[u8], level: u8, out: &mut Vec<u8>) {
-    out.clear();
-    let mut z = ZlibEncoder::new(std::mem::take(out), Compression::new(u32::from(level.clamp(1, 9))));
-    z.write_all(data).expect("writing into memory cannot fail");
-    *out = z.finish().expect("writing into memory cannot fail");
+    Zlib::default().compress(data, u32::from(level), out);
 }
 
 #[cfg(test)]

@@ -9,7 +9,7 @@ use super::{FileWrite, Part, PictureStream, Protocol};
 use crate::output::graphics::kitty::{self, KittyOptions, Medium};
 use crate::output::graphics::pack::{Packing, pack};
 use crate::output::graphics::sixel::SixelEncoder;
-use crate::output::graphics::{iterm2, lossy_png, scan};
+use crate::output::graphics::{iterm2, scan};
 use crate::simd::{Simd, Tier};
 
 /// The most colours a sixel palette fitted under a rate below [`FULL_PALETTE_RATE`] has
@@ -170,7 +170,7 @@ impl PictureStream {
             for row in y as usize..(y + h) as usize {
                 self.part_rgb.extend_from_slice(&self.candidate[row * stride + at..][..len]);
             }
-            lossy_png::encode(&mut self.part_rgb, w, h, q, &mut self.packed);
+            self.lossy.encode(&mut self.part_rgb, w, h, q, &mut self.packed);
             for (row, shown) in (y as usize..(y + h) as usize).zip(self.part_rgb.chunks_exact(len)) {
                 self.candidate[row * stride + at..][..len].copy_from_slice(shown);
             }
@@ -207,8 +207,10 @@ impl PictureStream {
                     }
                     _ => {
                         let packing = packing.unwrap_or(Packing::Zlib(1));
-                        if !matches!(packing, Packing::LossyPng(_)) {
-                            pack(packing, pixels, w, h, &mut self.packed);
+                        match packing {
+                            Packing::LossyPng(_) => {}
+                            Packing::Zlib(level) => self.zlib.compress(pixels, u32::from(level), &mut self.packed),
+                            _ => pack(packing, pixels, w, h, &mut self.packed),
                         }
                         let more: &[u8] = if whole { b"" } else { b"a=f," };
                         kitty::push_chunks(&mut self.bytes, &keys, more, packing, &self.packed, o.tmux);

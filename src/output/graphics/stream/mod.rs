@@ -73,8 +73,10 @@ use self::ladder::Resampler;
 #[cfg(test)]
 use self::plan::KITTY_STEP;
 use self::plan::{MIN_RATE, PICTURE_SHARE};
+use crate::output::graphics::deflate::Zlib;
 use crate::output::graphics::geometry::Layout;
 use crate::output::graphics::kitty::{KittyOptions, Medium};
+use crate::output::graphics::lossy_png;
 use crate::output::graphics::pack::Packing;
 use crate::output::graphics::scan;
 use crate::output::graphics::sixel::{Registers, SixelEncoder, SixelPalette, TMUX_MAX_IMAGE_BYTES};
@@ -274,6 +276,12 @@ pub struct PictureStream {
     part_rgb: Vec<u8>,
     rgb: Vec<u8>,
     resampler: Resampler,
+    /// kitty's compressors, kept from picture to picture (the same bytes as new ones).
+    zlib: Zlib,
+    lossy: lossy_png::Encoder,
+    /// Scratch of the block search (`refine.rs`): the blocks, and one region's error table.
+    blocks: Vec<refine::Block>,
+    block_table: Vec<u64>,
     sixel: Option<Box<SixelEncoder>>,
     /// kitty's placeholder text must be (re)printed after the next whole image.
     placeholders_due: bool,
@@ -326,6 +334,10 @@ impl PictureStream {
             part_rgb: Vec::new(),
             rgb: Vec::new(),
             resampler: Resampler::default(),
+            zlib: Zlib::default(),
+            lossy: lossy_png::Encoder::default(),
+            blocks: Vec::new(),
+            block_table: Vec::new(),
             sixel,
             placeholders_due: true,
             files: 0,

@@ -118,26 +118,30 @@ impl PictureStream {
         let rung = self.shown.as_ref()?.0;
         let mut side = BLOCK;
         loop {
-            let errors = {
+            let mut errors = std::mem::take(&mut self.blocks);
+            errors.clear();
+            {
                 let (Some((_, shown)), Some((_, sent))) = (&self.shown, &self.sent) else { return None };
                 let size = self.rungs[rung];
-                let mut errors = Vec::new();
-                block_errors(shown, sent, size, side, (0, 0, size.0, size.1), &mut errors);
+                block_errors(shown, sent, size, side, (0, 0, size.0, size.1), (&mut self.block_table, &mut errors));
                 worst_first(&mut errors);
-                errors
-            };
-            if errors.is_empty() {
+            }
+            let packed = (!errors.is_empty()).then(|| {
+                self.candidate.clear();
+                self.candidate.extend_from_slice(&self.shown.as_ref().expect("shown").1);
+                self.bytes.clear();
+                self.pack_blocks(rung, &errors, room, Truth::Sent)
+            });
+            self.blocks = errors;
+            let Some(packed) = packed else {
                 if rung == 0 {
                     self.shown_exact = true;
                     self.next_due = Some(now + interval);
                     return None;
                 }
                 return self.climb(rung, room, allowance, now);
-            }
-            self.candidate.clear();
-            self.candidate.extend_from_slice(&self.shown.as_ref().expect("shown").1);
-            self.bytes.clear();
-            match self.pack_blocks(rung, &errors, room, Truth::Sent) {
+            };
+            match packed {
                 Ok(((x0, y0, x1, y1), all)) => {
                     let (part, exact) = (Part::Changed(x0, y0, x1 - x0, y1 - y0), all && rung == 0);
                     return self.offer_as(rung, part, true, now + interval, Model::Keep, exact);
@@ -201,11 +205,13 @@ impl PictureStream {
         // Outside the box: the bands above and below it, and either side of it.
         let outside = [(0, 0, w, by), (0, y1, w, h), (0, by, bx, y1), (x1, by, w, y1)];
         let mut side = BLOCK;
-        let mut errors = Vec::new();
+        let mut errors = std::mem::take(&mut self.blocks);
+        let mut found = part;
         while self.bytes.len() + STILL_LEAST_BYTES <= limit {
             errors.clear();
             for region in outside {
-                block_errors(&self.candidate, &self.target, (w, h), side, region, &mut errors);
+                let scratch = (&mut self.block_table, &mut errors);
+                block_errors(&self.candidate, &self.target, (w, h), side, region, scratch);
             }
             if errors.is_empty() {
                 break;
@@ -214,13 +220,15 @@ impl PictureStream {
             match self.pack_blocks(rung, &errors, limit, Truth::Target) {
                 Ok((blocks, _)) => {
                     let (x0, y0, x1, y1) = union((bx, by, x1, y1), blocks);
-                    return Part::Changed(x0, y0, x1 - x0, y1 - y0);
+                    found = Part::Changed(x0, y0, x1 - x0, y1 - y0);
+                    break;
                 }
                 Err(_) if side > STILL_MIN_SIDE => side /= 2,
                 Err(_) => break,
             }
         }
-        part
+        self.blocks = errors;
+        found
     }
 
     /// A new image at the highest rung whose first picture fits a picture's bytes
@@ -264,17 +272,27 @@ impl PictureStream {
 }
 
 /// A block: its error (the sum of the byte differences) and its box `(x, y, w, h)`.
-type Block = (u64, (u32, u32, u32, u32));
+pub(super) type Block = (u64, (u32, u32, u32, u32));
 
 /// Appends to `out` the `side`-pixel blocks of `region` (corners; blocks at its right and
-/// bottom edges are cut to it) where `shown` differs from `truth` (RGB of `size`).
-fn block_errors(shown: &[u8], truth: &[u8], size: (u32, u32), side: u32, region: Corners, out: &mut Vec<Block>) {
+/// bottom edges are cut to it) where `shown` differs from `truth` (RGB of `size`). `table`:
+/// scratch for the region's sums (the stream's, kept from call to call).
+fn block_errors(
+    shown: &[u8],
+    truth: &[u8],
+    size: (u32, u32),
+    side: u32,
+    region: Corners,
+    (table, out): (&mut Vec<u64>, &mut Vec<Block>),
+) {
     let (x0, y0, x1, y1) = region;
     if x0 >= x1 || y0 >= y1 {
         return;
     }
     let (cols, rows) = ((x1 - x0).div_ceil(side), (y1 - y0).div_ceil(side));
-    let mut errors = vec![0u64; (cols * rows) as usize];
+    table.clear();
+    table.resize((cols * rows) as usize, 0);
+    let errors = &mut table[..];
     let (stride, from, to) = (size.0 as usize * 3, x0 as usize * 3, x1 as usize * 3);
     for y in y0..y1 {
         let at = y as usize * stride;
@@ -287,7 +305,7 @@ fn block_errors(shown: &[u8], truth: &[u8], size: (u32, u32), side: u32, region:
             row[col] += p.iter().zip(q).map(|(s, t)| u64::from(s.abs_diff(*t))).sum::<u64>();
         }
     }
-    for (i, e) in (0..).zip(errors) {
+    for (i, &e) in (0..).zip(errors.iter()) {
         if e > 0 {
             let (x, y) = (x0 + i % cols * side, y0 + i / cols * side);
             out.push((e, (x, y, side.min(x1 - x), side.min(y1 - y))));
