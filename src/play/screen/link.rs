@@ -23,7 +23,10 @@
 //! waits behind at most that. The first answer starts the rate from what the first frame was
 //! seen to take (never under [`SAFE_RATE`]): a base round trip taken while the start rate's
 //! queue stood would hide every later queue. An answer that does not come within
-//! [`PROBE_TIMEOUT`] (or four base round trips) counts as congestion too.
+//! [`PROBE_TIMEOUT`] (or four base round trips) counts as congestion too. A round trip counts
+//! from when the question's frame was handed to the door's writer
+//! ([`LinkControl::handed_over`]), not from when the frame began: on a loaded machine building
+//! a frame takes the player most of a frame interval, and its spread is not a queue.
 //!
 //! **The window.** A rate alone cannot keep the first seconds short on a very slow link: the
 //! first answer comes back only once the first frame has crossed the link, and until then the
