@@ -94,7 +94,8 @@ impl Session {
     }
 
     /// The bytes of the last [`Session::poll_transmit`] were handed to the door's writer at
-    /// `at`, after its files were written ([`Driver::handle_written`]).
+    /// `at`, after its files were written: the link's round trip counts from then, not from
+    /// the frame's `now` (building a frame on a loaded machine is not a queue on the link).
     pub fn handle_written(&mut self, at: Instant) {
         self.driver.handle_written(at);
     }
