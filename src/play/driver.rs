@@ -3,7 +3,8 @@
 //! in the sans-IO shape of quinn-proto's `Connection`:
 //!
 //! - inputs: [`Driver::handle_bytes`] (the terminal's bytes, when they arrived),
-//!   [`Driver::handle_resize`] (the terminal's size), [`Driver::handle_picture`] (a door whose
+//!   [`Driver::handle_resize`] (the terminal's size), [`Driver::handle_written`] (when a
+//!   frame's bytes were handed to the door's writer), [`Driver::handle_picture`] (a door whose
 //!   pictures come from elsewhere: a new one is there), [`Driver::handle_timeout`] (`now`:
 //!   the turn itself: the screen's deadlines, its layout and notices, the person's inputs);
 //! - outputs: [`Driver::poll_event`] (the seat's requests for the host, a new layout, quit),
@@ -104,6 +105,14 @@ impl Driver {
     /// something (the terminal's own answers are no sign of life).
     pub fn handle_bytes(&mut self, bytes: &[u8], arrived: Instant) -> bool {
         self.player.feed(bytes, arrived)
+    }
+
+    /// The bytes of the last [`Driver::transmit`] were handed to the door's writer at `at`
+    /// (once built, their files written): the link's round trip counts from then, not from
+    /// the frame's `now` (a frame that takes the player long to build is not a queue on the
+    /// link). A door that writes at once may skip it.
+    pub fn handle_written(&mut self, at: Instant) {
+        self.player.screen.handed_over(at);
     }
 
     /// The terminal is now `size` cells.

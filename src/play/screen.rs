@@ -386,6 +386,13 @@ impl Screen {
         }
     }
 
+    /// The last frame's bytes were handed to the door's writer at `at` (after they were built
+    /// and their files written): the link's question among them left then
+    /// ([`link::LinkControl::handed_over`]).
+    pub(crate) fn handed_over(&mut self, at: Instant) {
+        self.link.handed_over(at);
+    }
+
     /// The door could not write a temporary file: pixels go directly from now on (the next
     /// picture whole).
     pub(crate) fn handle_file_error(&mut self) {

@@ -8,7 +8,9 @@
 //!     session.handle_bytes(bytes, arrived); session.handle_resize(size)
 //!     session.handle_timeout(now)?
 //!     while let Some(event) = session.poll_event() { restore prefix / save a file / quit }
-//!     if session.poll_transmit(now, writer_idle, &mut transmit)? { write transmit.files, then transmit.bytes }
+//!     if session.poll_transmit(now, writer_idle, &mut transmit)? {
+//!         write transmit.files; session.handle_written(clock()); then write transmit.bytes
+//!     }
 //! }
 //! session.finish()   (the recording: a file to save)
 //! ```
@@ -89,6 +91,13 @@ impl Session {
     /// Takes the terminal's bytes (`arrived`: when they arrived).
     pub fn handle_bytes(&mut self, bytes: &[u8], arrived: Instant) {
         self.driver.handle_bytes(bytes, arrived);
+    }
+
+    /// The bytes of the last [`Session::poll_transmit`] were handed to the door's writer at
+    /// `at`, after its files were written: the link's round trip counts from then, not from
+    /// the frame's `now` (building a frame on a loaded machine is not a queue on the link).
+    pub fn handle_written(&mut self, at: Instant) {
+        self.driver.handle_written(at);
     }
 
     /// The terminal is now `size` cells.

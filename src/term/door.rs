@@ -198,6 +198,9 @@ impl DoorIo<'_> {
             if write_files(&mut transmit.files).is_err() {
                 session.handle_file_error();
             }
+            // The frame's question leaves now: building the frame (on a loaded machine, most
+            // of a frame interval) is the player's time, not the link's.
+            session.handle_written((self.clock)());
             self.sink.send(std::mem::take(&mut transmit.bytes));
             // After the first frame (not the probe's questions, which go before the host).
             if test_panic && session.host().is_some() {

@@ -138,11 +138,10 @@ async fn serve_finds_true_colour_by_asking_the_terminal() {
     }
 }
 
-/// Runs alone (`scripts/alone_tests.sh`), as its twin over a pty does
-/// (`tests/integration/fake_terminals.rs`): a real-time rate, which the test command's other
-/// tests beside it would take the CPU from.
+/// A real-time rate, measured beside the test command's other tests, as its twin over a pty
+/// is (`tests/integration/fake_terminals.rs`): the server's own time building a frame is not
+/// a queue on the link (`link/handover.rs`).
 #[tokio::test]
-#[ignore = "a real-time rate, measured alone: scripts/alone_tests.sh"]
 async fn a_kitty_slow_to_answer_keeps_its_rate_through_serve() {
     let _alone = SERVERS.write().await;
     // kitty 0.26 under llvmpipe, busy for its own answer time at each device-attributes

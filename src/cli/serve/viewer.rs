@@ -189,6 +189,9 @@ impl Viewer {
             if !self.frame(now, &shared) {
                 continue;
             }
+            // The frame's question leaves now: building the frame on a loaded server is the
+            // player's time, not the link's.
+            self.driver.handle_written(clock());
             if let Some(leave) = self.send(write, kill).await {
                 return leave;
             }

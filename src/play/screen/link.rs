@@ -23,7 +23,10 @@
 //! waits behind at most that. The first answer starts the rate from what the first frame was
 //! seen to take (never under [`SAFE_RATE`]): a base round trip taken while the start rate's
 //! queue stood would hide every later queue. An answer that does not come within
-//! [`PROBE_TIMEOUT`] (or four base round trips) counts as congestion too.
+//! [`PROBE_TIMEOUT`] (or four base round trips) counts as congestion too. A round trip counts
+//! from when the question's frame was handed to the door's writer
+//! ([`LinkControl::handed_over`]), not from when the frame began: on a loaded machine building
+//! a frame takes the player most of a frame interval, and its spread is not a queue.
 //!
 //! **The window.** A rate alone cannot keep the first seconds short on a very slow link: the
 //! first answer comes back only once the first frame has crossed the link, and until then the
@@ -73,6 +76,7 @@ use std::time::{Duration, Instant};
 
 mod answer_time;
 mod flight;
+mod handover;
 mod path;
 mod questions;
 mod screen_side;
@@ -244,6 +248,9 @@ pub struct LinkControl {
     flight: Flight,
     /// The bytes of the last frame sent.
     last_frame: u64,
+    /// The last question asked has not been handed to the writer yet
+    /// ([`LinkControl::handed_over`]).
+    unwritten: bool,
     /// Answers to foreign questions seen, and answers nobody asked for.
     foreign_answers: u64,
     stray_answers: u64,
@@ -293,6 +300,7 @@ impl LinkControl {
             clean_due: None,
             flight: Flight::default(),
             last_frame: 0,
+            unwritten: false,
             foreign_answers: 0,
             stray_answers: 0,
         }
@@ -325,8 +333,10 @@ impl LinkControl {
             self.clean_due = None;
         }
         let in_flight = self.flight.sent(now, bytes_sent, self.last_frame, self.capacity.unwrap_or(self.rate));
+        self.unwritten = true;
         self.questions.push(Question {
             asked: now,
+            out: now,
             bytes: bytes_sent,
             foreign: false,
             overdue: false,
@@ -381,6 +391,9 @@ impl LinkControl {
     /// The link's question `question` was answered at `now`.
     fn round_trip(&mut self, question: Question, now: Instant) -> Change {
         let (sent, bytes, app_limited) = (question.asked, question.bytes, question.app_limited);
+        // From when the question left the player: building its frame took the player's time,
+        // not the link's.
+        let left = question.out;
         let first = !self.answered;
         if first && self.path.asks_status() {
             // The terminal at the far end answers through the multiplexer: the path can be
@@ -394,7 +407,7 @@ impl LinkControl {
             Some((then, before)) => Some((then, bytes.saturating_sub(before))),
             // The first answer: its frame crossed the link within the round trip (a lower
             // bound of the link's rate, what the window starts from).
-            None => Some((sent, bytes)),
+            None => Some((left, bytes)),
         }
         // Between two answers, at least DELIVERY_BYTES: a question that followed a few bytes
         // (a frame with its window closed) and came late says how long the terminal took, not
@@ -410,7 +423,7 @@ impl LinkControl {
         if took.is_some() || self.last_answer.is_none() {
             self.last_answer = Some((now, bytes));
         }
-        let rtt = now.saturating_duration_since(sent);
+        let rtt = now.saturating_duration_since(left);
         self.last_rtt = Some(rtt);
         self.samples[self.sample_count % BASE_SAMPLES] = rtt;
         self.sample_count += 1;

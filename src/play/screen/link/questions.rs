@@ -8,8 +8,12 @@ use super::MAX_QUESTIONS;
 /// A question in flight, in the order asked.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Question {
-    /// When it went out.
+    /// When the frame it follows began (its budget was planned then; its age counts from it).
     pub(super) asked: Instant,
+    /// When it left the player: handed to the writer once the frame was built
+    /// ([`super::LinkControl::handed_over`]), else as `asked`. Its round trip counts from here:
+    /// the time the player took to build the frame is not the link's.
+    pub(super) out: Instant,
     /// The bytes sent up to it (0 for a foreign one).
     pub(super) bytes: u64,
     /// Asked by somebody else (the graphics probe): its answer is dropped.
@@ -48,6 +52,11 @@ impl Questions {
         self.list[self.len] = Some(question);
         self.len += 1;
         true
+    }
+
+    /// The newest of the link's own questions.
+    pub(super) fn newest_own_mut(&mut self) -> Option<&mut Question> {
+        self.list[..self.len].iter_mut().rev().flatten().find(|q| !q.foreign)
     }
 
     pub(super) fn pop_oldest(&mut self) -> Option<Question> {

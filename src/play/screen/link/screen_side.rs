@@ -78,6 +78,7 @@ impl LinkControl {
         for _ in 0..count {
             if !self.questions.push(Question {
                 asked: now,
+                out: now,
                 bytes: 0,
                 foreign: true,
                 overdue: false,

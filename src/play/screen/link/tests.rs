@@ -628,6 +628,7 @@ fn a_terminal_slow_to_read_is_a_queue_not_its_own_time() {
     }
 }
 
+mod late_player;
 mod stalls;
 
 /// A loaded machine's lateness of the player's `n`th wake-up (its timer, or its read of an
