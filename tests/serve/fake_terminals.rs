@@ -13,10 +13,6 @@ use crate::fake_terminal::{Edits, FakeTerminal, Profile, Sgr, Shown, Tcap, Watch
 const COLS: u32 = 160;
 const ROWS: u32 = 48;
 
-/// Held shared by the runs that go side by side and alone by a test that measures a rate, so
-/// that the extra servers never take the CPU it measures.
-static SERVERS: tokio::sync::RwLock<()> = tokio::sync::RwLock::const_new(());
-
 /// Plays `profile` on a fresh server until it shows something; the outcome and the terminal.
 async fn serve_to(profile: Profile) -> (Shown, FakeTerminal) {
     let server = Server::start(TEST_FLAGS);
@@ -97,7 +93,6 @@ async fn every_graphics_terminal_gets_pictures_or_cells_with_a_notice_over_ssh()
             let (profile, gate) = (profile.clone(), std::sync::Arc::clone(&gate));
             set.spawn(async move {
                 let _turn = gate.acquire_owned().await.expect("the gate stays open");
-                let _shared = SERVERS.read().await;
                 let (shown, fake) = serve_to(profile.clone()).await;
                 let (rgb, _) = fake.colour_codes();
                 if !expected(&shown) {
@@ -143,7 +138,6 @@ async fn serve_finds_true_colour_by_asking_the_terminal() {
 /// a queue on the link (`link/handover.rs`).
 #[tokio::test]
 async fn a_kitty_slow_to_answer_keeps_its_rate_through_serve() {
-    let _alone = SERVERS.write().await;
     // kitty 0.26 under llvmpipe, busy for its own answer time at each device-attributes
     // question (median 18 ms, p90 98 ms; reading nothing meanwhile): through serve the rate fell
     // to the 2 kB/s floor within 5 s (round 3, real kitty over the shaped link).
