@@ -97,6 +97,10 @@ pub const TRUE_COLOR_TERMS: &[&str] = &[
     "iterm2",
 ];
 
+/// `TERM` names of terminals that take 24-bit colours but draw water in them wrongly, so the
+/// status line does not suggest `--color truecolor` to them: mlterm (see [`TRUE_COLOR_TERMS`]).
+pub const RECYCLED_COLOR_TERMS: &[&str] = &["mlterm", "mlterm-256color"];
+
 /// Bayer 4x4 thresholds, 0..16.
 const BAYER4: [[u8; 4]; 4] = [[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]];
 
@@ -127,6 +131,12 @@ impl ColorMode {
         }
         let basic = ["linux", "vt100", "vt102", "vt220", "ansi", "dumb", "cons25", "xterm-color", "xterm-16color"];
         if term.is_empty() || basic.contains(&term.as_str()) { ColorMode::Palette16 } else { ColorMode::Palette256 }
+    }
+
+    /// Whether `--color truecolor` would draw better than what `--color auto` found for `term`:
+    /// not for a terminal that recycles its 24-bit colours ([`RECYCLED_COLOR_TERMS`]).
+    pub fn truecolor_helps(term: Option<&str>) -> bool {
+        !RECYCLED_COLOR_TERMS.contains(&term.unwrap_or("").to_ascii_lowercase().as_str())
     }
 
     /// The mode's name as `--color` spells it.
@@ -237,6 +247,8 @@ mod tests {
         // mlterm recycles its 24-bit colours (TRUE_COLOR_TERMS): the palette, unless the
         // terminal's answers say otherwise.
         assert_eq!(ColorMode::detect(None, Some("mlterm")), Palette256);
+        assert!(!ColorMode::truecolor_helps(Some("mlterm")), "no --color truecolor hint for mlterm");
+        assert!(ColorMode::truecolor_helps(Some("xterm-256color")) && ColorMode::truecolor_helps(None));
         assert_eq!(ColorMode::detect(None, Some("xterm-256color")), Palette256);
         assert_eq!(ColorMode::detect(None, Some("linux")), Palette16);
         assert_eq!(ColorMode::detect(None, None), Palette16);
