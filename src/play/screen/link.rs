@@ -252,6 +252,10 @@ pub struct LinkControl {
     /// The last question asked has not been handed to the writer yet
     /// ([`LinkControl::handed_over`]).
     unwritten: bool,
+    /// Since the last answer, a question waited past the window's time, so frames were held
+    /// ([`LinkControl::window_left`]): what the terminal took then is what the window let
+    /// through, a lower bound of the link, never a measure that lowers its capacity.
+    window_bound: bool,
     /// Answers to foreign questions seen, and answers nobody asked for.
     foreign_answers: u64,
     stray_answers: u64,
@@ -302,6 +306,7 @@ impl LinkControl {
             flight: Flight::default(),
             last_frame: 0,
             unwritten: false,
+            window_bound: false,
             foreign_answers: 0,
             stray_answers: 0,
         }
@@ -398,6 +403,7 @@ impl LinkControl {
     /// terminal silent for [`SILENCE`] gets [`SAFE_RATE`]; foreign answers overdue by
     /// [`FOREIGN_WAIT`] and questions older than [`GIVE_UP`] are forgotten.
     pub fn tick(&mut self, now: Instant) -> Change {
+        self.window_bound |= self.waited_past_window(now);
         let age = |q: &Question| now.saturating_duration_since(q.asked);
         self.questions.forget(|q| age(q) > GIVE_UP || (q.foreign && age(q) > FOREIGN_WAIT));
         let base = self.base().unwrap_or(Duration::ZERO);

@@ -49,6 +49,7 @@ impl LinkControl {
         self.silent = false;
         self.acknowledged = self.acknowledged.max(bytes);
         let took = self.take(&question, now);
+        let window_bound = std::mem::take(&mut self.window_bound);
         // From when the question left the player: building its frame took the player's time,
         // not the link's.
         let rtt = now.saturating_duration_since(question.out);
@@ -69,7 +70,7 @@ impl LinkControl {
             self.clean_due = Some(now);
         }
         let reading = self.read_queue(queue, base, question.in_flight);
-        self.measure_capacity(took, &reading, first, app_limited, bytes, now);
+        self.measure_capacity(took, &reading, first, &question, window_bound, now);
         if !self.path.answered_at_far_end() {
             // The answers come from this side of the link (a multiplexer, mosh-server): they
             // pace the window, never the rate.
@@ -145,17 +146,19 @@ impl LinkControl {
         Reading { link_queue, low, high, explained, slow_terminal, over, last }
     }
 
-    /// The link's capacity for the window, from what the terminal `took` (`bytes` sent up to
-    /// the question, `app_limited` when the sender left its budget unspent).
+    /// The link's capacity for the window, from what the terminal `took` since the last answer
+    /// to `question` (whose sender may have left its budget unspent), the window holding frames
+    /// (`window_bound`) or not.
     fn measure_capacity(
         &mut self,
         took: Option<f64>,
         reading: &Reading,
         first: bool,
-        app_limited: bool,
-        bytes: u64,
+        question: &Question,
+        window_bound: bool,
         now: Instant,
     ) {
+        let (app_limited, bytes) = (question.app_limited, question.bytes);
         // The link is first measured by a take that says something of it: a sender that used its
         // budget, and after the first question more than the set-up's few bytes. Until then the
         // window stays the first one (`window`): a capacity taken from 57 bytes of set-up
@@ -170,8 +173,13 @@ impl LinkControl {
         // one (two answers over the mark in a row): its late answers must not shrink the window
         // to one frame's take.
         let standing = reading.over && (reading.was_over() || !reading.slow_terminal);
+        // A take the window held back says the link carries at least that much, never less: a
+        // terminal that draws for a second before it answers (kitty through Mesa's softpipe on
+        // a busy machine) let each window through in a second, the window shrank to each
+        // take's size and the takes with it, to the 4 kB window floor and a 2 kB/s rate on a
+        // 250 kB/s link.
         self.capacity = Some(match self.capacity {
-            Some(c) if !standing => c.max(took),
+            Some(c) if !standing || window_bound => c.max(took),
             _ => self
                 .recent_takes
                 .iter()

@@ -100,3 +100,37 @@ fn a_loaded_machine_is_not_taken_for_a_slowing_link() {
     }
     assert!(failed.is_empty(), "{failed:#?}");
 }
+
+/// Debian's kitty 0.26 drawing through Mesa's softpipe on two busy cores: a drawing takes most
+/// of a second and it answers between drawings, 0.7-1.3 s after a question reached it, now and
+/// then at once (two questions read in one drawing are answered together: about two answers in
+/// five came within 150 ms in the tap's log). A fixed sequence with about those times.
+fn softpipe(n: u32) -> Duration {
+    quantiles(n, 2_654_435_761, &[(400, 20, 150), (1000, 700, 1300)])
+}
+
+#[test]
+fn a_terminal_that_takes_a_second_to_answer_keeps_the_window_it_was_given() {
+    // Real kitty through softpipe over the stock 2 Mbit/s link with 20 ms (the link harness):
+    // it read whatever came at once and answered a second later with as little as 237 bytes
+    // before the question. Each answer's take was what the window had let through in that
+    // second, a standing "queue" took the capacity down to it, the window followed, and the
+    // next take was smaller: the rate at the 2 kB/s floor within 8 s, keys' status lines
+    // held for seconds. A take the window held back never lowers the capacity now, so the
+    // rate stays at a quarter of the link seen (a late answer the bytes cannot explain).
+    // Before (the window's takes lowering the capacity), at 2 ms: lowest rate 7.8 kB/s, the
+    // terminal read 3.2 kB/s, the capacity ended at 2.1 kB/s; now 25 kB/s, 13 and 17 kB/s.
+    for rtt in [ms(2), ms(20)] {
+        let link = Link { answer_time: Some(softpipe), ..Link::far(250_000.0, rtt) };
+        let run = simulate(LinkPath::Direct, link, 30.0, busy);
+        let after: Vec<f64> = run.at.iter().zip(&run.rates).filter(|(t, _)| **t >= 5.0).map(|(_, r)| *r).collect();
+        let lowest = after.iter().copied().fold(f64::MAX, f64::min);
+        let read = run.throughput(250_000.0, 5.0, 30.0);
+        let capacity = run.link.as_ref().and_then(|l| l.capacity).unwrap_or(0.0);
+        println!(
+            "{rtt:?}: lowest rate {lowest:.0} B/s, the terminal read {read:.0} B/s, capacity at the end {capacity:.0} B/s"
+        );
+        assert!(lowest >= 20_000.0, "{rtt:?}: the rate fell to {lowest:.0} B/s on a 250 kB/s link");
+        assert!(read >= 8_000.0, "{rtt:?}: the terminal read only {read:.0} B/s");
+    }
+}
