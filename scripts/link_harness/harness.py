@@ -225,7 +225,7 @@ def open_terminal(lab, config, mode, args, raw, display):
     if mode in ("kitty", "xterm"):
         from real_terminal import TappedTerminal
 
-        return TappedTerminal(mode, cmd, display, lab.dir, raw)
+        return TappedTerminal(mode, cmd, display, lab.dir, raw, driver=args.kitty_driver)
     return Terminal(cmd, env, raw)
 
 
@@ -377,6 +377,14 @@ def parse_args():
     parser.add_argument("--presses", type=int, default=12, help="status-line keys timed per row (default 12)")
     parser.add_argument("--warm-up", type=float, default=6.0, help="seconds of busy water before timing (default 6)")
     parser.add_argument("--play-args", default="--seed 5 --color truecolor", help="arguments for `tidepool play` in the lab rows (default: --seed 5 --color truecolor)")
+    parser.add_argument(
+        "--kitty-driver",
+        default="softpipe",
+        choices=("softpipe", "llvmpipe"),
+        help="Mesa's software driver under the kitty rows (default softpipe: its screenshots are right, "
+        "llvmpipe draws a ghost status line, scripts/kitty_ghost.sh; llvmpipe is what LIBGL_ALWAYS_SOFTWARE=1 "
+        "picks and what issue 27 measured, and draws a frame several times faster)",
+    )
     parser.add_argument("--stock-play-args", default="", help="arguments for `tidepool play` in the stock rows (default none: the issue's commands)")
     parser.add_argument("--timeout", type=float, default=1200.0, help="the whole run ends after this many seconds (default 1200)")
     parser.add_argument("--shots", metavar="DIR", help="after each row's warm-up: a stone, then the screen as a PNG 3 s later and a 5 s GIF, as DIR/MODE-LINK[-TAG].png/.gif (needs pillow)")

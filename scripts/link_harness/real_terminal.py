@@ -61,7 +61,7 @@ class Display:
 class TappedTerminal(Screen):
     """A real terminal running `cmd` through the tap; keys go in through the tap's FIFO."""
 
-    def __init__(self, name, cmd, display, folder, raw_path=None):
+    def __init__(self, name, cmd, display, folder, raw_path=None, driver="softpipe"):
         self.name = name
         self.log_path = os.path.join(folder, f"tap-{name}.log")
         self.fifo_path = os.path.join(folder, f"tap-{name}.fifo")
@@ -72,7 +72,7 @@ class TappedTerminal(Screen):
         tap = ["python3", os.path.join(HERE, "tap.py"), self.log_path, self.fifo_path, "--", *cmd]
         self.env = display.env()
         self.output = open(os.path.join(folder, f"{name}.out"), "wb")
-        self.proc = subprocess.Popen(TERMINALS[name](tap), env=self.env, stdin=subprocess.DEVNULL, stdout=self.output, stderr=subprocess.STDOUT)
+        self.proc = subprocess.Popen(TERMINALS[name](tap, driver), env=self.env, stdin=subprocess.DEVNULL, stdout=self.output, stderr=subprocess.STDOUT)
         # The log's header says the terminal's size.
         deadline = time.monotonic() + 30
         while True:

@@ -214,9 +214,21 @@ def main():
                     base = os.path.join(args.out, f"{name}-{door}-{place}{tag}")
                     # Both directions (-B) with their times: the probe's answers and the pictures.
                     recorded = ["script", "-q", "-f", "-m", "advanced", "-T", f"{base}.timing", "-B", f"{base}.raw", "-c", shlex.join(client)]
+                    for stale in (f"{base}.timing", f"{base}.raw"):
+                        if os.path.exists(stale):
+                            os.remove(stale)
                     log = open(f"{base}.log", "wb")
                     term = subprocess.Popen(TERMINALS[name](recorded, args.kitty_driver), env=env, stdin=subprocess.DEVNULL, stdout=log, stderr=subprocess.STDOUT)
                     opened = time.monotonic()
+                    # When the terminal started `script` (it creates its logs at once): the
+                    # probe's and the picture's times below count from there, the shots from
+                    # `opened`, and a terminal slow to start (kitty under load) separates them.
+                    started = None
+                    while started is None and time.monotonic() < opened + 30 and term.poll() is None:
+                        if os.path.exists(f"{base}.timing"):
+                            started = time.monotonic() - opened
+                        else:
+                            time.sleep(0.01)
                     wid, box = window_box(env, term.pid)
                     stone = False
                     for t in shots:
@@ -235,7 +247,8 @@ def main():
                     stop(term)
                     log.close()
                     answered, picture = first_picture(f"{base}.raw", f"{base}.timing")
-                    line = (f"{name} {door} {place}: probe answered at "
+                    line = (f"{name} {door} {place}: "
+                            f"{'script never started, ' if started is None else f'started {started:.2f} s after the terminal opened, '}probe answered at "
                             f"{'-' if answered is None else f'{answered:.2f} s'}, first picture "
                             f"{'never' if picture is None else f'{picture:.2f} s after it'}")
                     summary.append(line)

@@ -71,10 +71,18 @@ impl Color {
 
 /// `TERM` names of terminals that always draw 24-bit colour (each sets its own name and has
 /// no palette-only mode): kitty, Ghostty, WezTerm (with its terminfo installed), foot,
-/// Alacritty, Contour, Rio, iTerm2's own entry; and mlterm, which takes 24-bit colours and
-/// draws them finer than the 256-colour palette (Debian's mlterm 3.9 under Xvfb: a grey ramp
-/// from 40 to 119 in 16 steps, the palette's 8), though it reads the probe's colour back as
-/// the palette's `38;5;16`, so the probe alone gave it 256 colours.
+/// Alacritty, Contour, Rio, iTerm2's own entry.
+///
+/// Not mlterm (`TERM=mlterm`, no `COLORTERM`), though it takes 24-bit colours: it keeps each
+/// one that is not near a palette colour in a table of 240 (`MAX_EXT_COLORS` in its
+/// `vt_color.c`) and, when the table is full, gives the oldest entry to the new colour, so
+/// every cell still showing the old colour changes with it. A grey ramp of 16 steps drew finer
+/// than the palette (round 8), but water in 24-bit cells brings thousands of colours a second:
+/// Debian's mlterm 3.9 under Xvfb showed patches of lane navy and bright cyan over the tiles
+/// and the lanes within 4 s, over the shaped link and through `tidepool serve`, while the same
+/// bytes replayed into pyte drew a clean pool. Its probe reads the player's 24-bit colour back
+/// as the palette's `38;5;16`, so it gets 256 colours, which it draws exactly;
+/// `--color truecolor` still forces 24 bits.
 pub const TRUE_COLOR_TERMS: &[&str] = &[
     "xterm-kitty",
     "xterm-ghostty",
@@ -87,9 +95,11 @@ pub const TRUE_COLOR_TERMS: &[&str] = &[
     "contour-latest",
     "rio",
     "iterm2",
-    "mlterm",
-    "mlterm-256color",
 ];
+
+/// `TERM` names of terminals that take 24-bit colours but draw water in them wrongly, so the
+/// status line does not suggest `--color truecolor` to them: mlterm (see [`TRUE_COLOR_TERMS`]).
+pub const RECYCLED_COLOR_TERMS: &[&str] = &["mlterm", "mlterm-256color"];
 
 /// Bayer 4x4 thresholds, 0..16.
 const BAYER4: [[u8; 4]; 4] = [[0, 8, 2, 10], [12, 4, 14, 6], [3, 11, 1, 9], [15, 7, 13, 5]];
@@ -121,6 +131,12 @@ impl ColorMode {
         }
         let basic = ["linux", "vt100", "vt102", "vt220", "ansi", "dumb", "cons25", "xterm-color", "xterm-16color"];
         if term.is_empty() || basic.contains(&term.as_str()) { ColorMode::Palette16 } else { ColorMode::Palette256 }
+    }
+
+    /// Whether `--color truecolor` would draw better than what `--color auto` found for `term`:
+    /// not for a terminal that recycles its 24-bit colours ([`RECYCLED_COLOR_TERMS`]).
+    pub fn truecolor_helps(term: Option<&str>) -> bool {
+        !RECYCLED_COLOR_TERMS.contains(&term.unwrap_or("").to_ascii_lowercase().as_str())
     }
 
     /// The mode's name as `--color` spells it.
@@ -228,7 +244,11 @@ mod tests {
         assert_eq!(ColorMode::detect(Some(""), Some("xterm-kitty")), TrueColor);
         assert_eq!(ColorMode::detect(None, Some("xterm-ghostty")), TrueColor);
         assert_eq!(ColorMode::detect(None, Some("foot")), TrueColor);
-        assert_eq!(ColorMode::detect(None, Some("mlterm")), TrueColor);
+        // mlterm recycles its 24-bit colours (TRUE_COLOR_TERMS): the palette, unless the
+        // terminal's answers say otherwise.
+        assert_eq!(ColorMode::detect(None, Some("mlterm")), Palette256);
+        assert!(!ColorMode::truecolor_helps(Some("mlterm")), "no --color truecolor hint for mlterm");
+        assert!(ColorMode::truecolor_helps(Some("xterm-256color")) && ColorMode::truecolor_helps(None));
         assert_eq!(ColorMode::detect(None, Some("xterm-256color")), Palette256);
         assert_eq!(ColorMode::detect(None, Some("linux")), Palette16);
         assert_eq!(ColorMode::detect(None, None), Palette16);

@@ -63,7 +63,8 @@ pub fn run(command: PlayCommand) -> Result<()> {
         bandwidth: command.max_bps.map_or(command.bandwidth, Bandwidth::Fixed),
         color,
         color_auto: command.color == ColorChoice::Auto,
-        colour_hint: command.color == ColorChoice::Auto,
+        // No hint where 24-bit colour draws worse (mlterm recycles its 24-bit colours).
+        colour_hint: command.color == ColorChoice::Auto && ColorMode::truecolor_helps(env("TERM").as_deref()),
         encode: EncodeOptions { threshold, sync: !command.no_sync },
         graphics: command.graphics.into(),
         // The door asks the terminal itself when both ends are terminals, and finds what sits

@@ -74,6 +74,7 @@
 
 use std::time::{Duration, Instant};
 
+mod answer;
 mod answer_time;
 mod flight;
 mod handover;
@@ -251,6 +252,10 @@ pub struct LinkControl {
     /// The last question asked has not been handed to the writer yet
     /// ([`LinkControl::handed_over`]).
     unwritten: bool,
+    /// Since the last answer, a question waited past the window's time, so frames were held
+    /// ([`LinkControl::window_left`]): what the terminal took then is what the window let
+    /// through, a lower bound of the link, never a measure that lowers its capacity.
+    window_bound: bool,
     /// Answers to foreign questions seen, and answers nobody asked for.
     foreign_answers: u64,
     stray_answers: u64,
@@ -301,6 +306,7 @@ impl LinkControl {
             flight: Flight::default(),
             last_frame: 0,
             unwritten: false,
+            window_bound: false,
             foreign_answers: 0,
             stray_answers: 0,
         }
@@ -388,204 +394,6 @@ impl LinkControl {
         }
     }
 
-    /// The link's question `question` was answered at `now`.
-    fn round_trip(&mut self, question: Question, now: Instant) -> Change {
-        let (sent, bytes, app_limited) = (question.asked, question.bytes, question.app_limited);
-        // From when the question left the player: building its frame took the player's time,
-        // not the link's.
-        let left = question.out;
-        let first = !self.answered;
-        if first && self.path.asks_status() {
-            // The terminal at the far end answers through the multiplexer: the path can be
-            // measured, and the rate may grow past the safe one.
-            self.ceiling = MAX_RATE;
-        }
-        self.answered = true;
-        self.silent = false;
-        self.acknowledged = self.acknowledged.max(bytes);
-        let took = match self.last_answer {
-            Some((then, before)) => Some((then, bytes.saturating_sub(before))),
-            // The first answer: its frame crossed the link within the round trip (a lower
-            // bound of the link's rate, what the window starts from).
-            None => Some((left, bytes)),
-        }
-        // Between two answers, at least DELIVERY_BYTES: a question that followed a few bytes
-        // (a frame with its window closed) and came late says how long the terminal took, not
-        // what the link carries (kitty 0.26 stalled 385 ms after 32 bytes, read as 78 B/s).
-        // A shorter interval is measured on with the next.
-        .filter(|&(_, b)| b > 0 && (self.last_answer.is_none() || b >= DELIVERY_BYTES))
-        .map(|(since, b)| (now.saturating_duration_since(since).as_secs_f64(), b))
-        .filter(|&(dt, _)| dt > 0.0)
-        .map(|(dt, b)| b as f64 / dt);
-        if let Some(rate) = took.filter(|_| self.last_answer.is_some() && !app_limited) {
-            self.delivered_before = self.delivered.replace(rate);
-        }
-        if took.is_some() || self.last_answer.is_none() {
-            self.last_answer = Some((now, bytes));
-        }
-        let rtt = now.saturating_duration_since(left);
-        self.last_rtt = Some(rtt);
-        self.samples[self.sample_count % BASE_SAMPLES] = rtt;
-        self.sample_count += 1;
-        let base = self.base().unwrap_or(rtt);
-        let queue = rtt.saturating_sub(base);
-        self.flight.answered(now, bytes);
-        if question.clean {
-            // Nothing was in flight under it: its delay beyond the base is the terminal's own
-            // time, and it says nothing of what the link carries (no frames crossed).
-            self.answer_time.record(queue);
-            let gap = answer_time::next_gap(
-                self.answer_time.bare_count(),
-                self.answer_time.slow(),
-                queue_marks(base).0,
-                base,
-            );
-            self.clean_due = Some(now + gap);
-            return Change::Hold;
-        }
-        if first && self.path.answered_at_far_end() {
-            // The first measurement of the terminal's own time comes right after: holding the
-            // frames until the first answer is in also drains what the start rate queued, so
-            // the bare question's round trip is the link's own.
-            self.clean_due = Some(now);
-        }
-        let (low, high) = queue_marks(base);
-        self.answer_time.infer(queue, question.in_flight, (low, high));
-        // The terminal's usual time to answer is not queue; its slow answers raise the high
-        // mark (a queue must stand beyond them to be the link's).
-        let (usual, slow) = (self.answer_time.usual(), self.answer_time.slow());
-        let link_queue = queue.saturating_sub(usual);
-        // Over the high mark, and either the bytes in flight explain it (a queue grows with
-        // them; the terminal's time does not) or it is beyond the terminal's slow answers too.
-        // Only a terminal the bare questions showed slow on its own is asked for that
-        // explanation: any other is late because it is still reading, a queue.
-        // (Until a few bare answers are in, it is taken for one: main's rules collapsed kitty
-        // 0.26 to 2 kB/s within the first second.)
-        let slow_terminal = self.answer_time.treat_as_slow((low, high));
-        let explained = !slow_terminal || 2 * question.in_flight >= link_queue;
-        let over = link_queue > high && (explained || queue > high + slow);
-        let last_queue = self.last_queue.replace((link_queue, over));
-        let was_over = last_queue.is_some_and(|(_, was_over)| was_over);
-        // The link is first measured by a take that says something of it: a sender that used its
-        // budget, and after the first question more than the set-up's few bytes. Until then the
-        // window stays the first one (`window`): a capacity taken from 57 bytes of set-up
-        // answered in 66 ms (857 B/s) held the window at its 4 kB floor, every frame then
-        // filled it, the takes stayed small, and a loaded machine's late answers took the rate
-        // down to 2-4 kB/s (the fake WezTerm with forced sixel over SSH, blank for 20 s in CI).
-        let measures = self.capacity.is_some() || (!app_limited && (!first || bytes >= FIRST_WINDOW / 4));
-        if let Some(took) = took.filter(|_| measures) {
-            self.capacity = Some(match self.capacity {
-                // A queue says the link was the limit; from a terminal slow on its own only a
-                // standing one (two answers over the mark in a row): its late answers must not
-                // shrink the window to one frame's take.
-                Some(c) if !(over && (was_over || !slow_terminal)) => c.max(took),
-                _ => self
-                    .recent_takes
-                    .iter()
-                    .flatten()
-                    .filter(|(at, _)| now.saturating_duration_since(*at) <= CAPACITY_MEMORY)
-                    .map(|(_, t)| *t)
-                    .fold(took, f64::max),
-            });
-            self.recent_takes[self.take_count % RECENT_TAKES] = Some((now, took));
-            self.take_count += 1;
-        }
-        if !self.path.answered_at_far_end() {
-            // The answers come from this side of the link (a multiplexer, mosh-server): they
-            // pace the window, never the rate.
-            return Change::Hold;
-        }
-        // Too few bytes before the first question (the set-up and a status line, sent before
-        // the bucket held anything) say nothing of the link either.
-        let informative = !app_limited && bytes >= FIRST_WINDOW / 4;
-        if first && informative {
-            // The first frame crossed the link within this round trip: the link carries at
-            // least that much, and the rate may be far above it (a 400 kB/s start on a 32 kB/s
-            // link). Starting from it drains what the first frames queued, so the next round
-            // trips show the link's own delay: a base taken from a queue would hide every
-            // later queue.
-            // A question after a few bytes says little of the link: never below the safe rate
-            // then (measured on the real 256 kbit/s link: the player's first question followed
-            // 4 kB, and 400 kB/s ran on for seconds of falls).
-            // A question after frames that left most of their budget unspent (the status line
-            // alone while the picture waits), or after a few hundred bytes, says nothing of the
-            // link at all: the rate stays, and the window (sized from what those bytes took)
-            // bounds the queue until answers to full frames measure the link (the rate fell to
-            // 16 kB/s on a 250 kB/s link, and on a local xterm whose first question followed
-            // 57 bytes).
-            let shown = took.map_or(self.rate, |t| (t * DRAIN_SHARE).max(SAFE_RATE)).max(MIN_RATE);
-            if shown < self.rate {
-                self.rate = shown.min(self.ceiling);
-                self.decided_at = Some(now);
-                return Change::Down;
-            }
-        }
-        if self.decided_at.is_some_and(|decided| sent < decided) {
-            // Asked before the last change: it measures the queue that change is acting on.
-            return Change::Hold;
-        }
-        // A queue that is not draining, over the high mark twice in a row, or once when it
-        // is beyond what a busy machine's late reads of an answer make (a long link then
-        // falls a round trip sooner).
-        let not_draining = last_queue.is_none_or(|(last, _)| link_queue >= last);
-        // One answer alone confirms a queue only when the bytes in flight explain it: a single
-        // late answer is the terminal's (kitty 0.26 under llvmpipe took up to a second now and
-        // then), never a collapse of the link. That holds for a terminal not found slow on
-        // its own too: a loaded machine reads answers late whatever the terminal (a slow
-        // kitty's rate fell to the floor by one late answer in four).
-        let bytes_explain = 2 * question.in_flight >= link_queue;
-        let confirmed = was_over || (link_queue > 2 * QUEUE_HIGH_MIN && explained && bytes_explain);
-        // A sender that left its budget unspent cannot have built a queue of a few marks: only
-        // a deep one lowers the rate then.
-        let caused = !app_limited || link_queue > 2 * high;
-        if over && not_draining && confirmed && caused {
-            // A queue of several marks drains faster: at 15 % under the link, a second of
-            // queue would take six to go.
-            // A late answer the bytes in flight cannot explain (a terminal slow on its own, in
-            // a standing queue of its own making) never takes the rate under a quarter of the
-            // link seen: kitty 0.26 stalling under load fell to 4 kB/s on a 250 kB/s link.
-            let floor = if explained { MIN_RATE } else { self.capacity.map_or(SAFE_RATE, |c| c * 0.25).max(SAFE_RATE) };
-            let deep = link_queue > 2 * high;
-            // What the terminal took measures the link only when a queue stood from the
-            // interval's start: else the sender set it (the rate, or less), and a fall to a
-            // share of it is a fall to a share of the rate, again at every late answer (a
-            // loaded machine's late reads took a slow kitty from 75 to 3 kB/s in 8 s).
-            let stood = last_queue.is_some_and(|(last, _)| last >= low);
-            self.fall(now, if deep { DEEP_DRAIN_SHARE } else { DRAIN_SHARE }, floor, stood);
-            Change::Down
-        } else if link_queue < low && self.rate < self.ceiling {
-            // Only a sender that used its budget learns that the link carries more: one that
-            // left it unspent (cells of calm water) would grow the rate without evidence, to
-            // "no limit" on a 250 kB/s link, and `auto` then switched to pixels that queued
-            // for seconds.
-            let growth = if self.fell { INCREASE_AFTER_LIMIT } else { INCREASE };
-            self.rate = (self.rate * growth).min(self.ceiling);
-            self.decided_at = Some(now);
-            Change::Up
-        } else {
-            Change::Hold
-        }
-    }
-
-    /// Lowers the rate to under what the terminal was seen to take (`measured`: while a queue
-    /// stood, so the link set it), else by [`DRAIN_SHARE`]; never under `floor`.
-    fn fall(&mut self, now: Instant, share: f64, floor: f64, measured: bool) {
-        let delivered = self.delivered.map(|d| d.max(self.delivered_before.unwrap_or(0.0)));
-        let target = match delivered {
-            // Far under the rate, though, the link (or the terminal) is the limit whatever
-            // stood before: a start rate far over a slow link comes down at once.
-            Some(d) if !measured && d >= self.rate * 0.5 => self.rate * DRAIN_SHARE,
-            // Under what the link was seen to carry (an estimate from two answers, so never
-            // below a quarter of the rate in one fall: a rate far over the link comes down in
-            // one or two round trips), and never up.
-            Some(delivered) => (delivered * share).max(self.rate * 0.25).min(self.rate * DRAIN_SHARE),
-            None => self.rate * DECREASE,
-        };
-        self.rate = target.max(floor.min(self.rate)).max(MIN_RATE);
-        self.decided_at = Some(now);
-        self.fell = true;
-    }
-
     /// Whether the terminal has not answered for [`SILENCE`] (a question waits that long).
     fn is_silent(&self, now: Instant) -> bool {
         self.silent || self.questions.iter().any(|q| !q.foreign && now.saturating_duration_since(q.asked) > SILENCE)
@@ -595,6 +403,7 @@ impl LinkControl {
     /// terminal silent for [`SILENCE`] gets [`SAFE_RATE`]; foreign answers overdue by
     /// [`FOREIGN_WAIT`] and questions older than [`GIVE_UP`] are forgotten.
     pub fn tick(&mut self, now: Instant) -> Change {
+        self.window_bound |= self.waited_past_window(now);
         let age = |q: &Question| now.saturating_duration_since(q.asked);
         self.questions.forget(|q| age(q) > GIVE_UP || (q.foreign && age(q) > FOREIGN_WAIT));
         let base = self.base().unwrap_or(Duration::ZERO);

@@ -556,52 +556,23 @@ fn a_first_question_after_the_set_up_bytes_alone_does_not_set_the_rate() {
 /// to the answer leaving it has a median of 18 ms, a 90th percentile of 98 ms, and now and then
 /// most of a second. A fixed sequence with those quantiles (no clock, no randomness).
 fn kitty_0_26(n: u32) -> Duration {
-    // A multiplicative hash spreads the question's number over 0..1000.
-    let u = (n.wrapping_mul(2_654_435_761) >> 8) % 1000;
-    ms(match u {
-        0..=499 => 2 + u as u64 * 16 / 500,            // 2-18 ms
-        500..=899 => 18 + (u as u64 - 500) * 80 / 400, // 18-98 ms
-        900..=989 => 98 + (u as u64 - 900) * 300 / 90, // 98-398 ms
-        _ => 400 + (u as u64 - 990) * 68,              // 0.4-1.1 s
-    })
+    quantiles(n, 2_654_435_761, &[(500, 2, 18), (900, 18, 98), (990, 98, 398), (1000, 400, 1080)])
 }
 
-#[test]
-fn the_kitty_answer_times_have_the_recorded_quantiles() {
-    let mut times: Vec<Duration> = (1..=5000).map(kitty_0_26).collect();
-    times.sort();
-    let (median, p90) = (times[2500], times[4500]);
-    assert!(median >= ms(14) && median <= ms(22), "median {median:?}");
-    assert!(p90 >= ms(90) && p90 <= ms(110), "p90 {p90:?}");
-}
-
-#[test]
-fn a_terminal_slow_to_answer_is_not_taken_for_a_queue() {
-    // The stock 2 Mbit/s link with no added delay and kitty 0.26 answering in its own time:
-    // the rate fell to the 2 kB/s floor within 5 s (every real kitty run, round 3), the
-    // picture black or half painted for seconds, then cells in palette colours.
-    for rtt in [ms(2), ms(20)] {
-        let link = Link { answer_time: Some(kitty_0_26), ..Link::far(250_000.0, rtt) };
-        let run = simulate(LinkPath::Direct, link, 30.0, busy);
-        let lowest =
-            run.at.iter().zip(&run.rates).filter(|(t, _)| **t >= 1.0).map(|(_, r)| *r).fold(f64::MAX, f64::min);
-        let used = run.throughput(250_000.0, 5.0, 30.0) / 250_000.0;
-        let p90 = run.queue_quantile(5.0, 0.9);
-        println!(
-            "kitty 0.26, {rtt:?}: lowest rate {lowest:.0} B/s, {:.0} % of the link, queue p90 {:.0} ms",
-            used * 100.0,
-            p90 * 1e3
-        );
-        assert!(lowest >= 0.25 * 250_000.0, "{rtt:?}: the rate fell to {lowest:.0} B/s");
-        // (1 % before the terminal's own time was told from the queue; 81 % at 2 ms and 77 %
-        // at 20 ms when it was inferred from every answer the bytes could not explain; 86 %
-        // and 74 % since bare questions measure it and decide whether to infer it at all.)
-        assert!(used >= 0.7, "{rtt:?}: only {:.0} % of the link used", used * 100.0);
-        // The queue may stand as long as the terminal's own slow answers (they hide it): the
-        // high mark, at most OWN_MAX of them, and the frames.
-        let bound = QUEUE_HIGH + super::answer_time::OWN_MAX;
-        assert!(p90 <= bound.as_secs_f64() + 2.0 / FPS, "{rtt:?}: the queue's p90 is {:.0} ms", p90 * 1e3);
+/// The `n`th of a fixed sequence (no clock, no randomness) with the quantiles of `pieces`: a
+/// multiplicative hash by `spread` takes `n` to a thousandth `u`, and each piece `(end, from,
+/// to)` maps the thousandths from the previous piece's end up to its own linearly from `from`
+/// to `to` ms.
+fn quantiles(n: u32, spread: u32, pieces: &[(u64, u64, u64)]) -> Duration {
+    let u = u64::from((n.wrapping_mul(spread) >> 8) % 1000);
+    let mut start = 0;
+    for &(end, from, to) in pieces {
+        if u < end {
+            return ms(from + (u - start) * (to - from) / (end - start));
+        }
+        start = end;
     }
+    unreachable!("the pieces end at 1000")
 }
 
 /// A terminal that reads at half the link's speed for 1.5 s in every 4 (a Python
@@ -611,24 +582,8 @@ fn slow_reader(t: f64) -> f64 {
     if t % 4.0 >= 2.5 { 0.5 } else { 1.0 }
 }
 
-#[test]
-fn a_terminal_slow_to_read_is_a_queue_not_its_own_time() {
-    // Round 4 learned the terminal's own time from answers the bytes in flight (timed at the
-    // link's capacity) could not explain: this terminal's backlog was learned as its own time,
-    // and the link harness's key-to-effect p90 went from 16-104 ms to 169-374 ms.
-    for rtt in [ms(2), ms(20)] {
-        let link = Link { reads: Some(slow_reader), ..Link::far(250_000.0, rtt) };
-        let run = simulate(LinkPath::Direct, link, 40.0, busy);
-        let p90 = run.queue_quantile(5.0, 0.9);
-        let own = run.link.as_ref().unwrap().answer_time.slow();
-        println!("a slow reader, {rtt:?}: queue p90 {:.0} ms, the terminal's slow answers learned {own:?}", p90 * 1e3);
-        assert!(own <= ms(5), "{rtt:?}: the backlog was learned as the terminal's own time ({own:?})");
-        let bound = 0.2;
-        assert!(p90 <= bound, "{rtt:?}: the queue's p90 is {:.0} ms, over {:.0} ms", p90 * 1e3, bound * 1e3);
-    }
-}
-
 mod late_player;
+mod slow_terminals;
 mod stalls;
 
 /// A loaded machine's lateness of the player's `n`th wake-up (its timer, or its read of an
@@ -636,53 +591,5 @@ mod stalls;
 /// 300 ms (no clock, no randomness).
 fn loaded(seed: u32, n: u32) -> Duration {
     let n = n.wrapping_add(seed.wrapping_mul(104_729));
-    let u = (n.wrapping_mul(2_246_822_519) >> 8) % 1000;
-    ms(match u {
-        0..=499 => u as u64 * 4 / 500,
-        500..=899 => 4 + (u as u64 - 500) * 36 / 400,
-        900..=989 => 40 + (u as u64 - 900) * 160 / 90,
-        _ => 200 + (u as u64 - 990) * 10,
-    })
-}
-
-#[test]
-fn a_loaded_machine_is_not_taken_for_a_slowing_link() {
-    // The integration tests' slow kitty on CI's loaded machine (load 7 and more): a pty read
-    // by a terminal that reads nothing while it answers in kitty 0.26's time, and the
-    // player's wake-ups late. A late answer read as a queue lowered the rate to a share of
-    // what the terminal took, which the rate itself had set, and the window to that take:
-    // each late read took the rate lower, to the 2 kB/s floor here (17.8 kB/s in CI, against
-    // the test's 20). Six sequences of lateness on three links.
-    let mut failed = Vec::new();
-    for (capacity, rtt) in [(300_000.0, ms(1)), (150_000.0, ms(30)), (50_000.0, ms(30))] {
-        for seed in 0..6 {
-            let link = Link {
-                answer_time: Some(kitty_0_26),
-                answering_blocks_reads: true,
-                player_late: Some(seed),
-                ..Link::far(capacity, rtt)
-            };
-            let run = simulate(LinkPath::Direct, link, 30.0, busy);
-            let after: Vec<f64> = run.at.iter().zip(&run.rates).filter(|(t, _)| **t >= 2.0).map(|(_, r)| *r).collect();
-            let low = after.iter().filter(|&&r| r < 0.1 * capacity).count() as f64 / after.len() as f64;
-            let lowest = after.iter().copied().fold(f64::MAX, f64::min);
-            let read = run.throughput(capacity, 2.0, 30.0);
-            println!(
-                "{capacity:.0} B/s, {rtt:?}, lateness {seed}: lowest rate {lowest:.0} B/s, under a tenth of the link \
-                 {:.1} % of the time, the terminal read {read:.0} B/s",
-                low * 100.0
-            );
-            // Under a tenth of the link for a moment, never for long: before, two of the slow
-            // link's runs sat there (at the 2 kB/s floor, where kitty's pictures stop) 63 and
-            // 64 % of the time, and one of the fast link's 16 %; now at most 4.4 %.
-            if low > 0.05 {
-                failed.push(format!(
-                    "{capacity} B/s {rtt:?} lateness {seed}: under a tenth of the link {:.0} % of the time (lowest \
-                     {lowest:.0} B/s)",
-                    low * 100.0
-                ));
-            }
-        }
-    }
-    assert!(failed.is_empty(), "{failed:#?}");
+    quantiles(n, 2_246_822_519, &[(500, 0, 4), (900, 4, 40), (990, 40, 200), (1000, 200, 300)])
 }

@@ -67,7 +67,7 @@ impl LinkControl {
     /// Whether one of the link's questions has waited longer than the window's time, once the
     /// link is measured (before, the first window and the silence rule bound it); an overdue
     /// one too: its replacement would let another window's time of frames go each second.
-    fn waited_past_window(&self, now: Instant) -> bool {
+    pub(super) fn waited_past_window(&self, now: Instant) -> bool {
         let time = self.window_time();
         self.measured() && self.questions.iter().any(|q| !q.foreign && now.saturating_duration_since(q.asked) > time)
     }

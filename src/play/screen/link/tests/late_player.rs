@@ -9,14 +9,7 @@ use super::*;
 /// a fake kitty: a 10th percentile of 51 ms, a median of 64 ms, a 90th of 92 ms, now and then
 /// 320 ms. A fixed sequence with about those quantiles (no clock, no randomness).
 fn building(n: u32) -> Duration {
-    let u = (n.wrapping_mul(2_246_822_519) >> 8) % 1000;
-    ms(match u {
-        0..=99 => 40 + u as u64 / 9,                   // 40-51 ms
-        100..=499 => 51 + (u as u64 - 100) * 13 / 400, // 51-64 ms
-        500..=899 => 64 + (u as u64 - 500) * 28 / 400, // 64-92 ms
-        900..=989 => 92 + (u as u64 - 900) * 100 / 90, // 92-192 ms
-        _ => 200 + (u as u64 - 990) * 12,              // 0.2-0.31 s
-    })
+    quantiles(n, 2_246_822_519, &[(100, 40, 51), (500, 51, 64), (900, 64, 92), (990, 92, 192), (1000, 200, 320)])
 }
 
 #[test]
