@@ -134,7 +134,7 @@ impl ColorMode {
     }
 
     /// Whether `--color truecolor` would draw better than what `--color auto` found for `term`:
-    /// not for a terminal that recycles its 24-bit colours ([`RECYCLED_COLOR_TERMS`]).
+    /// not for a terminal that recycles its 24-bit colours (`RECYCLED_COLOR_TERMS`: mlterm).
     pub fn truecolor_helps(term: Option<&str>) -> bool {
         !RECYCLED_COLOR_TERMS.contains(&term.unwrap_or("").to_ascii_lowercase().as_str())
     }
