@@ -7,6 +7,7 @@ use tiny_skia::Pixmap;
 use super::ui::{self, MIN_SIZE, Status};
 use crate::output::color::ColorMode;
 use crate::output::frame::Frame;
+use crate::output::graphics::stream::ladder::Resampler;
 use crate::output::units::{write_human_bytes, write_human_rate};
 use crate::play::host::SceneStatus;
 use crate::play::seat::SeatView;
@@ -42,6 +43,42 @@ pub fn big_enough((cols, rows): (u16, u16)) -> bool {
 pub fn half_block_picture((cols, rows): (u16, u16)) -> (u32, u32) {
     let (width, height) = crate::output::halfblock::picture_size(cols, rows.saturating_sub(1));
     (width.max(3), height.max(3))
+}
+
+/// The scene's picture at the cells' size, for the frames whose picture is another size.
+///
+/// The picture a frame brings was drawn for the screen's mode when the frame began: the frame
+/// in which `auto` leaves pixels for cells (and the first after a resize) brings one of the
+/// old size, and the cells, a pixel a column, would take its top-left corner (`tidepool serve`
+/// in xterm showed the pool magnified four times for a frame when it left sixel). Such a
+/// picture is resampled to the cells' size; one of their size is used as it is, so steady
+/// frames copy nothing.
+#[derive(Debug, Default)]
+pub struct CellsPicture {
+    resampler: Resampler,
+    rgb: Vec<u8>,
+    fitted: Option<Pixmap>,
+}
+
+impl CellsPicture {
+    /// `picture` at `size` (the cells' [`half_block_picture`]).
+    pub fn fit<'a>(&'a mut self, picture: &'a Pixmap, size: (u32, u32)) -> &'a Pixmap {
+        let from = (picture.width(), picture.height());
+        if from == size {
+            return picture;
+        }
+        self.resampler.resample(picture.data(), 4, from, size, &mut self.rgb);
+        let fitted = match self.fitted.take() {
+            Some(p) if (p.width(), p.height()) == size => p,
+            _ => Pixmap::new(size.0, size.1).expect("the cells' picture is at least 3x3"),
+        };
+        let fitted = self.fitted.insert(fitted);
+        // The scenes' pictures are opaque: premultiplied RGB is RGB.
+        for (px, rgb) in fitted.data_mut().chunks_exact_mut(4).zip(self.rgb.chunks_exact(3)) {
+            px.copy_from_slice(&[rgb[0], rgb[1], rgb[2], 255]);
+        }
+        fitted
+    }
 }
 
 /// Builds frames, reusing its buffers.

@@ -5,7 +5,7 @@ use std::time::{Duration, Instant};
 
 use tiny_skia::Pixmap;
 
-use super::compose::{Figures, big_enough};
+use super::compose::{Figures, big_enough, half_block_picture};
 use super::scratch::{self, Scratch};
 use super::switch::{self, Switch};
 use super::{APPROXIMATE_BELOW, CellSource, Screen, link, picture};
@@ -142,7 +142,7 @@ impl Screen {
         scratch: &mut Scratch,
         out: &mut Vec<u8>,
     ) -> (Report, Option<bool>) {
-        let Scratch { encoder, builder, bytes } = scratch;
+        let Scratch { encoder, builder, bytes, cells_picture } = scratch;
         let waits = matches!(self.switch, Some(Switch::ToCells { .. }));
         let covered = |shown: &Shown, wanted: &Frame| {
             waits.then(|| shown.frame.as_ref().is_some_and(|s| switch::covered(s, wanted)))
@@ -150,6 +150,12 @@ impl Screen {
         match cells {
             CellSource::Own { figures: given } => {
                 let figures = given.unwrap_or(plan.figures);
+                // Under real pixels the cells draw no picture (and the picture is the pixels').
+                let picture = if figures.pixels_elsewhere {
+                    picture
+                } else {
+                    cells_picture.fit(picture, half_block_picture(self.term))
+                };
                 builder.compose(self.term, picture, self.config.color, status, seat, &figures);
                 if self.keeps_cells()
                     && let Some(shown) = &self.shown.frame

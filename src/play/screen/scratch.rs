@@ -11,7 +11,7 @@
 
 use std::sync::Mutex;
 
-use super::compose::FrameBuilder;
+use super::compose::{CellsPicture, FrameBuilder};
 use crate::output::rate::RateEncoder;
 
 /// Spare scratches kept at most (more than the threads that encode at once on any machine
@@ -27,6 +27,8 @@ pub(crate) struct Scratch {
     pub builder: FrameBuilder,
     /// The frame's bytes before they are handed out.
     pub bytes: Vec<u8>,
+    /// The picture resampled to the cells' size when a frame brings another size.
+    pub cells_picture: CellsPicture,
 }
 
 static SPARE: Mutex<Vec<Scratch>> = Mutex::new(Vec::new());

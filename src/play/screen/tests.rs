@@ -63,6 +63,33 @@ fn a_screen_that_asks_nothing_draws_cells_and_sets_the_terminal_up_first() {
 }
 
 #[test]
+fn a_picture_of_another_size_is_drawn_whole_in_the_cells_never_its_corner() {
+    // `tidepool serve` in xterm (sixel), at `auto`'s switch to cells: the frame the switch was
+    // decided in brought the pixels' picture (840x481), the cells took its top-left corner,
+    // and the pool showed magnified four times over the screen for a frame
+    // (docs/terminals/right-pictures.md, round 11). A picture twice the cells' size, its
+    // top-left quarter blue and the rest red: the cells show both, as the picture is.
+    let t0 = Instant::now();
+    let mut screen = Screen::new(config(Bandwidth::Unlimited, false), (40, 12), t0);
+    let mut asked = Vec::new();
+    screen.start(t0, &mut asked);
+    frame(&mut screen, t0, 10);
+    let (w, h) = screen.picture_size();
+    let mut big = Pixmap::new(2 * w, 2 * h).unwrap();
+    big.fill(tiny_skia::Color::from_rgba8(200, 30, 30, 255));
+    let quarter = tiny_skia::Rect::from_xywh(0.0, 0.0, w as f32, h as f32).unwrap();
+    let mut blue = tiny_skia::Paint::default();
+    blue.set_color_rgba8(30, 30, 200, 255);
+    big.fill_rect(quarter, &blue, tiny_skia::Transform::identity(), None);
+    let mut out = Vec::new();
+    screen.frame(t0 + 40 * MS, &big, &status(), &SeatView { stone: 3, ..SeatView::default() }, &mut out);
+    assert!(contains(&out, b"200;30;30"), "the cells show the picture's red three quarters");
+    assert!(contains(&out, b"30;30;200"), "and its blue top-left quarter");
+    let next = frame(&mut screen, t0 + 80 * MS, 60);
+    assert!(contains(&next, b"60;90;160"), "the next picture, of the cells' size, is drawn as it is");
+}
+
+#[test]
 fn the_probe_holds_the_first_frame_until_the_answer_and_keys_typed_meanwhile_come_after() {
     let t0 = Instant::now();
     let mut screen = Screen::new(config(Bandwidth::Unlimited, true), (40, 12), t0);
