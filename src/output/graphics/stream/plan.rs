@@ -50,7 +50,11 @@ impl PictureStream {
         match &self.protocol {
             Protocol::Kitty(o) if matches!(o.medium, Medium::TempFile(_)) => None,
             Protocol::Kitty(_) if limited => Some(Packing::LossyPng(self.lossy_step(rung))),
-            Protocol::Kitty(_) => Some(Packing::Zlib(1)),
+            // Without a rate the exact picture as a PNG (row filters, fdeflate) rather than
+            // raw RGB under zlib level 1: the same pixels, about two thirds of the bytes, and
+            // miniz's deflate of raw RGB was a third of the in-band player's CPU
+            // (docs/pixels/cpu.md, Round 6).
+            Protocol::Kitty(_) => Some(Packing::Png),
             Protocol::Iterm2 { .. } if limited => Some(Packing::Jpeg(self.jpeg_quality(rung))),
             Protocol::Iterm2 { .. } => Some(Packing::Png),
             Protocol::Sixel { .. } => None,

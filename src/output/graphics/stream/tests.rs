@@ -124,6 +124,11 @@ fn kitty_offers_decode_to_the_picture_on_the_wire_and_edits_apply_to_it() {
         let budget = Budget::new(usize::MAX, rate, FRAME);
         let offer = stream.prepare(&picture, budget, t0 + FRAME * (10 * n)).expect("an offer");
         let part = offer.state.part;
+        if rate.is_none() {
+            // Unlimited: the exact picture as a PNG (fdeflate), not zlib of raw RGB, whose
+            // deflate cost a third of the player (docs/pixels/cpu.md, Round 6).
+            assert_eq!(offer.state.packing, Some(Packing::Png));
+        }
         wire.extend_from_slice(offer.bytes);
         stream.commit();
         let image = &kitty_decode::decode(&wire).unwrap().images[&kitty::IMAGE_ID];
