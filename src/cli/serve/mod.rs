@@ -134,12 +134,17 @@ pub fn run(args: ServeCommand) -> Result<()> {
     let fingerprint = host_key::fingerprint_line(&key);
     let scenes = specs(args.scene, &args.water)?;
     let game = server::GameOptions { scenes, size, fps: args.fps, seed: args.water.seed };
+    #[cfg(feature = "bus")]
+    let bus = bus_options(&args, &limits)?;
+    // An edge's threads share one malloc arena; asked before they start (`bus/heap.rs`).
+    #[cfg(feature = "bus")]
+    if bus.is_some() {
+        bus::one_arena();
+    }
     let runtime =
         tokio::runtime::Builder::new_multi_thread().enable_all().thread_name("tidepool-serve").build().map_err(
             |e| Error::Usage(format!("cannot start the server's threads ({e}); free some memory and try again")),
         )?;
-    #[cfg(feature = "bus")]
-    let bus = bus_options(&args, &limits)?;
     let options = server::ServerOptions {
         listen,
         host_key: key,

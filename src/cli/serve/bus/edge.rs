@@ -150,7 +150,10 @@ pub fn run(scene: PoolScene, fps: u32, links: GameLinks, mut bus: EdgeLinks) {
             }
         }
         said.say(&pending, now);
-        trim.due(now);
+        if let Some(took) = trim.due(now).filter(|_| bus.trace) {
+            let (used, free) = super::heap::held();
+            eprintln!("bus-trace trim {} us, malloc: {used} bytes in use, {free} free", took.as_micros());
+        }
         if now >= next_frame {
             next_frame = (next_frame + frame_period).max(now);
             let shots = bus.shots.clone();

@@ -30,6 +30,8 @@ mod pending;
 pub mod protocol;
 pub mod sequencer;
 
+pub use heap::one_arena;
+
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::time::Duration;
