@@ -30,7 +30,7 @@ fn rss_kb(pid: u32) -> u64 {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-#[ignore = "needs nats-server: scripts/bus_tests.sh installs it and runs these (.ci/run does)"]
+#[ignore = "needs nats-server and about 50 s: `scripts/bus_tests.sh memory` installs it and runs this (.ci/run does not)"]
 async fn an_edges_memory_stays_flat_under_players_dropping_stones() {
     let nats = Nats::start();
     let pool = pool_name("memory");
