@@ -1,8 +1,9 @@
 //! One terminal's pictures under rate control: a [`PictureStream`] is the picture encoder of a
 //! pixel mode (kitty, sixel, iTerm2) together with the choices that fit it to a link — the
 //! resolution (a [`ladder`] from the source picture's size down to half-block resolution), the
-//! packing (kitty: zlib RGB, or under a rate a lossy PNG ([`crate::output::graphics::lossy_png`]),
-//! whole images or `a=f` frame edits of changed rectangles,
+//! packing (kitty: a PNG, or under a rate a palette PNG of a few colours fitted to the scene
+//! ([`crate::output::graphics::palette_png`]), whole images or `a=f` frame edits of changed
+//! rectangles,
 //! or temporary files for a terminal on this machine; sixel: changed cell blocks; iTerm2: PNG
 //! or JPEG) and the picture rate — so that a picture never costs more than the bytes the caller
 //! has now.
