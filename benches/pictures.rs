@@ -439,9 +439,10 @@ fn cpu(c: &mut Criterion) {
         });
     }
     group.finish();
-    // kitty under a rate: the lossy PNG (`lossy_png`, step 24) of the scene's 480x282 picture
-    // alone, and the stream's whole frame at 2 MB/s (resampling, the changed box, the lossy
-    // PNG at the top rung, every frame a new picture).
+    // kitty under a rate: the lossy PNG (`lossy_png`, step 24; kitty's packing until Round 10)
+    // and the palette PNG of the scene's 480x282 picture alone, and the stream's whole frame
+    // at 2 MB/s (resampling, the changed box, the palette PNG at the top rung, every frame a
+    // new picture).
     let mut group = c.benchmark_group("pictures/kitty_lossy_480x282");
     group.sample_size(20);
     let rgbs: Vec<Vec<u8>> = shots
@@ -471,6 +472,18 @@ fn cpu(c: &mut Criterion) {
             pixels.clear();
             pixels.extend_from_slice(&rgbs[n % rgbs.len()]);
             encoder.encode(black_box(&mut pixels), SCENE.0, SCENE.1, 24, &mut out);
+            out.len()
+        })
+    });
+    // kitty's packing under a rate since Round 10: the palette PNG of 16 colours, the encoder
+    // (and its fitted palette) kept as the stream keeps it.
+    let mut palette = tidepool::testing::PalettePngEncoder::default();
+    group.bench_function("palette_png_16_kept", |b| {
+        b.iter(|| {
+            n += 1;
+            pixels.clear();
+            pixels.extend_from_slice(&rgbs[n % rgbs.len()]);
+            palette.encode(black_box(&mut pixels), SCENE.0, SCENE.1, 16, &mut out);
             out.len()
         })
     });

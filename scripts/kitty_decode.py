@@ -14,8 +14,8 @@ passthrough (`ESC P tmux ; ... ESC \\` with every inner ESC doubled); control ke
 separated by commas; chunked transmission (`m=1` on every chunk but the last; only the first
 chunk's keys count, later chunks carry `m` and may repeat `a=f`/`q`); base64 payloads; `t=d`
 (direct) only; `o=z` (RFC 1950 zlib); formats `f=24` (RGB), `f=32` (RGBA, alpha dropped) and
-`f=100` (PNG: 8-bit RGB, RGBA or palette, non-interlaced, decoded here with zlib and the five
-PNG row filters); actions `a=t`/`a=T` (transmit: the image is replaced), `a=f` (frame data with
+`f=100` (PNG: 8-bit RGB, RGBA or palette of 1-8 bits a pixel, non-interlaced, decoded here with
+zlib and the five PNG row filters); actions `a=t`/`a=T` (transmit: the image is replaced), `a=f` (frame data with
 `r=1`: replace the `s`x`v` rectangle at `x`,`y` of the root frame, `X=1` replacement), `a=d`
 (`d=i`/`d=I` by id, anything else: all). Other actions (placements, queries) change no pixels.
 """
@@ -102,11 +102,14 @@ def decode_png(data):
     if header is None:
         raise Misread("PNG without IHDR")
     w, h, depth, colour, _, _, interlace = header
-    if depth != 8 or interlace != 0 or colour not in (2, 3, 6):
+    # 8 bits a channel, or a palette of 1, 2, 4 or 8 bits a pixel (the stream's palette PNG).
+    depth_ok = depth == 8 or (colour == 3 and depth in (1, 2, 4))
+    if not depth_ok or interlace != 0 or colour not in (2, 3, 6):
         raise Misread(f"PNG depth {depth} colour type {colour} interlace {interlace} not understood")
     channels = {2: 3, 3: 1, 6: 4}[colour]
     raw = zlib.decompress(bytes(idat))
-    stride = w * channels
+    # Bytes a row; the filters look one byte back when pixels are smaller than a byte.
+    stride = (w * channels * depth + 7) // 8
     rows, prev, i = [], bytearray(stride), 0
     for _ in range(h):
         kind, line = raw[i], bytearray(raw[i + 1 : i + 1 + stride])
@@ -135,7 +138,12 @@ def decode_png(data):
             for x in range(w):
                 rgb += line[4 * x : 4 * x + 3]
         else:
-            for idx in line:
+            per_byte = 8 // depth
+            for x in range(w):
+                shift = 8 - depth - (x % per_byte) * depth
+                idx = (line[x // per_byte] >> shift) & ((1 << depth) - 1)
+                if 3 * idx + 3 > len(palette):
+                    raise Misread(f"palette index {idx} beyond the PLTE")
                 rgb += palette[3 * idx : 3 * idx + 3]
     return w, h, bytes(rgb)
 

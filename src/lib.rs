@@ -79,6 +79,7 @@ pub mod testing {
     pub use crate::output::graphics::lossy_png::Encoder as LossyPngEncoder;
     pub use crate::output::graphics::lossy_png::encode as lossy_png;
     pub use crate::output::graphics::pack::Packing;
+    pub use crate::output::graphics::palette_png::Encoder as PalettePngEncoder;
     pub use crate::output::graphics::sixel::dithered_rgb;
     pub use crate::output::graphics::sixel::{Registers, SixelEncoder, SixelPalette};
     pub use crate::output::graphics::stream::ladder::resample;

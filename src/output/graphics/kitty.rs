@@ -297,7 +297,7 @@ pub fn push_chunks(out: &mut Vec<u8>, keys: &[u8], more_keys: &[u8], packing: Pa
     all.extend_from_slice(keys);
     all.extend_from_slice(match packing {
         Packing::Zlib(_) => b",f=24,o=z".as_slice(),
-        Packing::Png | Packing::LossyPng(_) => b",f=100".as_slice(),
+        Packing::Png | Packing::LossyPng(_) | Packing::PalettePng(_) => b",f=100".as_slice(),
         Packing::Jpeg(_) => panic!("kitty decodes no JPEG"),
     });
     push_chunked_bytes(out, &all, more_keys, packed, tmux);

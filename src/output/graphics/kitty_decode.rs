@@ -4,7 +4,9 @@
 //! recorded stream).
 //!
 //! Understood: APC `ESC _ G keys ; payload ESC \` commands (also inside tmux passthrough
-//! wrappers), chunking (`m=1`), base64, zlib (`o=z`), RGB and RGBA (`f=24`, `f=32`), direct and
+//! wrappers), chunking (`m=1`), base64, zlib (`o=z`), RGB and RGBA (`f=24`, `f=32`), PNG
+//! (`f=100`: any PNG the `image` crate reads, as kitty reads any libpng does: RGB, and the
+//! stream's palette PNGs of 1 to 8 bits a pixel, expanded to RGB), direct and
 //! file transmission (`t=d`, `t=f`, `t=t`: the file is read, and deleted for `t=t`),
 //! transmit (`a=t`, `a=T`), root-frame edits (`a=f,r=1` with `x,y,s,v`, replacement) and
 //! deletes (`a=d`). Everything outside APC commands is ignored.

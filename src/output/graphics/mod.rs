@@ -28,6 +28,7 @@ pub mod kitty_decode;
 pub mod kitty_placeholder;
 pub mod lossy_png;
 pub mod pack;
+pub mod palette_png;
 pub mod scan;
 pub mod sixel;
 #[cfg(any(test, feature = "player", feature = "testing"))]

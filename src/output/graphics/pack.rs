@@ -8,7 +8,7 @@
 //! pack.
 
 use crate::output::graphics::deflate::Zlib;
-use crate::output::graphics::lossy_png;
+use crate::output::graphics::{lossy_png, palette_png};
 
 /// How a picture's pixels are packed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -26,9 +26,19 @@ pub enum Packing {
     /// kitty's `f=100` under a rate.
     #[cfg_attr(not(any(test, feature = "player", feature = "testing")), allow(dead_code))]
     LossyPng(u8),
+    /// An indexed PNG of at most this many colours fitted to the scene
+    /// (`output::graphics::palette_png`): kitty's `f=100` under a rate.
+    #[cfg_attr(not(any(test, feature = "player", feature = "testing")), allow(dead_code))]
+    PalettePng(u16),
 }
 
 impl Packing {
+    /// Whether the packing is one of kitty's lossy PNGs, whose encoder rewrites the pixels to
+    /// what the terminal will show (the stream's model of the terminal is then exact).
+    pub fn rewrites_pixels(self) -> bool {
+        matches!(self, Packing::LossyPng(_) | Packing::PalettePng(_))
+    }
+
     #[cfg(any(test, feature = "testing"))]
     /// A short name for tables and the status line.
     pub fn name(self) -> String {
@@ -37,6 +47,7 @@ impl Packing {
             Packing::Png => "png".to_string(),
             Packing::Jpeg(q) => format!("jpeg{q}"),
             Packing::LossyPng(q) => format!("png/{q}"),
+            Packing::PalettePng(n) => format!("png{n}c"),
         }
     }
 }
@@ -63,6 +74,7 @@ pub fn pack(packing: Packing, rgb: &[u8], width: u32, height: u32, out: &mut Vec
             // The caller that keeps the pixels the decoder shows calls `lossy_png::encode`.
             lossy_png::encode(&mut rgb.to_vec(), width, height, q, out);
         }
+        Packing::PalettePng(colours) => palette_png::encode(&mut rgb.to_vec(), width, height, colours, out),
         Packing::Jpeg(quality) => {
             image::codecs::jpeg::JpegEncoder::new_with_quality(&mut *out, quality.clamp(1, 100))
                 .encode(rgb, width, height, image::ExtendedColorType::Rgb8)

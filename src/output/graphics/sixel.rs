@@ -38,8 +38,8 @@
 //! same reason ([`crate::output::graphics::geometry`] picks such sizes).
 
 mod band;
-mod fit;
-mod lookup;
+pub(crate) mod fit;
+pub(crate) mod lookup;
 mod palette;
 
 use self::band::{Band, push_decimal};

@@ -67,8 +67,15 @@ pub struct ColourMap {
 impl ColourMap {
     /// The map for `palette`: an empty table and offsets that span its typical step.
     pub fn new(palette: &SixelPalette) -> ColourMap {
-        let labs = (0..palette.len()).map(|i| oklab::from_rgb(palette.rgb(i as u8))).collect();
-        let rgbs: Vec<[f32; 3]> = (0..palette.len()).map(|i| palette.rgb(i as u8).map(f32::from)).collect();
+        let colours: Vec<[u8; 3]> = (0..palette.len()).map(|i| palette.rgb(i as u8)).collect();
+        Self::of_colours(&colours)
+    }
+
+    /// The map for registers of these sRGB colours (at most 256): what [`ColourMap::new`]
+    /// makes of a sixel palette as shown, and kitty's palette PNG (`palette_png`) of its own.
+    pub fn of_colours(colours: &[[u8; 3]]) -> ColourMap {
+        let labs = colours.iter().map(|&c| oklab::from_rgb(c)).collect();
+        let rgbs: Vec<[f32; 3]> = colours.iter().map(|c| c.map(f32::from)).collect();
         let spread = Self::spread(&rgbs) * SPREAD_STEPS;
         let offsets = std::array::from_fn(|t| (((t as f32 + 0.5) / 64.0 - 0.5) * spread).round() as i16);
         let row_offsets = BAYER8.map(|row| std::array::from_fn(|k| offsets[usize::from(row[k / 3])]));

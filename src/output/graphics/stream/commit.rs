@@ -13,7 +13,10 @@ impl PictureStream {
     /// target sets it.
     pub(super) fn offer(&mut self, rung: usize, part: Part, limited: bool, next: Instant) -> Option<Offer<'_>> {
         let model = match (self.packing(limited, rung), part) {
-            (Some(Packing::LossyPng(_) | Packing::Jpeg(_)), Part::Whole | Part::Changed(..)) => Model::Set,
+            (
+                Some(Packing::LossyPng(_) | Packing::PalettePng(_) | Packing::Jpeg(_)),
+                Part::Whole | Part::Changed(..),
+            ) => Model::Set,
             _ => Model::Clear,
         };
         self.offer_as(rung, part, limited, next, model, false)

@@ -101,8 +101,8 @@ impl PictureStream {
         }
         self.resampler.resample(picture.data(), 4, from, size, &mut self.candidate);
         let packing = self.packing(limited, rung);
-        if let Some(Packing::LossyPng(q)) = packing {
-            return self.encode_lossy(rung, q);
+        if let Some(p) = packing.filter(|p| p.rewrites_pixels()) {
+            return self.encode_lossy(rung, p);
         }
         let part = match &self.shown {
             Some((r, old)) if *r == rung => match scan::changed_box(old, &self.candidate, size.0, 3, 0..size.1) {
@@ -123,11 +123,11 @@ impl PictureStream {
         Some(part)
     }
 
-    /// [`PictureStream::encode`] for a lossy PNG with step `q` (kitty under a rate), the picture
+    /// [`PictureStream::encode`] for a lossy PNG `packing` (kitty under a rate), the picture
     /// at `rung` in `self.candidate`: what changed is found against the picture the shown one
     /// was encoded from (`sent`), the changed box (or the whole picture) is encoded over what
     /// is shown, and the candidate becomes exactly what the terminal will show.
-    fn encode_lossy(&mut self, rung: usize, q: u8) -> Option<Part> {
+    fn encode_lossy(&mut self, rung: usize, packing: Packing) -> Option<Part> {
         std::mem::swap(&mut self.target, &mut self.candidate);
         let size = self.rungs[rung];
         let part = match (&self.shown, &self.sent) {
@@ -154,7 +154,7 @@ impl PictureStream {
             }
             _ => self.candidate.extend_from_slice(&self.target),
         }
-        self.push_part(part, rung, Some(Packing::LossyPng(q)));
+        self.push_part(part, rung, Some(packing));
         Some(part)
     }
 
@@ -163,14 +163,20 @@ impl PictureStream {
     pub(super) fn push_part(&mut self, part: Part, rung: usize, packing: Option<Packing>) {
         let size = self.rungs[rung];
         let (x, y, w, h) = part_box(part, size);
-        if let Some(Packing::LossyPng(q)) = packing {
+        if let Some(p) = packing.filter(|p| p.rewrites_pixels()) {
             // Packed here, and the candidate's box rewritten to what the terminal will show.
             let (stride, at, len) = (size.0 as usize * 3, x as usize * 3, w as usize * 3);
             self.part_rgb.clear();
             for row in y as usize..(y + h) as usize {
                 self.part_rgb.extend_from_slice(&self.candidate[row * stride + at..][..len]);
             }
-            self.lossy.encode(&mut self.part_rgb, w, h, q, &mut self.packed);
+            match p {
+                Packing::PalettePng(colours) => {
+                    self.palette.encode(&mut self.part_rgb, w, h, colours, &mut self.packed)
+                }
+                Packing::LossyPng(q) => self.lossy.encode(&mut self.part_rgb, w, h, q, &mut self.packed),
+                _ => unreachable!("only the lossy PNGs rewrite pixels"),
+            }
             for (row, shown) in (y as usize..(y + h) as usize).zip(self.part_rgb.chunks_exact(len)) {
                 self.candidate[row * stride + at..][..len].copy_from_slice(shown);
             }
@@ -208,7 +214,7 @@ impl PictureStream {
                     _ => {
                         let packing = packing.unwrap_or(Packing::Zlib(1));
                         match packing {
-                            Packing::LossyPng(_) => {}
+                            Packing::LossyPng(_) | Packing::PalettePng(_) => {}
                             Packing::Zlib(level) => self.zlib.compress(pixels, u32::from(level), &mut self.packed),
                             _ => pack(packing, pixels, w, h, &mut self.packed),
                         }

@@ -1,8 +1,9 @@
 //! One terminal's pictures under rate control: a [`PictureStream`] is the picture encoder of a
 //! pixel mode (kitty, sixel, iTerm2) together with the choices that fit it to a link — the
 //! resolution (a [`ladder`] from the source picture's size down to half-block resolution), the
-//! packing (kitty: zlib RGB, or under a rate a lossy PNG ([`crate::output::graphics::lossy_png`]),
-//! whole images or `a=f` frame edits of changed rectangles,
+//! packing (kitty: a PNG, or under a rate a palette PNG of a few colours fitted to the scene
+//! ([`crate::output::graphics::palette_png`]), whole images or `a=f` frame edits of changed
+//! rectangles,
 //! or temporary files for a terminal on this machine; sixel: changed cell blocks; iTerm2: PNG
 //! or JPEG) and the picture rate — so that a picture never costs more than the bytes the caller
 //! has now.
@@ -71,15 +72,15 @@ use tiny_skia::Pixmap;
 
 use self::ladder::Resampler;
 #[cfg(test)]
-use self::plan::KITTY_STEP;
+use self::plan::KITTY_COLOURS;
 use self::plan::{MIN_RATE, PICTURE_SHARE};
 use crate::output::graphics::deflate::Zlib;
 use crate::output::graphics::geometry::Layout;
 use crate::output::graphics::kitty::{KittyOptions, Medium};
-use crate::output::graphics::lossy_png;
 use crate::output::graphics::pack::Packing;
 use crate::output::graphics::scan;
 use crate::output::graphics::sixel::{Registers, SixelEncoder, SixelPalette, TMUX_MAX_IMAGE_BYTES};
+use crate::output::graphics::{lossy_png, palette_png};
 
 /// The soonest the next picture may follow a base image sent for tiles.
 const FRAME_MIN: Duration = Duration::from_millis(1);
@@ -279,6 +280,7 @@ pub struct PictureStream {
     /// kitty's compressors, kept from picture to picture (the same bytes as new ones).
     zlib: Zlib,
     lossy: lossy_png::Encoder,
+    palette: palette_png::Encoder,
     /// Scratch of the block search (`refine.rs`): the blocks, and one region's error table.
     blocks: Vec<refine::Block>,
     block_table: Vec<u64>,
@@ -336,6 +338,7 @@ impl PictureStream {
             resampler: Resampler::default(),
             zlib: Zlib::default(),
             lossy: lossy_png::Encoder::default(),
+            palette: palette_png::Encoder::default(),
             blocks: Vec::new(),
             block_table: Vec::new(),
             sixel,
@@ -527,7 +530,7 @@ impl PictureStream {
     /// this a link too slow for the bottom rung's whole picture kept a still picture at the
     /// bottom rung's lossy tiles for good.
     fn tiles_done(&mut self, rung: usize, limited: bool) {
-        let lossy = matches!(self.packing(limited, rung), Some(Packing::LossyPng(_)));
+        let lossy = self.packing(limited, rung).is_some_and(Packing::rewrites_pixels);
         if !lossy || self.sent.is_some() || self.source_now.is_empty() {
             return;
         }

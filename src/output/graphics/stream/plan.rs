@@ -22,11 +22,14 @@ const UP_SHARE: f64 = 0.85;
 const LEARN: f64 = 0.3;
 /// How per-pixel cost grows as a rung shrinks: bytes a pixel scale as (pixels ratio) ^ this.
 const DENSITY_EXPONENT: f64 = 0.2;
-/// kitty's lossy PNG step under a rate (`lossy_png`): in the pictures bench 24 scored above 16
-/// and 8 at 50 kB/s, 250 kB/s and 2 MB/s (0.636, 0.687, 0.779 against 0.620, 0.676, 0.747 for
-/// 8): the coarser step buys a larger rung, and a larger rung is worth more than the step's
-/// error (docs/pixels/block-codec.md).
-pub(super) const KITTY_STEP: u8 = 24;
+/// kitty's colours under a rate (`palette_png`: an indexed PNG of 4 bits a pixel). In the
+/// pictures bench (docs/pixels/block-codec.md, Round 10) 16 colours on every rung scored
+/// 0.657, 0.712 and 0.956 at 50 kB/s, 250 kB/s and 2 MB/s, where the lossy PNG of step 24
+/// (Rounds 6-9) scored 0.633, 0.703 and 0.759: a third of its bytes a picture at a luma error
+/// like the step's, so at 2 MB/s 30 pictures a second at 480x282 instead of 15. 8, 24, 32, 48,
+/// 64 and 256 colours, a Bayer dither and PNG's row filters on the indices all scored lower;
+/// 32 below the top rung won 0.003 at 250 kB/s and lost 0.018 at 50 kB/s.
+pub(super) const KITTY_COLOURS: u16 = 16;
 /// iTerm2's JPEG quality under a rate on the top rung and on the rungs below half-block
 /// resolution: at 2 MB/s 70 lets the top rung go 30 times a second (SSIM 0.931 against 0.858
 /// with 85 at 22 a second), and at 50 kB/s 70 at 100x59 scored 0.6456 against 85 at 84x49's
@@ -49,7 +52,7 @@ impl PictureStream {
     pub(super) fn packing(&self, limited: bool, rung: usize) -> Option<Packing> {
         match &self.protocol {
             Protocol::Kitty(o) if matches!(o.medium, Medium::TempFile(_)) => None,
-            Protocol::Kitty(_) if limited => Some(Packing::LossyPng(self.lossy_step(rung))),
+            Protocol::Kitty(_) if limited => Some(self.kitty_lossy(rung)),
             // Without a rate the exact picture as a PNG (row filters, fdeflate) rather than
             // raw RGB under zlib level 1: the same pixels, about two thirds of the bytes, and
             // miniz's deflate of raw RGB was a third of the in-band player's CPU
@@ -61,9 +64,9 @@ impl PictureStream {
         }
     }
 
-    /// kitty's lossy PNG step under a rate ([`KITTY_STEP`] on every rung).
-    pub(super) fn lossy_step(&self, _rung: usize) -> u8 {
-        KITTY_STEP
+    /// kitty's packing under a rate: a palette PNG of [`KITTY_COLOURS`] on every rung.
+    pub(super) fn kitty_lossy(&self, _rung: usize) -> Packing {
+        Packing::PalettePng(KITTY_COLOURS)
     }
 
     /// iTerm2's JPEG quality under a rate: [`ITERM2_QUALITY_LOW`] on the top rung and on the
@@ -113,7 +116,7 @@ impl PictureStream {
         let area = match part {
             Part::Whole => f64::from(w) * f64::from(h),
             Part::Changed(_, _, bw, bh)
-                if matches!(self.packing(limited, rung), Some(Packing::LossyPng(_))) && 2 * bw * bh >= w * h =>
+                if self.packing(limited, rung).is_some_and(Packing::rewrites_pixels) && 2 * bw * bh >= w * h =>
             {
                 f64::from(bw) * f64::from(bh)
             }

@@ -196,7 +196,7 @@ impl PictureStream {
     pub(super) fn refine_still(&mut self, rung: usize, part: Part, limit: usize) -> Part {
         let Part::Changed(bx, by, bw, bh) = part else { return part };
         let edits = matches!(&self.protocol, Protocol::Kitty(o) if o.frame_edits);
-        let lossy = matches!(self.packing(true, rung), Some(Packing::LossyPng(_)));
+        let lossy = self.packing(true, rung).is_some_and(Packing::rewrites_pixels);
         if !edits || !lossy || self.shown.as_ref().is_none_or(|(r, _)| *r != rung) {
             return part;
         }
