@@ -152,7 +152,11 @@ pub fn run(scene: PoolScene, fps: u32, links: GameLinks, mut bus: EdgeLinks) {
         said.say(&pending, now);
         if let Some(took) = trim.due(now).filter(|_| bus.trace) {
             let (used, free) = super::heap::held();
-            eprintln!("bus-trace trim {} us, malloc: {used} bytes in use, {free} free", took.as_micros());
+            let flying = crate::cli::serve::flight::all_in_flight();
+            eprintln!(
+                "bus-trace trim {} us, malloc: {used} bytes in use, {free} free; frames in flight {flying} bytes",
+                took.as_micros()
+            );
         }
         if now >= next_frame {
             next_frame = (next_frame + frame_period).max(now);
