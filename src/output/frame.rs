@@ -55,6 +55,7 @@ impl Cell {
 static ALIVE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
 
 /// How many frames are alive in this process.
+#[cfg(feature = "bus")]
 pub fn frames_alive() -> usize {
     ALIVE.load(std::sync::atomic::Ordering::Relaxed)
 }

@@ -270,7 +270,13 @@ impl Group {
         }
         after.clone_from(self.screen.shown());
         self.number += 1;
-        self.frames.push_back(Arc::new(GroupFrame { number: self.number, bytes, after, figures, _alive: Alive::new() }));
+        self.frames.push_back(Arc::new(GroupFrame {
+            number: self.number,
+            bytes,
+            after,
+            figures,
+            _alive: Alive::new(),
+        }));
         true
     }
 

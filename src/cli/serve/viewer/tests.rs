@@ -179,7 +179,10 @@ async fn the_viewer_hands_out_the_bytes_of_the_canonical_turn() {
 /// A channel that holds what it is handed, as russh's queue does, until the test lets it go;
 /// for every handing over: when, the bytes it already held, and how many came.
 #[derive(Clone, Default)]
-struct Queue(Arc<Mutex<(Vec<Bytes>, Vec<(Instant, usize, usize)>)>>);
+struct Queue(Arc<Mutex<(Vec<Bytes>, Vec<Handed>)>>);
+
+/// A handing over: when, the bytes already held, the bytes handed.
+type Handed = (Instant, usize, usize);
 
 impl Queue {
     /// Lets everything held go (russh took it into its write buffer).
