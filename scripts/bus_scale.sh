@@ -21,6 +21,7 @@ seconds=${RUN_SECONDS:-300}
 stone_ms=${STONE_MS:-4000}
 fps=${FPS:-15}
 warm=${WARM_UP:-15}
+slack=${CLIENT_SLACK:-30}
 nats_port=${NATS_PORT:-4301}
 monitor=$((nats_port + 1))
 first_port=${EDGE_PORT:-2301}
@@ -59,8 +60,11 @@ for i in $(seq 0 $((edges - 1))); do
 done
 client_pids=()
 for i in $(seq 0 $((edges - 1))); do
-    # The clients play 5 s past the window, so their processes' CPU can still be read at its end.
-    CROWD_PORT=$((first_port + i)) CROWD_PLAYERS="$players" CROWD_SECONDS=$((seconds + 5)) CROWD_WARM_UP="$warm" \
+    # Each client times its own window from when its own players are all in, which can be well
+    # before the others' (round 8: 10 s). They play CLIENT_SLACK s past this script's window, so
+    # every memory and CPU reading below is taken while all the players are still connected (each
+    # reading checks it and says so).
+    CROWD_PORT=$((first_port + i)) CROWD_PLAYERS="$players" CROWD_SECONDS=$((seconds + slack)) CROWD_WARM_UP="$warm" \
         CROWD_STONE_MS="$stone_ms" "$client" --ignored --exact crowd_client::crowd_client --nocapture \
         >"$work/client$i.log" 2>&1 &
     client_pids+=($!)
@@ -74,6 +78,18 @@ until [ "$(cat "$work"/client*.log 2>/dev/null | grep -c 'window starts')" -ge "
 done
 stat_cpu() { awk '{ print $14 + $15 }' "/proc/$1/stat"; }
 stat_rss() { awk '/VmRSS/ { print $2 }' "/proc/$1/status"; }
+# The clients whose process has ended (their players left): empty while every one still plays.
+gone_clients() {
+    local i gone=""
+    for i in "${!client_pids[@]}"; do kill -0 "${client_pids[$i]}" 2>/dev/null || gone="$gone client$i"; done
+    echo "${gone# }"
+}
+# The clients' CPU ticks together, or nothing when one of them has ended.
+clients_cpu() {
+    local p sum=0 t
+    for p in "${client_pids[@]}"; do t=$(stat_cpu "$p" 2>/dev/null) || return 0; sum=$((sum + t)); done
+    echo "$sum"
+}
 varz() { curl -sf "http://127.0.0.1:$monitor/varz"; }
 t0=$(date +%s.%N)
 t0_us=$(date +%s%6N)
@@ -81,7 +97,7 @@ v0=$(varz)
 cpu0=(); rss0=()
 for p in "${edge_pids[@]}"; do cpu0+=("$(stat_cpu "$p")"); rss0+=("$(stat_rss "$p")"); done
 ncpu0=$(stat_cpu "$nats")
-ccpu0=0; for p in "${client_pids[@]}"; do ccpu0=$((ccpu0 + $(stat_cpu "$p"))); done
+ccpu0=$(clients_cpu)
 echo "window: $seconds s from $(date -u +%T), load average $(cut -d' ' -f1-3 /proc/loadavg)"
 # Memory every 30 s.
 samples=""
@@ -89,22 +105,34 @@ for _ in $(seq $((seconds / 30))); do
     sleep 30
     line="$(( $(date +%s) - ${t0%.*} ))s:"
     for p in "${edge_pids[@]}"; do line="$line $(stat_rss "$p")"; done
+    gone=$(gone_clients)
+    [ -z "$gone" ] || line="$line (after $gone left)"
     samples="$samples$line kB; "
 done
 sleep $((seconds % 30))
 t1=$(date +%s.%N)
 v1=$(varz)
+rss1=(); for p in "${edge_pids[@]}"; do rss1+=("$(stat_rss "$p")"); done
+ccpu1=$(clients_cpu)
+gone=$(gone_clients)
 hz=$(getconf CLK_TCK)
 wall=$(awk -v a="$t0" -v b="$t1" 'BEGIN { print b - a }')
 echo "load average at the end: $(cut -d' ' -f1-3 /proc/loadavg)"
 for i in $(seq 0 $((edges - 1))); do
     p=${edge_pids[$i]}
     cores=$(awk -v a="${cpu0[$i]}" -v b="$(stat_cpu "$p")" -v hz="$hz" -v w="$wall" 'BEGIN { printf "%.3f", (b - a) / hz / w }')
-    echo "edge e$i: CPU $cores cores ($(awk -v c="$cores" -v n="$players" 'BEGIN { printf "%.5f", c / n }') cores a player), memory ${rss0[$i]} kB at the start, $(stat_rss "$p") kB at the end"
+    echo "edge e$i: CPU $cores cores ($(awk -v c="$cores" -v n="$players" 'BEGIN { printf "%.5f", c / n }') cores a player), memory ${rss0[$i]} kB at the start, ${rss1[$i]} kB at the end"
 done
-echo "edges' memory (s: kB each): $samples"
-ccpu1=0; for p in "${client_pids[@]}"; do ccpu1=$((ccpu1 + $(stat_cpu "$p"))); done
-echo "the load clients' processes: CPU $(awk -v a="$ccpu0" -v b="$ccpu1" -v hz="$hz" -v w="$wall" 'BEGIN { printf "%.3f", (b - a) / hz / w }') cores together"
+if [ -z "$gone" ]; then
+    echo "edges' memory (s: kB each; every reading with all clients' players connected): $samples"
+else
+    echo "edges' memory (s: kB each): $samples (the end's reading after $gone left: raise CLIENT_SLACK)"
+fi
+if [ -n "$ccpu0" ] && [ -n "$ccpu1" ]; then
+    echo "the load clients' processes: CPU $(awk -v a="$ccpu0" -v b="$ccpu1" -v hz="$hz" -v w="$wall" 'BEGIN { printf "%.3f", (b - a) / hz / w }') cores together"
+else
+    echo "the load clients' processes: CPU not read (a client had ended)"
+fi
 ncores=$(awk -v a="$ncpu0" -v b="$(stat_cpu "$nats")" -v hz="$hz" -v w="$wall" 'BEGIN { printf "%.3f", (b - a) / hz / w }')
 python3 - "$wall" "$ncores" <<EOF
 import json, sys

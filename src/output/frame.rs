@@ -50,17 +50,46 @@ impl Cell {
     }
 }
 
+/// Frames alive in this process: a player's model of its terminal, a group's, its frames'
+/// (`tidepool serve --bus` traces it: what an edge's memory in use follows, bus.md round 9).
+static ALIVE: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+
+/// How many frames are alive in this process.
+#[cfg(feature = "bus")]
+pub fn frames_alive() -> usize {
+    ALIVE.load(std::sync::atomic::Ordering::Relaxed)
+}
+
 /// A grid of cells, row-major.
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Debug, PartialEq, Eq)]
 pub struct Frame {
     cols: usize,
     rows: usize,
     cells: Vec<Cell>,
 }
 
+impl Clone for Frame {
+    fn clone(&self) -> Frame {
+        ALIVE.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        Frame { cols: self.cols, rows: self.rows, cells: self.cells.clone() }
+    }
+
+    fn clone_from(&mut self, from: &Frame) {
+        (self.cols, self.rows) = (from.cols, from.rows);
+        self.cells.clone_from(&from.cells);
+    }
+}
+
+impl Drop for Frame {
+    fn drop(&mut self) {
+        ALIVE.fetch_sub(1, std::sync::atomic::Ordering::Relaxed);
+    }
+}
+
 impl Frame {
     /// A `cols x rows` frame of blank cells.
     pub fn new(cols: usize, rows: usize) -> Frame {
+        ALIVE.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         Frame { cols, rows, cells: vec![Cell::BLANK; cols * rows] }
     }
 

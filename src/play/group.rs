@@ -27,6 +27,7 @@
 use std::collections::{HashMap, VecDeque};
 use std::hash::Hash;
 use std::sync::Arc;
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -143,6 +144,33 @@ impl GroupKey {
     }
 }
 
+/// Groups kept and group frames alive in this process (the feeds' and those members still
+/// hold), for the bus's trace: what an edge's memory in use follows (bus.md round 9).
+static GROUPS_KEPT: AtomicUsize = AtomicUsize::new(0);
+static FRAMES_ALIVE: AtomicUsize = AtomicUsize::new(0);
+
+/// The groups kept and the group frames alive in this process.
+pub fn alive() -> (usize, usize) {
+    (GROUPS_KEPT.load(Ordering::Relaxed), FRAMES_ALIVE.load(Ordering::Relaxed))
+}
+
+/// Counts a group frame while it lives.
+#[derive(Debug)]
+struct Alive;
+
+impl Alive {
+    fn new() -> Alive {
+        FRAMES_ALIVE.fetch_add(1, Ordering::Relaxed);
+        Alive
+    }
+}
+
+impl Drop for Alive {
+    fn drop(&mut self) {
+        FRAMES_ALIVE.fetch_sub(1, Ordering::Relaxed);
+    }
+}
+
 /// One frame a group encoded.
 #[derive(Debug)]
 pub struct GroupFrame {
@@ -154,6 +182,7 @@ pub struct GroupFrame {
     after: Shown,
     /// The figures its status line carries.
     figures: Figures,
+    _alive: Alive,
 }
 
 /// The group's last frames, oldest first, as published to its members.
@@ -241,7 +270,13 @@ impl Group {
         }
         after.clone_from(self.screen.shown());
         self.number += 1;
-        self.frames.push_back(Arc::new(GroupFrame { number: self.number, bytes, after, figures }));
+        self.frames.push_back(Arc::new(GroupFrame {
+            number: self.number,
+            bytes,
+            after,
+            figures,
+            _alive: Alive::new(),
+        }));
         true
     }
 
@@ -293,6 +328,7 @@ impl Groups {
             let note = notes.remove(&key).flatten();
             self.groups.entry(key).or_insert_with(|| Group::new(key, now).noted(note));
         }
+        GROUPS_KEPT.store(self.groups.len(), Ordering::Relaxed);
     }
 
     /// Encodes every group's frame from the picture of its size in `pictures`, in parallel;

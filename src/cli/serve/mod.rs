@@ -16,6 +16,7 @@ pub mod authorized_keys;
 #[cfg(feature = "bus")]
 pub mod bus;
 mod channel;
+pub mod flight;
 pub mod game;
 mod gate;
 pub mod handler;

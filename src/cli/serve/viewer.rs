@@ -2,12 +2,14 @@
 //! channel, paced by the shared pictures. The channel's bytes go to the driver (the terminal's
 //! answers stay in its screen: the graphics probe, the link's round trips), the seat's
 //! requests to the shared host through the player's gate; the newest shared picture becomes
-//! this player's frame. Never more than one frame in flight, so a slow player skips pictures,
-//! and the link control finds each player's own rate. This file is the channel's I/O only.
+//! this player's frame. A frame is built only while the player's earlier frames hold fewer than
+//! `FLIGHT_BUDGET_BYTES` in russh (`flight.rs`), so a slow player skips pictures, and the link
+//! control finds each player's own rate. This file is the channel's I/O only.
 //!
 //! Bounded everywhere: the pictures are the one `watch` slot every player shares (newest wins),
-//! input is a bounded queue of the channel's packets (the SSH window bounds each), and below us
-//! russh holds at most `SESSION_EVENT_QUEUE` messages and the kernel at most
+//! input is a bounded queue of the channel's packets (the SSH window bounds each), the frames
+//! handed to russh and not yet taken into its write buffer by the byte budget (and russh's
+//! queue by `SESSION_EVENT_QUEUE` messages), and the kernel holds at most
 //! `SOCKET_SEND_BUFFER_BYTES`.
 
 use std::net::SocketAddr;
@@ -23,6 +25,7 @@ use tokio::sync::{mpsc, watch};
 use tokio_util::sync::CancellationToken;
 
 use super::channel::{Channel, now as clock};
+use super::flight::Flight;
 use super::game::{SharedFrame, Viewing};
 use super::gate::RequestGate;
 use super::hub::Hub;
@@ -85,6 +88,7 @@ pub(crate) async fn run<W: Channel>(ctx: ViewerCtx<W>) {
         deferred: false,
         last_input: now,
         out: Bytes::new(),
+        flight: Flight::default(),
         from_group: false,
         tally: Tally::default(),
         scene_name: frames.borrow().status.name,
@@ -126,6 +130,8 @@ struct Viewer {
     last_input: Instant,
     /// The frame to write, and whether its bytes are the group's.
     out: Bytes,
+    /// This player's frames handed to russh and not yet taken by it, in bytes.
+    flight: Flight,
     from_group: bool,
     tally: Tally,
     scene_name: &'static str,
@@ -180,6 +186,8 @@ impl Viewer {
                     if changed.is_err() { return Leave::Shutdown; }
                     self.driver.handle_picture();
                 }
+                // Over the budget: the waiting picture or key's frame goes when bytes land.
+                _ = self.flight.landed(), if !self.flight.has_room() => {}
             }
             let now = clock();
             let shared = frames.borrow().clone();
@@ -238,8 +246,9 @@ impl Viewer {
     /// Builds the frame for `now` into `self.out` when one goes (a new shared picture or a
     /// key's frame, within the server's outbound rate); whether there is one to send.
     fn frame(&mut self, now: Instant, shared: &SharedFrame) -> bool {
-        // One frame in flight: the writer is idle here, the last write was awaited.
-        if !self.driver.poll_frame(now, true) {
+        // The last write was awaited; a new frame waits (the driver keeps what it owes and
+        // that a picture came) while the earlier ones hold the budget in russh.
+        if !self.flight.has_room() || !self.driver.poll_frame(now, true) {
             return false;
         }
         self.tally.count(shared);
@@ -260,7 +269,7 @@ impl Viewer {
         let (len, source) = BUILD.with_borrow_mut(|out| {
             out.clear();
             let made = self.membership.frame(player, now, &picture, &shared.status, feed, out);
-            self.out = if made.0 == 0 { Bytes::new() } else { Bytes::copy_from_slice(out) };
+            self.out = if made.0 == 0 { Bytes::new() } else { self.flight.carry(out) };
             made
         });
         if len == 0 {

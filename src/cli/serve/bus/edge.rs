@@ -150,9 +150,16 @@ pub fn run(scene: PoolScene, fps: u32, links: GameLinks, mut bus: EdgeLinks) {
             }
         }
         said.say(&pending, now);
-        if let Some(took) = trim.due(now).filter(|_| bus.trace) {
-            let (used, free) = super::heap::held();
-            eprintln!("bus-trace trim {} us, malloc: {used} bytes in use, {free} free", took.as_micros());
+        if let Some(check) = trim.due(now).filter(|_| bus.trace) {
+            let (used, free) = (check.used, check.free);
+            let took = check.trimmed.map_or_else(|| "not needed".to_string(), |t| format!("{} us", t.as_micros()));
+            let flying = crate::cli::serve::flight::all_in_flight();
+            let (groups, group_frames) = crate::play::group::alive();
+            let models = crate::output::frame::frames_alive();
+            eprintln!(
+                "bus-trace trim {took}, malloc: {used} bytes in use, {free} free; frames in flight {flying} bytes; \
+                 {groups} groups, {group_frames} group frames alive; {models} cell frames alive"
+            );
         }
         if now >= next_frame {
             next_frame = (next_frame + frame_period).max(now);

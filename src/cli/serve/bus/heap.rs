@@ -1,4 +1,5 @@
-//! Gives the memory an edge freed back to the system, every [`TRIM_PERIOD`].
+//! Gives the memory an edge freed back to the system when malloc keeps much of it: checked every
+//! [`TRIM_PERIOD`], done when the arenas' free bytes exceed [`TRIM_FREE_SHARE`] of those in use.
 //!
 //! Why: an edge's live heap is flat (heaptrack over 150 s, 100 to 150 players: 33 to 36 MB),
 //! but its resident memory grew in steps with the machine's load and stayed at each new high
@@ -10,9 +11,17 @@
 //! Since round 8 the edge asks for one arena ([`one_arena`]): its free list stops growing, and
 //! the trim still returns the free pages in it.
 //!
-//! The bound this gives: an edge's resident memory is its live heap (its players, the pool, the
-//! bus's bounded queues) plus what it freed in the last [`TRIM_PERIOD`], not the highest it ever
-//! used. A no-op where the C library is not glibc (musl returns free memory by itself).
+//! Round 9: with one arena the arena's size (in use + free) did not move by 20 kB in five
+//! minutes on any edge of the scale run, while a trim every 5 s made the resident size swing 2
+//! to 5 %: each trim gave back the free pages of the moment (3 to 10 MB, as the bytes in use
+//! moved by about 5 MB), and the next seconds' allocations touched them again. So the trim now
+//! runs only when the free bytes are a large share of the live ones (players left, a burst):
+//! between those, the resident size is the arena's, which does not move.
+//!
+//! The bound this gives: an edge's resident memory, at each check, is at most its live heap
+//! (its players, the pool, the bus's bounded queues) plus [`TRIM_FREE_SHARE`] of it, plus what
+//! it freed in the last [`TRIM_PERIOD`]; not the highest it ever used. A no-op where the C
+//! library is not glibc (musl returns free memory by itself).
 
 use std::time::{Duration, Instant};
 
@@ -21,7 +30,25 @@ use std::time::{Duration, Instant};
 /// load 7), an edge frees a few MB between trims.
 pub const TRIM_PERIOD: Duration = Duration::from_secs(5);
 
-/// Trims the heap every [`TRIM_PERIOD`].
+/// A trim is done when malloc's free bytes exceed this share of its bytes in use (a half: one
+/// arena kept 5 to 21 % free while the players played, round 9; 48 MB free against 10 MB in use
+/// once they left; the many arenas of round 6 kept 62 %).
+pub const TRIM_FREE_SHARE: f64 = 0.5;
+
+/// Whether malloc keeps enough free (`free` bytes against `used` in use) to give it back.
+pub fn worth_trimming(used: usize, free: usize) -> bool {
+    free as f64 > used as f64 * TRIM_FREE_SHARE
+}
+
+/// What one check found: malloc's bytes in use and free (before a trim), and how long the trim
+/// took if one was done.
+pub struct Check {
+    pub used: usize,
+    pub free: usize,
+    pub trimmed: Option<Duration>,
+}
+
+/// Checks the heap every [`TRIM_PERIOD`], trims it when [`worth_trimming`].
 pub struct Trim {
     next: Instant,
 }
@@ -32,15 +59,21 @@ impl Trim {
         Trim { next: now + TRIM_PERIOD }
     }
 
-    /// Trims when a period has passed since the last trim; how long the trim took, if it did.
-    pub fn due(&mut self, now: Instant) -> Option<Duration> {
+    /// Checks when a period has passed since the last check (and trims if it is worth it);
+    /// what it found, if it checked.
+    pub fn due(&mut self, now: Instant) -> Option<Check> {
         if now < self.next {
             return None;
         }
         self.next = now + TRIM_PERIOD;
-        let started = Instant::now();
-        trim();
-        Some(started.elapsed())
+        let (used, free) = held();
+        // Where `held` knows nothing (not glibc), trim as before: it is a no-op there.
+        let trimmed = ((used, free) == (0, 0) || worth_trimming(used, free)).then(|| {
+            let started = Instant::now();
+            trim();
+            started.elapsed()
+        });
+        Some(Check { used, free, trimmed })
     }
 }
 
@@ -123,6 +156,20 @@ pub fn trim() {
 mod tests {
     use super::*;
 
+    /// The edges of round 9's scale run while their players played (one arena: 49 to 59 MB in
+    /// use, 2.6 to 10.2 MB free) are not trimmed, so their resident size stays the arena's; an
+    /// edge whose players left (10 MB in use, 48 MB free) is, and so is round 6's many arenas'.
+    #[test]
+    fn a_trim_waits_until_the_free_bytes_are_half_those_in_use() {
+        const MB: usize = 1 << 20;
+        for (used, free) in [(50 * MB, 10 * MB), (56 * MB, 400 << 10), (40 * MB, 20 * MB)] {
+            assert!(!worth_trimming(used, free), "{used} in use, {free} free: no trim");
+        }
+        for (used, free) in [(10 * MB, 48 * MB), (45 * MB, 28 * MB), (40 * MB, 21 * MB), (0, 1)] {
+            assert!(worth_trimming(used, free), "{used} in use, {free} free: a trim");
+        }
+    }
+
     /// This process's resident memory in kB.
     fn rss_kb() -> u64 {
         let status = std::fs::read_to_string("/proc/self/status").unwrap();
@@ -151,7 +198,7 @@ mod tests {
         let before = rss_kb();
         let mut t = Trim::new(Instant::now() - TRIM_PERIOD);
         let started = Instant::now();
-        assert!(t.due(Instant::now()).is_some());
+        assert!(t.due(Instant::now()).is_some_and(|c| c.trimmed.is_some()), "63 MB free: worth a trim");
         let took = started.elapsed();
         assert!(t.due(Instant::now()).is_none(), "once a period");
         let after = rss_kb();

@@ -175,3 +175,97 @@ async fn the_viewer_hands_out_the_bytes_of_the_canonical_turn() {
     assert!(viewer == harness, "the viewer's bytes ({}) are the harness's ({})", viewer.len(), harness.len());
     assert_eq!(sent, asked, "the viewer sent the host the harness's requests");
 }
+
+/// A channel that holds what it is handed, as russh's queue does, until the test lets it go;
+/// for every handing over: when, the bytes it already held, and how many came.
+#[derive(Clone, Default)]
+struct Queue(Arc<Mutex<(Vec<Bytes>, Vec<Handed>)>>);
+
+/// A handing over: when, the bytes already held, the bytes handed.
+type Handed = (Instant, usize, usize);
+
+impl Queue {
+    /// Lets everything held go (russh took it into its write buffer).
+    fn release(&self) {
+        self.0.lock().unwrap().0.clear();
+    }
+}
+
+impl Channel for Queue {
+    async fn data(&self, bytes: Bytes) -> Result<(), ()> {
+        let (held, handed) = &mut *self.0.lock().unwrap();
+        handed.push((clock(), held.iter().map(Bytes::len).sum(), bytes.len()));
+        held.push(bytes);
+        Ok(())
+    }
+    async fn exit_status(&self, _status: u32) -> Result<(), ()> {
+        Ok(())
+    }
+    async fn eof(&self) -> Result<(), ()> {
+        Ok(())
+    }
+    async fn close(&self) -> Result<(), ()> {
+        Ok(())
+    }
+}
+
+/// Issue 31 (bus.md round 9): while russh has not taken a player's frames, the player hands it
+/// no new one once they hold the byte budget (the pictures meanwhile are skipped, not queued),
+/// and the frame a key owes goes the moment the bytes land, not at the next picture.
+#[tokio::test(start_paused = true)]
+async fn a_player_holds_its_byte_budget_in_flight_and_a_keys_frame_goes_when_it_lands() {
+    use crate::cli::serve::flight::FLIGHT_BUDGET_BYTES;
+    let t0 = clock();
+    let (probe_hub, ..) = hub(SharedFrame::default());
+    let fit = *new_player(&probe_hub, screen_config(), TERM, t0).fit();
+    let pictures = pictures(t0, &fit);
+    let (hub, (frames, _requests)) = hub(shared(0, &pictures, fit.target()));
+    let queue = Queue::default();
+    let (_terminal_tx, terminal) = watch::channel(TerminalState { size: TERM, closed: false });
+    let (input_tx, input) = mpsc::channel(16);
+    let ctx = ViewerCtx {
+        hub: hub.clone(),
+        id: 1,
+        peer: SocketAddr::from(([127, 0, 0, 1], 22)),
+        write: queue.clone(),
+        terminal,
+        input,
+        screen: screen_config(),
+        kill: CancellationToken::new(),
+        slot: hub.players.try_take().unwrap(),
+    };
+    let at = |ms: u64| tokio::time::sleep_until((t0 + Duration::from_millis(ms)).into());
+    let feed = async {
+        // Every picture for two seconds while russh takes nothing.
+        for k in 1..=PICTURES as usize {
+            at(k as u64 * PICTURE_MS).await;
+            frames.send_replace(Arc::new(shared(k, &pictures, fit.target())));
+        }
+        // No more pictures: a key's frame waits behind the held bytes, then they land.
+        at(2_010).await;
+        input_tx.send((clock(), b"?".to_vec())).await.unwrap();
+        at(2_050).await;
+        queue.release();
+        at(2_100).await;
+        input_tx.send((clock(), b"q".to_vec())).await.unwrap();
+    };
+    tokio::join!(run(ctx), feed);
+    let handed = std::mem::take(&mut queue.0.lock().unwrap().1);
+    let most = handed.iter().map(|&(_, held, len)| held + len).max().unwrap();
+    assert!(most >= FLIGHT_BUDGET_BYTES, "the frames reached the budget ({most} bytes held at most): the test binds");
+    for &(when, held, len) in &handed {
+        let ms = (when - t0).as_millis();
+        assert!(held < FLIGHT_BUDGET_BYTES, "at {ms} ms a frame of {len} bytes was handed over with {held} bytes held");
+    }
+    let during = handed.iter().filter(|&&(when, ..)| when < t0 + Duration::from_millis(2_050));
+    assert!(
+        during.count() < PICTURES as usize / 2,
+        "most pictures were skipped while russh held the budget: {handed:?}"
+    );
+    let landed = t0 + Duration::from_millis(2_050);
+    assert!(
+        handed.iter().any(|&(when, _, len)| when == landed && len > 0),
+        "the help's frame went when the bytes landed: {:?}",
+        handed.iter().map(|&(when, held, len)| ((when - t0).as_millis(), held, len)).collect::<Vec<_>>()
+    );
+}
