@@ -232,6 +232,12 @@ pub struct LinkControl {
     decided_at: Option<Instant>,
     /// Whether the rate ever fell (the link has shown its limit).
     fell: bool,
+    /// When the rate last fell.
+    fell_at: Option<Instant>,
+    /// What the terminal took while a queue stood, at the last fall that measured it: the
+    /// link's own rate (the takes between answers scatter above it; the capacity, their
+    /// most, sized the window, and growth past it kept queueing).
+    link_rate: Option<f64>,
     /// The bytes the terminal has answered for (or given up on): everything sent up to the
     /// last answered or overdue question.
     acknowledged: u64,
@@ -298,6 +304,8 @@ impl LinkControl {
             last_rtt: None,
             decided_at: None,
             fell: false,
+            fell_at: None,
+            link_rate: None,
             acknowledged: 0,
             asked_up_to: 0,
             spare_since_question: true,

@@ -8,15 +8,16 @@ use std::time::{Duration, Instant};
 use super::questions::Question;
 use super::{
     BASE_SAMPLES, CAPACITY_MEMORY, Change, DECREASE, DEEP_DRAIN_SHARE, DELIVERY_BYTES, DRAIN_SHARE, FIRST_WINDOW,
-    INCREASE, INCREASE_AFTER_LIMIT, LinkControl, MAX_RATE, MIN_RATE, QUEUE_HIGH_MIN, RECENT_TAKES, SAFE_RATE,
-    answer_time, queue_marks,
+    INCREASE, INCREASE_AFTER_LIMIT, LinkControl, MAX_RATE, MIN_RATE, QUEUE_HIGH, QUEUE_HIGH_MIN, RECENT_TAKES,
+    SAFE_RATE, answer_time, queue_marks,
 };
 
 /// How an answer's queue reads against the marks.
 struct Reading {
     /// The queue less the terminal's usual time to answer.
     link_queue: Duration,
-    /// The marks for the base round trip.
+    /// The base round trip and its marks.
+    base: Duration,
     low: Duration,
     high: Duration,
     /// The bytes in flight explain the queue (or the terminal is not one slow on its own).
@@ -83,7 +84,15 @@ impl LinkControl {
             // Asked before the last change: it measures the queue that change is acting on.
             return Change::Hold;
         }
-        self.decide(&reading, question.in_flight, app_limited, now)
+        // Asked within a round trip of a fall that took the rate under what the link was
+        // seen to carry: its answer still carries the queue the bytes sent before the fall
+        // built (they were in the link when it was asked), so it says nothing of whether the
+        // queue drains. A second fall on it took the rate to 0.57 of the link on the stock
+        // 256 kbit/s lab, and the rate then took six seconds to come back.
+        let settling = base > QUEUE_HIGH
+            && self.fell_at.is_some_and(|fell| sent < fell + base)
+            && self.delivered.is_some_and(|delivered| self.rate < delivered);
+        self.decide(&reading, question.in_flight, app_limited, settling, now)
     }
 
     /// What the terminal took since the last answer, bytes per second, for a question that
@@ -143,7 +152,7 @@ impl LinkControl {
         let explained = !slow_terminal || 2 * in_flight >= link_queue;
         let over = link_queue > high && (explained || queue > high + slow);
         let last = self.last_queue.replace((link_queue, over));
-        Reading { link_queue, low, high, explained, slow_terminal, over, last }
+        Reading { link_queue, base, low, high, explained, slow_terminal, over, last }
     }
 
     /// The link's capacity for the window, from what the terminal `took` since the last answer
@@ -224,7 +233,16 @@ impl LinkControl {
 
     /// The rate's decision on a queue read as `reading`, behind bytes that would take
     /// `in_flight` to cross, from a sender `app_limited` or not.
-    fn decide(&mut self, reading: &Reading, in_flight: Duration, app_limited: bool, now: Instant) -> Change {
+    /// `settling`: the question was asked while a fall's drain had not begun to show (no
+    /// second fall on it).
+    fn decide(
+        &mut self,
+        reading: &Reading,
+        in_flight: Duration,
+        app_limited: bool,
+        settling: bool,
+        now: Instant,
+    ) -> Change {
         let Reading { link_queue, low, high, explained, over, last, .. } = *reading;
         // A queue that is not draining, over the high mark twice in a row, or once when it
         // is beyond what a busy machine's late reads of an answer make (a long link then
@@ -240,7 +258,7 @@ impl LinkControl {
         // A sender that left its budget unspent cannot have built a queue of a few marks: only
         // a deep one lowers the rate then.
         let caused = !app_limited || link_queue > 2 * high;
-        if over && not_draining && confirmed && caused {
+        if over && not_draining && confirmed && caused && !settling {
             // A queue of several marks drains faster: at 15 % under the link, a second of
             // queue would take six to go.
             // A late answer the bytes in flight cannot explain (a terminal slow on its own, in
@@ -260,7 +278,19 @@ impl LinkControl {
             // left it unspent (cells of calm water) would grow the rate without evidence, to
             // "no limit" on a 250 kB/s link, and `auto` then switched to pixels that queued
             // for seconds.
-            let growth = if self.fell { INCREASE_AFTER_LIMIT } else { INCREASE };
+            // Past what the link was seen to carry, a step over the link's rate is a queue that
+            // grows each round trip until the answers that stop it come, a round trip late: a
+            // step of the same share of the high mark at any round trip (on a link whose round
+            // trip is longer than the mark, a smaller step: at 300 ms, 1 % rather than 3 %).
+            let past = self.link_rate.or(self.capacity).is_some_and(|c| self.rate >= c);
+            let growth = match (self.fell, past) {
+                (false, _) => INCREASE,
+                (true, false) => INCREASE_AFTER_LIMIT,
+                (true, true) => {
+                    let share = (high.as_secs_f64() / reading.base.as_secs_f64().max(1e-3)).min(1.0);
+                    1.0 + (INCREASE_AFTER_LIMIT - 1.0) * share
+                }
+            };
             self.rate = (self.rate * growth).min(self.ceiling);
             self.decided_at = Some(now);
             Change::Up
@@ -273,6 +303,9 @@ impl LinkControl {
     /// stood, so the link set it), else by [`DRAIN_SHARE`]; never under `floor`.
     pub(super) fn fall(&mut self, now: Instant, share: f64, floor: f64, measured: bool) {
         let delivered = self.delivered.map(|d| d.max(self.delivered_before.unwrap_or(0.0)));
+        if measured && let Some(d) = delivered {
+            self.link_rate = Some(d);
+        }
         let target = match delivered {
             // Far under the rate, though, the link (or the terminal) is the limit whatever
             // stood before: a start rate far over a slow link comes down at once.
@@ -285,6 +318,7 @@ impl LinkControl {
         };
         self.rate = target.max(floor.min(self.rate)).max(MIN_RATE);
         self.decided_at = Some(now);
+        self.fell_at = Some(now);
         self.fell = true;
     }
 }

@@ -583,6 +583,7 @@ fn slow_reader(t: f64) -> f64 {
 }
 
 mod late_player;
+mod long_links;
 mod slow_terminals;
 mod stalls;
 
