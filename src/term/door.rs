@@ -207,7 +207,9 @@ impl DoorIo<'_> {
                 panic!("{TEST_PANIC_VAR} is set: panicking on purpose to test the terminal restore");
             }
         }
-        Ok(())
+        // A signal ends the session as `q` does: its questions' answers must not reach the
+        // shell either (echoed by the terminal once it is back in cooked mode).
+        self.linger(session)
     }
 
     /// A question asked but not yet answered would reach the shell as typed text once the

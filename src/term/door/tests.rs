@@ -17,6 +17,8 @@ struct Scripted<'a> {
     frames: u32,
     clock: &'a Mutex<Instant>,
     t0: Instant,
+    /// Set at this frame, as a signal handler sets it.
+    quit: Option<(u32, Arc<AtomicBool>)>,
 }
 
 impl TerminalInput for Scripted<'_> {
@@ -25,6 +27,11 @@ impl TerminalInput for Scripted<'_> {
             return Ok(false);
         }
         *self.clock.lock().unwrap() = self.t0 + FRAME * self.frame;
+        if let Some((at, quit)) = &self.quit
+            && *at == self.frame
+        {
+            quit.store(true, std::sync::atomic::Ordering::SeqCst);
+        }
         for (_, bytes) in self.script.iter().filter(|(at, _)| *at == self.frame) {
             buf.extend_from_slice(bytes);
         }
@@ -58,18 +65,41 @@ impl Sink for Memory {
 
 /// Every byte the door writes for `script` over `frames` frames from `t0`.
 fn through_the_door(t0: Instant, script: &[(u32, &[u8])], frames: u32) -> Vec<u8> {
+    door_run(t0, script, frames, None, screen_config()).0
+}
+
+/// The bytes the door writes, and how many reads it made, for `script` over `frames` frames,
+/// with the quit flag set at frame `signal_at` when given.
+fn door_run(
+    t0: Instant,
+    script: &[(u32, &[u8])],
+    frames: u32,
+    signal_at: Option<u32>,
+    screen: crate::play::screen::ScreenConfig,
+) -> (Vec<u8>, u32) {
     let clock = Mutex::new(t0);
-    let mut input = Scripted { script, frame: 0, frames, clock: &clock, t0 };
+    let quit = Arc::new(AtomicBool::new(false));
+    let mut input =
+        Scripted { script, frame: 0, frames, clock: &clock, t0, quit: signal_at.map(|at| (at, Arc::clone(&quit))) };
     let mut sink = Memory::default();
-    let config = PlayConfig {
-        host: host_config(),
-        screen: screen_config(),
-        greeting: None,
-        storage: None,
-        quit: Arc::new(AtomicBool::new(false)),
-    };
+    let config = PlayConfig { host: host_config(), screen, greeting: None, storage: None, quit };
     drive(&mut input, &mut sink, config, &mut |_| {}, &|| *clock.lock().unwrap(), false).unwrap();
-    sink.0
+    (sink.0, input.frame)
+}
+
+/// A question in flight when the person quits is waited for (its answer would be echoed to
+/// the shell once the terminal is back in cooked mode), for a signal as for `q`: the door
+/// keeps reading after the quit until the answer comes.
+#[test]
+fn a_signal_waits_for_the_last_answer_as_q_does() {
+    let t0 = Instant::now();
+    // The link control asks after frames; the terminal never answers, so the last question is
+    // still in flight at the quit.
+    let screen = || crate::play::screen::ScreenConfig { bandwidth: crate::play::Bandwidth::Auto, ..screen_config() };
+    let (_, after_q) = door_run(t0, &[(30, b"q")], 200, None, screen());
+    let (_, after_signal) = door_run(t0, &[], 200, Some(30), screen());
+    assert!(after_q > 32, "q waited for the answer: {after_q} reads");
+    assert_eq!(after_signal, after_q, "a signal waits as long as q");
 }
 
 #[test]
