@@ -60,9 +60,9 @@ async fn serve_to(profile: Profile) -> (Shown, FakeTerminal) {
     }
 }
 
-/// How many times each scenario runs (`TIDEPOOL_FAKE_RUNS`, default 3).
+/// How many times each scenario runs (`TIDEPOOL_FAKE_RUNS`, default 2, as over a pty).
 fn runs() -> usize {
-    std::env::var("TIDEPOOL_FAKE_RUNS").ok().and_then(|v| v.parse().ok()).unwrap_or(3)
+    std::env::var("TIDEPOOL_FAKE_RUNS").ok().and_then(|v| v.parse().ok()).unwrap_or(2)
 }
 
 #[tokio::test]
