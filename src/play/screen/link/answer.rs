@@ -276,7 +276,9 @@ impl LinkControl {
         // its own too: a loaded machine reads answers late whatever the terminal (a slow
         // kitty's rate fell to the floor by one late answer in four).
         let bytes_explain = 2 * in_flight >= link_queue;
-        let confirmed = reading.was_over() || (link_queue > 2 * QUEUE_HIGH_MIN && explained && bytes_explain);
+        let growing = reading.base > QUEUE_HIGH && last.is_some_and(|(last, _)| last >= low && link_queue > last);
+        let confirmed =
+            reading.was_over() || growing || (link_queue > 2 * QUEUE_HIGH_MIN && explained && bytes_explain);
         // A sender that left its budget unspent cannot have built a queue of a few marks: only
         // a deep one lowers the rate then.
         let caused = !app_limited || link_queue > 2 * high;
