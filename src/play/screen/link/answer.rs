@@ -276,6 +276,9 @@ impl LinkControl {
         // its own too: a loaded machine reads answers late whatever the terminal (a slow
         // kitty's rate fell to the floor by one late answer in four).
         let bytes_explain = 2 * in_flight >= link_queue;
+        // On a long link a queue that grew from over the low mark is confirmed too: the rate past
+        // the link's held between the marks while the queue grew 30-40 ms a round trip, and the
+        // answer that confirmed it came a round trip later (the sawtooth's top 221 ms, now 169).
         let growing = reading.base > QUEUE_HIGH && last.is_some_and(|(last, _)| last >= low && link_queue > last);
         let confirmed =
             reading.was_over() || growing || (link_queue > 2 * QUEUE_HIGH_MIN && explained && bytes_explain);

@@ -14,7 +14,8 @@
 //! So the first fall is a drain (BBR's DRAIN): the rate goes to [`DRAIN_START_SHARE`] of the
 //! least the terminal was seen to take since the start (each take reads high for its own
 //! reason, seldom all of them), and holds there, neither falling nor growing, until an answer
-//! to a question asked since shows the queue under the low mark (or [`DRAIN_MAX`] has passed).
+//! to a question asked since shows the queue under the low mark (or [`DRAIN_RTTS`] base round
+//! trips have passed).
 //! It then starts from [`DRAIN_SHARE`] of what the terminal took while the drain's queue still
 //! stood (the link's own rate: it was busy all through), or of that least take when no such
 //! take came, and grows gently from there ([`INCREASE_AFTER_LIMIT`]).
