@@ -87,7 +87,8 @@ fn the_start_s_queue_is_drained_before_the_first_key_on_a_slow_long_link() {
     // first keys are pressed about 3 s into the player's life (the harness's 6 s warm-up less
     // the SSH set-up). Before the drain, the start's queue still stood then: 589 ms at 2.5-2.75
     // s over ssh, 1.2 s at 3.75 s over serve (the lab's traces: 0.7 and 2.2 s at 3.6 s).
-    // Now what stands after 2.5 s is the gentle growth's sawtooth (its top 221 ms over ssh).
+    // Now what stands after 2.5 s is the gentle growth's sawtooth: its top 169 ms over ssh (221
+    // when a queue over the high mark waited for a second answer to confirm it).
     for (what, link) in [
         ("ssh", Link { burst: 4_000.0, ..Link::far(28_900.0, ms(300)) }),
         ("serve", Link { burst: 4_000.0, late_first: &[355, 125], ..Link::far(28_900.0, ms(300)) }),
@@ -96,7 +97,7 @@ fn the_start_s_queue_is_drained_before_the_first_key_on_a_slow_long_link() {
         let worst = run.at.iter().zip(&run.queue).filter(|(t, _)| **t >= 2.5).map(|(_, q)| *q).fold(0.0, f64::max);
         let used = run.throughput(28_900.0, 2.5, 12.0) / 28_900.0;
         println!("{what}: the longest queue from 2.5 s {:.0} ms, {:.0} % of the link used", worst * 1e3, used * 100.0);
-        assert!(worst <= 0.3, "{what}: a queue of {:.0} ms after 2.5 s", worst * 1e3);
+        assert!(worst <= 0.2, "{what}: a queue of {:.0} ms after 2.5 s", worst * 1e3);
         assert!(used >= 0.85, "{what}: only {:.0} % of the link used", used * 100.0);
     }
 }
