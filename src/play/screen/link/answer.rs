@@ -5,6 +5,7 @@
 
 use std::time::{Duration, Instant};
 
+use super::drain::START_KEEP_UP;
 use super::questions::Question;
 use super::{
     BASE_SAMPLES, CAPACITY_MEMORY, Change, DECREASE, DEEP_DRAIN_SHARE, DELIVERY_BYTES, DRAIN_SHARE, FIRST_WINDOW,
@@ -71,14 +72,34 @@ impl LinkControl {
             self.clean_due = Some(now);
         }
         let reading = self.read_queue(queue, base, question.in_flight);
-        self.measure_capacity(took, &reading, first, &question, window_bound, now);
+        let measured_before = self.capacity.is_some();
+        if self.measure_capacity(took, &reading, first, &question, window_bound, now)
+            && let Some(took) = took
+        {
+            let busy = reading.link_queue >= reading.low && reading.last.is_some_and(|(last, _)| last >= reading.low);
+            self.drain.took(took, busy);
+        }
         if !self.path.answered_at_far_end() {
             // The answers come from this side of the link (a multiplexer, mosh-server): they
             // pace the window, never the rate.
             return Change::Hold;
         }
+        if let Some(change) = self.drain_step(sent, reading.link_queue, (reading.low, base), now) {
+            return change;
+        }
         if first && let Some(change) = self.start_from_first(took, app_limited, bytes, now) {
             return change;
+        }
+        if !first && !measured_before && self.capacity.is_some() && base > QUEUE_HIGH {
+            // The first answer that measures the link (the first one followed the set-up's few
+            // bytes): the start ends here as it would have at the first answer, by a drain when
+            // the queue already shows.
+            if reading.over && self.drain.first_fall() {
+                return self.start_drain(now, DECREASE);
+            }
+            if let Some(change) = self.start_from_first(took, app_limited, bytes, now) {
+                return change;
+            }
         }
         if self.decided_at.is_some_and(|decided| sent < decided) {
             // Asked before the last change: it measures the queue that change is acting on.
@@ -157,7 +178,7 @@ impl LinkControl {
 
     /// The link's capacity for the window, from what the terminal `took` since the last answer
     /// to `question` (whose sender may have left its budget unspent), the window holding frames
-    /// (`window_bound`) or not.
+    /// (`window_bound`) or not; whether the take measured the link.
     fn measure_capacity(
         &mut self,
         took: Option<f64>,
@@ -166,7 +187,7 @@ impl LinkControl {
         question: &Question,
         window_bound: bool,
         now: Instant,
-    ) {
+    ) -> bool {
         let (app_limited, bytes) = (question.app_limited, question.bytes);
         // The link is first measured by a take that says something of it: a sender that used its
         // budget, and after the first question more than the set-up's few bytes. Until then the
@@ -176,7 +197,7 @@ impl LinkControl {
         // down to 2-4 kB/s (the fake WezTerm with forced sixel over SSH, blank for 20 s in CI).
         let measures = self.capacity.is_some() || (!app_limited && (!first || bytes >= FIRST_WINDOW / 4));
         let Some(took) = took.filter(|_| measures) else {
-            return;
+            return false;
         };
         // A queue says the link was the limit; from a terminal slow on its own only a standing
         // one (two answers over the mark in a row): its late answers must not shrink the window
@@ -199,6 +220,7 @@ impl LinkControl {
         });
         self.recent_takes[self.take_count % RECENT_TAKES] = Some((now, took));
         self.take_count += 1;
+        true
     }
 
     /// The first answer: the rate starts from what the first frame was seen to take, when that
@@ -254,11 +276,27 @@ impl LinkControl {
         // its own too: a loaded machine reads answers late whatever the terminal (a slow
         // kitty's rate fell to the floor by one late answer in four).
         let bytes_explain = 2 * in_flight >= link_queue;
-        let confirmed = reading.was_over() || (link_queue > 2 * QUEUE_HIGH_MIN && explained && bytes_explain);
+        // On a long link a queue that grew from over the low mark is confirmed too: the rate past
+        // the link's held between the marks while the queue grew 30-40 ms a round trip, and the
+        // answer that confirmed it came a round trip later (the sawtooth's top 221 ms, now 169).
+        let growing = reading.base > QUEUE_HIGH && last.is_some_and(|(last, _)| last >= low && link_queue > last);
+        let confirmed =
+            reading.was_over() || growing || (link_queue > 2 * QUEUE_HIGH_MIN && explained && bytes_explain);
         // A sender that left its budget unspent cannot have built a queue of a few marks: only
         // a deep one lowers the rate then.
         let caused = !app_limited || link_queue > 2 * high;
-        if over && not_draining && confirmed && caused && !settling {
+        if over
+            && not_draining
+            && caused
+            && reading.base > QUEUE_HIGH
+            && self.drain.first_fall()
+            && self.drain.has_take()
+        {
+            // The start's first queue on a long link: drained at once (the answer that would
+            // confirm it comes a round trip later, behind another round trip of the start's
+            // growth).
+            self.start_drain(now, DECREASE)
+        } else if over && not_draining && confirmed && caused && !settling {
             // A queue of several marks drains faster: at 15 % under the link, a second of
             // queue would take six to go.
             // A late answer the bytes in flight cannot explain (a terminal slow on its own, in
@@ -283,8 +321,14 @@ impl LinkControl {
             // step of the same share of the high mark at any round trip (on a link whose round
             // trip is longer than the mark, a smaller step: at 300 ms, 1 % rather than 3 %).
             let past = self.link_rate.or(self.capacity).is_some_and(|c| self.rate >= c);
+            // The start grows fast while the terminal takes what it is sent; on a long link,
+            // once it takes less, the link has shown its limit though no queue shows yet (the
+            // answer that shows it comes a round trip later).
+            let keeping_up =
+                reading.base <= QUEUE_HIGH || self.delivered.is_none_or(|d| d >= START_KEEP_UP * self.rate);
             let growth = match (self.fell, past) {
-                (false, _) => INCREASE,
+                (false, _) if keeping_up => INCREASE,
+                (false, _) => INCREASE_AFTER_LIMIT,
                 (true, false) => INCREASE_AFTER_LIMIT,
                 (true, true) => {
                     let share = (high.as_secs_f64() / reading.base.as_secs_f64().max(1e-3)).min(1.0);
@@ -302,6 +346,10 @@ impl LinkControl {
     /// Lowers the rate to under what the terminal was seen to take (`measured`: while a queue
     /// stood, so the link set it), else by [`DRAIN_SHARE`]; never under `floor`.
     pub(super) fn fall(&mut self, now: Instant, share: f64, floor: f64, measured: bool) {
+        if self.drain.first_fall() && self.drain.has_take() && self.base().is_some_and(|b| b > QUEUE_HIGH) {
+            self.start_drain(now, DECREASE);
+            return;
+        }
         let delivered = self.delivered.map(|d| d.max(self.delivered_before.unwrap_or(0.0)));
         if measured && let Some(d) = delivered {
             self.link_rate = Some(d);
