@@ -38,8 +38,8 @@
 //! # Rate control
 //!
 //! The rung is the largest whose whole picture is predicted to cost at most the bytes the rate
-//! brings in a tenth of a second ([`MIN_RATE`] pictures a second; kitty a sixteenth,
-//! `plan::KITTY_MIN_RATE`: fresher, smaller pictures scored truer), within the bucket's burst
+//! brings in a tenth of a second ([`MIN_RATE`] pictures a second; kitty from 150 kB/s
+//! a sixteenth, `plan::KITTY_MIN_RATE`: fresher, smaller pictures scored truer), within the bucket's burst
 //! and less a share kept for the status line ([`PICTURE_SHARE`]). The stream learns what each
 //! rung costs (bytes a pixel, a moving average per rung, the first guess scaled from a
 //! neighbour). Pictures then go as often as the bucket holds the rung's predicted cost (at most
@@ -441,8 +441,7 @@ impl PictureStream {
         // A still scene under a rate: the bytes refine what is shown towards the source.
         if limited && self.still(picture) {
             // Refined at [`MIN_RATE`]'s allowance whatever the moving picture's rate: a still
-            // picture is not made staler by bigger steps, and kitty's sixteenth of a second at
-            // 5 kB/s (265 bytes) held neither a climb's first picture nor its smallest blocks.
+            // picture is not made staler by bigger steps (as before kitty's own rate).
             let allowance = budget.rate.map_or(allowance, |r| plan::allowance(r, MIN_RATE) as usize);
             let room = allowance.min(budget.available);
             let interval = self.interval(budget);

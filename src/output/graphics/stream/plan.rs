@@ -26,7 +26,12 @@ pub(super) const MIN_RATE: f64 = 10.0;
 /// crosses the link in that time, so a key's effect shows sooner. iTerm2's JPEG gained nothing
 /// from a higher rate (13: 0.715 / 0.718, 16: 0.714 / 0.723, 20: 0.697), so it keeps
 /// [`MIN_RATE`].
+/// At 50 kB/s it lost (84x49 at 20 a second 0.643 / 0.644 against 100x59 at 14's 0.657 /
+/// 0.652), and at 5 kB/s a sixteenth (265 bytes) held no tile of the bottom rung, so it holds
+/// from [`KITTY_MIN_RATE_FROM`] on (between 50 and 250 kB/s not measured).
 pub(super) const KITTY_MIN_RATE: f64 = 16.0;
+/// The rate (bytes a second) from which kitty's rung is chosen for [`KITTY_MIN_RATE`].
+pub(super) const KITTY_MIN_RATE_FROM: f64 = 150e3;
 /// A rung above the current one is taken only when it is predicted to fit this share of the
 /// allowance (hysteresis: no flapping between two rungs).
 const UP_SHARE: f64 = 0.85;
@@ -83,11 +88,11 @@ impl PictureStream {
         }
     }
 
-    /// The picture rate the rung is chosen for: [`KITTY_MIN_RATE`] for kitty, [`MIN_RATE`]
-    /// for the others.
-    pub(super) fn min_rate(&self) -> f64 {
+    /// The picture rate the rung is chosen for at `rate`: [`KITTY_MIN_RATE`] for kitty from
+    /// [`KITTY_MIN_RATE_FROM`], [`MIN_RATE`] otherwise.
+    pub(super) fn min_rate(&self, rate: f64) -> f64 {
         match self.protocol {
-            Protocol::Kitty(_) => KITTY_MIN_RATE,
+            Protocol::Kitty(_) if rate >= KITTY_MIN_RATE_FROM => KITTY_MIN_RATE,
             _ => MIN_RATE,
         }
     }
@@ -114,7 +119,7 @@ impl PictureStream {
             self.rung = 0;
             return usize::MAX;
         };
-        let allowance = allowance(rate, self.min_rate());
+        let allowance = allowance(rate, self.min_rate(rate));
         let last = self.rungs.len() - 1;
         let mut rung = (0..self.rungs.len()).find(|&r| self.predict(r).is_none_or(|c| c <= allowance)).unwrap_or(last);
         // Hysteresis: a bigger rung only when it fits with room to spare.
