@@ -164,6 +164,18 @@ impl Terminal {
         }
     }
 
+    /// What is shown: RGB at its size, and whether the terminal repeats its pixels (sixel).
+    fn rgb(&self) -> Option<(u32, u32, &[u8], bool)> {
+        match self {
+            Terminal::Kitty(state) => {
+                let image = state.images.get(&KittyOptions::IMAGE_ID)?;
+                Some((image.width, image.height, &image.rgb, false))
+            }
+            Terminal::Iterm2(shown) => shown.as_ref().map(|(w, h, rgb)| (*w, *h, &rgb[..], false)),
+            Terminal::Sixel(canvas, size) => Some((size.0, size.1, &canvas[..], true)),
+        }
+    }
+
     fn luma(&self) -> Option<Luma> {
         match self {
             Terminal::Kitty(state) => {
@@ -252,6 +264,14 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
                     .flat_map(|y| (0..pw as usize).map(move |x| (x, y)))
                     .flat_map(|(x, y)| screen.pixel(x, y).unwrap_or([0, 0, 0]))
                     .collect();
+                if n / SAMPLE_EVERY == DUMP_SAMPLE {
+                    dump(
+                        &format!("cells-{}", rate.map_or("unlimited".into(), |r| format!("{:.0}k", r / 1e3))),
+                        &rgb,
+                        (pw, ph),
+                        true,
+                    );
+                }
                 let shown = luma_at(&rgb, (pw, ph), AREA, true);
                 row.ssim.push(view_ssim(&shown, &truths[n]));
             }
@@ -273,6 +293,21 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
             row.bytes += bytes.len();
             row.pictures += 1;
             terminal.feed(&bytes);
+        }
+        if sample(n) && n / SAMPLE_EVERY == DUMP_SAMPLE {
+            let (w, h, rgb, nearest) = terminal.rgb().unwrap_or((1, 1, &[0, 0, 0], true));
+            dump(
+                &format!("{mode}-{}", rate.map_or("unlimited".into(), |r| format!("{:.0}k", r / 1e3))),
+                rgb,
+                (w, h),
+                nearest,
+            );
+            dump(
+                &format!("truth-{n}"),
+                &shot.data().chunks_exact(4).flat_map(|p| [p[0], p[1], p[2]]).collect::<Vec<u8>>(),
+                SCENE,
+                false,
+            );
         }
         if sample(n) {
             let truth = &truths[n];
@@ -309,6 +344,30 @@ fn run(mode: &str, rate: Option<f64>, shots: &[Pixmap], truths: &[Luma]) -> Row 
     let state = stream.state();
     row.rung = format!("{}x{} {}", state.size.0, state.size.1, state.packing.map_or("-".into(), |p| p.name()));
     row
+}
+
+/// The sample whose picture `PICTURES_DUMP` writes: about 6 s in (the stream long settled).
+const DUMP_SAMPLE: usize = 30;
+
+/// With `PICTURES_DUMP=dir`: writes `rgb` (`size`) as the terminal shows it at the cell area's
+/// size (scaled as `luma_at` scales it) to `dir/name.png`, to look at.
+fn dump(name: &str, rgb: &[u8], size: (u32, u32), nearest: bool) {
+    let Ok(dir) = std::env::var("PICTURES_DUMP") else { return };
+    let mut out = Vec::new();
+    if nearest {
+        let (w, h) = (size.0 as usize, size.1 as usize);
+        for y in 0..AREA.1 as usize {
+            for x in 0..AREA.0 as usize {
+                let i = 3 * (y * h / AREA.1 as usize * w + x * w / AREA.0 as usize);
+                out.extend_from_slice(&rgb[i..i + 3]);
+            }
+        }
+    } else {
+        tidepool::testing::resample(rgb, 3, size, AREA, &mut out);
+    }
+    let path = std::path::Path::new(&dir).join(format!("{name}.png"));
+    image::save_buffer(&path, &out, AREA.0, AREA.1, image::ExtendedColorType::Rgb8)
+        .expect("PICTURES_DUMP: the picture is written");
 }
 
 /// SSIM of `a` against `b`, both first averaged over `PICTURES_VIEW`-pixel squares when that

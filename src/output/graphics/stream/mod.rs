@@ -38,7 +38,8 @@
 //! # Rate control
 //!
 //! The rung is the largest whose whole picture is predicted to cost at most the bytes the rate
-//! brings in a tenth of a second ([`MIN_RATE`] pictures a second), within the bucket's burst
+//! brings in a tenth of a second ([`MIN_RATE`] pictures a second; kitty from 150 kB/s
+//! a sixteenth, `plan::KITTY_MIN_RATE`: fresher, smaller pictures scored truer), within the bucket's burst
 //! and less a share kept for the status line ([`PICTURE_SHARE`]). The stream learns what each
 //! rung costs (bytes a pixel, a moving average per rung, the first guess scaled from a
 //! neighbour). Pictures then go as often as the bucket holds the rung's predicted cost (at most
@@ -439,6 +440,10 @@ impl PictureStream {
         let limited = budget.rate.is_some();
         // A still scene under a rate: the bytes refine what is shown towards the source.
         if limited && self.still(picture) {
+            // Refined at [`MIN_RATE`]'s allowance whatever the moving picture's rate: a still
+            // picture is not made staler by bigger steps (as before kitty's own rate).
+            let allowance = budget.rate.map_or(allowance, |r| plan::allowance(r, MIN_RATE) as usize);
+            let room = allowance.min(budget.available);
             let interval = self.interval(budget);
             return self.refine(budget, (room, allowance), now, interval);
         }

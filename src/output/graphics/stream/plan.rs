@@ -1,5 +1,5 @@
 //! How a [`PictureStream`] fits a link: the rung whose whole picture the rate pays for at
-//! [`MIN_RATE`] pictures a second (learned from what each rung cost), the picture rate that
+//! [`MIN_RATE`] pictures a second ([`KITTY_MIN_RATE`] for kitty) (learned from what each rung cost), the picture rate that
 //! follows, and the packing and its lossy setting at each rung.
 
 use std::time::Duration;
@@ -12,9 +12,26 @@ use crate::output::graphics::pack::Packing;
 /// The share of a picture interval's bytes a picture may take: the rest is left for the status
 /// line and the cells' own changes.
 pub(super) const PICTURE_SHARE: f64 = 0.85;
-/// The picture rate the rung is chosen for: the rung's whole picture fits a tenth of a second
-/// of the rate, so a moving picture keeps at least this many pictures a second.
+/// The picture rate the rung is chosen for (iTerm2, sixel, and a link whose rate is not known
+/// yet): the rung's whole picture fits a tenth of a second of the rate, so a moving picture
+/// keeps at least this many pictures a second.
 pub(super) const MIN_RATE: f64 = 10.0;
+/// kitty's picture rate the rung is chosen for under a known rate: a rung whose whole picture
+/// fits a sixteenth of a second of the rate. In the pictures bench (docs/pixels/block-codec.md,
+/// Round 11) a picture a frame old scores far below a fresh one (kitty at 239x140: SSIM 0.80 at
+/// 30 pictures a second, 0.71 at the 14 a second that 250 kB/s paid for at [`MIN_RATE`]), so
+/// at 250 kB/s 169x99 at 22 a second (0.736 / 0.747 on the bench's two phases) beat 239x140 at
+/// 14 (0.712 / 0.722), 201x118 at 19 (13: 0.750 / 0.709) and 169x99 at 26 (20: 0.735 /
+/// 0.734); 142x83 at 30 (25) scored 0.716. A picture of a sixteenth of a second's bytes also
+/// crosses the link in that time, so a key's effect shows sooner. iTerm2's JPEG gained nothing
+/// from a higher rate (13: 0.715 / 0.718, 16: 0.714 / 0.723, 20: 0.697), so it keeps
+/// [`MIN_RATE`].
+/// At 50 kB/s it lost (84x49 at 20 a second 0.643 / 0.644 against 100x59 at 14's 0.657 /
+/// 0.652), and at 5 kB/s a sixteenth (265 bytes) held no tile of the bottom rung, so it holds
+/// from [`KITTY_MIN_RATE_FROM`] on (between 50 and 250 kB/s not measured).
+pub(super) const KITTY_MIN_RATE: f64 = 16.0;
+/// The rate (bytes a second) from which kitty's rung is chosen for [`KITTY_MIN_RATE`].
+pub(super) const KITTY_MIN_RATE_FROM: f64 = 150e3;
 /// A rung above the current one is taken only when it is predicted to fit this share of the
 /// allowance (hysteresis: no flapping between two rungs).
 const UP_SHARE: f64 = 0.85;
@@ -38,6 +55,13 @@ const ITERM2_QUALITY_LOW: u8 = 70;
 /// iTerm2's JPEG quality under a rate on the rungs between: at 250 kB/s 85 at 201x118 scored
 /// 0.7146 against 70 at 284x167's 0.6959 (docs/pixels/block-codec.md).
 const ITERM2_QUALITY: u8 = 85;
+
+/// The bytes a picture may take at `rate` (bytes a second) for `pictures` a second: that share
+/// of the rate, within the bucket's burst, less the status line's share.
+pub(super) fn allowance(rate: f64, pictures: f64) -> f64 {
+    let burst = (rate * MAX_BURST.as_secs_f64()).max(MIN_CAPACITY);
+    (rate / pictures).min(burst) * PICTURE_SHARE
+}
 
 impl PictureStream {
     /// The least time between pictures: the protocol's picture rate, a picture at most once a
@@ -64,6 +88,15 @@ impl PictureStream {
         }
     }
 
+    /// The picture rate the rung is chosen for at `rate`: [`KITTY_MIN_RATE`] for kitty from
+    /// [`KITTY_MIN_RATE_FROM`], [`MIN_RATE`] otherwise.
+    pub(super) fn min_rate(&self, rate: f64) -> f64 {
+        match self.protocol {
+            Protocol::Kitty(_) if rate >= KITTY_MIN_RATE_FROM => KITTY_MIN_RATE,
+            _ => MIN_RATE,
+        }
+    }
+
     /// kitty's packing under a rate: a palette PNG of [`KITTY_COLOURS`] on every rung.
     pub(super) fn kitty_lossy(&self, _rung: usize) -> Packing {
         Packing::PalettePng(KITTY_COLOURS)
@@ -86,8 +119,7 @@ impl PictureStream {
             self.rung = 0;
             return usize::MAX;
         };
-        let burst = (rate * MAX_BURST.as_secs_f64()).max(MIN_CAPACITY);
-        let allowance = (rate / MIN_RATE).min(burst) * PICTURE_SHARE;
+        let allowance = allowance(rate, self.min_rate(rate));
         let last = self.rungs.len() - 1;
         let mut rung = (0..self.rungs.len()).find(|&r| self.predict(r).is_none_or(|c| c <= allowance)).unwrap_or(last);
         // Hysteresis: a bigger rung only when it fits with room to spare.

@@ -75,6 +75,11 @@ fn at_250_kb_a_second_every_mode_moves_at_10_fps_or_more_within_the_budget() {
             stream.state()
         );
         assert!(bytes as f64 / seconds <= 250e3 * 1.05, "{name}: {bytes} bytes in {seconds} s");
+        // kitty's rung is chosen for 16 pictures a second (`plan::KITTY_MIN_RATE`): fresher
+        // pictures, and a key's effect crosses the link in a sixteenth of a second.
+        if name == "kitty" {
+            assert!(f64::from(pictures) / seconds >= 16.0, "kitty: {pictures} pictures in {seconds} s");
+        }
     }
 }
 
