@@ -149,7 +149,8 @@ impl GroupKey {
 static GROUPS_KEPT: AtomicUsize = AtomicUsize::new(0);
 static FRAMES_ALIVE: AtomicUsize = AtomicUsize::new(0);
 
-/// The groups kept and the group frames alive in this process.
+/// The groups kept and the group frames alive in this process (the bus's trace reads it).
+#[cfg(feature = "bus")]
 pub fn alive() -> (usize, usize) {
     (GROUPS_KEPT.load(Ordering::Relaxed), FRAMES_ALIVE.load(Ordering::Relaxed))
 }

@@ -28,7 +28,8 @@ pub const FLIGHT_BUDGET_BYTES: usize = 16 * 1024;
 /// Every player's bytes in flight in this process, for the bus's trace (`bus-trace trim`).
 static ALL: AtomicUsize = AtomicUsize::new(0);
 
-/// The bytes in flight of all players of this process.
+/// The bytes in flight of all players of this process (the bus's trace reads it).
+#[cfg(feature = "bus")]
 pub fn all_in_flight() -> usize {
     ALL.load(Ordering::Relaxed)
 }
