@@ -99,8 +99,7 @@ impl Encoder {
         header[4..8].copy_from_slice(&height.to_be_bytes());
         header[8..].copy_from_slice(&[bits as u8, 3, 0, 0, 0]); // palette, deflate, adaptive filters, no interlace
         chunk(out, b"IHDR", &header);
-        let plte: Vec<u8> = palette.iter().flatten().copied().collect();
-        chunk(out, b"PLTE", &plte);
+        chunk(out, b"PLTE", palette.as_flattened());
         self.zlib.compress(&self.rows, LEVEL, &mut self.idat);
         chunk(out, b"IDAT", &self.idat);
         chunk(out, b"IEND", &[]);

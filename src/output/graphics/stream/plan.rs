@@ -76,7 +76,7 @@ impl PictureStream {
     pub(super) fn packing(&self, limited: bool, rung: usize) -> Option<Packing> {
         match &self.protocol {
             Protocol::Kitty(o) if matches!(o.medium, Medium::TempFile(_)) => None,
-            Protocol::Kitty(_) if limited => Some(self.kitty_lossy(rung)),
+            Protocol::Kitty(_) if limited => Some(Packing::PalettePng(KITTY_COLOURS)),
             // Without a rate the exact picture as a PNG (row filters, fdeflate) rather than
             // raw RGB under zlib level 1: the same pixels, about two thirds of the bytes, and
             // miniz's deflate of raw RGB was a third of the in-band player's CPU
@@ -95,11 +95,6 @@ impl PictureStream {
             Protocol::Kitty(_) if rate >= KITTY_MIN_RATE_FROM => KITTY_MIN_RATE,
             _ => MIN_RATE,
         }
-    }
-
-    /// kitty's packing under a rate: a palette PNG of [`KITTY_COLOURS`] on every rung.
-    pub(super) fn kitty_lossy(&self, _rung: usize) -> Packing {
-        Packing::PalettePng(KITTY_COLOURS)
     }
 
     /// iTerm2's JPEG quality under a rate: [`ITERM2_QUALITY_LOW`] on the top rung and on the

@@ -285,18 +285,11 @@ impl LinkControl {
         // A sender that left its budget unspent cannot have built a queue of a few marks: only
         // a deep one lowers the rate then.
         let caused = !app_limited || link_queue > 2 * high;
-        if over
-            && not_draining
-            && caused
-            && reading.base > QUEUE_HIGH
-            && self.drain.first_fall()
-            && self.drain.has_take()
-        {
-            // The start's first queue on a long link: drained at once (the answer that would
-            // confirm it comes a round trip later, behind another round trip of the start's
-            // growth).
-            self.start_drain(now, DECREASE)
-        } else if over && not_draining && confirmed && caused && !settling {
+        // The start's first queue on a long link needs no confirmation: it is drained at once
+        // (the answer that would confirm it comes a round trip later, behind another round trip
+        // of the start's growth); `fall` turns that fall into the drain.
+        let drain_due = self.drain_due(reading.base);
+        if over && not_draining && caused && (drain_due || (confirmed && !settling)) {
             // A queue of several marks drains faster: at 15 % under the link, a second of
             // queue would take six to go.
             // A late answer the bytes in flight cannot explain (a terminal slow on its own, in
@@ -346,7 +339,7 @@ impl LinkControl {
     /// Lowers the rate to under what the terminal was seen to take (`measured`: while a queue
     /// stood, so the link set it), else by [`DRAIN_SHARE`]; never under `floor`.
     pub(super) fn fall(&mut self, now: Instant, share: f64, floor: f64, measured: bool) {
-        if self.drain.first_fall() && self.drain.has_take() && self.base().is_some_and(|b| b > QUEUE_HIGH) {
+        if self.base().is_some_and(|b| self.drain_due(b)) {
             self.start_drain(now, DECREASE);
             return;
         }

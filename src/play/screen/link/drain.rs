@@ -26,7 +26,7 @@
 
 use std::time::{Duration, Instant};
 
-use super::{Change, DRAIN_SHARE, LinkControl, MIN_RATE};
+use super::{Change, DRAIN_SHARE, LinkControl, MIN_RATE, QUEUE_HIGH};
 
 /// The share of the least take the start's queue drains at: under the link even when that take
 /// read half again as high as the link.
@@ -84,6 +84,12 @@ impl Drain {
 }
 
 impl LinkControl {
+    /// Whether the next fall is the start's drain: the first, on a link whose base round trip
+    /// `base` is past the high mark's ceiling, with a take to size it from.
+    pub(super) fn drain_due(&self, base: Duration) -> bool {
+        base > QUEUE_HIGH && self.drain.first_fall() && self.drain.has_take()
+    }
+
     /// The first fall: the rate drains the start's queue at [`DRAIN_START_SHARE`] of the least
     /// take seen (or falls by `fallback` of itself when none is known).
     pub(super) fn start_drain(&mut self, now: Instant, fallback: f64) -> Change {
